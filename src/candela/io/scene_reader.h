@@ -1,0 +1,27 @@
+#pragma once
+// Entry points of the scene readers. Each returns a complete SceneDesc (meshes loaded, includes
+// resolved) or throws SceneError naming the file and place of the first problem.
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "candela/scene/description.h"
+
+namespace candela {
+
+// Chooses the reader by extension: .json, .pbrt. Throws SceneError for a missing file or an
+// unknown extension.
+SceneDesc read_scene_file(const std::filesystem::path& file);
+
+// The native JSON format (docs/scene-format.md). `file_name` is used in messages; relative mesh
+// paths are resolved against `base_dir`.
+SceneDesc read_json_scene(std::string_view text, const std::string& file_name,
+                          const std::filesystem::path& base_dir);
+
+// pbrt-v4's scene format (the subset in docs/scene-format.md).
+SceneDesc read_pbrt_scene(const std::filesystem::path& file);
+
+// scenes/cornell-box.json, compiled into the program.
+std::string_view builtin_scene_json();
+
+}  // namespace candela
