@@ -1,0 +1,27 @@
+#pragma once
+// A linear RGB float image, row-major, top row first.
+#include <vector>
+
+#include "candela/math/color.h"
+
+namespace candela {
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<float> rgb;  // 3 floats per pixel
+
+  Image() = default;
+  Image(int w, int h) : width(w), height(h), rgb(size_t(w) * size_t(h) * 3, 0.0f) {}
+  RGB at(int x, int y) const {
+    const float* p = &rgb[(size_t(y) * width + x) * 3];
+    return {p[0], p[1], p[2]};
+  }
+  void set(int x, int y, const RGB& c) {
+    float* p = &rgb[(size_t(y) * width + x) * 3];
+    p[0] = c.r;
+    p[1] = c.g;
+    p[2] = c.b;
+  }
+};
+
+}  // namespace candela

@@ -1,0 +1,27 @@
+#pragma once
+// Image files through OpenImageIO. The format follows the extension: .exr (linear float, with
+// metadata), .pfm (linear float), .png (sRGB-encoded 8-bit, values clipped to [0,1]).
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include "candela/film/image.h"
+
+namespace candela {
+
+// True for the extensions write_image accepts (case-insensitive).
+bool is_supported_output(const std::filesystem::path& file);
+
+// Writes atomically: to a temporary file beside the target, then renamed over it, so an existing
+// file is never left half-written. `metadata` goes into EXR headers (string attributes; keys such
+// as "candela:spp"). Throws std::runtime_error naming the file on failure.
+void write_image(const std::filesystem::path& file, const Image& image,
+                 const std::map<std::string, std::string>& metadata = {});
+
+// Reads any image OpenImageIO reads as linear RGB float (8-bit sRGB data is decoded).
+Image read_image(const std::filesystem::path& file);
+
+// The metadata attributes of an image file (for tests and tools).
+std::map<std::string, std::string> read_image_metadata(const std::filesystem::path& file);
+
+}  // namespace candela

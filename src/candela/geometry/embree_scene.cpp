@@ -1,0 +1,265 @@
+#include "candela/geometry/embree_scene.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace candela {
+namespace {
+
+void report_embree_error(void*, RTCError code, const char* message) {
+  // Errors from Embree are programming or resource errors, not user input errors.
+  throw std::runtime_error("Embree error " + std::to_string(int(code)) + ": " + (message ? message : ""));
+}
+
+struct Vec3d {
+  double x, y, z;
+};
+double dot(const Vec3d& a, const Vec3d& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+Vec3d apply(const Matrix4& m, double x, double y, double z, double w) {
+  return {m.m[0][0] * x + m.m[0][1] * y + m.m[0][2] * z + m.m[0][3] * w,
+          m.m[1][0] * x + m.m[1][1] * y + m.m[1][2] * z + m.m[1][3] * w,
+          m.m[2][0] * x + m.m[2][1] * y + m.m[2][2] * z + m.m[2][3] * w};
+}
+
+// Nearest root of the ray-sphere quadratic in (t_near, t_far), solved in object space in double
+// precision with the cancellation-free form of the quadratic formula.
+bool intersect_sphere(const SphereGeometry& s, const Vec3d& o_world, const Vec3d& d_world, double t_near,
+                      double t_far, double& t_hit) {
+  const Matrix4& inv = s.to_world.inverse_matrix();
+  Vec3d o = apply(inv, o_world.x, o_world.y, o_world.z, 1);
+  Vec3d d = apply(inv, d_world.x, d_world.y, d_world.z, 0);
+  Vec3d f{o.x - s.center.x, o.y - s.center.y, o.z - s.center.z};
+  double a = dot(d, d);
+  double b_half = dot(f, d);
+  // Discriminant from the perpendicular distance (Ray Tracing Gems, ch. 7): stable for distant rays.
+  double inv_len = 1.0 / std::sqrt(a);
+  Vec3d dn{d.x * inv_len, d.y * inv_len, d.z * inv_len};
+  double fd = dot(f, dn);
+  Vec3d perp{f.x - fd * dn.x, f.y - fd * dn.y, f.z - fd * dn.z};
+  double r = s.radius;
+  double disc = (r - std::sqrt(dot(perp, perp))) * (r + std::sqrt(dot(perp, perp)));
+  if (disc < 0) return false;
+  double c = dot(f, f) - r * r;
+  double q = -(b_half + std::copysign(std::sqrt(a * disc), b_half));
+  double t0 = q / a, t1 = q != 0 ? c / q : t0;
+  if (t0 > t1) std::swap(t0, t1);
+  if (t0 > t_near && t0 < t_far) { t_hit = t0; return true; }
+  if (t1 > t_near && t1 < t_far) { t_hit = t1; return true; }
+  return false;
+}
+
+bool intersect_plane(const PlaneGeometry& pl, float extent, const Vec3d& o, const Vec3d& d, double t_near,
+                     double t_far, double& t_hit) {
+  Vec3d n{pl.normal.x, pl.normal.y, pl.normal.z};
+  double denom = dot(d, n);
+  if (denom == 0) return false;
+  Vec3d po{pl.point.x - o.x, pl.point.y - o.y, pl.point.z - o.z};
+  double t = dot(po, n) / denom;
+  if (!(t > t_near && t < t_far)) return false;
+  // Stay inside the finite bounds given to Embree.
+  double px = o.x + t * d.x - pl.point.x, py = o.y + t * d.y - pl.point.y, pz = o.z + t * d.z - pl.point.z;
+  if (std::abs(px) > extent || std::abs(py) > extent || std::abs(pz) > extent) return false;
+  t_hit = t;
+  return true;
+}
+
+template <typename Args>
+void read_ray(const Args* args, unsigned i, Vec3d& o, Vec3d& d, double& t_near, double& t_far) {
+  RTCRayN* ray = nullptr;
+  if constexpr (std::is_same_v<Args, RTCIntersectFunctionNArguments>)
+    ray = RTCRayHitN_RayN(args->rayhit, args->N);
+  else
+    ray = args->ray;
+  unsigned N = args->N;
+  o = {RTCRayN_org_x(ray, N, i), RTCRayN_org_y(ray, N, i), RTCRayN_org_z(ray, N, i)};
+  d = {RTCRayN_dir_x(ray, N, i), RTCRayN_dir_y(ray, N, i), RTCRayN_dir_z(ray, N, i)};
+  t_near = RTCRayN_tnear(ray, N, i);
+  t_far = RTCRayN_tfar(ray, N, i);
+}
+
+void write_hit(const RTCIntersectFunctionNArguments* args, unsigned i, double t) {
+  unsigned N = args->N;
+  RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, N);
+  RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, N);
+  RTCRayN_tfar(ray, N, i) = float(t);
+  RTCHitN_u(hit, N, i) = 0;
+  RTCHitN_v(hit, N, i) = 0;
+  RTCHitN_Ng_x(hit, N, i) = 0;
+  RTCHitN_Ng_y(hit, N, i) = 0;
+  RTCHitN_Ng_z(hit, N, i) = 1;
+  RTCHitN_primID(hit, N, i) = args->primID;
+  RTCHitN_geomID(hit, N, i) = args->geomID;
+  RTCHitN_instID(hit, N, i, 0) = args->context->instID[0];
+}
+
+template <typename Shape, typename IntersectFn>
+void user_intersect(const RTCIntersectFunctionNArguments* args, const Shape& shape, IntersectFn fn) {
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    Vec3d o, d;
+    double t_near, t_far, t;
+    read_ray(args, i, o, d, t_near, t_far);
+    if (fn(shape, o, d, t_near, t_far, t)) write_hit(args, i, t);
+  }
+}
+
+template <typename Shape, typename IntersectFn>
+void user_occluded(const RTCOccludedFunctionNArguments* args, const Shape& shape, IntersectFn fn) {
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    Vec3d o, d;
+    double t_near, t_far, t;
+    read_ray(args, i, o, d, t_near, t_far);
+    if (fn(shape, o, d, t_near, t_far, t)) RTCRayN_tfar(args->ray, args->N, i) = -std::numeric_limits<float>::infinity();
+  }
+}
+
+RTCRay make_rtc_ray(const Ray& r) {
+  RTCRay ray;
+  ray.org_x = r.origin.x;
+  ray.org_y = r.origin.y;
+  ray.org_z = r.origin.z;
+  ray.tnear = 0;
+  ray.dir_x = r.direction.x;
+  ray.dir_y = r.direction.y;
+  ray.dir_z = r.direction.z;
+  ray.time = r.time;
+  ray.tfar = r.t_max;
+  ray.mask = 0xffffffffu;
+  ray.id = 0;
+  ray.flags = 0;
+  return ray;
+}
+
+}  // namespace
+
+EmbreeScene::EmbreeScene() {
+  device_ = rtcNewDevice(nullptr);
+  if (!device_) throw std::runtime_error("cannot create an Embree device");
+  rtcSetDeviceErrorFunction(device_, report_embree_error, nullptr);
+  scene_ = rtcNewScene(device_);
+  rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+}
+
+EmbreeScene::~EmbreeScene() {
+  if (scene_) rtcReleaseScene(scene_);
+  if (device_) rtcReleaseDevice(device_);
+}
+
+void EmbreeScene::add_triangles(uint32_t id, const std::vector<Point3>& positions, const std::vector<uint32_t>& indices) {
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+  // Embree reads vertices with 16-byte SSE loads: a shared buffer needs one float of padding at the end,
+  // so give it its own copy with the padding rather than aliasing the std::vector.
+  auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                               RTC_FORMAT_FLOAT3, sizeof(Point3), positions.size()));
+  std::copy_n(&positions[0].x, positions.size() * 3, vertices);
+  auto* tris = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                              3 * sizeof(uint32_t), indices.size() / 3));
+  std::copy(indices.begin(), indices.end(), tris);
+  rtcCommitGeometry(geom);
+  rtcAttachGeometryByID(scene_, geom, id);
+  rtcReleaseGeometry(geom);
+}
+
+void EmbreeScene::add_sphere(uint32_t id, const SphereGeometry& sphere) {
+  spheres_.push_back(std::make_unique<SphereGeometry>(sphere));
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(geom, 1);
+  rtcSetGeometryUserData(geom, spheres_.back().get());
+  rtcSetGeometryBoundsFunction(geom, sphere_bounds, nullptr);
+  rtcSetGeometryIntersectFunction(geom, sphere_intersect);
+  rtcSetGeometryOccludedFunction(geom, sphere_occluded);
+  rtcCommitGeometry(geom);
+  rtcAttachGeometryByID(scene_, geom, id);
+  rtcReleaseGeometry(geom);
+}
+
+void EmbreeScene::add_plane(uint32_t id, const PlaneGeometry& plane, float extent) {
+  planes_.push_back(std::make_unique<PlaneRecord>(PlaneRecord{plane, extent}));
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(geom, 1);
+  rtcSetGeometryUserData(geom, planes_.back().get());
+  rtcSetGeometryBoundsFunction(geom, plane_bounds, nullptr);
+  rtcSetGeometryIntersectFunction(geom, plane_intersect);
+  rtcSetGeometryOccludedFunction(geom, plane_occluded);
+  rtcCommitGeometry(geom);
+  rtcAttachGeometryByID(scene_, geom, id);
+  rtcReleaseGeometry(geom);
+}
+
+void EmbreeScene::commit() { rtcCommitScene(scene_); }
+
+bool EmbreeScene::intersect(const Ray& r, EmbreeHit& hit) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rayhit;
+  rayhit.ray = make_rtc_ray(r);
+  rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(scene_, &context, &rayhit);
+  if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  hit = {rayhit.ray.tfar, rayhit.hit.geomID, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v};
+  return true;
+}
+
+bool EmbreeScene::occluded(const Ray& r) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRay ray = make_rtc_ray(r);
+  rtcOccluded1(scene_, &context, &ray);
+  return ray.tfar < 0;
+}
+
+void EmbreeScene::sphere_bounds(const RTCBoundsFunctionArguments* args) {
+  const auto& s = *static_cast<const SphereGeometry*>(args->geometryUserPtr);
+  // Bounds of the transformed sphere: transform the 8 corners of its object-space box.
+  Bounds3 b;
+  for (int i = 0; i < 8; ++i) {
+    Vec3 corner(i & 1 ? s.radius : -s.radius, i & 2 ? s.radius : -s.radius, i & 4 ? s.radius : -s.radius);
+    b.extend(s.to_world.point(s.center + corner));
+  }
+  // Pad by a relative epsilon: the box is in float and the intersection in double.
+  Vec3 pad = Vec3(1e-5f) * (1.0f + max_component(max(b.hi, -b.lo)));
+  args->bounds_o->lower_x = b.lo.x - pad.x;
+  args->bounds_o->lower_y = b.lo.y - pad.y;
+  args->bounds_o->lower_z = b.lo.z - pad.z;
+  args->bounds_o->upper_x = b.hi.x + pad.x;
+  args->bounds_o->upper_y = b.hi.y + pad.y;
+  args->bounds_o->upper_z = b.hi.z + pad.z;
+}
+
+void EmbreeScene::sphere_intersect(const RTCIntersectFunctionNArguments* args) {
+  user_intersect(args, *static_cast<const SphereGeometry*>(args->geometryUserPtr), intersect_sphere);
+}
+
+void EmbreeScene::sphere_occluded(const RTCOccludedFunctionNArguments* args) {
+  user_occluded(args, *static_cast<const SphereGeometry*>(args->geometryUserPtr), intersect_sphere);
+}
+
+void EmbreeScene::plane_bounds(const RTCBoundsFunctionArguments* args) {
+  const auto& r = *static_cast<const PlaneRecord*>(args->geometryUserPtr);
+  const Point3& p = r.plane.point;
+  args->bounds_o->lower_x = p.x - r.extent;
+  args->bounds_o->lower_y = p.y - r.extent;
+  args->bounds_o->lower_z = p.z - r.extent;
+  args->bounds_o->upper_x = p.x + r.extent;
+  args->bounds_o->upper_y = p.y + r.extent;
+  args->bounds_o->upper_z = p.z + r.extent;
+}
+
+void EmbreeScene::plane_intersect(const RTCIntersectFunctionNArguments* args) {
+  const auto& r = *static_cast<const PlaneRecord*>(args->geometryUserPtr);
+  user_intersect(args, r, [](const PlaneRecord& rec, const Vec3d& o, const Vec3d& d, double tn, double tf,
+                             double& t) { return intersect_plane(rec.plane, rec.extent, o, d, tn, tf, t); });
+}
+
+void EmbreeScene::plane_occluded(const RTCOccludedFunctionNArguments* args) {
+  const auto& r = *static_cast<const PlaneRecord*>(args->geometryUserPtr);
+  user_occluded(args, r, [](const PlaneRecord& rec, const Vec3d& o, const Vec3d& d, double tn, double tf,
+                            double& t) { return intersect_plane(rec.plane, rec.extent, o, d, tn, tf, t); });
+}
+
+}  // namespace candela

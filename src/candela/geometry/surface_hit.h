@@ -1,0 +1,19 @@
+#pragma once
+// What the shading code needs to know about a ray-surface intersection.
+#include <cstdint>
+
+#include "candela/math/vec.h"
+
+namespace candela {
+
+struct SurfaceHit {
+  Point3 p;
+  float t = 0;
+  Normal3 ng;  // geometric normal: the emitting side of one-sided emitters, the outside of dielectrics
+  Normal3 ns;  // shading normal (interpolated vertex normals), same side as ng
+  Vec2 uv;
+  uint32_t shape = 0;      // index into Scene::shapes
+  uint32_t primitive = 0;  // triangle index within a mesh
+};
+
+}  // namespace candela

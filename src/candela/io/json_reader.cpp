@@ -1,0 +1,882 @@
+// The native JSON scene format (docs/scene-format.md) read into a SceneDesc.
+//
+// Every value is read through CheckedObject, which checks types and ranges as it reads and, once an
+// object is done, rejects any key nobody asked for: a misspelt optional key would otherwise be
+// silently ignored. Errors name the value by JSON pointer and, found again in the source text, by line.
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "candela/io/error.h"
+#include "candela/io/mesh_io.h"
+#include "candela/io/scene_reader.h"
+
+namespace candela {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;  // ordered: materials keep the file's order
+
+constexpr int kMaxResolution = 65536;
+constexpr int64_t kMaxPixels = int64_t(1) << 28;
+
+// ---------------------------------------------------------------- JSON pointers and source positions
+
+// RFC 6901: '~' and '/' inside a key are written "~0" and "~1".
+std::string escape_pointer_token(std::string_view key) {
+  std::string token;
+  for (char c : key) {
+    if (c == '~') token += "~0";
+    else if (c == '/') token += "~1";
+    else token += c;
+  }
+  return token;
+}
+
+std::string child_pointer(const std::string& parent, std::string_view key) {
+  return parent + "/" + escape_pointer_token(key);
+}
+
+std::string child_pointer(const std::string& parent, size_t index) {
+  return parent + "/" + std::to_string(index);
+}
+
+struct TextPosition {
+  int line = 1, column = 1;
+};
+
+// 1-based line and (byte) column of `offset` in `text`.
+TextPosition position_of(std::string_view text, size_t offset) {
+  offset = std::min(offset, text.size());
+  std::string_view before = text.substr(0, offset);
+  size_t line_start = before.rfind('\n');
+  int line = 1 + int(std::count(before.begin(), before.end(), '\n'));
+  size_t column = line_start == std::string_view::npos ? offset + 1 : offset - line_start;
+  return {line, int(column)};
+}
+
+// nlohmann::json keeps no source positions, so this walks the text (already validated by
+// nlohmann) again: to find where the value at a JSON pointer starts, for messages, and to find keys
+// repeated within one object, which nlohmann would silently collapse to the last one.
+class SourceScanner {
+ public:
+  explicit SourceScanner(std::string_view text) : text_(text) {}
+
+  // Offset of the value at `target`; for an object member, of its key.
+  std::optional<size_t> offset_of(const std::string& target) {
+    restart();
+    if (target.empty()) {
+      skip_whitespace();
+      return pos_;
+    }
+    std::optional<size_t> found;
+    std::string pointer;
+    walk_value(pointer, [&](const std::string& entry, size_t offset) {
+      if (entry == target) {
+        found = offset;
+        stop_ = true;
+        return false;
+      }
+      return target.size() > entry.size() && target.starts_with(entry) && target[entry.size()] == '/';
+    });
+    return found;
+  }
+
+  struct Duplicate {
+    std::string pointer;
+    size_t offset;
+  };
+  std::optional<Duplicate> first_duplicate_key() {
+    restart();
+    check_duplicates_ = true;
+    std::string pointer;
+    walk_value(pointer, [](const std::string&, size_t) { return true; });
+    return duplicate_;
+  }
+
+ private:
+  // Deeper nesting is skipped without recursing, so hostile input cannot exhaust the stack.
+  static constexpr int kMaxDepth = 256;
+
+  void restart() {
+    pos_ = text_.starts_with("\xEF\xBB\xBF") ? 3 : 0;  // nlohmann accepts a UTF-8 byte order mark
+    depth_ = 0;
+    stop_ = false;
+  }
+  bool at(char c) const { return pos_ < text_.size() && text_[pos_] == c; }
+  void skip_whitespace() {
+    while (pos_ < text_.size() && std::string_view(" \t\r\n").find(text_[pos_]) != std::string_view::npos) ++pos_;
+  }
+  void skip_string() {
+    ++pos_;  // opening quote
+    while (pos_ < text_.size()) {
+      char c = text_[pos_++];
+      if (c == '\\') ++pos_;
+      else if (c == '"') return;
+    }
+  }
+  std::string read_string() {
+    size_t start = pos_;
+    skip_string();
+    std::string_view raw = text_.substr(start, pos_ - start);
+    if (raw.find('\\') == std::string_view::npos) return std::string(raw.substr(1, raw.size() - 2));
+    return Json::parse(raw.begin(), raw.end()).get<std::string>();  // let nlohmann decode the escapes
+  }
+  void skip_scalar() {
+    while (pos_ < text_.size() && std::string_view(",]} \t\r\n").find(text_[pos_]) == std::string_view::npos) ++pos_;
+  }
+  void skip_value() {
+    skip_whitespace();
+    if (at('"')) return skip_string();
+    if (!at('{') && !at('[')) return skip_scalar();
+    int depth = 0;
+    while (pos_ < text_.size()) {
+      char c = text_[pos_];
+      if (c == '"') {
+        skip_string();
+        continue;
+      }
+      ++pos_;
+      if (c == '{' || c == '[') ++depth;
+      else if ((c == '}' || c == ']') && --depth == 0) return;
+    }
+  }
+
+  // `enter(pointer, offset)` sees every member and element and says whether to walk into it.
+  template <class Enter>
+  void walk_value(std::string& pointer, const Enter& enter) {
+    skip_whitespace();
+    if (depth_ >= kMaxDepth || (!at('{') && !at('['))) return skip_value();
+    ++depth_;
+    if (at('{')) walk_object(pointer, enter);
+    else walk_array(pointer, enter);
+    --depth_;
+  }
+
+  template <class Enter>
+  void walk_object(std::string& pointer, const Enter& enter) {
+    ++pos_;  // '{'
+    std::set<std::string> keys;
+    for (skip_whitespace(); !stop_ && pos_ < text_.size() && !at('}'); skip_whitespace()) {
+      size_t key_offset = pos_;
+      std::string key = read_string();
+      skip_whitespace();
+      ++pos_;  // ':'
+      size_t parent_length = pointer.size();
+      pointer += '/' + escape_pointer_token(key);
+      if (check_duplicates_ && !keys.insert(key).second) {
+        duplicate_ = Duplicate{pointer, key_offset};
+        stop_ = true;
+        return;
+      }
+      if (enter(pointer, key_offset)) walk_value(pointer, enter);
+      else skip_value();
+      pointer.resize(parent_length);
+      skip_whitespace();
+      if (at(',')) ++pos_;
+    }
+    ++pos_;  // '}'
+  }
+
+  template <class Enter>
+  void walk_array(std::string& pointer, const Enter& enter) {
+    ++pos_;  // '['
+    size_t index = 0;
+    for (skip_whitespace(); !stop_ && pos_ < text_.size() && !at(']'); skip_whitespace(), ++index) {
+      size_t parent_length = pointer.size();
+      pointer += '/' + std::to_string(index);
+      if (enter(pointer, pos_)) walk_value(pointer, enter);
+      else skip_value();
+      pointer.resize(parent_length);
+      skip_whitespace();
+      if (at(',')) ++pos_;
+    }
+    ++pos_;  // ']'
+  }
+
+  std::string_view text_;
+  size_t pos_ = 0;
+  int depth_ = 0;
+  bool stop_ = false;
+  bool check_duplicates_ = false;
+  std::optional<Duplicate> duplicate_;
+};
+
+// Builds the SourceLocation of a JSON pointer and throws the SceneError.
+class ErrorReporter {
+ public:
+  ErrorReporter(std::string_view text, std::string file_name) : text_(text), file_name_(std::move(file_name)) {}
+
+  const std::string& file_name() const { return file_name_; }
+
+  SourceLocation location_of_offset(size_t offset, std::string pointer = {}) const {
+    TextPosition position = position_of(text_, offset);
+    return {file_name_, position.line, position.column, std::move(pointer)};
+  }
+
+  // Lines are looked up only here, when something is wrong, so correct scenes never pay for it.
+  SourceLocation location(const std::string& pointer) const {
+    if (auto offset = SourceScanner(text_).offset_of(pointer)) return location_of_offset(*offset, pointer);
+    return {file_name_, 0, 0, pointer};
+  }
+
+  template <typename... Args>
+  [[noreturn]] void fail(const std::string& pointer, fmt::format_string<Args...> format, Args&&... args) const {
+    throw_scene_error(location(pointer), format, std::forward<Args>(args)...);
+  }
+
+ private:
+  std::string_view text_;
+  std::string file_name_;
+};
+
+// ---------------------------------------------------------------- typed values
+
+// What a value was instead of what was expected: its type, or its length for arrays.
+std::string describe(const Json& value) {
+  if (value.is_array()) return fmt::format("an array of {} element{}", value.size(), value.size() == 1 ? "" : "s");
+  return value.type_name();
+}
+
+double read_double(const ErrorReporter& report, const Json& value, const std::string& pointer) {
+  if (!value.is_number()) report.fail(pointer, "expected a number, got {}", describe(value));
+  double x = value.get<double>();
+  if (!std::isfinite(x)) report.fail(pointer, "expected a finite number, got {}", x);
+  return x;
+}
+
+float read_float(const ErrorReporter& report, const Json& value, const std::string& pointer) {
+  double x = read_double(report, value, pointer);
+  if (std::abs(x) > double(FLT_MAX)) report.fail(pointer, "{} is out of range for a 32-bit float", x);
+  return float(x);
+}
+
+int64_t read_int64(const ErrorReporter& report, const Json& value, const std::string& pointer) {
+  if (!value.is_number()) report.fail(pointer, "expected an integer, got {}", describe(value));
+  if (value.is_number_unsigned()) {
+    uint64_t u = value.get<uint64_t>();
+    if (u > uint64_t(std::numeric_limits<int64_t>::max())) report.fail(pointer, "integer {} is too large", u);
+    return int64_t(u);
+  }
+  if (value.is_number_integer()) return value.get<int64_t>();
+  double x = read_double(report, value, pointer);  // JSON does not distinguish 3 from 3.0
+  if (x != std::floor(x)) report.fail(pointer, "expected an integer, got {}", x);
+  if (std::abs(x) > 9.0e18) report.fail(pointer, "integer {} is too large", x);
+  return int64_t(x);
+}
+
+uint64_t read_uint64(const ErrorReporter& report, const Json& value, const std::string& pointer) {
+  if (value.is_number_unsigned()) return value.get<uint64_t>();
+  int64_t n = read_int64(report, value, pointer);
+  if (n < 0) report.fail(pointer, "expected a non-negative integer, got {}", n);
+  return uint64_t(n);
+}
+
+Vec3 read_vec3(const ErrorReporter& report, const Json& value, const std::string& pointer) {
+  if (!value.is_array() || value.size() != 3)
+    report.fail(pointer, "expected an array of 3 numbers, got {}", describe(value));
+  Vec3 v;
+  for (int i = 0; i < 3; ++i) v[i] = read_float(report, value[i], child_pointer(pointer, size_t(i)));
+  return v;
+}
+
+Vec2 read_vec2(const ErrorReporter& report, const Json& value, const std::string& pointer) {
+  if (!value.is_array() || value.size() != 2)
+    report.fail(pointer, "expected an array of 2 numbers, got {}", describe(value));
+  return {read_float(report, value[0], child_pointer(pointer, size_t(0))),
+          read_float(report, value[1], child_pointer(pointer, size_t(1)))};
+}
+
+// Reflectances and albedos cannot exceed 1 without creating energy; emission can.
+enum class ColorKind { Albedo, Emission };
+
+float read_color_component(const ErrorReporter& report, const Json& value, const std::string& pointer,
+                           ColorKind kind) {
+  float c = read_float(report, value, pointer);
+  if (c < 0) report.fail(pointer, "colour components must be >= 0, got {}", c);
+  if (kind == ColorKind::Albedo && c > 1)
+    report.fail(pointer, "a reflectance must be <= 1 in each channel (more would create energy), got {}", c);
+  return c;
+}
+
+// [r, g, b], or one number for grey.
+RGB read_rgb(const ErrorReporter& report, const Json& value, const std::string& pointer, ColorKind kind) {
+  if (value.is_number()) return RGB(read_color_component(report, value, pointer, kind));
+  if (!value.is_array() || value.size() != 3)
+    report.fail(pointer, "expected a colour, [r, g, b] or a single number, got {}", describe(value));
+  RGB rgb;
+  for (int i = 0; i < 3; ++i) rgb[i] = read_color_component(report, value[i], child_pointer(pointer, size_t(i)), kind);
+  return rgb;
+}
+
+Vec3 read_direction(const ErrorReporter& report, const Json& value, const std::string& pointer) {
+  Vec3 v = read_vec3(report, value, pointer);
+  if (length_squared(v) == 0 || !is_finite(normalize(v)))
+    report.fail(pointer, "expected a non-zero vector, got [{}, {}, {}]", v.x, v.y, v.z);
+  return v;
+}
+
+bool read_bool(const ErrorReporter& report, const Json& value, const std::string& pointer) {
+  if (!value.is_boolean()) report.fail(pointer, "expected true or false, got {}", describe(value));
+  return value.get<bool>();
+}
+
+std::string read_string(const ErrorReporter& report, const Json& value, const std::string& pointer) {
+  if (!value.is_string()) report.fail(pointer, "expected a string, got {}", describe(value));
+  return value.get<std::string>();
+}
+
+void check_is_array(const ErrorReporter& report, const Json& value, const std::string& pointer,
+                    std::string_view of_what) {
+  if (!value.is_array()) report.fail(pointer, "expected an array of {}, got {}", of_what, describe(value));
+}
+
+enum class Bound { Any, Positive, NonNegative, UnitInterval };
+
+float check_bound(const ErrorReporter& report, float x, Bound bound, const std::string& pointer) {
+  if (bound == Bound::Positive && !(x > 0)) report.fail(pointer, "expected a positive number, got {}", x);
+  if (bound == Bound::NonNegative && !(x >= 0)) report.fail(pointer, "expected a number >= 0, got {}", x);
+  if (bound == Bound::UnitInterval && !(x >= 0 && x <= 1))
+    report.fail(pointer, "expected a number in [0, 1], got {}", x);
+  return x;
+}
+
+// ---------------------------------------------------------------- CheckedObject
+
+// One JSON object, read key by key with type checks. finish() reports the first key that no read
+// asked for, listing the keys that were asked for (the object's schema, as far as it was read).
+class CheckedObject {
+ public:
+  CheckedObject(const ErrorReporter& report, const Json& value, std::string pointer)
+      : report_(report), value_(value), pointer_(std::move(pointer)) {
+    if (!value_.is_object()) report_.fail(pointer_, "expected an object, got {}", describe(value_));
+  }
+
+  const std::string& pointer() const { return pointer_; }
+  std::string pointer_of(std::string_view key) const { return child_pointer(pointer_, key); }
+  const ErrorReporter& report() const { return report_; }
+
+  const Json* find(std::string_view key) {
+    if (std::find(asked_.begin(), asked_.end(), key) == asked_.end()) asked_.emplace_back(key);
+    auto it = value_.find(std::string(key));
+    return it == value_.end() ? nullptr : &*it;
+  }
+  bool has(std::string_view key) { return find(key) != nullptr; }
+  const Json& require(std::string_view key) {
+    const Json* value = find(key);
+    if (!value) report_.fail(pointer_, "missing required key \"{}\"", key);
+    return *value;
+  }
+
+  float number(std::string_view key, Bound bound = Bound::Any) {
+    return check_bound(report_, read_float(report_, require(key), pointer_of(key)), bound, pointer_of(key));
+  }
+  float number_or(std::string_view key, float fallback, Bound bound = Bound::Any) {
+    return has(key) ? number(key, bound) : fallback;
+  }
+  int integer_or(std::string_view key, int fallback, int64_t min, int64_t max) {
+    const Json* value = find(key);
+    if (!value) return fallback;
+    int64_t n = read_int64(report_, *value, pointer_of(key));
+    if (n < min || n > max) {
+      if (max == std::numeric_limits<int>::max()) report_.fail(pointer_of(key), "expected an integer >= {}, got {}", min, n);
+      report_.fail(pointer_of(key), "expected an integer in [{}, {}], got {}", min, max, n);
+    }
+    return int(n);
+  }
+  Vec3 vec3(std::string_view key) { return read_vec3(report_, require(key), pointer_of(key)); }
+  Vec3 vec3_or(std::string_view key, Vec3 fallback) { return has(key) ? vec3(key) : fallback; }
+  Vec3 direction(std::string_view key) { return read_direction(report_, require(key), pointer_of(key)); }
+  Vec3 direction_or(std::string_view key, Vec3 fallback) { return has(key) ? direction(key) : fallback; }
+  RGB rgb(std::string_view key, ColorKind kind) { return read_rgb(report_, require(key), pointer_of(key), kind); }
+  RGB rgb_or(std::string_view key, ColorKind kind, RGB fallback) { return has(key) ? rgb(key, kind) : fallback; }
+  std::optional<RGB> optional_rgb(std::string_view key, ColorKind kind) {
+    return has(key) ? std::optional(rgb(key, kind)) : std::nullopt;
+  }
+  bool boolean_or(std::string_view key, bool fallback) {
+    const Json* value = find(key);
+    return value ? read_bool(report_, *value, pointer_of(key)) : fallback;
+  }
+  std::string string(std::string_view key) { return read_string(report_, require(key), pointer_of(key)); }
+  std::string string_or(std::string_view key, std::string fallback) {
+    return has(key) ? string(key) : std::move(fallback);
+  }
+
+  void finish() const {
+    for (auto it = value_.begin(); it != value_.end(); ++it) {
+      const std::string& key = it.key();
+      if (key == "_comment" || std::find(asked_.begin(), asked_.end(), key) != asked_.end()) continue;
+      report_.fail(pointer_of(key), "unknown key; expected one of: {}", fmt::join(asked_, ", "));
+    }
+  }
+
+ private:
+  const ErrorReporter& report_;
+  const Json& value_;
+  std::string pointer_;
+  std::vector<std::string> asked_;
+};
+
+// ---------------------------------------------------------------- the reader
+
+class JsonSceneReader {
+ public:
+  JsonSceneReader(std::string_view text, const std::string& file_name, const fs::path& base_dir)
+      : text_(text), report_(text, file_name), base_dir_(base_dir) {}
+
+  SceneDesc read() {
+    Json document = parse_document();
+    reject_duplicate_keys();
+    CheckedObject root(report_, document, "");
+    const Json empty = Json::object();  // absent sections still get their defaults
+    const Json* camera = root.find("camera");
+    read_camera(camera ? *camera : empty, root.pointer_of("camera"));
+    const Json* render = root.find("render");
+    read_render(render ? *render : empty, root.pointer_of("render"));
+    if (const Json* materials = root.find("materials")) read_materials(*materials, root.pointer_of("materials"));
+    if (const Json* shapes = root.find("shapes")) read_shapes(*shapes, root.pointer_of("shapes"));
+    if (const Json* lights = root.find("lights")) read_lights(*lights, root.pointer_of("lights"));
+    root.finish();
+    scene_.source_file = report_.file_name();
+    return std::move(scene_);
+  }
+
+ private:
+  Json parse_document() const {
+    try {
+      return Json::parse(text_.begin(), text_.end());
+    } catch (const Json::parse_error& e) {
+      size_t offset = e.byte == 0 ? 0 : e.byte - 1;  // e.byte is 1-based: the last byte read
+      throw_scene_error(report_.location_of_offset(offset), "malformed JSON: {}", parse_error_reason(e.what()));
+    } catch (const Json::out_of_range& e) {
+      throw_number_overflow(e.what());
+    }
+  }
+
+  // nlohmann rejects numbers beyond double's range ("number overflow parsing '1e999'") without a
+  // position; the literal itself is found in the text instead.
+  [[noreturn]] void throw_number_overflow(std::string_view what) const {
+    size_t open = what.find('\''), close = what.rfind('\'');
+    std::string_view literal = open < close ? what.substr(open + 1, close - open - 1) : std::string_view();
+    size_t offset = literal.empty() ? std::string_view::npos : text_.find(literal);
+    SourceLocation where = offset == std::string_view::npos ? SourceLocation{report_.file_name(), 0, 0, {}}
+                                                            : report_.location_of_offset(offset);
+    throw_scene_error(where, "number {} is out of range", literal);
+  }
+
+  // nlohmann's message repeats its own position: keep only the reason after it.
+  static std::string parse_error_reason(std::string_view what) {
+    size_t start = what.find("parse error");
+    size_t colon = what.find(": ", start == std::string_view::npos ? 0 : start);
+    return std::string(colon == std::string_view::npos ? what : what.substr(colon + 2));
+  }
+
+  void reject_duplicate_keys() const {
+    if (auto duplicate = SourceScanner(text_).first_duplicate_key())
+      throw_scene_error(report_.location_of_offset(duplicate->offset, duplicate->pointer),
+                        "duplicate key (each key may appear only once in an object)");
+  }
+
+  // ---- camera and render settings
+
+  void read_camera(const Json& value, const std::string& pointer) {
+    CheckedObject camera(report_, value, pointer);
+    Point3 position = camera.vec3_or("position", {0, 0, 0});
+    Point3 look_at = camera.vec3_or("look_at", {0, 0, 1});
+    Vec3 up = camera.direction_or("up", {0, 1, 0});
+    float fov = camera.number_or("fov", 40);
+    if (!(fov > 0 && fov < 180))
+      report_.fail(camera.pointer_of("fov"), "the vertical field of view must be in (0, 180) degrees, got {}", fov);
+    scene_.film.width = camera.integer_or("width", scene_.film.width, 1, kMaxResolution);
+    scene_.film.height = camera.integer_or("height", scene_.film.height, 1, kMaxResolution);
+    camera.finish();
+    if (int64_t(scene_.film.width) * scene_.film.height > kMaxPixels)
+      report_.fail(pointer, "{} x {} pixels exceeds the limit of 2^28 pixels", scene_.film.width, scene_.film.height);
+    check_view_direction(camera, position, look_at, up);
+    scene_.camera.world_from_camera = Transform::look_at_right_handed(position, look_at, up);
+    scene_.camera.fov_degrees = fov;
+    scene_.camera.fov_axis = FovAxis::Y;
+  }
+
+  void check_view_direction(const CheckedObject& camera, Point3 position, Point3 look_at, Vec3 up) const {
+    Vec3 forward = look_at - position;
+    if (length_squared(forward) == 0 || !is_finite(normalize(forward)))
+      report_.fail(camera.pointer_of("look_at"), "look_at must differ from position (it sets the view direction)");
+    if (length(cross(normalize(forward), normalize(up))) < 1e-6f)
+      report_.fail(camera.pointer_of("up"), "up is parallel to the view direction, so the image has no defined up");
+  }
+
+  void read_render(const Json& value, const std::string& pointer) {
+    CheckedObject render(report_, value, pointer);
+    constexpr int64_t kIntMax = std::numeric_limits<int>::max();
+    RenderSettings& settings = scene_.settings;
+    settings.spp = render.integer_or("spp", settings.spp, 1, kIntMax);
+    settings.max_depth = render.integer_or("max_depth", settings.max_depth, 1, kIntMax);
+    if (const Json* seed = render.find("seed")) settings.seed = read_uint64(report_, *seed, render.pointer_of("seed"));
+    settings.integrator = render.string_or("integrator", settings.integrator);
+    if (settings.integrator.empty()) report_.fail(render.pointer_of("integrator"), "the integrator name is empty");
+    scene_.film.filename = render.string_or("output", "");
+    settings.rr_start_depth = render.integer_or("rr_start_depth", settings.rr_start_depth, 0, kIntMax);
+    render.finish();
+  }
+
+  // ---- materials
+
+  void read_materials(const Json& value, const std::string& pointer) {
+    if (!value.is_object())
+      report_.fail(pointer, "expected an object mapping material names to materials, got {}", describe(value));
+    for (auto it = value.begin(); it != value.end(); ++it) {
+      if (it.key() == "_comment") continue;
+      material_index_[it.key()] = add_material(read_material(it.value(), child_pointer(pointer, it.key())));
+    }
+  }
+
+  int add_material(MaterialDesc material) {
+    scene_.materials.push_back(std::move(material));
+    return int(scene_.materials.size()) - 1;
+  }
+
+  MaterialDesc read_material(const Json& value, const std::string& pointer) {
+    CheckedObject m(report_, value, pointer);
+    std::string type = m.string("type");
+    MaterialDesc material;
+    if (type == "diffuse") material = read_diffuse(m);
+    else if (type == "phong") material = read_phong(m);
+    else if (type == "mirror") material = MirrorMaterial{m.rgb_or("reflectance", ColorKind::Albedo, MirrorMaterial{}.reflectance)};
+    else if (type == "glass") material = read_glass(m);
+    else if (type == "black") material = BlackMaterial{};
+    else report_.fail(m.pointer_of("type"), "unknown material type \"{}\"; expected one of: diffuse, phong, mirror, glass, black", type);
+    m.finish();
+    return material;
+  }
+
+  static DiffuseMaterial read_diffuse(CheckedObject& m) {
+    return {m.rgb_or("reflectance", ColorKind::Albedo, DiffuseMaterial{}.reflectance)};
+  }
+
+  PhongMaterial read_phong(CheckedObject& m) const {
+    PhongMaterial p;
+    p.diffuse = m.rgb_or("diffuse", ColorKind::Albedo, p.diffuse);
+    p.specular = m.rgb_or("specular", ColorKind::Albedo, p.specular);
+    p.exponent = m.number_or("exponent", p.exponent, Bound::NonNegative);
+    p.transmission = m.rgb_or("transmission", ColorKind::Albedo, p.transmission);
+    p.ior = m.number_or("ior", p.ior, Bound::Positive);
+    p.d = m.number_or("d", p.d, Bound::UnitInterval);
+    p.s = m.number_or("s", p.s, Bound::UnitInterval);
+    p.t = m.number_or("t", p.t, Bound::UnitInterval);
+    // The probabilities of Russian roulette's diffuse, specular and transmitted choices.
+    double sum = double(p.d) + p.s + p.t;
+    if (sum > 1 + 1e-6)
+      report_.fail(m.pointer(), "d + s + t must be <= 1 (the rest is absorbed), got {} + {} + {} = {}", p.d, p.s, p.t,
+                   float(sum));
+    return p;
+  }
+
+  static GlassMaterial read_glass(CheckedObject& m) {
+    GlassMaterial g;
+    g.ior = m.number_or("ior", g.ior, Bound::Positive);
+    g.reflectance = m.rgb_or("reflectance", ColorKind::Albedo, g.reflectance);
+    g.transmittance = m.rgb_or("transmittance", ColorKind::Albedo, g.transmittance);
+    return g;
+  }
+
+  int material_by_name(const std::string& name, const std::string& pointer) const {
+    auto it = material_index_.find(name);
+    if (it != material_index_.end()) return it->second;
+    std::vector<std::string> names;
+    for (const auto& entry : material_index_) names.push_back(entry.first);
+    if (names.empty()) report_.fail(pointer, "unknown material \"{}\" (\"materials\" defines none)", name);
+    report_.fail(pointer, "unknown material \"{}\"; defined: {}", name, fmt::join(names, ", "));
+  }
+
+  int black_material() {
+    if (!black_material_) black_material_ = add_material(BlackMaterial{});
+    return *black_material_;
+  }
+
+  // ---- shapes
+
+  void read_shapes(const Json& value, const std::string& pointer) {
+    check_is_array(report_, value, pointer, "shapes");
+    for (size_t i = 0; i < value.size(); ++i) scene_.shapes.push_back(read_shape(value[i], child_pointer(pointer, i)));
+  }
+
+  ShapeDesc read_shape(const Json& value, const std::string& pointer) {
+    CheckedObject s(report_, value, pointer);
+    ShapeDesc shape;
+    shape.geometry = read_geometry(s);
+    shape.material = read_shape_material(s);
+    if (const Json* emission = s.find("emission")) shape.emission = read_emission(*emission, s.pointer_of("emission"));
+    shape.to_world = read_transform_key(s);
+    shape.name = s.string_or("name", "");
+    shape.reverse_orientation = s.boolean_or("reverse_orientation", false);
+    s.finish();
+    return shape;
+  }
+
+  ShapeGeometry read_geometry(CheckedObject& s) {
+    std::string type = s.string("type");
+    if (type == "sphere") return read_sphere(s);
+    if (type == "plane") return PlaneShape{s.vec3("point"), normalize(s.direction("normal"))};
+    if (type == "box") return read_box(s);
+    if (type == "rectangle") return read_rectangle(s);
+    if (type == "mesh") return read_mesh(s);
+    report_.fail(s.pointer_of("type"), "unknown shape type \"{}\"; expected one of: sphere, plane, box, rectangle, mesh", type);
+  }
+
+  static SphereShape read_sphere(CheckedObject& s) { return {s.vec3("center"), s.number("radius", Bound::Positive)}; }
+
+  BoxShape read_box(CheckedObject& s) const {
+    BoxShape box{s.vec3("min"), s.vec3("max")};
+    for (int axis = 0; axis < 3; ++axis)
+      if (!(box.lo[axis] < box.hi[axis]))
+        report_.fail(s.pointer_of("max"), "max must exceed min on every axis; on axis {} min is {} and max is {}",
+                     "xyz"[axis], box.lo[axis], box.hi[axis]);
+    return box;
+  }
+
+  RectangleShape read_rectangle(CheckedObject& s) const {
+    RectangleShape r{s.vec3("corner"), s.direction("edge_u"), s.direction("edge_v")};
+    if (length(cross(r.edge_u, r.edge_v)) <= 1e-6f * length(r.edge_u) * length(r.edge_v))
+      report_.fail(s.pointer_of("edge_v"), "edge_u and edge_v are parallel, so the rectangle has no area");
+    return r;
+  }
+
+  int read_shape_material(CheckedObject& s) {
+    const Json* material = s.find("material");
+    if (!material) return -1;  // the default diffuse 0.5
+    std::string pointer = s.pointer_of("material");
+    if (material->is_string()) return material_by_name(material->get<std::string>(), pointer);
+    if (material->is_object()) return add_material(read_material(*material, pointer));
+    report_.fail(pointer, "expected a material name or a material object, got {}", describe(*material));
+  }
+
+  AreaEmission read_emission(const Json& value, const std::string& pointer) const {
+    CheckedObject e(report_, value, pointer);
+    AreaEmission emission{e.rgb("radiance", ColorKind::Emission), e.boolean_or("two_sided", false)};
+    e.finish();
+    return emission;
+  }
+
+  // ---- meshes
+
+  MeshShape read_mesh(CheckedObject& s) const {
+    bool from_file = s.has("file"), inline_data = s.has("positions");
+    if (from_file && inline_data)
+      report_.fail(s.pointer(), "a mesh takes either \"file\" or inline \"positions\", not both");
+    if (from_file) return {read_mesh_file(s)};
+    if (!inline_data) report_.fail(s.pointer(), "a mesh needs either \"file\" or inline \"positions\"");
+    return {read_inline_mesh(s)};
+  }
+
+  TriangleMesh read_mesh_file(CheckedObject& s) const {
+    for (std::string_view key : {"indices", "normals", "uvs"})
+      if (s.has(key)) report_.fail(s.pointer_of(key), "inline mesh data cannot be combined with \"file\"");
+    std::string file = s.string("file");
+    if (file.empty()) report_.fail(s.pointer_of("file"), "the mesh file name is empty");
+    return load_mesh_file(base_dir_ / file, report_.location(s.pointer_of("file")));
+  }
+
+  TriangleMesh read_inline_mesh(CheckedObject& s) const {
+    TriangleMesh mesh;
+    mesh.positions = read_vec3_list(s.require("positions"), s.pointer_of("positions"), "positions [x, y, z]");
+    if (mesh.positions.size() < 3)
+      report_.fail(s.pointer_of("positions"), "a mesh needs at least 3 positions, got {}", mesh.positions.size());
+    if (const Json* indices = s.find("indices")) mesh.indices = read_indices(*indices, s.pointer_of("indices"), mesh.positions.size());
+    else if (mesh.positions.size() == 3) mesh.indices = {0, 1, 2};
+    else report_.fail(s.pointer(), "missing required key \"indices\" (only a single triangle of 3 positions may leave it out)");
+    if (const Json* normals = s.find("normals")) {
+      mesh.normals = read_vec3_list(*normals, s.pointer_of("normals"), "normals [x, y, z]");
+      check_per_vertex_count(mesh.normals.size(), mesh.positions.size(), s.pointer_of("normals"));
+      check_nonzero_normals(mesh.normals, s.pointer_of("normals"));
+    }
+    if (const Json* uvs = s.find("uvs")) {
+      mesh.uvs = read_vec2_list(*uvs, s.pointer_of("uvs"));
+      check_per_vertex_count(mesh.uvs.size(), mesh.positions.size(), s.pointer_of("uvs"));
+    }
+    return mesh;
+  }
+
+  std::vector<Vec3> read_vec3_list(const Json& value, const std::string& pointer, std::string_view of_what) const {
+    check_is_array(report_, value, pointer, of_what);
+    std::vector<Vec3> list;
+    list.reserve(value.size());
+    for (size_t i = 0; i < value.size(); ++i) list.push_back(read_vec3(report_, value[i], child_pointer(pointer, i)));
+    return list;
+  }
+
+  std::vector<Vec2> read_vec2_list(const Json& value, const std::string& pointer) const {
+    check_is_array(report_, value, pointer, "uvs [u, v]");
+    std::vector<Vec2> list;
+    list.reserve(value.size());
+    for (size_t i = 0; i < value.size(); ++i) list.push_back(read_vec2(report_, value[i], child_pointer(pointer, i)));
+    return list;
+  }
+
+  std::vector<uint32_t> read_indices(const Json& value, const std::string& pointer, size_t vertex_count) const {
+    check_is_array(report_, value, pointer, "vertex indices");
+    if (value.empty() || value.size() % 3 != 0)
+      report_.fail(pointer, "expected a non-zero multiple of 3 indices (three per triangle), got {}", value.size());
+    std::vector<uint32_t> indices;
+    indices.reserve(value.size());
+    for (size_t i = 0; i < value.size(); ++i) {
+      int64_t index = read_int64(report_, value[i], child_pointer(pointer, i));
+      if (index < 0 || uint64_t(index) >= vertex_count)
+        report_.fail(child_pointer(pointer, i), "index {} is out of range: the mesh has {} positions", index, vertex_count);
+      indices.push_back(uint32_t(index));
+    }
+    return indices;
+  }
+
+  void check_per_vertex_count(size_t count, size_t vertex_count, const std::string& pointer) const {
+    if (count != vertex_count)
+      report_.fail(pointer, "expected one entry per position ({}), got {}", vertex_count, count);
+  }
+
+  void check_nonzero_normals(const std::vector<Normal3>& normals, const std::string& pointer) const {
+    for (size_t i = 0; i < normals.size(); ++i)
+      if (length_squared(normals[i]) == 0) report_.fail(child_pointer(pointer, i), "a normal must be non-zero");
+  }
+
+  // ---- transforms
+
+  Transform read_transform_key(CheckedObject& object) const {
+    const Json* steps = object.find("transform");
+    return steps ? read_transform(*steps, object.pointer_of("transform")) : Transform();
+  }
+
+  // Steps apply in the order listed: the first one acts on the object first.
+  Transform read_transform(const Json& value, const std::string& pointer) const {
+    check_is_array(report_, value, pointer, "transform steps such as {\"translate\": [x, y, z]}");
+    Transform to_world;
+    for (size_t i = 0; i < value.size(); ++i) to_world = read_transform_step(value[i], child_pointer(pointer, i)) * to_world;
+    return to_world;
+  }
+
+  Transform read_transform_step(const Json& value, const std::string& pointer) const {
+    CheckedObject step(report_, value, pointer);
+    std::vector<std::string_view> operations;
+    for (std::string_view op : {"translate", "rotate", "scale", "matrix"})
+      if (step.has(op)) operations.push_back(op);
+    if (operations.size() != 1) {
+      step.finish();  // a misspelt operation is best reported as such
+      report_.fail(pointer, "a transform step needs exactly one of: translate, rotate, scale, matrix; got {}",
+                   operations.empty() ? std::string("none") : fmt::format("{}", fmt::join(operations, ", ")));
+    }
+    Transform transform;
+    std::string op_pointer = step.pointer_of(operations[0]);
+    if (operations[0] == "translate") transform = Transform::translate(step.vec3("translate"));
+    else if (operations[0] == "rotate") transform = read_rotation(step.require("rotate"), op_pointer);
+    else if (operations[0] == "scale") transform = read_scale(step.require("scale"), op_pointer);
+    else transform = read_matrix(step.require("matrix"), op_pointer);
+    step.finish();
+    return transform;
+  }
+
+  Transform read_rotation(const Json& value, const std::string& pointer) const {
+    CheckedObject rotation(report_, value, pointer);
+    float degrees = rotation.number("angle");
+    Vec3 axis = rotation.direction("axis");
+    rotation.finish();
+    return Transform::rotate(degrees, axis);
+  }
+
+  Transform read_scale(const Json& value, const std::string& pointer) const {
+    Vec3 factors = value.is_number() ? Vec3(read_float(report_, value, pointer)) : read_vec3(report_, value, pointer);
+    if (factors.x == 0 || factors.y == 0 || factors.z == 0)
+      report_.fail(pointer, "scale factors must be non-zero, got [{}, {}, {}]", factors.x, factors.y, factors.z);
+    return Transform::scale(factors);
+  }
+
+  Transform read_matrix(const Json& value, const std::string& pointer) const {
+    if (!value.is_array() || value.size() != 16)
+      report_.fail(pointer, "expected 16 numbers (a 4x4 matrix, row by row), got {}", describe(value));
+    Matrix4 m;
+    for (size_t i = 0; i < 16; ++i) m.m[i / 4][i % 4] = read_double(report_, value[i], child_pointer(pointer, i));
+    // Normals, bounds and instancing assume affine maps: no projective bottom row.
+    if (m.m[3][0] != 0 || m.m[3][1] != 0 || m.m[3][2] != 0 || m.m[3][3] != 1)
+      report_.fail(pointer, "the matrix must be affine: its last row must be [0, 0, 0, 1]");
+    std::optional<Transform> transform = Transform::from_matrix(m);
+    if (!transform) report_.fail(pointer, "the matrix is singular (not invertible)");
+    return *transform;
+  }
+
+  // ---- lights
+
+  void read_lights(const Json& value, const std::string& pointer) {
+    check_is_array(report_, value, pointer, "lights");
+    for (size_t i = 0; i < value.size(); ++i) read_light(value[i], child_pointer(pointer, i));
+  }
+
+  void read_light(const Json& value, const std::string& pointer) {
+    CheckedObject light(report_, value, pointer);
+    std::string type = light.string("type");
+    if (type == "point") scene_.lights.push_back(PointLight{light.vec3("position"), light.rgb("intensity", ColorKind::Emission)});
+    else if (type == "sky") scene_.lights.push_back(read_sky(light));
+    else if (type == "sphere") scene_.shapes.push_back(read_shape_light(light, read_sphere(light)));
+    else if (type == "rectangle") scene_.shapes.push_back(read_shape_light(light, read_rectangle(light)));
+    else report_.fail(light.pointer_of("type"), "unknown light type \"{}\"; expected one of: point, sky, sphere, rectangle", type);
+    light.finish();
+  }
+
+  // Sphere and rectangle lights are emitting shapes that reflect nothing.
+  ShapeDesc read_shape_light(CheckedObject& light, ShapeGeometry geometry) {
+    ShapeDesc shape;
+    shape.geometry = std::move(geometry);
+    shape.material = black_material();
+    shape.emission = AreaEmission{light.rgb("radiance", ColorKind::Emission), light.boolean_or("two_sided", false)};
+    shape.to_world = read_transform_key(light);
+    return shape;
+  }
+
+  // Either one constant "radiance", or a gradient where a missing horizon takes the zenith's value,
+  // a missing zenith the horizon's, and a missing ground the horizon's.
+  SkyLight read_sky(CheckedObject& light) const {
+    SkyLight sky;
+    bool constant = light.has("radiance");
+    std::optional<RGB> zenith = light.optional_rgb("zenith", ColorKind::Emission);
+    std::optional<RGB> horizon = light.optional_rgb("horizon", ColorKind::Emission);
+    std::optional<RGB> ground = light.optional_rgb("ground", ColorKind::Emission);
+    if (constant && (zenith || horizon || ground))
+      report_.fail(light.pointer(), "a sky takes either \"radiance\" or \"zenith\"/\"horizon\"/\"ground\", not both");
+    if (constant) {
+      sky.zenith = sky.horizon = sky.ground = light.rgb("radiance", ColorKind::Emission);
+    } else {
+      if (!zenith && !horizon)
+        report_.fail(light.pointer(), "a sky needs \"radiance\", or a gradient with \"zenith\" and/or \"horizon\"");
+      sky.zenith = zenith.value_or(horizon.value_or(RGB()));
+      sky.horizon = horizon.value_or(sky.zenith);
+      sky.ground = ground.value_or(sky.horizon);
+    }
+    sky.up = normalize(light.direction_or("up", sky.up));
+    return sky;
+  }
+
+  std::string_view text_;
+  ErrorReporter report_;
+  fs::path base_dir_;
+  SceneDesc scene_;
+  std::map<std::string, int> material_index_;
+  std::optional<int> black_material_;
+};
+
+}  // namespace
+
+SceneDesc read_json_scene(std::string_view text, const std::string& file_name, const std::filesystem::path& base_dir) {
+  return JsonSceneReader(text, file_name, base_dir).read();
+}
+
+}  // namespace candela

@@ -1,0 +1,647 @@
+// Tests of the native JSON scene format and of read_scene_file's dispatch.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "candela/io/error.h"
+#include "candela/io/scene_reader.h"
+
+namespace candela {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kSourceDir = CANDELA_SOURCE_DIR;
+const fs::path kSharedDir = CANDELA_SHARED_DIR;
+
+SceneDesc read(const std::string& text, const fs::path& base_dir = fs::current_path()) {
+  return read_json_scene(text, "test.json", base_dir);
+}
+
+// The message of the SceneError that reading `text` throws; fails the test if none is thrown.
+std::string error_of(const std::string& text, const fs::path& base_dir = fs::current_path()) {
+  try {
+    read(text, base_dir);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no SceneError for: " << text;
+  return {};
+}
+
+std::string scene_file_error_of(const fs::path& file) {
+  try {
+    read_scene_file(file);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no SceneError for: " << file;
+  return {};
+}
+
+// One shape in an otherwise empty scene.
+std::string with_shape(const std::string& shape, const std::string& materials = "{}") {
+  return R"({"materials": )" + materials + R"(, "shapes": [)" + shape + "]}";
+}
+
+std::string with_material(const std::string& material) {
+  return with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"})",
+                    R"({"m": )" + material + "}");
+}
+
+std::string with_light(const std::string& light) { return R"({"lights": [)" + light + "]}"; }
+
+void expect_near(const Vec3& a, const Vec3& b, float tolerance = 1e-5f) {
+  EXPECT_NEAR(a.x, b.x, tolerance);
+  EXPECT_NEAR(a.y, b.y, tolerance);
+  EXPECT_NEAR(a.z, b.z, tolerance);
+}
+
+// ---------------------------------------------------------------- valid scenes
+
+TEST(JsonReader, ReadsTheCornellBox) {
+  SceneDesc scene = read_scene_file(kSourceDir / "scenes/cornell-box.json");
+  EXPECT_EQ(scene.source_file, (kSourceDir / "scenes/cornell-box.json").string());
+  ASSERT_EQ(scene.shapes.size(), 8u);
+  ASSERT_EQ(scene.materials.size(), 3u);
+  EXPECT_EQ(std::get<DiffuseMaterial>(scene.materials[1]).reflectance, RGB(0.63f, 0.065f, 0.05f));  // file order
+  ASSERT_TRUE(scene.shapes[0].emission.has_value());
+  EXPECT_EQ(scene.shapes[0].emission->radiance, RGB(17, 12, 4));
+  EXPECT_FALSE(scene.shapes[0].emission->two_sided);
+  EXPECT_EQ(scene.shapes[0].name, "light");
+  EXPECT_EQ(scene.shapes[0].material, 0);
+  EXPECT_EQ(scene.shapes[4].material, 2);  // green
+  EXPECT_EQ(std::get<MeshShape>(scene.shapes[6].geometry).mesh.triangle_count(), 10u);
+  for (size_t i = 1; i < scene.shapes.size(); ++i) EXPECT_FALSE(scene.shapes[i].emission.has_value());
+  EXPECT_EQ(scene.film.width, 512);
+  EXPECT_EQ(scene.film.height, 512);
+  EXPECT_EQ(scene.film.filename, "cornell-box.png");
+  EXPECT_EQ(scene.settings.spp, 64);
+  EXPECT_FLOAT_EQ(scene.camera.fov_degrees, 39.3077f);
+  EXPECT_EQ(scene.camera.fov_axis, FovAxis::Y);
+  expect_near(scene.camera.world_from_camera.point({0, 0, 0}), {278, 273, -800});
+  expect_near(scene.camera.world_from_camera.vector({0, 0, 1}), {0, 0, 1});
+  expect_near(scene.camera.world_from_camera.vector({0, 1, 0}), {0, 1, 0});
+  expect_near(scene.camera.world_from_camera.vector({1, 0, 0}), {-1, 0, 0});  // right-handed: +x image right
+}
+
+TEST(JsonReader, EmptySceneGetsDefaults) {
+  SceneDesc scene = read("{}");
+  EXPECT_EQ(scene.film.width, 512);
+  EXPECT_EQ(scene.film.height, 512);
+  EXPECT_TRUE(scene.film.filename.empty());
+  EXPECT_EQ(scene.settings.spp, 16);
+  EXPECT_EQ(scene.settings.max_depth, 16);
+  EXPECT_EQ(scene.settings.seed, 0u);
+  EXPECT_EQ(scene.settings.integrator, "path");
+  EXPECT_EQ(scene.settings.rr_start_depth, 3);
+  EXPECT_FLOAT_EQ(scene.camera.fov_degrees, 40);
+  EXPECT_EQ(scene.camera.world_from_camera, Transform::look_at_right_handed({0, 0, 0}, {0, 0, 1}, {0, 1, 0}));
+  EXPECT_TRUE(scene.shapes.empty());
+  EXPECT_TRUE(scene.materials.empty());
+  EXPECT_TRUE(scene.lights.empty());
+  EXPECT_EQ(scene.source_file, "test.json");
+}
+
+TEST(JsonReader, ReadsCameraAndRenderSettings) {
+  SceneDesc scene = read(R"({
+    "camera": {"position": [1, 2, 3], "look_at": [1, 2, 4], "up": [0, 2, 0], "fov": 60, "width": 640, "height": 480},
+    "render": {"spp": 100, "max_depth": 5, "seed": 18446744073709551615, "integrator": "direct",
+               "output": "out.exr", "rr_start_depth": 0}})");
+  EXPECT_EQ(scene.film.width, 640);
+  EXPECT_EQ(scene.film.height, 480);
+  EXPECT_FLOAT_EQ(scene.camera.fov_degrees, 60);
+  expect_near(scene.camera.world_from_camera.point({0, 0, 0}), {1, 2, 3});
+  EXPECT_EQ(scene.settings.spp, 100);
+  EXPECT_EQ(scene.settings.max_depth, 5);
+  EXPECT_EQ(scene.settings.seed, 18446744073709551615u);
+  EXPECT_EQ(scene.settings.integrator, "direct");
+  EXPECT_EQ(scene.film.filename, "out.exr");
+  EXPECT_EQ(scene.settings.rr_start_depth, 0);
+}
+
+TEST(JsonReader, AcceptsIntegralFloatsAndComments) {
+  SceneDesc scene = read(R"({"_comment": "top", "camera": {"_comment": 3, "width": 640.0},
+    "shapes": [{"_comment": ["any"], "type": "sphere", "center": [0, 0, 0], "radius": 1,
+                "transform": [{"_comment": "step", "scale": 2}]}]})");
+  EXPECT_EQ(scene.film.width, 640);
+  EXPECT_EQ(scene.shapes.size(), 1u);
+}
+
+TEST(JsonReader, ReadsSphere) {
+  SceneDesc scene = read(with_shape(
+      R"({"type": "sphere", "center": [1, 2, 3], "radius": 0.5, "name": "ball", "reverse_orientation": true})"));
+  ASSERT_EQ(scene.shapes.size(), 1u);
+  const ShapeDesc& shape = scene.shapes[0];
+  const auto& sphere = std::get<SphereShape>(shape.geometry);
+  EXPECT_EQ(sphere.center, Vec3(1, 2, 3));
+  EXPECT_FLOAT_EQ(sphere.radius, 0.5f);
+  EXPECT_EQ(shape.name, "ball");
+  EXPECT_TRUE(shape.reverse_orientation);
+  EXPECT_EQ(shape.material, -1);  // the default diffuse 0.5
+  EXPECT_FALSE(shape.emission.has_value());
+  EXPECT_TRUE(shape.to_world.is_identity());
+}
+
+TEST(JsonReader, ReadsPlaneWithNormalisedNormal) {
+  SceneDesc scene = read(with_shape(R"({"type": "plane", "point": [0, -1, 0], "normal": [0, 3, 0]})"));
+  const auto& plane = std::get<PlaneShape>(scene.shapes[0].geometry);
+  EXPECT_EQ(plane.point, Vec3(0, -1, 0));
+  expect_near(plane.normal, {0, 1, 0});
+}
+
+TEST(JsonReader, ReadsBox) {
+  SceneDesc scene = read(with_shape(R"({"type": "box", "min": [-1, 0, -2], "max": [1, 3, 2]})"));
+  const auto& box = std::get<BoxShape>(scene.shapes[0].geometry);
+  EXPECT_EQ(box.lo, Vec3(-1, 0, -2));
+  EXPECT_EQ(box.hi, Vec3(1, 3, 2));
+}
+
+TEST(JsonReader, ReadsRectangleWithTwoSidedEmission) {
+  SceneDesc scene = read(with_shape(
+      R"({"type": "rectangle", "corner": [0, 5, 0], "edge_u": [1, 0, 0], "edge_v": [0, 0, 2],
+          "emission": {"radiance": [10, 20, 30], "two_sided": true}})"));
+  const ShapeDesc& shape = scene.shapes[0];
+  const auto& rectangle = std::get<RectangleShape>(shape.geometry);
+  EXPECT_EQ(rectangle.corner, Vec3(0, 5, 0));
+  EXPECT_EQ(rectangle.edge_u, Vec3(1, 0, 0));
+  EXPECT_EQ(rectangle.edge_v, Vec3(0, 0, 2));
+  ASSERT_TRUE(shape.emission.has_value());
+  EXPECT_EQ(shape.emission->radiance, RGB(10, 20, 30));
+  EXPECT_TRUE(shape.emission->two_sided);
+}
+
+TEST(JsonReader, ReadsInlineMeshWithNormalsAndUvs) {
+  SceneDesc scene = read(with_shape(R"({"type": "mesh",
+      "positions": [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], "indices": [0, 1, 2, 0, 2, 3],
+      "normals": [[0, 0, 1], [0, 0, 1], [0, 0, 1], [0, 0, 1]], "uvs": [[0, 0], [1, 0], [1, 1], [0, 1]]})"));
+  const TriangleMesh& mesh = std::get<MeshShape>(scene.shapes[0].geometry).mesh;
+  EXPECT_EQ(mesh.positions.size(), 4u);
+  EXPECT_EQ(mesh.triangle_count(), 2u);
+  EXPECT_EQ(mesh.indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3}));
+  EXPECT_EQ(mesh.normals.size(), 4u);
+  ASSERT_EQ(mesh.uvs.size(), 4u);
+  EXPECT_EQ(mesh.uvs[2].x, 1);
+  EXPECT_EQ(mesh.uvs[2].y, 1);
+}
+
+TEST(JsonReader, SingleTriangleMeshMayOmitIndices) {
+  SceneDesc scene = read(with_shape(R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]]})"));
+  EXPECT_EQ(std::get<MeshShape>(scene.shapes[0].geometry).mesh.indices, (std::vector<uint32_t>{0, 1, 2}));
+}
+
+TEST(JsonReader, ReadsObjMeshFileRelativeToBaseDir) {
+  SceneDesc scene = read(with_shape(R"({"type": "mesh", "file": "spot/spot.obj"})"), kSharedDir / "meshes");
+  const TriangleMesh& mesh = std::get<MeshShape>(scene.shapes[0].geometry).mesh;
+  EXPECT_EQ(mesh.triangle_count(), 5856u);
+  EXPECT_FALSE(mesh.uvs.empty());
+}
+
+TEST(JsonReader, ReadsPlyMeshFile) {
+  fs::path ply = kSharedDir / "meshes/bunny/stanford-original/bun_zipper_res4.ply";
+  SceneDesc scene = read(with_shape(R"({"type": "mesh", "file": ")" + ply.string() + R"("})"));
+  const TriangleMesh& mesh = std::get<MeshShape>(scene.shapes[0].geometry).mesh;
+  EXPECT_EQ(mesh.triangle_count(), 948u);
+}
+
+TEST(JsonReader, ReadsEveryMaterialType) {
+  SceneDesc scene = read(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "glass"})",
+                                    R"({"matte": {"type": "diffuse", "reflectance": 0.25},
+      "plastic": {"type": "phong", "diffuse": [0.5, 0.4, 0.3], "specular": 0.9, "exponent": 200,
+                  "transmission": [0.1, 0.2, 0.3], "ior": 1.33, "d": 0.6, "s": 0.3, "t": 0.1},
+      "chrome": {"type": "mirror", "reflectance": [0.9, 0.8, 0.7]},
+      "glass": {"type": "glass", "ior": 1.7, "reflectance": 0.95, "transmittance": [1, 0.9, 0.8]},
+      "void": {"type": "black"},
+      "plain": {"type": "phong"}})"));
+  ASSERT_EQ(scene.materials.size(), 6u);
+  EXPECT_EQ(std::get<DiffuseMaterial>(scene.materials[0]).reflectance, RGB(0.25f));
+  const auto& phong = std::get<PhongMaterial>(scene.materials[1]);
+  EXPECT_EQ(phong.diffuse, RGB(0.5f, 0.4f, 0.3f));
+  EXPECT_EQ(phong.specular, RGB(0.9f));
+  EXPECT_FLOAT_EQ(phong.exponent, 200);
+  EXPECT_EQ(phong.transmission, RGB(0.1f, 0.2f, 0.3f));
+  EXPECT_FLOAT_EQ(phong.ior, 1.33f);
+  EXPECT_FLOAT_EQ(phong.d, 0.6f);
+  EXPECT_FLOAT_EQ(phong.s, 0.3f);
+  EXPECT_FLOAT_EQ(phong.t, 0.1f);
+  EXPECT_EQ(std::get<MirrorMaterial>(scene.materials[2]).reflectance, RGB(0.9f, 0.8f, 0.7f));
+  const auto& glass = std::get<GlassMaterial>(scene.materials[3]);
+  EXPECT_FLOAT_EQ(glass.ior, 1.7f);
+  EXPECT_EQ(glass.reflectance, RGB(0.95f));
+  EXPECT_EQ(glass.transmittance, RGB(1, 0.9f, 0.8f));
+  EXPECT_TRUE(std::holds_alternative<BlackMaterial>(scene.materials[4]));
+  const auto& plain = std::get<PhongMaterial>(scene.materials[5]);  // all defaults from description.h
+  EXPECT_EQ(plain.diffuse, PhongMaterial{}.diffuse);
+  EXPECT_FLOAT_EQ(plain.d, 1);
+  EXPECT_FLOAT_EQ(plain.exponent, 32);
+  EXPECT_EQ(scene.shapes[0].material, 3);
+}
+
+TEST(JsonReader, InlineMaterialIsAppended) {
+  SceneDesc scene = read(with_shape(
+      R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": {"type": "mirror"}})",
+      R"({"red": {"type": "diffuse", "reflectance": [0.8, 0.1, 0.1]}})"));
+  ASSERT_EQ(scene.materials.size(), 2u);
+  EXPECT_EQ(scene.shapes[0].material, 1);
+  EXPECT_EQ(std::get<MirrorMaterial>(scene.materials[1]).reflectance, RGB(1));
+}
+
+TEST(JsonReader, ReadsPointAndSkyLights) {
+  SceneDesc scene = read(with_light(R"({"type": "point", "position": [1, 2, 3], "intensity": [100, 50, 25]},
+      {"type": "sky", "radiance": 0.5},
+      {"type": "sky", "zenith": [0.2, 0.3, 1], "up": [0, 0, 2]},
+      {"type": "sky", "horizon": 1, "ground": 0.1})"));
+  ASSERT_EQ(scene.lights.size(), 4u);
+  const auto& point = std::get<PointLight>(scene.lights[0]);
+  EXPECT_EQ(point.position, Vec3(1, 2, 3));
+  EXPECT_EQ(point.intensity, RGB(100, 50, 25));
+  const auto& constant = std::get<SkyLight>(scene.lights[1]);
+  EXPECT_TRUE(constant.is_constant());
+  EXPECT_EQ(constant.zenith, RGB(0.5f));
+  const auto& zenith_only = std::get<SkyLight>(scene.lights[2]);
+  EXPECT_EQ(zenith_only.horizon, RGB(0.2f, 0.3f, 1));  // horizon defaults to zenith
+  EXPECT_EQ(zenith_only.ground, RGB(0.2f, 0.3f, 1));   // ground defaults to horizon
+  expect_near(zenith_only.up, {0, 0, 1});
+  const auto& gradient = std::get<SkyLight>(scene.lights[3]);
+  EXPECT_EQ(gradient.zenith, RGB(1));  // zenith defaults to horizon
+  EXPECT_EQ(gradient.ground, RGB(0.1f));
+  EXPECT_FALSE(gradient.is_constant());
+}
+
+TEST(JsonReader, ShapeLightsBecomeEmittersWithOneSharedBlackMaterial) {
+  SceneDesc scene = read(R"({"materials": {"white": {"type": "diffuse"}}, "lights": [
+      {"type": "sphere", "center": [0, 5, 0], "radius": 2, "radiance": [4, 4, 8]},
+      {"type": "rectangle", "corner": [0, 0, 0], "edge_u": [1, 0, 0], "edge_v": [0, 1, 0], "radiance": 3,
+       "two_sided": true, "transform": [{"translate": [0, 0, 7]}]}]})");
+  EXPECT_TRUE(scene.lights.empty());
+  ASSERT_EQ(scene.shapes.size(), 2u);
+  ASSERT_EQ(scene.materials.size(), 2u);
+  EXPECT_TRUE(std::holds_alternative<BlackMaterial>(scene.materials[1]));
+  const ShapeDesc& sphere = scene.shapes[0];
+  EXPECT_FLOAT_EQ(std::get<SphereShape>(sphere.geometry).radius, 2);
+  EXPECT_EQ(sphere.material, 1);
+  ASSERT_TRUE(sphere.emission.has_value());
+  EXPECT_EQ(sphere.emission->radiance, RGB(4, 4, 8));
+  EXPECT_FALSE(sphere.emission->two_sided);
+  const ShapeDesc& rectangle = scene.shapes[1];
+  EXPECT_TRUE(std::holds_alternative<RectangleShape>(rectangle.geometry));
+  EXPECT_EQ(rectangle.material, 1);
+  EXPECT_TRUE(rectangle.emission->two_sided);
+  expect_near(rectangle.to_world.point({0, 0, 0}), {0, 0, 7});
+}
+
+// ---------------------------------------------------------------- transforms
+
+Transform transform_of(const std::string& steps) {
+  SceneDesc scene = read(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "transform": )" + steps + "}"));
+  return scene.shapes[0].to_world;
+}
+
+TEST(JsonReader, TransformStepsApplyInListedOrder) {
+  Transform translate_then_rotate =
+      transform_of(R"([{"translate": [1, 0, 0]}, {"rotate": {"angle": 90, "axis": [0, 0, 1]}}])");
+  expect_near(translate_then_rotate.point({0, 0, 0}), {0, 1, 0});
+  Transform rotate_then_translate =
+      transform_of(R"([{"rotate": {"angle": 90, "axis": [0, 0, 1]}}, {"translate": [1, 0, 0]}])");
+  expect_near(rotate_then_translate.point({0, 0, 0}), {1, 0, 0});
+  expect_near(rotate_then_translate.point({1, 0, 0}), {1, 1, 0});
+}
+
+TEST(JsonReader, ReadsScaleAndMatrix) {
+  expect_near(transform_of(R"([{"scale": 2}])").point({1, 2, 3}), {2, 4, 6});
+  expect_near(transform_of(R"([{"scale": [1, -1, 3]}])").point({1, 2, 3}), {1, -2, 9});
+  Transform matrix = transform_of(R"([{"matrix": [2, 0, 0, 5,  0, 1, 0, 6,  0, 0, 1, 7,  0, 0, 0, 1]}])");
+  expect_near(matrix.point({1, 1, 1}), {7, 7, 8});  // row-major: the translation is the last column
+  expect_near(matrix.inverse().point({7, 7, 8}), {1, 1, 1});
+  EXPECT_TRUE(transform_of("[]").is_identity());
+}
+
+// ---------------------------------------------------------------- bad input
+
+TEST(JsonReader, MalformedJsonReportsLineAndColumn) {
+  std::string message = error_of("{\n  \"camera\": {\n    \"fov\": 40,\n  }\n}");
+  EXPECT_EQ(message.rfind("test.json:4:3: malformed JSON", 0), 0u) << message;
+  EXPECT_NE(message.find("unexpected '}'"), std::string::npos) << message;
+  EXPECT_EQ(error_of("").rfind("test.json:1:1: malformed JSON", 0), 0u);
+  EXPECT_EQ(error_of("{\"shapes\": [\n").rfind("test.json:2:", 0), 0u) << error_of("{\"shapes\": [\n");
+}
+
+TEST(JsonReader, NumberBeyondDoubleRangeIsAnError) {
+  std::string message = error_of("{\"camera\": {\n\"fov\": 1e999}}");
+  EXPECT_EQ(message.rfind("test.json:2:8:", 0), 0u) << message;
+  EXPECT_NE(message.find("1e999 is out of range"), std::string::npos) << message;
+  EXPECT_NE(error_of(R"({"camera": {"fov": 1e300}})").find("out of range for a 32-bit float"), std::string::npos);
+}
+
+TEST(JsonReader, UnknownKeyNamesItsJsonPointer) {
+  std::string message = error_of(
+      "{\"shapes\": [\n"
+      "  {\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1},\n"
+      "  {\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"radiuss\": 2}]}");
+  EXPECT_EQ(message, "test.json:3:56: at /shapes/1/radiuss: unknown key; expected one of: type, center, radius, "
+                     "material, emission, transform, name, reverse_orientation");
+  EXPECT_NE(error_of(R"({"camera": {"fov": 40, "zoom": 2}})").find("at /camera/zoom: unknown key"), std::string::npos);
+  EXPECT_NE(error_of(R"({"scene": {}})").find("at /scene: unknown key"), std::string::npos);
+  EXPECT_NE(error_of(R"({"render": {"samples": 4}})").find("at /render/samples: unknown key"), std::string::npos);
+  EXPECT_NE(error_of(with_material(R"({"type": "diffuse", "albedo": 0.5})")).find("at /materials/m/albedo: unknown key"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_light(R"({"type": "point", "position": [0, 0, 0], "intensity": 1, "radius": 1})"))
+                .find("at /lights/0/radius: unknown key"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1,
+                                    "emission": {"radiance": 1, "power": 3}})"))
+                .find("at /shapes/0/emission/power: unknown key"),
+            std::string::npos);
+}
+
+TEST(JsonReader, PointerEscapesSlashAndTildeInMaterialNames) {
+  std::string message = error_of(with_material(R"({"type": "diffuse"}, "a/b~c": {"type": "diffuse", "x": 1})"));
+  EXPECT_NE(message.find("at /materials/a~1b~0c/x: unknown key"), std::string::npos) << message;
+  EXPECT_EQ(message.rfind("test.json:1:", 0), 0u) << message;  // found again in the text despite the escapes
+}
+
+TEST(JsonReader, DuplicateKeyIsAnError) {
+  std::string message = error_of("{\"shapes\": [{\"type\": \"sphere\", \"center\": [0, 0, 0],\n \"radius\": 1, \"radius\": 2}]}");
+  EXPECT_NE(message.find("test.json:2:15: at /shapes/0/radius: duplicate key"), std::string::npos) << message;
+}
+
+TEST(JsonReader, WrongTypeIsAnError) {
+  std::string radius_message =
+      error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": "big"})"));
+  EXPECT_NE(radius_message.find("at /shapes/0/radius: expected a number, got string"), std::string::npos)
+      << radius_message;
+  EXPECT_NE(error_of(with_shape(R"({"type": "sphere", "center": [0, 0], "radius": 1})"))
+                .find("at /shapes/0/center: expected an array of 3 numbers, got an array of 2 elements"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_shape(R"({"type": "sphere", "center": [0, null, 0], "radius": 1})"))
+                .find("at /shapes/0/center/1: expected a number, got null"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"render": {"spp": 2.5}})").find("at /render/spp: expected an integer, got 2.5"), std::string::npos);
+  EXPECT_NE(error_of(R"({"render": {"output": 3}})").find("expected a string, got number"), std::string::npos);
+  EXPECT_NE(error_of(R"({"shapes": {}})").find("at /shapes: expected an array of shapes, got object"), std::string::npos);
+  EXPECT_NE(error_of(R"({"materials": []})").find("at /materials: expected an object"), std::string::npos);
+  EXPECT_NE(error_of(R"({"camera": 5})").find("at /camera: expected an object, got number"), std::string::npos);
+  EXPECT_NE(error_of("[]").find("expected an object, got an array of 0 elements"), std::string::npos);
+  EXPECT_NE(error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "reverse_orientation": 1})"))
+                .find("expected true or false, got number"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": 3})"))
+                .find("expected a material name or a material object, got number"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_material(R"({"type": "diffuse", "reflectance": "red"})"))
+                .find("expected a colour, [r, g, b] or a single number, got string"),
+            std::string::npos);
+}
+
+TEST(JsonReader, MissingRequiredKeyIsAnError) {
+  EXPECT_NE(error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0]})"))
+                .find("at /shapes/0: missing required key \"radius\""),
+            std::string::npos);
+  EXPECT_NE(error_of(with_shape(R"({"center": [0, 0, 0], "radius": 1})")).find("missing required key \"type\""),
+            std::string::npos);
+  EXPECT_NE(error_of(with_light(R"({"type": "point", "position": [0, 0, 0]})")).find("missing required key \"intensity\""),
+            std::string::npos);
+  EXPECT_NE(error_of(with_shape(R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]]})"))
+                .find("missing required key \"indices\""),
+            std::string::npos);
+  EXPECT_NE(error_of(with_shape(R"({"type": "mesh"})")).find("a mesh needs either \"file\" or inline \"positions\""),
+            std::string::npos);
+  EXPECT_NE(error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "emission": {}})"))
+                .find("at /shapes/0/emission: missing required key \"radiance\""),
+            std::string::npos);
+  EXPECT_NE(error_of(with_light(R"({"type": "sky", "ground": 1})")).find("a sky needs \"radiance\""), std::string::npos);
+}
+
+TEST(JsonReader, NonPositiveSizesAreErrors) {
+  std::string message = error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": -1})"));
+  EXPECT_NE(message.find("test.json:1:"), std::string::npos) << message;
+  EXPECT_NE(message.find("at /shapes/0/radius: expected a positive number, got -1"), std::string::npos) << message;
+  EXPECT_NE(error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 0})")).find("positive"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_shape(R"({"type": "box", "min": [0, 0, 0], "max": [1, 0, 1]})"))
+                .find("at /shapes/0/max: max must exceed min on every axis; on axis y"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_shape(R"({"type": "plane", "point": [0, 0, 0], "normal": [0, 0, 0]})"))
+                .find("at /shapes/0/normal: expected a non-zero vector"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_shape(R"({"type": "rectangle", "corner": [0, 0, 0], "edge_u": [1, 0, 0], "edge_v": [2, 0, 0]})"))
+                .find("edge_u and edge_v are parallel"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_light(R"({"type": "sphere", "center": [0, 0, 0], "radius": -2, "radiance": 1})"))
+                .find("at /lights/0/radius: expected a positive number, got -2"),
+            std::string::npos);
+}
+
+TEST(JsonReader, BadResolutionIsAnError) {
+  EXPECT_NE(error_of(R"({"camera": {"width": 0}})").find("at /camera/width: expected an integer in [1, 65536], got 0"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"camera": {"height": -5}})").find("at /camera/height: expected an integer in [1, 65536]"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"camera": {"width": 100000}})").find("expected an integer in [1, 65536], got 100000"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"camera": {"width": 65536, "height": 65536}})").find("exceeds the limit of 2^28 pixels"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"camera": {"width": 1e30}})").find("too large"), std::string::npos);
+}
+
+TEST(JsonReader, BadRenderSettingsAreErrors) {
+  EXPECT_NE(error_of(R"({"render": {"spp": 0}})").find("at /render/spp: expected an integer >= 1, got 0"), std::string::npos);
+  EXPECT_NE(error_of(R"({"render": {"max_depth": 0}})").find("expected an integer >= 1"), std::string::npos);
+  EXPECT_NE(error_of(R"({"render": {"rr_start_depth": -1}})").find("expected an integer >= 0"), std::string::npos);
+  EXPECT_NE(error_of(R"({"render": {"seed": -1}})").find("expected a non-negative integer, got -1"), std::string::npos);
+  EXPECT_NE(error_of(R"({"render": {"spp": 3000000000}})").find("expected an integer >= 1, got 3000000000"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"render": {"integrator": ""}})").find("the integrator name is empty"), std::string::npos);
+}
+
+TEST(JsonReader, DegenerateCameraIsAnError) {
+  EXPECT_NE(error_of(R"({"camera": {"position": [1, 1, 1], "look_at": [1, 1, 1]}})")
+                .find("at /camera/look_at: look_at must differ from position"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"camera": {"position": [0, 0, 0], "look_at": [0, 5, 0]}})")
+                .find("at /camera/up: up is parallel to the view direction"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"camera": {"up": [0, 0, 0]}})").find("at /camera/up: expected a non-zero vector"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"camera": {"fov": 180}})").find("field of view must be in (0, 180) degrees, got 180"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"camera": {"fov": 0}})").find("field of view"), std::string::npos);
+}
+
+TEST(JsonReader, UnknownMaterialNameIsAnError) {
+  std::string message = error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "gold"})",
+                                            R"({"red": {"type": "diffuse"}, "blue": {"type": "diffuse"}})"));
+  EXPECT_NE(message.find("at /shapes/0/material: unknown material \"gold\"; defined: blue, red"), std::string::npos)
+      << message;
+  EXPECT_NE(error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "gold"})"))
+                .find("defines none"),
+            std::string::npos);
+}
+
+TEST(JsonReader, UnknownTypesAreErrors) {
+  EXPECT_NE(error_of(with_shape(R"({"type": "torus"})"))
+                .find("at /shapes/0/type: unknown shape type \"torus\"; expected one of: sphere, plane, box, rectangle, mesh"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_material(R"({"type": "velvet"})"))
+                .find("at /materials/m/type: unknown material type \"velvet\""),
+            std::string::npos);
+  EXPECT_NE(error_of(with_light(R"({"type": "spot"})")).find("at /lights/0/type: unknown light type \"spot\""),
+            std::string::npos);
+}
+
+TEST(JsonReader, BadMaterialValuesAreErrors) {
+  std::string message = error_of(with_material(R"({"type": "phong", "d": 0.6, "s": 0.3, "t": 0.2})"));
+  EXPECT_NE(message.find("at /materials/m: d + s + t must be <= 1"), std::string::npos) << message;
+  EXPECT_NO_THROW(read(with_material(R"({"type": "phong", "d": 0.6, "s": 0.3, "t": 0.1})")));
+  EXPECT_NE(error_of(with_material(R"({"type": "phong", "d": 1.5})")).find("expected a number in [0, 1], got 1.5"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_material(R"({"type": "phong", "exponent": -1})")).find("expected a number >= 0"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_material(R"({"type": "glass", "ior": 0})")).find("at /materials/m/ior: expected a positive"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_material(R"({"type": "diffuse", "reflectance": [0.5, 1.2, 0.5]})"))
+                .find("at /materials/m/reflectance/1: a reflectance must be <= 1"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_material(R"({"type": "mirror", "reflectance": -0.1})")).find("must be >= 0, got -0.1"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_light(R"({"type": "point", "position": [0, 0, 0], "intensity": [1, -1, 1]})"))
+                .find("at /lights/0/intensity/1: colour components must be >= 0"),
+            std::string::npos);
+  EXPECT_NO_THROW(read(with_light(R"({"type": "point", "position": [0, 0, 0], "intensity": 1000})")));
+}
+
+TEST(JsonReader, BadMeshDataIsAnError) {
+  std::string out_of_range = error_of(with_shape(
+      R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [0, 1, 3]})"));
+  EXPECT_NE(out_of_range.find("at /shapes/0/indices/2: index 3 is out of range: the mesh has 3 positions"),
+            std::string::npos)
+      << out_of_range;
+  EXPECT_NE(error_of(with_shape(R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [0, -1, 2]})"))
+                .find("index -1 is out of range"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_shape(R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [0, 1]})"))
+                .find("expected a non-zero multiple of 3 indices"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_shape(R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0]]})"))
+                .find("a mesh needs at least 3 positions"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_shape(R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "normals": [[0, 0, 1]]})"))
+                .find("at /shapes/0/normals: expected one entry per position (3), got 1"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_shape(R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "uvs": [[0, 0], [1, 0], [0]]})"))
+                .find("at /shapes/0/uvs/2: expected an array of 2 numbers"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_shape(R"({"type": "mesh", "file": "a.obj", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]]})"))
+                .find("either \"file\" or inline \"positions\", not both"),
+            std::string::npos);
+  EXPECT_NE(error_of(with_shape(R"({"type": "mesh", "file": "a.obj", "indices": [0, 1, 2]})"))
+                .find("at /shapes/0/indices: inline mesh data cannot be combined with \"file\""),
+            std::string::npos);
+}
+
+TEST(JsonReader, MissingMeshFileNamesTheFile) {
+  std::string message = error_of(with_shape(R"({"type": "mesh", "file": "no-such-cow.obj"})"), "/tmp/candela-no-dir");
+  EXPECT_NE(message.find("no-such-cow.obj"), std::string::npos) << message;
+  EXPECT_NE(message.find("/shapes/0/file"), std::string::npos) << message;
+}
+
+TEST(JsonReader, BadTransformsAreErrors) {
+  auto transform_error = [](const std::string& steps) {
+    return error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "transform": )" + steps + "}"));
+  };
+  EXPECT_NE(transform_error(R"([{"scale": [1, 0, 1]}])").find("at /shapes/0/transform/0/scale: scale factors must be non-zero"),
+            std::string::npos);
+  EXPECT_NE(transform_error(R"([{"translate": [1, 0, 0], "scale": 2}])")
+                .find("at /shapes/0/transform/0: a transform step needs exactly one of: translate, rotate, scale, matrix; "
+                      "got translate, scale"),
+            std::string::npos);
+  EXPECT_NE(transform_error(R"([{"translat": [1, 0, 0]}])").find("at /shapes/0/transform/0/translat: unknown key"),
+            std::string::npos);
+  EXPECT_NE(transform_error(R"([{}])").find("needs exactly one of"), std::string::npos);
+  EXPECT_NE(transform_error(R"([{"rotate": {"angle": 10, "axis": [0, 0, 0]}}])").find("expected a non-zero vector"),
+            std::string::npos);
+  EXPECT_NE(transform_error(R"([{"rotate": {"axis": [0, 1, 0]}}])").find("missing required key \"angle\""),
+            std::string::npos);
+  EXPECT_NE(transform_error(R"([{"matrix": [1, 0, 0, 0,  0, 1, 0, 0,  0, 0, 0, 0,  0, 0, 0, 1]}])")
+                .find("the matrix is singular"),
+            std::string::npos);
+  EXPECT_NE(transform_error(R"([{"matrix": [1, 0, 0, 0,  0, 1, 0, 0,  0, 0, 1, 0,  0, 0, 1, 1]}])")
+                .find("last row must be [0, 0, 0, 1]"),
+            std::string::npos);
+  EXPECT_NE(transform_error(R"([{"matrix": [1, 0, 0]}])").find("expected 16 numbers"), std::string::npos);
+  EXPECT_NE(transform_error(R"({"translate": [1, 0, 0]})").find("expected an array of transform steps"),
+            std::string::npos);
+}
+
+TEST(JsonReader, BadSkyIsAnError) {
+  EXPECT_NE(error_of(with_light(R"({"type": "sky", "radiance": 1, "zenith": 2})")).find("not both"), std::string::npos);
+}
+
+// ---------------------------------------------------------------- read_scene_file
+
+TEST(JsonReader, SceneFileWithUnknownExtensionIsAnError) {
+  std::string message = scene_file_error_of(kSharedDir / "meshes/spot/spot.obj");
+  EXPECT_NE(message.find("spot.obj"), std::string::npos) << message;
+  EXPECT_NE(message.find("unsupported scene file extension \".obj\"; supported: .json, .pbrt"), std::string::npos)
+      << message;
+  EXPECT_NE(scene_file_error_of(kSharedDir / "README.md").find("\".md\""), std::string::npos);
+}
+
+TEST(JsonReader, MissingSceneFileIsAnError) {
+  std::string message = scene_file_error_of("/tmp/candela-no-such-scene.json");
+  EXPECT_NE(message.find("/tmp/candela-no-such-scene.json"), std::string::npos) << message;
+  EXPECT_NE(message.find("not found"), std::string::npos) << message;
+  EXPECT_NE(scene_file_error_of(kSourceDir / "scenes").find("is a directory"), std::string::npos);
+}
+
+TEST(JsonReader, SceneFileErrorsNameTheFile) {
+  // The JSON reader's messages carry the path as given to read_scene_file.
+  fs::path file = fs::temp_directory_path() / "candela-json-reader-test-bad.json";
+  {
+    std::ofstream out(file);
+    out << "{\n  \"shapes\": [{\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": -1}]\n}\n";
+  }
+  std::string message = scene_file_error_of(file);
+  fs::remove(file);
+  EXPECT_EQ(message.rfind(file.string() + ":2:", 0), 0u) << message;
+}
+
+TEST(JsonReader, PbrtSceneFilesGoToThePbrtReader) {
+  fs::path file = kSharedDir / "scenes/cornell-box/cornell-box.pbrt";
+  SceneDesc scene = read_scene_file(file);
+  EXPECT_FALSE(scene.shapes.empty());
+  EXPECT_EQ(scene.source_file, file.string());
+}
+
+// ---------------------------------------------------------------- the paper's scenes
+
+TEST(JsonReader, ReadsTheCowScene) {
+  SceneDesc scene = read_scene_file(kSourceDir / "scenes/cow.json");
+  bool has_cow = false, has_sphere_light = false;
+  for (const ShapeDesc& shape : scene.shapes) {
+    if (const auto* mesh = std::get_if<MeshShape>(&shape.geometry)) has_cow |= mesh->mesh.triangle_count() == 5856;
+    if (std::holds_alternative<SphereShape>(shape.geometry) && shape.emission) has_sphere_light = true;
+  }
+  EXPECT_TRUE(has_cow);
+  EXPECT_TRUE(has_sphere_light);
+  EXPECT_EQ(scene.settings.spp, 64);
+}
+
+TEST(JsonReader, ReadsTheRoomScene) {
+  SceneDesc scene = read_scene_file(kSourceDir / "scenes/room.json");
+  bool has_phong = false;
+  for (const MaterialDesc& material : scene.materials)
+    if (const auto* phong = std::get_if<PhongMaterial>(&material)) has_phong |= phong->s > 0;
+  EXPECT_TRUE(has_phong);
+  bool has_light = false;
+  for (const ShapeDesc& shape : scene.shapes) has_light |= shape.emission.has_value();
+  EXPECT_TRUE(has_light);
+  EXPECT_EQ(scene.settings.spp, 64);
+}
+
+}  // namespace
+}  // namespace candela

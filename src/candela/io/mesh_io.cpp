@@ -1,0 +1,421 @@
+#include "candela/io/mesh_io.h"
+
+#include <assimp/Importer.hpp>
+#include <assimp/mesh.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <fmt/format.h>
+#include <tiny_obj_loader.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <new>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <unordered_map>
+#include <vector>
+
+namespace candela {
+namespace {
+
+// What went wrong with the mesh file itself; load_mesh_file prefixes the place that referenced the
+// file and the file's name, so every failure reaches the user as one SceneError.
+class MeshFileProblem : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+template <typename... Args>
+[[noreturn]] void fail(fmt::format_string<Args...> format, Args&&... args) {
+  throw MeshFileProblem(fmt::format(format, std::forward<Args>(args)...));
+}
+
+// ---------------------------------------------------------------- file access
+
+enum class MeshFormat { Obj, Ply };
+
+MeshFormat mesh_format_of(const std::filesystem::path& file) {
+  std::string extension = file.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (extension == ".obj") return MeshFormat::Obj;
+  if (extension == ".ply") return MeshFormat::Ply;
+  if (extension.empty()) fail("the file name has no extension; supported mesh formats are .obj and .ply");
+  fail("unsupported mesh format '{}'; supported mesh formats are .obj and .ply", file.extension().string());
+}
+
+std::string read_whole_file(const std::filesystem::path& file) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(file, ec);
+  if (status.type() == std::filesystem::file_type::not_found) fail("no such file");
+  if (status.type() == std::filesystem::file_type::directory) fail("it is a directory, not a file");
+
+  struct FileCloser {
+    void operator()(std::FILE* f) const { std::fclose(f); }
+  };
+  std::unique_ptr<std::FILE, FileCloser> handle(std::fopen(file.c_str(), "rb"));
+  if (!handle) fail("cannot open it: {}", std::strerror(errno));
+
+  // Read in chunks rather than trusting a size from stat: works for pipes and files that change.
+  std::string bytes;
+  char chunk[1 << 16];
+  size_t got = 0;
+  while ((got = std::fread(chunk, 1, sizeof chunk, handle.get())) > 0) bytes.append(chunk, got);
+  if (std::ferror(handle.get())) fail("read error: {}", std::strerror(errno));
+  return bytes;
+}
+
+// ---------------------------------------------------------------- OBJ
+
+// One corner of an OBJ face: OBJ indexes positions, uvs and normals separately.
+struct ObjCorner {
+  int position, uv, normal;
+  bool operator==(const ObjCorner&) const = default;
+};
+
+struct ObjCornerHash {
+  size_t operator()(const ObjCorner& c) const {
+    uint64_t h = static_cast<uint32_t>(c.position);
+    h = h * 0x9E3779B97F4A7C15ull ^ static_cast<uint32_t>(c.uv);
+    h = h * 0x9E3779B97F4A7C15ull ^ static_cast<uint32_t>(c.normal);
+    return static_cast<size_t>(h ^ (h >> 29));
+  }
+};
+
+std::string first_line(std::string_view text) {
+  while (!text.empty() && (text.front() == '\n' || text.front() == '\r')) text.remove_prefix(1);
+  return std::string(text.substr(0, text.find_first_of("\r\n")));
+}
+
+void check_obj_index(int index, size_t count, const char* what, size_t face) {
+  if (index < 0 || static_cast<size_t>(index) >= count)
+    fail("malformed OBJ: face {} refers to {} {} but the file has {} of them", face + 1, what,
+         index < 0 ? fmt::format("{} (before the first one)", index) : std::to_string(index + 1), count);
+}
+
+void check_obj_corners(const tinyobj::attrib_t& attrib, const std::vector<tinyobj::shape_t>& shapes) {
+  const size_t positions = attrib.vertices.size() / 3, normals = attrib.normals.size() / 3,
+               uvs = attrib.texcoords.size() / 2;
+  size_t face = 0;
+  for (const tinyobj::shape_t& shape : shapes) {
+    size_t corner = 0;
+    for (const unsigned char face_size : shape.mesh.num_face_vertices) {
+      for (size_t k = 0; k < face_size; ++k) {
+        const tinyobj::index_t& index = shape.mesh.indices[corner + k];
+        check_obj_index(index.vertex_index, positions, "vertex", face);
+        if (index.normal_index != -1) check_obj_index(index.normal_index, normals, "normal", face);
+        if (index.texcoord_index != -1) check_obj_index(index.texcoord_index, uvs, "texture coordinate", face);
+      }
+      corner += face_size;
+      ++face;
+    }
+  }
+}
+
+// tinyobjloader drops faces with bad indices it notices while triangulating and only warns about it;
+// a mesh with faces silently missing is worse than an error.
+void fail_on_dropped_obj_faces(const std::string& warnings) {
+  for (const char* dropped : {"out of bounds", "invalid vertex index"}) {
+    const size_t at = warnings.find(dropped);
+    if (at == std::string::npos) continue;
+    const size_t line_start = warnings.rfind('\n', at);
+    fail("malformed OBJ: {}", first_line(std::string_view(warnings).substr(line_start == std::string::npos ? 0 : line_start)));
+  }
+}
+
+bool every_corner_has(const std::vector<tinyobj::shape_t>& shapes, int tinyobj::index_t::*attribute) {
+  for (const tinyobj::shape_t& shape : shapes)
+    for (const tinyobj::index_t& index : shape.mesh.indices)
+      if (index.*attribute < 0) return false;
+  return true;
+}
+
+class ObjMeshBuilder {
+ public:
+  ObjMeshBuilder(const tinyobj::attrib_t& attrib, bool with_normals, bool with_uvs)
+      : attrib_(attrib), with_normals_(with_normals), with_uvs_(with_uvs) {}
+
+  void add_face(const tinyobj::index_t* corners, size_t count) {
+    // Fan for anything tinyobjloader left as a polygon; its own triangulation already gives triangles.
+    for (size_t k = 1; k + 1 < count; ++k) {
+      mesh_.indices.push_back(vertex_for(corners[0]));
+      mesh_.indices.push_back(vertex_for(corners[k]));
+      mesh_.indices.push_back(vertex_for(corners[k + 1]));
+    }
+  }
+
+  TriangleMesh take() { return std::move(mesh_); }
+
+ private:
+  // Corners with the same (position, uv, normal) become one vertex, so shared vertices stay shared.
+  // Attributes that are being dropped do not take part, so they cannot split a vertex.
+  uint32_t vertex_for(const tinyobj::index_t& index) {
+    const ObjCorner key{index.vertex_index, with_uvs_ ? index.texcoord_index : -1,
+                        with_normals_ ? index.normal_index : -1};
+    const auto [slot, inserted] = vertex_of_corner_.try_emplace(key, 0);
+    if (!inserted) return slot->second;
+    if (mesh_.positions.size() >= std::numeric_limits<uint32_t>::max())
+      fail("too many distinct vertices for 32-bit indices");
+    slot->second = static_cast<uint32_t>(mesh_.positions.size());
+    const float* p = &attrib_.vertices[3 * static_cast<size_t>(key.position)];
+    mesh_.positions.push_back({p[0], p[1], p[2]});
+    if (with_normals_) {
+      const float* n = &attrib_.normals[3 * static_cast<size_t>(key.normal)];
+      mesh_.normals.push_back({n[0], n[1], n[2]});
+    }
+    if (with_uvs_) {
+      const float* t = &attrib_.texcoords[2 * static_cast<size_t>(key.uv)];
+      mesh_.uvs.push_back({t[0], t[1]});
+    }
+    return slot->second;
+  }
+
+  const tinyobj::attrib_t& attrib_;
+  bool with_normals_, with_uvs_;
+  TriangleMesh mesh_;
+  std::unordered_map<ObjCorner, uint32_t, ObjCornerHash> vertex_of_corner_;
+};
+
+TriangleMesh load_obj(const std::string& text) {
+  tinyobj::ObjReaderConfig config;
+  config.triangulate = true;
+  config.vertex_color = false;
+  tinyobj::ObjReader reader;
+  // Parsing from a string makes tinyobjloader ignore `mtllib`: materials are not used yet, and a
+  // missing or misplaced .mtl file must not fail the load.
+  if (!reader.ParseFromString(text, "", config)) fail("malformed OBJ: {}", first_line(reader.Error()));
+
+  const tinyobj::attrib_t& attrib = reader.GetAttrib();
+  const std::vector<tinyobj::shape_t>& shapes = reader.GetShapes();
+  check_obj_corners(attrib, shapes);
+  fail_on_dropped_obj_faces(reader.Warning());
+
+  size_t corner_count = 0;
+  for (const tinyobj::shape_t& shape : shapes) corner_count += shape.mesh.indices.size();
+  if (corner_count == 0) fail("the OBJ file contains no triangles (no 'f' faces)");
+
+  ObjMeshBuilder builder(attrib, every_corner_has(shapes, &tinyobj::index_t::normal_index),
+                         every_corner_has(shapes, &tinyobj::index_t::texcoord_index));
+  for (const tinyobj::shape_t& shape : shapes) {
+    size_t corner = 0;
+    for (const unsigned char face_size : shape.mesh.num_face_vertices) {
+      builder.add_face(&shape.mesh.indices[corner], face_size);
+      corner += face_size;
+    }
+  }
+  return builder.take();
+}
+
+// ---------------------------------------------------------------- PLY
+
+// The least number of bytes one value of a PLY scalar type takes in a binary file.
+uint64_t ply_binary_size(std::string_view type) {
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "double" || type == "float64") return 8;
+  return 4;  // int, uint, float and their sized spellings; an unknown type is Assimp's to reject
+}
+
+std::vector<std::string_view> split_words(std::string_view line) {
+  std::vector<std::string_view> words;
+  size_t at = 0;
+  while (true) {
+    at = line.find_first_not_of(" \t\r", at);
+    if (at == std::string_view::npos) return words;
+    const size_t end = std::min(line.find_first_of(" \t\r", at), line.size());
+    words.push_back(line.substr(at, end - at));
+    at = end;
+  }
+}
+
+struct PlyElementDeclaration {
+  std::string name;
+  uint64_t count = 0;
+  uint64_t min_binary_bytes = 0;  // per element: fixed-size properties plus each list's length field
+  uint64_t property_count = 0;
+};
+
+struct PlyHeader {
+  bool binary = false;
+  size_t data_offset = 0;  // first byte after "end_header"
+  std::vector<PlyElementDeclaration> elements;
+};
+
+// Reads the element declarations of a PLY header; nullopt when this is not a header we understand
+// (Assimp then gives the reason).
+std::optional<PlyHeader> read_ply_header(std::string_view bytes) {
+  PlyHeader header;
+  size_t line_start = 0;
+  bool first = true;
+  while (line_start < bytes.size()) {
+    const size_t newline = bytes.find('\n', line_start);
+    if (newline == std::string_view::npos) return std::nullopt;
+    const std::vector<std::string_view> words = split_words(bytes.substr(line_start, newline - line_start));
+    line_start = newline + 1;
+    if (first) {
+      if (words.size() != 1 || words[0] != "ply") return std::nullopt;
+      first = false;
+    } else if (words.empty() || words[0] == "comment" || words[0] == "obj_info") {
+      continue;
+    } else if (words[0] == "format" && words.size() >= 2) {
+      header.binary = words[1] != "ascii";
+    } else if (words[0] == "element" && words.size() == 3) {
+      PlyElementDeclaration element{std::string(words[1])};
+      const auto [end, error] = std::from_chars(words[2].data(), words[2].data() + words[2].size(), element.count);
+      if (error != std::errc() || end != words[2].data() + words[2].size())
+        fail("malformed PLY: element '{}' has an invalid count '{}'", words[1], words[2]);
+      header.elements.push_back(element);
+    } else if (words[0] == "property" && !header.elements.empty()) {
+      PlyElementDeclaration& element = header.elements.back();
+      const bool list = words.size() >= 2 && words[1] == "list";
+      if (words.size() >= 3) element.min_binary_bytes += ply_binary_size(words[list ? 2 : 1]);
+      ++element.property_count;
+    } else if (words[0] == "end_header") {
+      header.data_offset = line_start;
+      return header;
+    }
+  }
+  return std::nullopt;
+}
+
+// The fewest bytes one element can take: binary files as declared (lists may be empty); in ASCII every
+// value is at least one digit and a separator. At least one byte, so that a count is never free.
+uint64_t min_bytes_per_element(const PlyElementDeclaration& element, bool binary) {
+  return std::max<uint64_t>(1, binary ? element.min_binary_bytes : 2 * element.property_count);
+}
+
+// Assimp allocates for the element counts a header declares before it reads the data, so a corrupt
+// count of billions would exhaust memory; a count the data cannot possibly hold is rejected first.
+void check_ply_counts_fit_data(const PlyHeader& header, size_t file_size) {
+  const uint64_t data_size = file_size - header.data_offset;
+  // The last ASCII value may lack its trailing separator.
+  const uint64_t available = data_size + (header.binary ? 0 : 1);
+  uint64_t needed = 0;
+  for (const PlyElementDeclaration& element : header.elements) {
+    const uint64_t each = min_bytes_per_element(element, header.binary);
+    if (element.count > (available - needed) / each)
+      fail("{} PLY: the header declares {} '{}' elements, which need at least {} bytes, but only {} bytes of "
+           "data follow the header",
+           element.count > available ? "corrupt" : "truncated", element.count, element.name,
+           element.count > std::numeric_limits<uint64_t>::max() / each ? std::string("more than 2^64")
+                                                                       : std::to_string(element.count * each),
+           data_size);
+    needed += element.count * each;
+  }
+}
+
+std::string describe_elements(const std::optional<PlyHeader>& header) {
+  if (!header) return "";
+  std::string list;
+  for (const PlyElementDeclaration& element : header->elements)
+    list += fmt::format("{}{} '{}'", list.empty() ? "" : ", ", element.count, element.name);
+  return fmt::format(" (the header declares {})", list.empty() ? "no elements" : list);
+}
+
+bool has_triangles(const aiMesh& mesh) { return (mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) != 0; }
+
+void append_assimp_mesh(const aiMesh& source, bool with_normals, bool with_uvs, TriangleMesh& mesh) {
+  const uint64_t base = mesh.positions.size();
+  if (base + source.mNumVertices > std::numeric_limits<uint32_t>::max())
+    fail("too many vertices for 32-bit indices");
+  for (unsigned i = 0; i < source.mNumVertices; ++i) {
+    const aiVector3D& p = source.mVertices[i];
+    mesh.positions.push_back({p.x, p.y, p.z});
+    if (with_normals) {
+      const aiVector3D& n = source.mNormals[i];
+      mesh.normals.push_back({n.x, n.y, n.z});
+    }
+    if (with_uvs) {
+      const aiVector3D& t = source.mTextureCoords[0][i];
+      mesh.uvs.push_back({t.x, t.y});
+    }
+  }
+  for (unsigned f = 0; f < source.mNumFaces; ++f) {
+    const aiFace& face = source.mFaces[f];
+    if (face.mNumIndices != 3) continue;  // points and lines: not surfaces
+    for (unsigned k = 0; k < 3; ++k) {
+      if (face.mIndices[k] >= source.mNumVertices)
+        fail("malformed PLY: face {} refers to vertex {} but there are {} vertices", f, face.mIndices[k],
+             source.mNumVertices);
+      mesh.indices.push_back(static_cast<uint32_t>(base + face.mIndices[k]));
+    }
+  }
+}
+
+TriangleMesh load_ply(const std::string& bytes) {
+  const std::optional<PlyHeader> header = read_ply_header(bytes);
+  if (header) check_ply_counts_fit_data(*header, bytes.size());
+  Assimp::Importer importer;
+  // No normal generation and no vertex joining: the mesh is exactly what the file holds.
+  const aiScene* scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), aiProcess_Triangulate, "ply");
+  if (!scene) fail("malformed PLY: {}", importer.GetErrorString());
+
+  bool with_normals = true, with_uvs = true, any_triangles = false;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh& source = *scene->mMeshes[m];
+    if (!has_triangles(source)) continue;
+    any_triangles = true;
+    with_normals = with_normals && source.HasNormals();
+    with_uvs = with_uvs && source.HasTextureCoords(0);
+  }
+  if (!any_triangles) fail("the PLY file contains no triangles, only points{}", describe_elements(header));
+
+  TriangleMesh mesh;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m)
+    if (has_triangles(*scene->mMeshes[m])) append_assimp_mesh(*scene->mMeshes[m], with_normals, with_uvs, mesh);
+  return mesh;
+}
+
+// ---------------------------------------------------------------- checks common to both formats
+
+bool is_finite_uv(const Vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); }
+
+void validate_mesh(const TriangleMesh& mesh) {
+  if (mesh.indices.empty()) fail("the file contains no triangles");
+  if (mesh.indices.size() % 3 != 0) fail("internal error: {} indices is not whole triangles", mesh.indices.size());
+  if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
+    fail("internal error: {} normals for {} vertices", mesh.normals.size(), mesh.positions.size());
+  if (!mesh.uvs.empty() && mesh.uvs.size() != mesh.positions.size())
+    fail("internal error: {} uvs for {} vertices", mesh.uvs.size(), mesh.positions.size());
+  for (size_t i = 0; i < mesh.indices.size(); ++i)
+    if (mesh.indices[i] >= mesh.positions.size())
+      fail("triangle {} refers to vertex {} but there are {} vertices", i / 3, mesh.indices[i], mesh.positions.size());
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    const Point3& p = mesh.positions[i];
+    if (!is_finite(p)) fail("vertex {} has a non-finite position ({}, {}, {})", i, p.x, p.y, p.z);
+    if (!mesh.normals.empty() && !is_finite(mesh.normals[i]))
+      fail("vertex {} has a non-finite normal ({}, {}, {})", i, mesh.normals[i].x, mesh.normals[i].y,
+           mesh.normals[i].z);
+    if (!mesh.uvs.empty() && !is_finite_uv(mesh.uvs[i]))
+      fail("vertex {} has a non-finite texture coordinate ({}, {})", i, mesh.uvs[i].x, mesh.uvs[i].y);
+  }
+}
+
+}  // namespace
+
+TriangleMesh load_mesh_file(const std::filesystem::path& file, const SourceLocation& referenced_from) {
+  try {
+    const MeshFormat format = mesh_format_of(file);
+    const std::string bytes = read_whole_file(file);
+    TriangleMesh mesh = format == MeshFormat::Obj ? load_obj(bytes) : load_ply(bytes);
+    validate_mesh(mesh);
+    return mesh;
+  } catch (const MeshFileProblem& problem) {
+    throw_scene_error(referenced_from, "cannot read mesh '{}': {}", file.string(), problem.what());
+  } catch (const std::bad_alloc&) {
+    throw_scene_error(referenced_from, "cannot read mesh '{}': out of memory", file.string());
+  }
+}
+
+}  // namespace candela

@@ -1,0 +1,631 @@
+// Tests of the pbrt-v4 reader: the Cornell box, transforms and graphics-state scoping, Include /
+// Import, and one test per kind of bad input, each checking the file:line:column of the message.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "candela/io/error.h"
+#include "candela/io/scene_reader.h"
+#include "candela/scene/description.h"
+
+namespace candela {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kSharedCornellBox = fs::path(CANDELA_SHARED_DIR) / "scenes/cornell-box/cornell-box.pbrt";
+const fs::path kRepoCornellBox = fs::path(CANDELA_SOURCE_DIR) / "scenes/cornell-box.pbrt";
+const fs::path kTestData = fs::path(CANDELA_SOURCE_DIR) / "tests/data/pbrt";
+
+// Each scene goes to its own file, named after the test, so tests can run in parallel processes.
+fs::path write_scene(const std::vector<std::string>& lines) {
+  static int counter = 0;
+  const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+  fs::path dir = fs::temp_directory_path() / fmt::format("candela_pbrt_reader_{}", getpid());
+  fs::create_directories(dir);
+  fs::path file = dir / fmt::format("{}_{}.pbrt", test->name(), counter++);
+  std::ofstream out(file);
+  for (const std::string& line : lines) out << line << '\n';
+  return file;
+}
+
+SceneDesc read_lines(const std::vector<std::string>& lines) { return read_pbrt_scene(write_scene(lines)); }
+
+// The message of the error reading `file` gives, or "" when it reads without one.
+std::string error_reading(const fs::path& file) {
+  try {
+    read_pbrt_scene(file);
+  } catch (const SceneError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+// Expects the scene to fail with a message that starts "<file>:<line>:<column>: ", where the column
+// is that of `marker` in the line, and that contains `fragment`.
+void expect_error(const std::vector<std::string>& lines, int line, std::string_view marker, std::string_view fragment) {
+  fs::path file = write_scene(lines);
+  size_t column = lines.at(line - 1).find(marker);
+  ASSERT_NE(column, std::string::npos) << "marker " << marker << " is not in line " << line;
+  std::string message = error_reading(file);
+  std::string place = fmt::format("{}:{}:{}: ", file.string(), line, column + 1);
+  EXPECT_TRUE(message.starts_with(place)) << "expected the error at " << place << "\ngot: " << message;
+  EXPECT_NE(message.find(fragment), std::string::npos) << "expected \"" << fragment << "\" in: " << message;
+}
+
+void expect_near(const Vec3& actual, const Vec3& expected, float tolerance = 1e-4f) {
+  EXPECT_NEAR(actual.x, expected.x, tolerance);
+  EXPECT_NEAR(actual.y, expected.y, tolerance);
+  EXPECT_NEAR(actual.z, expected.z, tolerance);
+}
+
+const TriangleMesh& mesh_of(const ShapeDesc& shape) { return std::get<MeshShape>(shape.geometry).mesh; }
+
+RGB reflectance_of(const SceneDesc& scene, const ShapeDesc& shape) {
+  return std::get<DiffuseMaterial>(scene.materials.at(shape.material)).reflectance;
+}
+
+// ---------------------------------------------------------------- the Cornell box
+
+void expect_cornell_box(const SceneDesc& scene) {
+  ASSERT_EQ(scene.shapes.size(), 8u);
+  const RGB white(0.725f, 0.71f, 0.68f), red(0.63f, 0.065f, 0.05f), green(0.14f, 0.45f, 0.091f);
+  // light, floor, ceiling, back wall, right (green) wall, left (red) wall, short block, tall block
+  const RGB expected[8] = {white, white, white, white, green, red, white, white};
+  const size_t triangles[8] = {2, 2, 2, 2, 2, 2, 10, 10};
+  for (size_t i = 0; i < 8; ++i) {
+    SCOPED_TRACE(scene.shapes[i].name);
+    EXPECT_EQ(reflectance_of(scene, scene.shapes[i]), expected[i]);
+    EXPECT_EQ(mesh_of(scene.shapes[i]).triangle_count(), triangles[i]);
+    EXPECT_TRUE(scene.shapes[i].to_world.is_identity());
+    EXPECT_FALSE(scene.shapes[i].reverse_orientation);
+    EXPECT_EQ(scene.shapes[i].emission.has_value(), i == 0);
+  }
+  EXPECT_EQ(scene.shapes[0].emission->radiance, RGB(17, 12, 4));
+  EXPECT_FALSE(scene.shapes[0].emission->two_sided);
+  EXPECT_EQ(mesh_of(scene.shapes[0]).positions[0], Point3(343, 548.7f, 227));
+  EXPECT_TRUE(scene.lights.empty());
+
+  // The camera sits at (278, 273, -800) looking along +z with +y up, and world +x is image LEFT.
+  const Transform& camera = scene.camera.world_from_camera;
+  expect_near(camera.point(Point3(0, 0, 0)), Point3(278, 273, -800));
+  expect_near(camera.vector(Vec3(0, 0, 1)), Vec3(0, 0, 1));
+  expect_near(camera.vector(Vec3(0, 1, 0)), Vec3(0, 1, 0));
+  expect_near(camera.vector(Vec3(1, 0, 0)), Vec3(-1, 0, 0));
+  EXPECT_FLOAT_EQ(scene.camera.fov_degrees, 39.3077f);
+  EXPECT_EQ(scene.camera.fov_axis, FovAxis::Smaller);
+
+  EXPECT_EQ(scene.film.width, 512);
+  EXPECT_EQ(scene.film.height, 512);
+  EXPECT_EQ(scene.film.filename, "cornell-box.exr");
+  EXPECT_EQ(scene.settings.integrator, "path");
+  EXPECT_EQ(scene.settings.max_depth, 16);
+}
+
+TEST(PbrtReader, ReadsTheSharedCornellBox) {
+  SceneDesc scene = read_pbrt_scene(kSharedCornellBox);
+  expect_cornell_box(scene);
+  EXPECT_EQ(scene.settings.spp, 256);
+  EXPECT_EQ(scene.source_file, kSharedCornellBox.string());
+}
+
+TEST(PbrtReader, RepositoryCornellBoxIsTheSharedSceneAt64Samples) {
+  SceneDesc ours = read_pbrt_scene(kRepoCornellBox);
+  expect_cornell_box(ours);
+  EXPECT_EQ(ours.settings.spp, 64);
+  SceneDesc shared = read_pbrt_scene(kSharedCornellBox);
+  for (size_t i = 0; i < shared.shapes.size(); ++i) {
+    EXPECT_EQ(mesh_of(ours.shapes[i]).positions, mesh_of(shared.shapes[i]).positions);
+    EXPECT_EQ(mesh_of(ours.shapes[i]).indices, mesh_of(shared.shapes[i]).indices);
+  }
+  EXPECT_EQ(ours.camera.world_from_camera, shared.camera.world_from_camera);
+}
+
+// ---------------------------------------------------------------- defaults
+
+TEST(PbrtReader, UsesPbrtDefaultsForAbsentDirectivesAndParameters) {
+  SceneDesc scene = read_lines({"Camera \"perspective\"", "Film \"rgb\"", "Sampler \"zsobol\"",
+                                "Integrator \"path\"", "WorldBegin", "Shape \"sphere\"", "Material \"diffuse\"",
+                                "Shape \"sphere\""});
+  EXPECT_FLOAT_EQ(scene.camera.fov_degrees, 90);
+  EXPECT_EQ(scene.camera.fov_axis, FovAxis::Smaller);
+  EXPECT_TRUE(scene.camera.world_from_camera.is_identity());
+  EXPECT_EQ(scene.film.width, 1280);
+  EXPECT_EQ(scene.film.height, 720);
+  EXPECT_EQ(scene.film.filename, "");
+  EXPECT_EQ(scene.settings.spp, 16);
+  EXPECT_EQ(scene.settings.max_depth, 5);
+  ASSERT_EQ(scene.shapes.size(), 2u);
+  EXPECT_FLOAT_EQ(std::get<SphereShape>(scene.shapes[0].geometry).radius, 1);
+  EXPECT_EQ(scene.shapes[0].material, -1);  // pbrt's default, diffuse 0.5
+  EXPECT_EQ(reflectance_of(scene, scene.shapes[1]), RGB(0.5f));
+}
+
+TEST(PbrtReader, SceneWithOnlyWorldBeginGetsTheDefaults) {
+  SceneDesc scene = read_lines({"WorldBegin"});
+  EXPECT_EQ(scene.film.width, 1280);
+  EXPECT_EQ(scene.settings.spp, 16);
+  EXPECT_EQ(scene.settings.max_depth, 5);
+  EXPECT_EQ(scene.settings.integrator, "path");
+  EXPECT_FLOAT_EQ(scene.camera.fov_degrees, 90);
+  EXPECT_TRUE(scene.shapes.empty());
+}
+
+TEST(PbrtReader, KeepsOtherIntegratorNamesAndStratifiedSampleCounts) {
+  SceneDesc scene = read_lines({"Integrator \"bdpt\" \"integer maxdepth\" 7",
+                                "Sampler \"stratified\" \"integer xsamples\" 3 \"integer ysamples\" 5 \"bool jitter\" false",
+                                "WorldBegin"});
+  EXPECT_EQ(scene.settings.integrator, "bdpt");
+  EXPECT_EQ(scene.settings.max_depth, 7);
+  EXPECT_EQ(scene.settings.spp, 15);
+}
+
+TEST(PbrtReader, SamplerSeedSetsTheRenderSeed) {
+  SceneDesc scene = read_lines({"Sampler \"halton\" \"integer pixelsamples\" 8 \"integer seed\" 42", "WorldBegin"});
+  EXPECT_EQ(scene.settings.spp, 8);
+  EXPECT_EQ(scene.settings.seed, 42u);
+}
+
+// ---------------------------------------------------------------- transforms
+
+TEST(PbrtReader, TransformsComposeInFileOrder) {
+  // pbrt post-multiplies: the last transform given is applied to the object first.
+  SceneDesc scene = read_lines({"WorldBegin", "Translate 1 2 3", "Scale 2 2 2", "Rotate 90 0 0 1", "Shape \"sphere\""});
+  const Transform& t = scene.shapes.at(0).to_world;
+  expect_near(t.point(Point3(1, 0, 0)), Point3(1, 4, 3));  // rotate to (0,1,0), scale to (0,2,0), translate
+  expect_near(t.point(Point3(0, 0, 0)), Point3(1, 2, 3));
+}
+
+TEST(PbrtReader, TransformIsColumnMajorAndConcatTransformMultiplies) {
+  SceneDesc scene = read_lines({"WorldBegin",
+                                "Transform [ 1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1 ]",
+                                "Shape \"sphere\"",
+                                "ConcatTransform [ 2 0 0 0  0 2 0 0  0 0 2 0  1 0 0 1 ]",
+                                "Shape \"sphere\""});
+  expect_near(scene.shapes.at(0).to_world.point(Point3(0, 0, 0)), Point3(5, 6, 7));
+  expect_near(scene.shapes.at(1).to_world.point(Point3(1, 1, 1)), Point3(8, 8, 9));
+}
+
+TEST(PbrtReader, AttributeBlocksScopeTheGraphicsState) {
+  SceneDesc scene = read_lines({"WorldBegin",
+                                "Translate 1 0 0",
+                                "AttributeBegin",
+                                "  Translate 0 1 0",
+                                "  Material \"dielectric\"",
+                                "  AreaLightSource \"diffuse\" \"rgb L\" [ 1 2 3 ]",
+                                "  ReverseOrientation",
+                                "  Shape \"sphere\"",
+                                "  AttributeBegin",
+                                "    Scale 2 2 2",
+                                "    Shape \"sphere\"",
+                                "  AttributeEnd",
+                                "AttributeEnd",
+                                "Shape \"sphere\""});
+  ASSERT_EQ(scene.shapes.size(), 3u);
+  const ShapeDesc &inner = scene.shapes[0], &innermost = scene.shapes[1], &outer = scene.shapes[2];
+  expect_near(inner.to_world.point(Point3(0, 0, 0)), Point3(1, 1, 0));
+  EXPECT_TRUE(std::holds_alternative<GlassMaterial>(scene.materials.at(inner.material)));
+  ASSERT_TRUE(inner.emission.has_value());
+  EXPECT_EQ(inner.emission->radiance, RGB(1, 2, 3));
+  EXPECT_TRUE(inner.reverse_orientation);
+  expect_near(innermost.to_world.point(Point3(1, 0, 0)), Point3(3, 1, 0));
+  EXPECT_TRUE(innermost.emission.has_value());
+  EXPECT_TRUE(innermost.reverse_orientation);
+  // After AttributeEnd everything is back as it was.
+  expect_near(outer.to_world.point(Point3(0, 0, 0)), Point3(1, 0, 0));
+  EXPECT_EQ(outer.material, -1);
+  EXPECT_FALSE(outer.emission.has_value());
+  EXPECT_FALSE(outer.reverse_orientation);
+}
+
+TEST(PbrtReader, DeprecatedTransformBeginEndRestoreTheTransform) {
+  SceneDesc scene = read_lines({"WorldBegin", "TransformBegin", "Translate 0 0 4", "Shape \"sphere\"", "TransformEnd",
+                                "Shape \"sphere\""});
+  expect_near(scene.shapes.at(0).to_world.point(Point3(0, 0, 0)), Point3(0, 0, 4));
+  EXPECT_TRUE(scene.shapes.at(1).to_world.is_identity());
+}
+
+TEST(PbrtReader, WorldBeginAndIdentityResetTheTransform) {
+  SceneDesc scene = read_lines({"Translate 5 5 5", "WorldBegin", "Shape \"sphere\"", "Translate 1 1 1", "Identity",
+                                "Shape \"sphere\""});
+  EXPECT_TRUE(scene.shapes.at(0).to_world.is_identity());
+  EXPECT_TRUE(scene.shapes.at(1).to_world.is_identity());
+}
+
+TEST(PbrtReader, NamedCoordinateSystems) {
+  SceneDesc scene = read_lines({"LookAt 0 0 -10  0 0 0  0 1 0",
+                                "Camera \"perspective\" \"float fov\" 45",
+                                "WorldBegin",
+                                "Translate 3 0 0",
+                                "CoordinateSystem \"shelf\"",
+                                "Identity",
+                                "CoordSysTransform \"shelf\"",
+                                "Shape \"sphere\"",
+                                "CoordSysTransform \"camera\"",
+                                "Shape \"sphere\"",
+                                "CoordSysTransform \"world\"",
+                                "Shape \"sphere\""});
+  expect_near(scene.shapes.at(0).to_world.point(Point3(0, 0, 0)), Point3(3, 0, 0));
+  expect_near(scene.shapes.at(1).to_world.point(Point3(0, 0, 1)), Point3(0, 0, -9));  // 1 in front of the camera
+  EXPECT_TRUE(scene.shapes.at(2).to_world.is_identity());
+}
+
+TEST(PbrtReader, CameraLooksAlongLookAtWithPbrtHandedness) {
+  SceneDesc scene = read_lines({"LookAt 1 2 3  1 2 4  0 1 0", "Camera \"perspective\"", "WorldBegin"});
+  const Transform& camera = scene.camera.world_from_camera;
+  expect_near(camera.point(Point3(0, 0, 0)), Point3(1, 2, 3));
+  expect_near(camera.vector(Vec3(0, 0, 1)), Vec3(0, 0, 1));
+  // Without a mirror, pbrt's left-handed camera puts world +x on the image's right.
+  expect_near(camera.vector(Vec3(1, 0, 0)), Vec3(1, 0, 0));
+}
+
+// ---------------------------------------------------------------- materials, lights, shapes
+
+TEST(PbrtReader, ReadsDiffuseAndSmoothDielectricMaterials) {
+  SceneDesc scene = read_lines({"WorldBegin",
+                                "Material \"dielectric\" \"float eta\" 1.33 \"float roughness\" 0",
+                                "Shape \"sphere\"",
+                                "MakeNamedMaterial \"paint\" \"string type\" \"diffuse\" \"color reflectance\" [ 0.2 0.3 0.4 ]",
+                                "Shape \"sphere\"",
+                                "NamedMaterial \"paint\"",
+                                "Shape \"sphere\""});
+  const auto& glass = std::get<GlassMaterial>(scene.materials.at(scene.shapes.at(0).material));
+  EXPECT_FLOAT_EQ(glass.ior, 1.33f);
+  EXPECT_EQ(scene.shapes.at(1).material, scene.shapes.at(0).material);  // MakeNamedMaterial does not select
+  EXPECT_EQ(reflectance_of(scene, scene.shapes.at(2)), RGB(0.2f, 0.3f, 0.4f));
+}
+
+TEST(PbrtReader, PointLightIsPlacedByTheTransform) {
+  SceneDesc scene = read_lines({"WorldBegin", "Translate 1 0 0",
+                                "LightSource \"point\" \"rgb I\" [ 1 2 3 ] \"point3 from\" [ 0 1 0 ] \"float scale\" 2"});
+  const auto& light = std::get<PointLight>(scene.lights.at(0));
+  expect_near(light.position, Point3(1, 1, 0));
+  EXPECT_EQ(light.intensity, RGB(2, 4, 6));
+}
+
+TEST(PbrtReader, InfiniteLightIsAConstantSky) {
+  SceneDesc scene = read_lines({"WorldBegin", "LightSource \"infinite\" \"rgb L\" [ 0.5 0.25 1 ] \"float scale\" 2"});
+  const auto& sky = std::get<SkyLight>(scene.lights.at(0));
+  EXPECT_TRUE(sky.is_constant());
+  EXPECT_EQ(sky.zenith, RGB(1, 0.5f, 2));
+}
+
+TEST(PbrtReader, AreaLightScaleAndTwoSided) {
+  SceneDesc scene = read_lines({"WorldBegin",
+                                "AttributeBegin",
+                                "AreaLightSource \"diffuse\" \"rgb L\" [ 1 1 2 ] \"float scale\" 3 \"bool twosided\" true",
+                                "Shape \"sphere\"",
+                                "AttributeEnd"});
+  ASSERT_TRUE(scene.shapes.at(0).emission.has_value());
+  EXPECT_EQ(scene.shapes.at(0).emission->radiance, RGB(3, 3, 6));
+  EXPECT_TRUE(scene.shapes.at(0).emission->two_sided);
+}
+
+TEST(PbrtReader, TriangleMeshWithNormalsUvsAndImplicitIndices) {
+  SceneDesc scene = read_lines({"WorldBegin",
+                                "Shape \"trianglemesh\" \"point P\" [ 0 0 0  1 0 0  0 1 0 ]",
+                                "    \"normal N\" [ 0 0 1  0 0 1  0 0 1 ] \"point2 uv\" [ 0 0  1 0  0 1 ]"});
+  const TriangleMesh& mesh = mesh_of(scene.shapes.at(0));
+  EXPECT_EQ(mesh.indices, (std::vector<uint32_t>{0, 1, 2}));
+  ASSERT_EQ(mesh.normals.size(), 3u);
+  EXPECT_EQ(mesh.normals[2], Normal3(0, 0, 1));
+  ASSERT_EQ(mesh.uvs.size(), 3u);
+  EXPECT_FLOAT_EQ(mesh.uvs[1].x, 1);
+}
+
+TEST(PbrtReader, AcceptsBareSingleValuesQuotedBoolsEscapesAndComments) {
+  SceneDesc scene = read_lines({"Film \"rgb\" \"integer xresolution\" 640 # a comment",
+                                "  \"integer yresolution\" [ 480 ] \"string filename\" \"out \\\"1\\\".exr\"",
+                                "Option \"disablepixeljitter\" true",
+                                "ColorSpace \"srgb\"",
+                                "WorldBegin",
+                                "AreaLightSource \"diffuse\" \"bool twosided\" \"true\"",
+                                "Shape \"sphere\" \"float radius\" +2.5e0"});
+  EXPECT_EQ(scene.film.width, 640);
+  EXPECT_EQ(scene.film.height, 480);
+  EXPECT_EQ(scene.film.filename, "out \"1\".exr");
+  EXPECT_TRUE(scene.shapes.at(0).emission->two_sided);
+  EXPECT_FLOAT_EQ(std::get<SphereShape>(scene.shapes.at(0).geometry).radius, 2.5f);
+}
+
+TEST(PbrtReader, ObjectInstancesAreExpandedWithTheComposedTransform) {
+  SceneDesc scene = read_lines({"WorldBegin",
+                                "ObjectBegin \"pair\"",
+                                "  Material \"dielectric\"",
+                                "  Translate 1 0 0",
+                                "  Shape \"sphere\"",
+                                "  Shape \"sphere\" \"float radius\" 0.5",
+                                "ObjectEnd",
+                                "Shape \"sphere\" \"float radius\" 3",  // ObjectEnd restored the state
+                                "Translate 0 10 0",
+                                "ObjectInstance \"pair\"",
+                                "Translate 0 10 0",
+                                "ObjectInstance \"pair\""});
+  ASSERT_EQ(scene.shapes.size(), 5u);
+  EXPECT_TRUE(scene.shapes[0].to_world.is_identity());
+  EXPECT_EQ(scene.shapes[0].material, -1);
+  expect_near(scene.shapes[1].to_world.point(Point3(0, 0, 0)), Point3(1, 10, 0));
+  expect_near(scene.shapes[4].to_world.point(Point3(0, 0, 0)), Point3(1, 20, 0));
+  EXPECT_FLOAT_EQ(std::get<SphereShape>(scene.shapes[4].geometry).radius, 0.5f);
+  EXPECT_TRUE(std::holds_alternative<GlassMaterial>(scene.materials.at(scene.shapes[4].material)));
+}
+
+// ---------------------------------------------------------------- Include and Import
+
+TEST(PbrtReader, IncludeResolvesNamesBesideTheNamingFile) {
+  SceneDesc scene = read_pbrt_scene(kTestData / "include/main.pbrt");
+  EXPECT_EQ(scene.film.width, 64);
+  ASSERT_EQ(scene.shapes.size(), 3u);
+  expect_near(scene.shapes[0].to_world.point(Point3(0, 0, 0)), Point3(0, 0, 5));
+  EXPECT_FLOAT_EQ(std::get<SphereShape>(scene.shapes[0].geometry).radius, 2);
+  for (const ShapeDesc& shape : scene.shapes) EXPECT_EQ(reflectance_of(scene, shape), RGB(0.1f, 0.2f, 0.9f));
+  // The same .ply named relative to the including file and relative to the top-level file.
+  EXPECT_EQ(mesh_of(scene.shapes[1]).triangle_count(), 1u);
+  EXPECT_EQ(mesh_of(scene.shapes[2]).positions, mesh_of(scene.shapes[1]).positions);
+}
+
+TEST(PbrtReader, ErrorInAnIncludedFileNamesThatFileAndLine) {
+  fs::path main = kTestData / "include/bad_main.pbrt";
+  std::string message = error_reading(main);
+  std::string included = (kTestData / "include/parts/bad.pbrt").string();
+  EXPECT_TRUE(message.starts_with(included + ":3:1: unknown directive \"Shap\"")) << message;
+  EXPECT_NE(message.find(main.string() + ":3:9"), std::string::npos) << message;
+}
+
+TEST(PbrtReader, IncludeCycleIsAnError) {
+  std::string message = error_reading(kTestData / "include/cycle_a.pbrt");
+  EXPECT_NE(message.find("cycle_b.pbrt:1:9: \"" + (kTestData / "include/cycle_a.pbrt").string() + "\" includes itself"),
+            std::string::npos)
+      << message;
+}
+
+TEST(PbrtReader, ImportedGraphicsStateDoesNotLeak) {
+  SceneDesc scene = read_pbrt_scene(kTestData / "include/import_main.pbrt");
+  ASSERT_EQ(scene.shapes.size(), 2u);
+  expect_near(scene.shapes[0].to_world.point(Point3(0, 0, 0)), Point3(10, 0, 0));
+  EXPECT_TRUE(std::holds_alternative<GlassMaterial>(scene.materials.at(scene.shapes[0].material)));
+  EXPECT_TRUE(scene.shapes[1].to_world.is_identity());
+  EXPECT_EQ(reflectance_of(scene, scene.shapes[1]), RGB(0.5f));
+}
+
+TEST(PbrtReader, MissingIncludeFile) {
+  expect_error({"WorldBegin", "Include \"no/such/file.pbrt\""}, 2, "\"no/such", "Include: cannot find \"no/such/file.pbrt\"");
+}
+
+TEST(PbrtReader, MissingPlyFile) {
+  expect_error({"WorldBegin", "Shape \"plymesh\" \"string filename\" \"missing.ply\""}, 2, "\"string filename\"",
+               "cannot find \"missing.ply\"");
+}
+
+TEST(PbrtReader, MissingSceneFile) {
+  fs::path file = kTestData / "no-such-scene.pbrt";
+  EXPECT_EQ(error_reading(file), file.string() + ": no such scene file");
+}
+
+TEST(PbrtReader, ImportBeforeWorldBegin) {
+  expect_error({"Import \"x.pbrt\""}, 1, "Import", "Import is not allowed before WorldBegin");
+}
+
+// ---------------------------------------------------------------- bad input: syntax
+
+TEST(PbrtReader, UnknownDirective) {
+  expect_error({"WorldBegin", "", "  Sphere \"x\""}, 3, "Sphere", "unknown directive \"Sphere\"");
+}
+
+TEST(PbrtReader, UnsupportedDirectiveIsNamed) {
+  expect_error({"WorldBegin", "Texture \"t\" \"spectrum\" \"checkerboard\""}, 2, "Texture",
+               "\"Texture\" is not supported yet");
+}
+
+TEST(PbrtReader, WorldEndIsExplainedAsPbrtV3) {
+  expect_error({"WorldBegin", "WorldEnd"}, 2, "WorldEnd", "pbrt-v3");
+}
+
+TEST(PbrtReader, UnterminatedString) {
+  expect_error({"WorldBegin", "Shape \"sphere", "  \"float radius\" 1"}, 2, "\"sphere", "unterminated string");
+}
+
+TEST(PbrtReader, UnknownEscapeInString) {
+  expect_error({"WorldBegin", "Shape \"sph\\qere\""}, 2, "\\q", "unknown escape sequence");
+}
+
+TEST(PbrtReader, TooFewNumbersForATransform) {
+  expect_error({"Translate 1 2", "WorldBegin"}, 2, "WorldBegin", "Translate: expected 3 numbers, got WorldBegin");
+}
+
+TEST(PbrtReader, TransformNeedsBrackets) {
+  expect_error({"WorldBegin", "Transform 1 0 0 0"}, 2, "1", "Transform: expected \"[\"");
+}
+
+TEST(PbrtReader, SingularTransformAndZeroScale) {
+  expect_error({"WorldBegin", "Transform [ 0 0 0 0  0 1 0 0  0 0 1 0  0 0 0 1 ]"}, 2, "Transform", "singular");
+  expect_error({"WorldBegin", "Scale 1 0 1"}, 2, "Scale", "non-zero");
+}
+
+TEST(PbrtReader, DegenerateLookAt) {
+  expect_error({"LookAt 0 0 0  0 1 0  0 1 0", "WorldBegin"}, 1, "LookAt", "parallel");
+}
+
+TEST(PbrtReader, StrayStringWhereADirectiveShouldBe) {
+  expect_error({"WorldBegin", "MakeNamedMaterial \"a\" \"string type\" \"diffuse\"", "NamedMaterial \"a\" \"b\""}, 3,
+               "\"b\"", "expected a directive (such as Shape or AttributeBegin), got \"b\"");
+}
+
+// ---------------------------------------------------------------- bad input: parameters
+
+TEST(PbrtReader, UnusedParameter) {
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" 1 \"float radiu\" 2"}, 2, "\"float radiu\"",
+               "unused parameter \"float radiu\" (parameters read here: radius, zmin, zmax, phimax)");
+}
+
+TEST(PbrtReader, ParameterOfTheWrongType) {
+  expect_error({"WorldBegin", "Shape \"sphere\" \"integer radius\" 2"}, 2, "\"integer radius\"",
+               "parameter \"radius\" must be of type \"float\", not \"integer\"");
+  expect_error({"WorldBegin", "Shape \"trianglemesh\" \"float uv\" [ 0 0 1 0 0 1 ] \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ]"},
+               2, "\"float uv\"", "must be of type \"point2\"");
+}
+
+TEST(PbrtReader, WrongNumberOfValues) {
+  expect_error({"Camera \"perspective\" \"float fov\" [ 30 40 ]", "WorldBegin"}, 1, "\"float fov\"",
+               "\"float fov\" takes exactly 1 value, got 2");
+  expect_error({"WorldBegin", "Material \"diffuse\" \"rgb reflectance\" [ 0.5 0.5 ]"}, 2, "\"rgb reflectance\"",
+               "takes exactly 3 values, got 2");
+  expect_error({"WorldBegin", "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  1 0 ]"}, 2, "\"point3 P\"",
+               "needs a multiple of 3 values, got 5");
+}
+
+TEST(PbrtReader, ValuesThatDoNotMatchTheDeclaredType) {
+  expect_error({"Sampler \"halton\" \"integer pixelsamples\" 1.5", "WorldBegin"}, 1, "1.5", "expects integers, got 1.5");
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" \"big\""}, 2, "\"big\"", "expects numbers, got \"big\"");
+  expect_error({"Film \"rgb\" \"string filename\" out.exr", "WorldBegin"}, 1, "out.exr", "expects quoted strings");
+  expect_error({"WorldBegin", "AreaLightSource \"diffuse\" \"bool twosided\" 1"}, 2, "1", "expects true or false");
+}
+
+TEST(PbrtReader, MalformedParameterDeclarations) {
+  expect_error({"Camera \"perspective\" \"floot fov\" 30", "WorldBegin"}, 1, "\"floot", "unknown parameter type \"floot\"");
+  expect_error({"Camera \"perspective\" \"fov\" 30", "WorldBegin"}, 1, "\"fov\"", "declared as \"type name\"");
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" [ ]"}, 2, "\"float radius\"", "has no values");
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" [ 1"}, 2, "[", "never closed");
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" 1 \"float radius\" 2"}, 2, "\"float radius\" 2",
+               "given twice");
+}
+
+TEST(PbrtReader, SpectrumAndTextureParametersAreNotSupported) {
+  expect_error({"WorldBegin", "Material \"dielectric\" \"spectrum eta\" \"glass-BK7\""}, 2, "\"spectrum eta\"",
+               "spectral values are not supported yet");
+  expect_error({"WorldBegin", "Material \"diffuse\" \"texture reflectance\" \"checks\""}, 2, "\"texture reflectance\"",
+               "textures are not supported yet");
+}
+
+TEST(PbrtReader, ReflectanceAboveOneOrNegativeColour) {
+  expect_error({"WorldBegin", "Material \"diffuse\" \"rgb reflectance\" [ 1.2 0.5 0.5 ]"}, 2, "\"rgb reflectance\"",
+               "must not exceed 1");
+  expect_error({"WorldBegin", "AreaLightSource \"diffuse\" \"rgb L\" [ -1 0 0 ]"}, 2, "\"rgb L\"", "negative");
+}
+
+// ---------------------------------------------------------------- bad input: values
+
+TEST(PbrtReader, BadSphereRadius) {
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" nan"}, 2, "nan", "expects numbers, got nan");
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" -1"}, 2, "\"float radius\"",
+               "Shape \"sphere\": \"radius\" must be positive, got -1");
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" 0"}, 2, "\"float radius\"", "must be positive, got 0");
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" 1e999"}, 2, "1e999", "expects numbers");
+}
+
+TEST(PbrtReader, PartialSphere) {
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float phimax\" 180"}, 2, "\"float phimax\"", "partial spheres");
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float zmax\" 0.5"}, 2, "\"float zmax\"", "partial spheres");
+}
+
+TEST(PbrtReader, BadTriangleIndices) {
+  const std::string points = "\"point3 P\" [ 0 0 0  1 0 0  0 1 0  1 1 0 ]";
+  expect_error({"WorldBegin", "Shape \"trianglemesh\" " + points + " \"integer indices\" [ 0 1 4 ]"}, 2,
+               "\"integer indices\"", "value 4 (number 3) is out of range: \"P\" has 4 points");
+  expect_error({"WorldBegin", "Shape \"trianglemesh\" " + points + " \"integer indices\" [ 0 -1 2 ]"}, 2,
+               "\"integer indices\"", "out of range");
+  expect_error({"WorldBegin", "Shape \"trianglemesh\" " + points + " \"integer indices\" [ 0 1 2 3 ]"}, 2,
+               "\"integer indices\"", "not a multiple of 3");
+  expect_error({"WorldBegin", "Shape \"trianglemesh\" " + points}, 2, "Shape", "\"indices\" is required");
+  expect_error({"WorldBegin", "Shape \"trianglemesh\""}, 2, "Shape", "\"P\" is required");
+  expect_error({"WorldBegin", "Shape \"trianglemesh\" " + points + " \"integer indices\" [ 0 1 2 ] \"normal N\" [ 0 0 1 ]"},
+               2, "\"normal N\"", "one normal per point");
+}
+
+TEST(PbrtReader, BadResolution) {
+  expect_error({"Film \"rgb\" \"integer xresolution\" 0", "WorldBegin"}, 1, "\"integer xresolution\"",
+               "\"xresolution\" must be between 1 and 65536, got 0");
+  expect_error({"Film \"rgb\" \"integer yresolution\" 70000", "WorldBegin"}, 1, "\"integer yresolution\"",
+               "must be between 1 and 65536, got 70000");
+  expect_error({"Film \"rgb\" \"integer xresolution\" 20000 \"integer yresolution\" 20000", "WorldBegin"}, 1,
+               "\"integer yresolution\"", "20000 x 20000 is too many pixels");
+}
+
+TEST(PbrtReader, BadSampleCountsAndDepth) {
+  expect_error({"Sampler \"zsobol\" \"integer pixelsamples\" 0", "WorldBegin"}, 1, "\"integer", "must be positive");
+  expect_error({"Integrator \"path\" \"integer maxdepth\" -1", "WorldBegin"}, 1, "\"integer", "must not be negative");
+}
+
+// ---------------------------------------------------------------- bad input: types
+
+TEST(PbrtReader, UnknownAndUnsupportedTypes) {
+  expect_error({"WorldBegin", "Shape \"spere\""}, 2, "\"spere\"",
+               "unknown shape type \"spere\" (supported: \"sphere\", \"trianglemesh\", \"plymesh\")");
+  expect_error({"WorldBegin", "Shape \"disk\""}, 2, "\"disk\"", "shape type \"disk\" is not supported yet");
+  expect_error({"WorldBegin", "Material \"plastic\""}, 2, "\"plastic\"", "unknown material type \"plastic\"");
+  expect_error({"WorldBegin", "Material \"conductor\""}, 2, "\"conductor\"",
+               "material type \"conductor\" is not supported yet");
+  expect_error({"WorldBegin", "Material \"interface\""}, 2, "\"interface\"", "\"interface\" is not supported");
+  expect_error({"WorldBegin", "MakeNamedMaterial \"m\" \"string type\" \"coateddiffuse\""}, 2, "\"string type\"",
+               "not supported yet");
+  expect_error({"WorldBegin", "LightSource \"sun\""}, 2, "\"sun\"", "unknown light type \"sun\"");
+  expect_error({"WorldBegin", "LightSource \"spot\""}, 2, "\"spot\"", "light type \"spot\" is not supported yet");
+  expect_error({"WorldBegin", "AreaLightSource \"glow\""}, 2, "\"glow\"", "unknown area light type");
+  expect_error({"Camera \"orthographic\"", "WorldBegin"}, 1, "\"orthographic\"", "not supported yet");
+  expect_error({"Film \"gbuffer\"", "WorldBegin"}, 1, "\"gbuffer\"", "not supported yet");
+  expect_error({"PixelFilter \"gaussian\"", "WorldBegin"}, 1, "\"gaussian\"",
+               "pixel filter type \"gaussian\" is not supported yet");
+}
+
+TEST(PbrtReader, UnsupportedFeaturesOfSupportedTypes) {
+  expect_error({"WorldBegin", "LightSource \"infinite\" \"string filename\" \"sky.exr\""}, 2, "\"string filename\"",
+               "environment maps are not supported yet");
+  expect_error({"WorldBegin", "Material \"dielectric\" \"float roughness\" 0.1"}, 2, "\"float roughness\"",
+               "only smooth dielectrics");
+  expect_error({"Camera \"perspective\" \"float lensradius\" 0.1", "WorldBegin"}, 1, "\"float lensradius\"",
+               "depth of field");
+  expect_error({"PixelFilter \"box\" \"float xradius\" 1", "WorldBegin"}, 1, "\"float xradius\"", "must be 0.5");
+  expect_error({"WorldBegin", "MakeNamedMaterial \"m\" \"rgb reflectance\" [ 1 1 1 ]"}, 2, "MakeNamedMaterial",
+               "missing the \"string type\" parameter");
+}
+
+// ---------------------------------------------------------------- bad input: structure
+
+TEST(PbrtReader, NamedMaterialMustBeDefined) {
+  expect_error({"WorldBegin", "NamedMaterial \"gold\""}, 2, "\"gold\"", "no material named \"gold\"");
+  expect_error({"WorldBegin", "MakeNamedMaterial \"a\" \"string type\" \"diffuse\"",
+                "MakeNamedMaterial \"a\" \"string type\" \"diffuse\""},
+               3, "\"a\"", "already defined");
+}
+
+TEST(PbrtReader, UnbalancedAttributeBlocks) {
+  expect_error({"WorldBegin", "AttributeEnd"}, 2, "AttributeEnd", "AttributeEnd without a matching AttributeBegin");
+  expect_error({"WorldBegin", "AttributeBegin", "Shape \"sphere\""}, 2, "AttributeBegin",
+               "AttributeBegin is never closed");
+  expect_error({"WorldBegin", "ObjectBegin \"o\"", "AttributeEnd"}, 3, "AttributeEnd", "does not match the open ObjectBegin");
+  expect_error({"WorldBegin", "ObjectEnd"}, 2, "ObjectEnd", "without a matching ObjectBegin");
+}
+
+TEST(PbrtReader, DirectivesInTheWrongSection) {
+  expect_error({"Shape \"sphere\"", "WorldBegin"}, 1, "Shape", "Shape is not allowed before WorldBegin");
+  expect_error({"AttributeBegin", "AttributeEnd", "WorldBegin"}, 1, "AttributeBegin", "not allowed before WorldBegin");
+  expect_error({"WorldBegin", "Camera \"perspective\""}, 2, "Camera", "Camera is not allowed after WorldBegin");
+  expect_error({"WorldBegin", "WorldBegin"}, 2, "WorldBegin", "not allowed after WorldBegin");
+  expect_error({"Film \"rgb\"", "Shape \"sphere\""}, 2, "Shape", "not allowed before WorldBegin");
+}
+
+TEST(PbrtReader, SceneMustReachWorldBegin) {
+  fs::path file = write_scene({"Film \"rgb\"", "# no world"});
+  // The error is at the end of the file: line 3, after the last newline.
+  EXPECT_EQ(error_reading(file),
+            file.string() + ":3:1: the scene ends before WorldBegin; the shapes and lights must follow a WorldBegin");
+}
+
+TEST(PbrtReader, ObjectInstancingErrors) {
+  expect_error({"WorldBegin", "ObjectInstance \"tree\""}, 2, "\"tree\"", "no object named \"tree\"");
+  expect_error({"WorldBegin", "ObjectBegin \"a\"", "ObjectBegin \"b\""}, 3, "ObjectBegin", "cannot nest");
+  expect_error({"WorldBegin", "ObjectBegin \"a\"", "AreaLightSource \"diffuse\"", "Shape \"sphere\""}, 4, "Shape",
+               "area lights in object instances are not supported");
+  expect_error({"WorldBegin", "CoordSysTransform \"nowhere\""}, 2, "\"nowhere\"", "no coordinate system named");
+}
+
+}  // namespace
+}  // namespace candela

@@ -1,0 +1,60 @@
+// read_scene_file: picks the reader by the file's extension.
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <system_error>
+
+#include "candela/io/error.h"
+#include "candela/io/scene_reader.h"
+
+namespace candela {
+namespace {
+
+namespace fs = std::filesystem;
+
+SourceLocation location_of_file(const fs::path& file) { return {file.string(), 0, 0, {}}; }
+
+std::string lowercase_extension(const fs::path& file) {
+  std::string extension = file.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return extension;
+}
+
+void check_is_readable_file(const fs::path& file) {
+  SourceLocation where = location_of_file(file);
+  std::error_code error;
+  fs::file_status status = fs::status(file, error);
+  if (!fs::exists(status)) throw_scene_error(where, "scene file not found");
+  if (fs::is_directory(status)) throw_scene_error(where, "is a directory, not a scene file");
+}
+
+std::string read_text_file(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw_scene_error(location_of_file(file), "cannot open scene file: {}", std::strerror(errno));
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw_scene_error(location_of_file(file), "cannot read scene file");
+  return std::move(text).str();
+}
+
+}  // namespace
+
+SceneDesc read_scene_file(const std::filesystem::path& file) {
+  check_is_readable_file(file);
+  std::string extension = lowercase_extension(file);
+  SceneDesc scene;
+  if (extension == ".json") scene = read_json_scene(read_text_file(file), file.string(), file.parent_path());
+  else if (extension == ".pbrt") scene = read_pbrt_scene(file);
+  else
+    throw_scene_error(location_of_file(file), "unsupported scene file extension {}; supported: .json, .pbrt",
+                      extension.empty() ? std::string("(none)") : "\"" + extension + "\"");
+  scene.source_file = file.string();
+  return scene;
+}
+
+}  // namespace candela

@@ -1,0 +1,102 @@
+#pragma once
+// Diffuse area lights on shapes: one TriangleLight per emissive triangle (meshes, boxes and
+// rectangles become triangles) and SphereLight for emissive spheres. Radiance is constant over the
+// surface and emitted on the side of `n` (both sides if two_sided).
+#include "candela/lights/light_sample.h"
+#include "candela/math/frame.h"
+#include "candela/sampling/warp.h"
+
+namespace candela {
+
+// Converts an area density at p_light into a solid-angle density seen from p.
+inline float area_to_solid_angle_pdf(float pdf_area, const Point3& p, const Point3& p_light, const Normal3& n_light) {
+  Vec3 d = p_light - p;
+  float dist2 = length_squared(d);
+  float cos_l = std::abs(dot(n_light, d)) / std::sqrt(dist2);
+  return cos_l > 0 ? pdf_area * dist2 / cos_l : 0.0f;
+}
+
+struct TriangleLight {
+  Point3 p0, p1, p2;
+  Normal3 n;  // unit, the emitting side
+  float area;
+  RGB radiance;
+  bool two_sided;
+
+  bool emits_towards(const Vec3& w) const { return two_sided || dot(n, w) > 0; }
+
+  LightSample sample_li(const LightSampleContext& ctx, Vec2 u) const {
+    // Uniform point on the triangle, then converted to solid angle.
+    Vec2 b = square_to_uniform_triangle(u);
+    Point3 p = p0 * b.x + p1 * b.y + p2 * (1 - b.x - b.y);
+    Vec3 d = p - ctx.p;
+    float dist2 = length_squared(d);
+    if (dist2 == 0) return {};
+    float dist = std::sqrt(dist2);
+    Vec3 wi = d / dist;
+    if (!emits_towards(-wi)) return {};
+    float pdf = area_to_solid_angle_pdf(1 / area, ctx.p, p, n);
+    if (pdf <= 0 || !std::isfinite(pdf)) return {};
+    return {radiance, wi, dist, pdf, p, n, false};
+  }
+  float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const {
+    return area_to_solid_angle_pdf(1 / area, ctx.p, p, n);
+  }
+  float power() const { return radiance.luminance() * area * kPi * (two_sided ? 2 : 1); }
+};
+
+// A sphere seen from outside is sampled uniformly in the cone it subtends (every sample hits it);
+// from inside, uniformly by area.
+struct SphereLight {
+  Point3 center;
+  float radius;
+  RGB radiance;
+  bool two_sided;
+  bool emits_inward;  // reverse orientation: the emitting side faces the centre
+
+  bool emits_from(const Normal3& outward, const Vec3& w) const {
+    return two_sided || ((dot(outward, w) > 0) != emits_inward);
+  }
+  bool outside(const Point3& p) const { return length_squared(p - center) > radius * radius * 1.0001f; }
+  float cone_cos_max(const Point3& p) const {
+    float sin2 = radius * radius / length_squared(p - center);
+    return safe_sqrt(1 - sin2);
+  }
+
+  LightSample sample_li(const LightSampleContext& ctx, Vec2 u) const {
+    Point3 p;
+    float pdf;
+    if (outside(ctx.p)) {
+      // Sample the cone of directions subtended by the sphere, then find the visible point it hits.
+      float dc = distance(ctx.p, center);
+      float cos_max = cone_cos_max(ctx.p);
+      Vec3 local = square_to_uniform_cone(u, cos_max);
+      Frame frame(normalize(center - ctx.p));
+      Vec3 wi = frame.to_world(local);
+      // Nearest intersection of the ray (ctx.p, wi) with the sphere (clamped for grazing samples).
+      float b = dc * local.z;
+      float disc = std::max(0.0f, radius * radius - dc * dc * (1 - local.z * local.z));
+      float t = b - std::sqrt(disc);
+      p = ctx.p + wi * t;
+      pdf = uniform_cone_pdf(cos_max);
+      if (cos_max >= 1) return {};  // too small to see from here in float
+    } else {
+      p = center + square_to_uniform_sphere(u) * radius;
+      pdf = area_to_solid_angle_pdf(1 / (4 * kPi * radius * radius), ctx.p, p, normalize(p - center));
+    }
+    Normal3 n = normalize(p - center);
+    Vec3 d = p - ctx.p;
+    float dist = length(d);
+    if (dist == 0 || !(pdf > 0) || !std::isfinite(pdf)) return {};
+    Vec3 wi = d / dist;
+    if (!emits_from(n, -wi)) return {};
+    return {radiance, wi, dist, pdf, p, n, false};
+  }
+  float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const {
+    if (outside(ctx.p)) return uniform_cone_pdf(cone_cos_max(ctx.p));
+    return area_to_solid_angle_pdf(1 / (4 * kPi * radius * radius), ctx.p, p, normalize(p - center));
+  }
+  float power() const { return radiance.luminance() * 4 * kPi * radius * radius * kPi * (two_sided ? 2 : 1); }
+};
+
+}  // namespace candela

@@ -1,0 +1,32 @@
+#pragma once
+// The light contract. Each light offers
+//   sample_li(ctx, u)         a point or direction on the light as seen from ctx, with the radiance
+//                             arriving along it and the solid-angle pdf (1 for delta lights)
+//   pdf_li(ctx, wi, p, n)     the solid-angle pdf sample_li would give for the direction wi reaching
+//                             the light at point p with normal n (for MIS on BSDF-sampled hits)
+//   power()                   emitted power (luminance), for choosing lights proportionally
+// The closed list of lights is the variant `Light`; dispatch happens once, here.
+#include <limits>
+#include <variant>
+
+#include "candela/lights/area_lights.h"
+#include "candela/lights/point_light.h"
+#include "candela/lights/sky_light.h"
+
+namespace candela {
+
+using Light = std::variant<PointLightSource, TriangleLight, SphereLight, SkyLightSource>;
+
+inline LightSample light_sample_li(const Light& l, const LightSampleContext& ctx, Vec2 u) {
+  return std::visit([&](const auto& x) { return x.sample_li(ctx, u); }, l);
+}
+inline float light_pdf_li(const Light& l, const LightSampleContext& ctx, const Vec3& wi, const Point3& p,
+                          const Normal3& n) {
+  return std::visit([&](const auto& x) { return x.pdf_li(ctx, wi, p, n); }, l);
+}
+inline float light_power(const Light& l) {
+  return std::visit([](const auto& x) { return x.power(); }, l);
+}
+inline bool light_is_delta(const Light& l) { return std::holds_alternative<PointLightSource>(l); }
+
+}  // namespace candela

@@ -1,0 +1,34 @@
+#pragma once
+// The BSDF contract. Every BSDF works in the local shading frame (normal = +z, directions point away
+// from the surface: wo towards the viewer, wi towards the light) and offers
+//   eval(wo, wi)            f(wo, wi) of the non-delta parts (without the cosine)
+//   pdf(wo, wi)             solid-angle density with which sample() produces wi (non-delta parts)
+//   sample(wo, u_lobe, u)   a direction with weight f |cos| / pdf, or nothing when the path is absorbed
+//   has_non_delta()         whether light sampling can help at all
+// The closed list of BSDFs is the variant `Bsdf`; dispatch happens once, here.
+#include <optional>
+#include <variant>
+
+#include "candela/materials/diffuse.h"
+#include "candela/materials/phong.h"
+#include "candela/materials/specular.h"
+
+namespace candela {
+
+using Bsdf = std::variant<DiffuseBsdf, PhongBsdf, MirrorBsdf, GlassBsdf, BlackBsdf>;
+
+inline RGB bsdf_eval(const Bsdf& b, const Vec3& wo, const Vec3& wi) {
+  return std::visit([&](const auto& x) { return x.eval(wo, wi); }, b);
+}
+inline float bsdf_pdf(const Bsdf& b, const Vec3& wo, const Vec3& wi) {
+  return std::visit([&](const auto& x) { return x.pdf(wo, wi); }, b);
+}
+inline std::optional<BsdfSample> bsdf_sample(const Bsdf& b, const Vec3& wo, float u_lobe, Vec2 u) {
+  return std::visit([&](const auto& x) { return x.sample(wo, u_lobe, u); }, b);
+}
+inline bool bsdf_has_non_delta(const Bsdf& b) {
+  return std::visit([](const auto& x) { return x.has_non_delta(); }, b);
+}
+inline bool bsdf_is_black(const Bsdf& b) { return std::holds_alternative<BlackBsdf>(b); }
+
+}  // namespace candela

@@ -1,0 +1,27 @@
+#pragma once
+// A progress bar with percentage, elapsed time and ETA on stderr, drawn only when stderr is a
+// terminal, at most ten times a second, from whichever worker thread finishes a piece of work.
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <mutex>
+
+namespace candela {
+
+class ProgressBar {
+ public:
+  ProgressBar(uint64_t total_work, bool enabled);
+  void advance(uint64_t work);  // thread-safe
+  void finish();
+
+ private:
+  void draw(uint64_t done, bool final);
+
+  uint64_t total_;
+  bool enabled_;
+  std::atomic<uint64_t> done_{0};
+  std::mutex draw_mutex_;
+  std::chrono::steady_clock::time_point start_, last_draw_;
+};
+
+}  // namespace candela

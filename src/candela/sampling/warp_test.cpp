@@ -1,0 +1,149 @@
+// Warps: samples land in their domain, pdfs integrate to one, and the sample histograms match the
+// pdfs (chi-square over a grid in (cos theta, phi) or (x, y)).
+#include "candela/sampling/warp.h"
+
+#include <gtest/gtest.h>
+
+#include <functional>
+
+#include "candela/sampling/distribution1d.h"
+#include "candela/sampling/rng.h"
+#include "candela/testing/statistics.h"
+
+namespace candela {
+namespace {
+
+constexpr int kSamples = 200000;
+
+// Monte Carlo integral of pdf over the sphere with uniform directions: must be 1 within 5 sigma.
+void expect_pdf_integrates_to_one(const std::function<float(const Vec3&)>& pdf) {
+  Rng rng(7, 11);
+  double sum = 0, sum_sq = 0;
+  for (int i = 0; i < kSamples; ++i) {
+    Vec3 w = square_to_uniform_sphere({rng.next_float(), rng.next_float()});
+    double v = pdf(w) / uniform_sphere_pdf();
+    sum += v;
+    sum_sq += v * v;
+  }
+  double mean = sum / kSamples;
+  double se = std::sqrt((sum_sq / kSamples - mean * mean) / kSamples);
+  EXPECT_NEAR(mean, 1.0, 5 * se + 1e-3);
+}
+
+TEST(Warp, UniformSphere) {
+  Rng rng(1, 2);
+  for (int i = 0; i < 10000; ++i) EXPECT_NEAR(length(square_to_uniform_sphere({rng.next_float(), rng.next_float()})), 1, 1e-5);
+  auto sample = [](Vec2 u) { return square_to_uniform_sphere(u); };
+  auto pdf = [](const Vec3&) { return uniform_sphere_pdf(); };
+  EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 3), 1e-3);
+}
+
+TEST(Warp, UniformHemisphere) {
+  Rng rng(1, 3);
+  for (int i = 0; i < 10000; ++i) EXPECT_GE(square_to_uniform_hemisphere({rng.next_float(), rng.next_float()}).z, 0);
+  expect_pdf_integrates_to_one([](const Vec3& w) { return uniform_hemisphere_pdf(w); });
+  auto sample = [](Vec2 u) { return square_to_uniform_hemisphere(u); };
+  auto pdf = [](const Vec3& w) { return uniform_hemisphere_pdf(w); };
+  EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 4), 1e-3);
+}
+
+TEST(Warp, CosineHemisphere) {
+  Rng rng(1, 4);
+  for (int i = 0; i < 10000; ++i) {
+    Vec3 w = square_to_cosine_hemisphere({rng.next_float(), rng.next_float()});
+    EXPECT_GE(w.z, 0);
+    EXPECT_NEAR(length(w), 1, 1e-5);
+  }
+  expect_pdf_integrates_to_one([](const Vec3& w) { return cosine_hemisphere_pdf(w); });
+  auto sample = [](Vec2 u) { return square_to_cosine_hemisphere(u); };
+  auto pdf = [](const Vec3& w) { return cosine_hemisphere_pdf(w); };
+  EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 5), 1e-3);
+}
+
+TEST(Warp, UniformCone) {
+  for (float cos_max : {0.2f, 0.9f, 0.999f}) {
+    Rng rng(1, 5);
+    for (int i = 0; i < 10000; ++i)
+      EXPECT_GE(square_to_uniform_cone({rng.next_float(), rng.next_float()}, cos_max).z, cos_max - 1e-6f);
+    expect_pdf_integrates_to_one([&](const Vec3& w) { return w.z >= cos_max ? uniform_cone_pdf(cos_max) : 0.0f; });
+    auto sample = [&](Vec2 u) { return square_to_uniform_cone(u, cos_max); };
+    auto pdf = [&](const Vec3& w) { return w.z >= cos_max ? uniform_cone_pdf(cos_max) : 0.0f; };
+    EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 6, cos_max), 1e-3) << "cos_max " << cos_max;
+  }
+}
+
+TEST(Warp, PhongLobe) {
+  for (float n : {1.0f, 10.0f, 200.0f}) {
+    expect_pdf_integrates_to_one([&](const Vec3& w) { return phong_lobe_pdf(w.z, n); });
+    auto sample = [&](Vec2 u) { return square_to_phong_lobe(u, n); };
+    auto pdf = [&](const Vec3& w) { return phong_lobe_pdf(w.z, n); };
+    float z_min = n > 50 ? 0.9f : -1.0f;  // resolve the narrow lobe
+    EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 7, z_min), 1e-3) << "exponent " << n;
+  }
+}
+
+TEST(Warp, ConcentricDiskIsUniform) {
+  // Samples land in the unit disk, and each quadrant ring holds its share of the area.
+  Rng rng(3, 4);
+  int counts[4][4] = {};
+  for (int i = 0; i < kSamples; ++i) {
+    Vec2 p = square_to_concentric_disk({rng.next_float(), rng.next_float()});
+    float r2 = p.x * p.x + p.y * p.y;
+    ASSERT_LE(r2, 1 + 1e-5f);
+    int ring = std::min(3, int(r2 * 4));  // equal-area rings
+    int quadrant = (p.x >= 0 ? 0 : 1) + (p.y >= 0 ? 0 : 2);
+    ++counts[ring][quadrant];
+  }
+  std::vector<double> observed, expected;
+  for (auto& ring : counts)
+    for (int c : ring) {
+      observed.push_back(c);
+      expected.push_back(kSamples / 16.0);
+    }
+  EXPECT_GT(testing::chi_square_p_value(observed, expected), 1e-3);
+  EXPECT_FLOAT_EQ(concentric_disk_pdf({0.5f, 0.5f}), kInvPi);
+}
+
+TEST(Warp, UniformTriangle) {
+  // Barycentrics are valid and uniform: split the triangle into 4 congruent sub-triangles.
+  Rng rng(5, 6);
+  std::vector<double> observed(4, 0), expected(4, kSamples / 4.0);
+  for (int i = 0; i < kSamples; ++i) {
+    Vec2 b = square_to_uniform_triangle({rng.next_float(), rng.next_float()});
+    float b2 = 1 - b.x - b.y;
+    ASSERT_GE(b.x, 0);
+    ASSERT_GE(b.y, 0);
+    ASSERT_GE(b2, -1e-6f);
+    int region = b.x > 0.5f ? 0 : b.y > 0.5f ? 1 : b2 > 0.5f ? 2 : 3;
+    observed[region] += 1;
+  }
+  EXPECT_GT(testing::chi_square_p_value(observed, expected), 1e-3);
+}
+
+TEST(Distribution1D, SamplesProportionally) {
+  std::vector<float> w = {1, 0, 3, 6};
+  Distribution1D d(w);
+  EXPECT_FLOAT_EQ(d.pmf(0), 0.1f);
+  EXPECT_FLOAT_EQ(d.pmf(1), 0.0f);
+  Rng rng(9, 9);
+  std::vector<double> observed(4, 0), expected = {0.1 * kSamples, 0, 0.3 * kSamples, 0.6 * kSamples};
+  for (int i = 0; i < kSamples; ++i) observed[d.sample(rng.next_float())] += 1;
+  EXPECT_EQ(observed[1], 0);
+  EXPECT_GT(testing::chi_square_p_value(observed, expected), 1e-3);
+}
+
+}  // namespace
+}  // namespace candela
+
+namespace candela {
+namespace {
+
+TEST(Warp, ChiSquareRejectsAMismatchedPdf) {
+  // The test must be able to fail: uniform hemisphere samples judged against the cosine pdf.
+  auto sample = [](Vec2 u) { return square_to_uniform_hemisphere(u); };
+  auto pdf = [](const Vec3& w) { return cosine_hemisphere_pdf(w); };
+  EXPECT_LT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 8), 1e-6);
+}
+
+}  // namespace
+}  // namespace candela

@@ -1,0 +1,233 @@
+#include "candela/scene/scene.h"
+
+#include <cmath>
+
+#include "candela/io/error.h"
+
+namespace candela {
+namespace {
+
+Bsdf make_bsdf(const MaterialDesc& desc) {
+  return std::visit(
+      [](const auto& m) -> Bsdf {
+        using T = std::decay_t<decltype(m)>;
+        if constexpr (std::is_same_v<T, DiffuseMaterial>) return DiffuseBsdf{m.reflectance};
+        else if constexpr (std::is_same_v<T, PhongMaterial>)
+          return PhongBsdf{m.diffuse, m.specular, m.exponent, m.transmission, m.ior, m.d, m.s, m.t};
+        else if constexpr (std::is_same_v<T, MirrorMaterial>) return MirrorBsdf{m.reflectance};
+        else if constexpr (std::is_same_v<T, GlassMaterial>) return GlassBsdf{m.ior, m.reflectance, m.transmittance};
+        else return BlackBsdf{};
+      },
+      desc);
+}
+
+TriangleMesh box_mesh(const BoxShape& box) {
+  TriangleMesh m;
+  const Point3 &a = box.lo, &b = box.hi;
+  for (int i = 0; i < 8; ++i) m.positions.push_back({i & 1 ? b.x : a.x, i & 2 ? b.y : a.y, i & 4 ? b.z : a.z});
+  // Six faces, counter-clockwise seen from outside so normals point out.
+  const uint32_t faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : faces) m.indices.insert(m.indices.end(), {f[0], f[1], f[2], f[0], f[2], f[3]});
+  return m;
+}
+
+TriangleMesh rectangle_mesh(const RectangleShape& r) {
+  TriangleMesh m;
+  m.positions = {r.corner, r.corner + r.edge_u, r.corner + r.edge_u + r.edge_v, r.corner + r.edge_v};
+  m.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  m.indices = {0, 1, 2, 0, 2, 3};
+  return m;
+}
+
+std::string shape_label(const ShapeDesc& desc, size_t index) {
+  return desc.name.empty() ? fmt::format("shape {}", index) : fmt::format("shape {} (\"{}\")", index, desc.name);
+}
+
+}  // namespace
+
+Scene::Scene(const SceneDesc& desc) : source_file_(desc.source_file.empty() ? "scene" : desc.source_file) {
+  for (const auto& m : desc.materials) materials_.push_back(make_bsdf(m));
+  materials_.push_back(DiffuseBsdf{RGB(0.5f)});  // the default material, index materials.size()
+  int material_count = int(desc.materials.size());
+
+  for (size_t i = 0; i < desc.shapes.size(); ++i) add_shape(desc.shapes[i], i, material_count);
+
+  // Infinite planes get finite bounds far beyond everything else.
+  float scene_size = bounds_.empty() ? 1.0f : std::max(1.0f, length(bounds_.diagonal()));
+  for (size_t id = 0; id < shapes_.size(); ++id)
+    if (shapes_[id].kind == ShapeRecord::Kind::Plane) embree_.add_plane(uint32_t(id), shapes_[id].plane, 1e4f * scene_size);
+  embree_.commit();
+
+  float radius = bounds_.empty() ? 1.0f : std::max(1e-3f, length(bounds_.diagonal()) / 2);
+  for (const auto& l : desc.lights) {
+    if (const auto* p = std::get_if<PointLight>(&l)) {
+      lights_.push_back(PointLightSource{p->position, p->intensity});
+    } else if (const auto* s = std::get_if<SkyLight>(&l)) {
+      if (sky_light_ >= 0) throw SceneError(fmt::format("{}: only one sky light is supported", source_file_));
+      sky_light_ = int(lights_.size());
+      lights_.push_back(SkyLightSource{s->zenith, s->horizon, s->ground, normalize(s->up), radius});
+    }
+  }
+
+  std::vector<float> power;
+  for (const auto& l : lights_) power.push_back(light_power(l));
+  light_distribution_ = Distribution1D(power);
+
+  int w = desc.film.width, h = desc.film.height;
+  camera_ = PerspectiveCamera(desc.camera, w, h);
+}
+
+void Scene::add_shape(const ShapeDesc& desc, size_t index, int material_count) {
+  ShapeRecord rec;
+  rec.name = shape_label(desc, index);
+  rec.material = uint32_t(desc.material >= 0 && desc.material < material_count ? desc.material : material_count);
+  rec.flip_normal = desc.reverse_orientation;
+  const Transform& T = desc.to_world;
+
+  if (const auto* s = std::get_if<SphereShape>(&desc.geometry)) {
+    rec.kind = ShapeRecord::Kind::Sphere;
+    rec.sphere = SphereGeometry{T, s->center, s->radius};
+    for (int i = 0; i < 8; ++i) {
+      Vec3 c(i & 1 ? s->radius : -s->radius, i & 2 ? s->radius : -s->radius, i & 4 ? s->radius : -s->radius);
+      bounds_.extend(T.point(s->center + c));
+    }
+    if (desc.emission) {
+      // Sampling by solid angle needs a true sphere in world space: allow only similarity transforms.
+      Vec3 ex = T.vector({1, 0, 0}), ey = T.vector({0, 1, 0}), ez = T.vector({0, 0, 1});
+      float lx = length(ex), ly = length(ey), lz = length(ez);
+      if (std::abs(lx - ly) > 1e-4f * lx || std::abs(lx - lz) > 1e-4f * lx || std::abs(dot(ex, ey)) > 1e-4f * lx * ly ||
+          std::abs(dot(ex, ez)) > 1e-4f * lx * lz || std::abs(dot(ey, ez)) > 1e-4f * ly * lz)
+        throw SceneError(fmt::format("{}: {}: an emissive sphere must not be scaled non-uniformly or sheared",
+                                     source_file_, rec.name));
+      rec.first_light = int(lights_.size());
+      rec.radiance = desc.emission->radiance;
+      rec.two_sided_emission = desc.emission->two_sided;
+      lights_.push_back(SphereLight{T.point(s->center), s->radius * lx, rec.radiance, rec.two_sided_emission,
+                                    desc.reverse_orientation});
+    }
+    embree_.add_sphere(uint32_t(shapes_.size()), rec.sphere);
+    shapes_.push_back(std::move(rec));
+    return;
+  }
+  if (const auto* p = std::get_if<PlaneShape>(&desc.geometry)) {
+    if (desc.emission)
+      throw SceneError(fmt::format("{}: {}: an infinite plane cannot emit light (its power would be infinite)",
+                                   source_file_, rec.name));
+    rec.kind = ShapeRecord::Kind::Plane;
+    rec.plane = PlaneGeometry{T.point(p->point), normalize(T.normal(p->normal))};
+    // Its Embree geometry is added once the size of everything else is known (see the constructor).
+    shapes_.push_back(std::move(rec));
+    return;
+  }
+  TriangleMesh mesh;
+  if (const auto* b = std::get_if<BoxShape>(&desc.geometry)) mesh = box_mesh(*b);
+  else if (const auto* r = std::get_if<RectangleShape>(&desc.geometry)) mesh = rectangle_mesh(*r);
+  else mesh = std::get<MeshShape>(desc.geometry).mesh;
+  add_triangles(std::move(rec), mesh, T, desc.reverse_orientation, desc.emission);
+}
+
+void Scene::add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Transform& T, bool reverse,
+                          const std::optional<AreaEmission>& emission) {
+  rec.kind = ShapeRecord::Kind::Triangles;
+  rec.positions.reserve(mesh.positions.size());
+  for (const auto& p : mesh.positions) {
+    rec.positions.push_back(T.point(p));
+    bounds_.extend(rec.positions.back());
+  }
+  for (const auto& n : mesh.normals) rec.normals.push_back(normalize(T.normal(n)) * (reverse ? -1.0f : 1.0f));
+  rec.uvs = mesh.uvs;
+  rec.indices = mesh.indices;
+  // Keep cross(p1-p0, p2-p0) equal to the object-space normal transformed as a normal: a mirroring
+  // transform reverses the winding, and so does reverse orientation.
+  if (T.swaps_handedness() != reverse)
+    for (size_t i = 0; i < rec.indices.size(); i += 3) std::swap(rec.indices[i + 1], rec.indices[i + 2]);
+  triangle_count_ += rec.indices.size() / 3;
+
+  if (emission) {
+    rec.first_light = int(lights_.size());
+    rec.radiance = emission->radiance;
+    rec.two_sided_emission = emission->two_sided;
+    for (size_t i = 0; i < rec.indices.size(); i += 3) {
+      const Point3 &p0 = rec.positions[rec.indices[i]], &p1 = rec.positions[rec.indices[i + 1]],
+                   &p2 = rec.positions[rec.indices[i + 2]];
+      Vec3 c = cross(p1 - p0, p2 - p0);
+      float len = length(c);
+      Normal3 n = len > 0 ? c / len : Normal3(0, 0, 1);
+      if (!rec.normals.empty()) {
+        Normal3 ns = rec.normals[rec.indices[i]] + rec.normals[rec.indices[i + 1]] + rec.normals[rec.indices[i + 2]];
+        n = face_forward(n, ns);
+      }
+      // Degenerate triangles get a zero-area light that is never chosen (zero power).
+      lights_.push_back(TriangleLight{p0, p1, p2, n, len / 2, rec.radiance, rec.two_sided_emission});
+    }
+  }
+  if (!rec.indices.empty()) embree_.add_triangles(uint32_t(shapes_.size()), rec.positions, rec.indices);
+  shapes_.push_back(std::move(rec));
+}
+
+bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {
+  EmbreeHit eh;
+  if (!embree_.intersect(ray, eh)) return false;
+  const ShapeRecord& rec = shapes_[eh.geometry];
+  hit.t = eh.t;
+  hit.shape = eh.geometry;
+  hit.primitive = eh.primitive;
+  switch (rec.kind) {
+    case ShapeRecord::Kind::Triangles: {
+      uint32_t i0 = rec.indices[3 * eh.primitive], i1 = rec.indices[3 * eh.primitive + 1],
+               i2 = rec.indices[3 * eh.primitive + 2];
+      float b0 = 1 - eh.u - eh.v;
+      const Point3 &p0 = rec.positions[i0], &p1 = rec.positions[i1], &p2 = rec.positions[i2];
+      hit.p = p0 * b0 + p1 * eh.u + p2 * eh.v;
+      hit.ng = normalize(cross(p1 - p0, p2 - p0));
+      if (!rec.normals.empty()) {
+        Normal3 ns = rec.normals[i0] * b0 + rec.normals[i1] * eh.u + rec.normals[i2] * eh.v;
+        float len = length(ns);
+        hit.ns = len > 0 ? ns / len : hit.ng;
+        hit.ng = face_forward(hit.ng, hit.ns);
+      } else {
+        hit.ns = hit.ng;
+      }
+      hit.uv = rec.uvs.empty() ? Vec2(eh.u, eh.v) : rec.uvs[i0] * b0 + rec.uvs[i1] * eh.u + rec.uvs[i2] * eh.v;
+      break;
+    }
+    case ShapeRecord::Kind::Sphere: {
+      const SphereGeometry& s = rec.sphere;
+      hit.p = ray.at(eh.t);
+      // Re-project onto the surface in object space to remove the error of o + t d, then map back.
+      Point3 po = s.to_world.inverse().point(hit.p) - s.center;
+      po = po * (s.radius / length(po));
+      hit.p = s.to_world.point(s.center + po);
+      hit.ng = normalize(s.to_world.normal(po));
+      if (rec.flip_normal) hit.ng = -hit.ng;
+      hit.ns = hit.ng;
+      float phi = std::atan2(po.y, po.x);
+      if (phi < 0) phi += 2 * kPi;
+      hit.uv = {phi * kInv2Pi, std::acos(std::clamp(po.z / s.radius, -1.0f, 1.0f)) * kInvPi};
+      break;
+    }
+    case ShapeRecord::Kind::Plane: {
+      hit.p = ray.at(eh.t);
+      hit.ng = rec.flip_normal ? -rec.plane.normal : rec.plane.normal;
+      hit.ns = hit.ng;
+      hit.uv = {0, 0};
+      break;
+    }
+  }
+  return true;
+}
+
+RGB Scene::emitted(const SurfaceHit& hit, const Vec3& wo) const {
+  const ShapeRecord& rec = shapes_[hit.shape];
+  if (!rec.is_emissive()) return RGB(0.0f);
+  if (rec.two_sided_emission || dot(hit.ng, wo) > 0) return rec.radiance;
+  return RGB(0.0f);
+}
+
+int Scene::light_index(const SurfaceHit& hit) const {
+  const ShapeRecord& rec = shapes_[hit.shape];
+  if (!rec.is_emissive()) return -1;
+  return rec.kind == ShapeRecord::Kind::Triangles ? rec.first_light + int(hit.primitive) : rec.first_light;
+}
+
+}  // namespace candela

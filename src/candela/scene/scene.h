@@ -1,0 +1,76 @@
+#pragma once
+// The render scene: built once from a SceneDesc, immutable while rendering. Owns the Embree
+// acceleration structure, the world-space shape data needed for shading, the materials, the lights
+// with their power distribution, and the camera.
+#include <memory>
+#include <vector>
+
+#include "candela/camera/camera.h"
+#include "candela/geometry/embree_scene.h"
+#include "candela/geometry/surface_hit.h"
+#include "candela/lights/light.h"
+#include "candela/materials/bsdf.h"
+#include "candela/sampling/distribution1d.h"
+#include "candela/scene/description.h"
+
+namespace candela {
+
+struct ShapeRecord {
+  enum class Kind : uint8_t { Triangles, Sphere, Plane };
+  Kind kind = Kind::Triangles;
+  uint32_t material = 0;
+  int first_light = -1;  // index of the light of primitive 0 when emissive (one light per triangle)
+  RGB radiance;          // emitted radiance when emissive
+  bool two_sided_emission = false;
+  bool flip_normal = false;  // spheres and planes: reverse orientation
+  // Triangles, in world space, winding baked so cross(p1-p0, p2-p0) is the oriented normal.
+  std::vector<Point3> positions;
+  std::vector<Normal3> normals;
+  std::vector<Vec2> uvs;
+  std::vector<uint32_t> indices;
+  SphereGeometry sphere;
+  PlaneGeometry plane;
+  std::string name;
+  bool is_emissive() const { return first_light >= 0; }
+};
+
+class Scene {
+ public:
+  // Throws SceneError for descriptions that cannot be rendered (e.g. an emissive infinite plane).
+  explicit Scene(const SceneDesc& desc);
+
+  bool intersect(const Ray& ray, SurfaceHit& hit) const;
+  bool occluded(const Ray& ray) const { return embree_.occluded(ray); }
+
+  const ShapeRecord& shape(const SurfaceHit& hit) const { return shapes_[hit.shape]; }
+  const Bsdf& bsdf(const SurfaceHit& hit) const { return materials_[shapes_[hit.shape].material]; }
+  // Radiance emitted from the hit point towards wo (zero for non-emitters and their back faces).
+  RGB emitted(const SurfaceHit& hit, const Vec3& wo) const;
+  // The light of an emissive hit, or -1.
+  int light_index(const SurfaceHit& hit) const;
+
+  const std::vector<Light>& lights() const { return lights_; }
+  const Distribution1D& light_distribution() const { return light_distribution_; }
+  int sky_light() const { return sky_light_; }  // index into lights(), or -1
+  const PerspectiveCamera& camera() const { return camera_; }
+  const Bounds3& bounds() const { return bounds_; }
+  size_t triangle_count() const { return triangle_count_; }
+
+ private:
+  void add_shape(const ShapeDesc& desc, size_t index, int material_count);
+  void add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Transform& to_world, bool reverse,
+                     const std::optional<AreaEmission>& emission);
+
+  std::string source_file_;  // for messages
+  EmbreeScene embree_;
+  std::vector<ShapeRecord> shapes_;  // indexed by Embree geometry id
+  std::vector<Bsdf> materials_;
+  std::vector<Light> lights_;
+  Distribution1D light_distribution_;
+  int sky_light_ = -1;
+  PerspectiveCamera camera_;
+  Bounds3 bounds_;
+  size_t triangle_count_ = 0;
+};
+
+}  // namespace candela

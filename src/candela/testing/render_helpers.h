@@ -1,0 +1,63 @@
+#pragma once
+// Helpers for tests that render: build a scene description in code, render it, and reduce images
+// to means with standard errors estimated from the render itself.
+#include <cmath>
+#include <functional>
+
+#include "candela/film/film.h"
+#include "candela/render/renderer.h"
+#include "candela/scene/description.h"
+#include "candela/scene/scene.h"
+
+namespace candela::testing {
+
+inline Film render_description(const SceneDesc& desc, int threads = 0) {
+  Scene scene(desc);
+  Film film(desc.film.width, desc.film.height);
+  RenderOptions options;
+  options.threads = threads;
+  options.progress = false;
+  render(scene, desc.settings, film, options);
+  return film;
+}
+
+// The mean over the selected pixels of one channel (or the average of all three when channel < 0),
+// and its standard error from the spread of the pixel values (pixels are independent estimates of
+// the same value when the selection covers a uniform region).
+struct MeanEstimate {
+  double mean = 0, standard_error = 0;
+  int pixels = 0;
+};
+
+inline MeanEstimate region_mean(const Image& img, int channel,
+                                const std::function<bool(int, int)>& selected = [](int, int) { return true; }) {
+  double sum = 0, sum_sq = 0;
+  int n = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      if (!selected(x, y)) continue;
+      RGB c = img.at(x, y);
+      double v = channel < 0 ? c.average() : c[channel];
+      sum += v;
+      sum_sq += v * v;
+      ++n;
+    }
+  MeanEstimate e;
+  e.pixels = n;
+  if (n == 0) return e;
+  e.mean = sum / n;
+  double var = n > 1 ? std::max(0.0, (sum_sq - n * e.mean * e.mean) / (n - 1)) : 0.0;
+  e.standard_error = std::sqrt(var / n);
+  return e;
+}
+
+// Camera at `eye` looking at `target` with a vertical fov, on a small square image.
+inline CameraDesc look_at_camera(const Point3& eye, const Point3& target, float fov_degrees) {
+  CameraDesc c;
+  Vec3 up = std::abs(normalize(target - eye).y) > 0.99f ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
+  c.world_from_camera = Transform::look_at_right_handed(eye, target, up);
+  c.fov_degrees = fov_degrees;
+  return c;
+}
+
+}  // namespace candela::testing

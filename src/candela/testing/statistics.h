@@ -1,0 +1,25 @@
+#pragma once
+// Statistical tools for tests: Pearson's chi-square test of observed counts against expected
+// counts (cells with small expectation pooled, as Mitsuba's chi2 test does), and a spherical
+// version that bins sampled directions over (cos theta, phi) and integrates the pdf per cell.
+#include <functional>
+#include <vector>
+
+#include "candela/math/vec.h"
+
+namespace candela::testing {
+
+// p-value of the chi-square statistic; cells with expected count < 5 are pooled together.
+double chi_square_p_value(const std::vector<double>& observed, const std::vector<double>& expected);
+
+// Draws `samples` directions from `sample(u)` (u uniform on [0,1)^2, seeded by `seed`), bins them
+// on a grid uniform in cos(theta) over [z_min, 1] and in phi (directions with z < z_min share one
+// extra cell, so narrow lobes can be resolved), and compares with the pdf integrated numerically per cell.
+double spherical_chi_square_p_value(const std::function<Vec3(Vec2)>& sample,
+                                    const std::function<float(const Vec3&)>& pdf, int samples, uint64_t seed,
+                                    float z_min = -1, int theta_bins = 20, int phi_bins = 40);
+
+// Regularised upper incomplete gamma Q(a, x): the chi-square survival function is Q(k/2, x/2).
+double gamma_q(double a, double x);
+
+}  // namespace candela::testing
