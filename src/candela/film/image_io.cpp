@@ -5,6 +5,10 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -24,6 +28,19 @@ uint8_t encode_srgb8(float linear) {
   return uint8_t(std::clamp(std::lround(v * 255.0f), 0L, 255L));
 }
 
+// Debian's OpenImageIO 2.4 reads PFM but its PNM writer only writes 8/16-bit PPM, so PFM is written
+// here: the header "PF\n<w> <h>\n-1.0\n" (negative scale = little-endian), then rows bottom to top.
+bool write_pfm(const std::filesystem::path& file, const Image& image) {
+  FILE* f = std::fopen(file.c_str(), "wb");
+  if (!f) return false;
+  bool ok = std::fprintf(f, "PF\n%d %d\n-1.0\n", image.width, image.height) > 0;
+  static_assert(std::endian::native == std::endian::little, "PFM writer assumes a little-endian machine");
+  for (int y = image.height - 1; y >= 0 && ok; --y)
+    ok = std::fwrite(&image.rgb[size_t(y) * image.width * 3], sizeof(float), size_t(image.width) * 3, f) ==
+         size_t(image.width) * 3;
+  return std::fclose(f) == 0 && ok;
+}
+
 }  // namespace
 
 bool is_supported_output(const std::filesystem::path& file) {
@@ -31,16 +48,11 @@ bool is_supported_output(const std::filesystem::path& file) {
   return ext == ".exr" || ext == ".png" || ext == ".pfm";
 }
 
-void write_image(const std::filesystem::path& file, const Image& image,
-                 const std::map<std::string, std::string>& metadata) {
-  if (!is_supported_output(file))
-    throw std::runtime_error(fmt::format("{}: unsupported image format (use .exr, .png or .pfm)", file.string()));
-  std::string ext = lower_extension(file);
-  std::filesystem::path dir = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
-  std::filesystem::path tmp = dir / fmt::format(".{}.{}.tmp{}", file.stem().string(), getpid(), ext);
-
+// Writes with OpenImageIO; returns an error message, empty on success.
+std::string write_with_oiio(const std::filesystem::path& tmp, const std::string& ext, const Image& image,
+                            const std::map<std::string, std::string>& metadata) {
   auto out = OIIO::ImageOutput::create(tmp.string());
-  if (!out) throw std::runtime_error(fmt::format("{}: cannot create image writer: {}", file.string(), OIIO::geterror()));
+  if (!out) return "cannot create image writer: " + OIIO::geterror();
   bool ok;
   if (ext == ".png") {
     OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
@@ -51,24 +63,33 @@ void write_image(const std::filesystem::path& file, const Image& image,
   } else {
     OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::FLOAT);
     spec.attribute("oiio:ColorSpace", "Linear");
-    if (ext == ".exr") {
-      spec.attribute("compression", "zip");
-      for (const auto& [key, value] : metadata) spec.attribute(key, value);
-    }
+    spec.attribute("compression", "zip");
+    for (const auto& [key, value] : metadata) spec.attribute(key, value);
     ok = out->open(tmp.string(), spec) && out->write_image(OIIO::TypeDesc::FLOAT, image.rgb.data());
   }
   std::string error = ok ? "" : out->geterror();
-  ok = out->close() && ok;
-  if (!ok) {
-    std::error_code ec;
+  if (!out->close() && error.empty()) error = out->geterror();
+  return ok && error.empty() ? "" : (error.empty() ? "write failed" : error);
+}
+
+void write_image(const std::filesystem::path& file, const Image& image,
+                 const std::map<std::string, std::string>& metadata) {
+  if (!is_supported_output(file))
+    throw std::runtime_error(fmt::format("{}: unsupported image format (use .exr, .png or .pfm)", file.string()));
+  std::string ext = lower_extension(file);
+  std::filesystem::path dir = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+  std::filesystem::path tmp = dir / fmt::format(".{}.{}.tmp{}", file.stem().string(), getpid(), ext);
+
+  std::string error = ext == ".pfm" ? (write_pfm(tmp, image) ? "" : std::string(std::strerror(errno)))
+                                    : write_with_oiio(tmp, ext, image, metadata);
+  std::error_code ec;
+  if (error.empty()) {
+    std::filesystem::rename(tmp, file, ec);
+    if (ec) error = ec.message();
+  }
+  if (!error.empty()) {
     std::filesystem::remove(tmp, ec);
     throw std::runtime_error(fmt::format("{}: cannot write image: {}", file.string(), error));
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw std::runtime_error(fmt::format("{}: cannot write image: {}", file.string(), ec.message()));
   }
 }
 

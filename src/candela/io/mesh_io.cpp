@@ -5,6 +5,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
@@ -219,12 +220,14 @@ TriangleMesh load_obj(const std::string& text) {
 
 // ---------------------------------------------------------------- PLY
 
-// The least number of bytes one value of a PLY scalar type takes in a binary file.
-uint64_t ply_binary_size(std::string_view type) {
+// Bytes one value of a PLY scalar type takes in a binary file; nullopt for a name that is no PLY type.
+std::optional<uint64_t> ply_type_size(std::string_view type) {
   if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
   if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "int" || type == "uint" || type == "int32" || type == "uint32") return 4;
+  if (type == "float" || type == "float32") return 4;
   if (type == "double" || type == "float64") return 8;
-  return 4;  // int, uint, float and their sized spellings; an unknown type is Assimp's to reject
+  return std::nullopt;
 }
 
 std::vector<std::string_view> split_words(std::string_view line) {
@@ -248,45 +251,81 @@ struct PlyElementDeclaration {
 
 struct PlyHeader {
   bool binary = false;
-  size_t data_offset = 0;  // first byte after "end_header"
+  size_t data_offset = 0;  // first byte after the "end_header" line
   std::vector<PlyElementDeclaration> elements;
 };
 
-// Reads the element declarations of a PLY header; nullopt when this is not a header we understand
-// (Assimp then gives the reason).
-std::optional<PlyHeader> read_ply_header(std::string_view bytes) {
+uint64_t ply_type_size_or_fail(std::string_view type) {
+  const std::optional<uint64_t> size = ply_type_size(type);
+  if (!size) fail("malformed PLY: unknown property type '{}' in the header", type);
+  return *size;
+}
+
+void read_ply_format(const std::vector<std::string_view>& words, PlyHeader& header) {
+  if (words.size() != 3 || (words[1] != "ascii" && words[1] != "binary_little_endian" &&
+                            words[1] != "binary_big_endian"))
+    fail("malformed PLY: unknown format line '{}'", fmt::join(words, " "));
+  header.binary = words[1] != "ascii";
+}
+
+void read_ply_element(const std::vector<std::string_view>& words, PlyHeader& header) {
+  if (words.size() != 3) fail("malformed PLY: bad element line '{}'", fmt::join(words, " "));
+  PlyElementDeclaration element{std::string(words[1])};
+  const char* end = words[2].data() + words[2].size();
+  const auto [stop, error] = std::from_chars(words[2].data(), end, element.count);
+  if (error != std::errc() || stop != end)
+    fail("malformed PLY: element '{}' has an invalid count '{}'", words[1], words[2]);
+  header.elements.push_back(element);
+}
+
+void read_ply_property(const std::vector<std::string_view>& words, PlyHeader& header) {
+  if (header.elements.empty()) fail("malformed PLY: a property comes before any element");
+  PlyElementDeclaration& element = header.elements.back();
+  const bool list = words.size() >= 2 && words[1] == "list";
+  if (words.size() != (list ? 5u : 3u)) fail("malformed PLY: bad property line '{}'", fmt::join(words, " "));
+  if (list) {
+    element.min_binary_bytes += ply_type_size_or_fail(words[2]);  // the length; the list may be empty
+    ply_type_size_or_fail(words[3]);
+  } else {
+    element.min_binary_bytes += ply_type_size_or_fail(words[1]);
+  }
+  ++element.property_count;
+}
+
+// Reads and checks the whole header. Assimp only ever sees headers that pass: it loops forever on a
+// header cut short before "end_header".
+PlyHeader read_ply_header(std::string_view bytes) {
   PlyHeader header;
+  bool seen_magic = false, seen_format = false;
   size_t line_start = 0;
-  bool first = true;
   while (line_start < bytes.size()) {
     const size_t newline = bytes.find('\n', line_start);
-    if (newline == std::string_view::npos) return std::nullopt;
+    if (newline == std::string_view::npos) break;
     const std::vector<std::string_view> words = split_words(bytes.substr(line_start, newline - line_start));
     line_start = newline + 1;
-    if (first) {
-      if (words.size() != 1 || words[0] != "ply") return std::nullopt;
-      first = false;
-    } else if (words.empty() || words[0] == "comment" || words[0] == "obj_info") {
+    if (words.empty()) continue;
+    if (!seen_magic) {
+      if (words.size() != 1 || words[0] != "ply") fail("malformed PLY: the file does not start with 'ply'");
+      seen_magic = true;
+    } else if (words[0] == "comment" || words[0] == "obj_info") {
       continue;
-    } else if (words[0] == "format" && words.size() >= 2) {
-      header.binary = words[1] != "ascii";
-    } else if (words[0] == "element" && words.size() == 3) {
-      PlyElementDeclaration element{std::string(words[1])};
-      const auto [end, error] = std::from_chars(words[2].data(), words[2].data() + words[2].size(), element.count);
-      if (error != std::errc() || end != words[2].data() + words[2].size())
-        fail("malformed PLY: element '{}' has an invalid count '{}'", words[1], words[2]);
-      header.elements.push_back(element);
-    } else if (words[0] == "property" && !header.elements.empty()) {
-      PlyElementDeclaration& element = header.elements.back();
-      const bool list = words.size() >= 2 && words[1] == "list";
-      if (words.size() >= 3) element.min_binary_bytes += ply_binary_size(words[list ? 2 : 1]);
-      ++element.property_count;
+    } else if (words[0] == "format") {
+      read_ply_format(words, header);
+      seen_format = true;
+    } else if (words[0] == "element") {
+      read_ply_element(words, header);
+    } else if (words[0] == "property") {
+      read_ply_property(words, header);
     } else if (words[0] == "end_header") {
+      if (!seen_format) fail("malformed PLY: the header has no format line");
       header.data_offset = line_start;
       return header;
+    } else {
+      fail("malformed PLY: unexpected header line '{}'", fmt::join(words, " "));
     }
   }
-  return std::nullopt;
+  fail("{}", seen_magic ? "truncated PLY: the header has no 'end_header' line"
+                        : "malformed PLY: the file does not start with 'ply'");
 }
 
 // The fewest bytes one element can take: binary files as declared (lists may be empty); in ASCII every
@@ -315,10 +354,9 @@ void check_ply_counts_fit_data(const PlyHeader& header, size_t file_size) {
   }
 }
 
-std::string describe_elements(const std::optional<PlyHeader>& header) {
-  if (!header) return "";
+std::string describe_elements(const PlyHeader& header) {
   std::string list;
-  for (const PlyElementDeclaration& element : header->elements)
+  for (const PlyElementDeclaration& element : header.elements)
     list += fmt::format("{}{} '{}'", list.empty() ? "" : ", ", element.count, element.name);
   return fmt::format(" (the header declares {})", list.empty() ? "no elements" : list);
 }
@@ -354,8 +392,8 @@ void append_assimp_mesh(const aiMesh& source, bool with_normals, bool with_uvs, 
 }
 
 TriangleMesh load_ply(const std::string& bytes) {
-  const std::optional<PlyHeader> header = read_ply_header(bytes);
-  if (header) check_ply_counts_fit_data(*header, bytes.size());
+  const PlyHeader header = read_ply_header(bytes);
+  check_ply_counts_fit_data(header, bytes.size());
   Assimp::Importer importer;
   // No normal generation and no vertex joining: the mesh is exactly what the file holds.
   const aiScene* scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), aiProcess_Triangulate, "ply");

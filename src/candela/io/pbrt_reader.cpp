@@ -600,8 +600,9 @@ SourceLocation PbrtParser::parse_file(const fs::path& file, const SourceLocation
   SourceLocation blame = included_from ? *included_from : location(file.string(), 0, 0);
   if (!included_from && !fs::is_regular_file(file)) throw_scene_error(blame, "no such scene file");
   if (open_files_.size() >= kMaxIncludeDepth) throw_scene_error(blame, "files are included more than {} deep", kMaxIncludeDepth);
-  std::error_code ignored;
-  fs::path canonical = fs::weakly_canonical(file, ignored);
+  std::error_code error;
+  fs::path canonical = fs::weakly_canonical(file, error);
+  if (error) canonical = fs::absolute(file).lexically_normal();
   if (std::find(open_files_.begin(), open_files_.end(), canonical) != open_files_.end())
     throw_scene_error(blame, "\"{}\" includes itself (directly or through other files)", file.string());
 

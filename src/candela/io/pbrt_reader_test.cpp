@@ -25,19 +25,33 @@ const fs::path kSharedCornellBox = fs::path(CANDELA_SHARED_DIR) / "scenes/cornel
 const fs::path kRepoCornellBox = fs::path(CANDELA_SOURCE_DIR) / "scenes/cornell-box.pbrt";
 const fs::path kTestData = fs::path(CANDELA_SOURCE_DIR) / "tests/data/pbrt";
 
-// Each scene goes to its own file, named after the test, so tests can run in parallel processes.
-fs::path write_scene(const std::vector<std::string>& lines) {
-  static int counter = 0;
-  const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-  fs::path dir = fs::temp_directory_path() / fmt::format("candela_pbrt_reader_{}", getpid());
-  fs::create_directories(dir);
-  fs::path file = dir / fmt::format("{}_{}.pbrt", test->name(), counter++);
-  std::ofstream out(file);
-  for (const std::string& line : lines) out << line << '\n';
-  return file;
-}
+// A scene written to its own file, named after the test so that tests can run in parallel
+// processes; the file is removed again when the object goes out of scope.
+class ScratchScene {
+ public:
+  explicit ScratchScene(const std::vector<std::string>& lines) {
+    static int counter = 0;
+    const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+    fs::path dir = fs::temp_directory_path() / fmt::format("candela_pbrt_reader_{}", getpid());
+    fs::create_directories(dir);
+    path_ = dir / fmt::format("{}_{}.pbrt", test->name(), counter++);
+    std::ofstream out(path_);
+    for (const std::string& line : lines) out << line << '\n';
+  }
+  ScratchScene(const ScratchScene&) = delete;
+  ScratchScene& operator=(const ScratchScene&) = delete;
+  ~ScratchScene() {
+    std::error_code ignored;
+    fs::remove(path_, ignored);
+    fs::remove(path_.parent_path(), ignored);  // only succeeds once the directory is empty
+  }
+  const fs::path& path() const { return path_; }
 
-SceneDesc read_lines(const std::vector<std::string>& lines) { return read_pbrt_scene(write_scene(lines)); }
+ private:
+  fs::path path_;
+};
+
+SceneDesc read_lines(const std::vector<std::string>& lines) { return read_pbrt_scene(ScratchScene(lines).path()); }
 
 // The message of the error reading `file` gives, or "" when it reads without one.
 std::string error_reading(const fs::path& file) {
@@ -52,11 +66,11 @@ std::string error_reading(const fs::path& file) {
 // Expects the scene to fail with a message that starts "<file>:<line>:<column>: ", where the column
 // is that of `marker` in the line, and that contains `fragment`.
 void expect_error(const std::vector<std::string>& lines, int line, std::string_view marker, std::string_view fragment) {
-  fs::path file = write_scene(lines);
+  ScratchScene scene(lines);
   size_t column = lines.at(line - 1).find(marker);
   ASSERT_NE(column, std::string::npos) << "marker " << marker << " is not in line " << line;
-  std::string message = error_reading(file);
-  std::string place = fmt::format("{}:{}:{}: ", file.string(), line, column + 1);
+  std::string message = error_reading(scene.path());
+  std::string place = fmt::format("{}:{}:{}: ", scene.path().string(), line, column + 1);
   EXPECT_TRUE(message.starts_with(place)) << "expected the error at " << place << "\ngot: " << message;
   EXPECT_NE(message.find(fragment), std::string::npos) << "expected \"" << fragment << "\" in: " << message;
 }
@@ -613,10 +627,11 @@ TEST(PbrtReader, DirectivesInTheWrongSection) {
 }
 
 TEST(PbrtReader, SceneMustReachWorldBegin) {
-  fs::path file = write_scene({"Film \"rgb\"", "# no world"});
+  ScratchScene scene({"Film \"rgb\"", "# no world"});
   // The error is at the end of the file: line 3, after the last newline.
-  EXPECT_EQ(error_reading(file),
-            file.string() + ":3:1: the scene ends before WorldBegin; the shapes and lights must follow a WorldBegin");
+  EXPECT_EQ(error_reading(scene.path()), scene.path().string() +
+                                             ":3:1: the scene ends before WorldBegin; the shapes and lights must "
+                                             "follow a WorldBegin");
 }
 
 TEST(PbrtReader, ObjectInstancingErrors) {

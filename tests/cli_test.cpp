@@ -1,0 +1,166 @@
+// The command line end to end: bad input exits non-zero with one message naming the file and place,
+// and leaves an existing output file untouched; good input writes the image with its metadata.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "candela/film/image_io.h"
+
+namespace fs = std::filesystem;
+
+namespace candela {
+namespace {
+
+struct RunResult {
+  int exit_code;
+  std::string output;  // stdout and stderr together
+};
+
+RunResult run_cli(const std::string& args) {
+  std::string cmd = std::string(CANDELA_CLI_PATH) + " " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (size_t n = fread(buf.data(), 1, buf.size(), pipe)) out.append(buf.data(), n);
+  int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+class CommandLine : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("candela_cli_test_" + std::to_string(getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+    // An existing output that must survive every failed run.
+    std::ofstream(dir_ / "out.exr") << "previous render";
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string write(const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / name) << text;
+    return (dir_ / name).string();
+  }
+  std::string out() const { return (dir_ / "out.exr").string(); }
+  std::string previous_output() const {
+    std::ifstream in(dir_ / "out.exr");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }
+  // Runs and expects failure with a message matching `pattern`, and the old output untouched.
+  void expect_failure(const std::string& args, const std::string& pattern) {
+    RunResult r = run_cli(args);
+    EXPECT_NE(r.exit_code, 0) << r.output;
+    EXPECT_THAT_MATCHES(r.output, pattern);
+    EXPECT_EQ(previous_output(), "previous render");
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << "one message expected:\n" << r.output;
+  }
+  static void EXPECT_THAT_MATCHES(const std::string& text, const std::string& pattern) {
+    EXPECT_TRUE(std::regex_search(text, std::regex(pattern))) << "output:\n" << text << "\ndoes not match: " << pattern;
+  }
+  fs::path dir_;
+};
+
+const char* kGoodJson = R"({
+  "camera": {"position": [0, 0, -3], "look_at": [0, 0, 0], "fov": 40, "width": 16, "height": 12},
+  "render": {"spp": 2},
+  "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1}],
+  "lights": [{"type": "sky", "radiance": 1}]
+})";
+
+TEST_F(CommandLine, RendersAndWritesMetadata) {
+  std::string scene = write("good.json", kGoodJson);
+  RunResult r = run_cli("render " + scene + " -o " + out() + " --spp 3 --threads 2 --seed 5 -q");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT_MATCHES(r.output, "16x12, 3 spp in .* s: .* Msamples/s, .* Mrays/s");
+  auto meta = read_image_metadata(out());
+  EXPECT_EQ(meta["candela:spp"], "3");
+  EXPECT_EQ(meta["candela:seed"], "5");
+  EXPECT_EQ(meta["candela:scene"], scene);
+  EXPECT_TRUE(meta.count("candela:render_time_seconds"));
+  Image img = read_image(out());
+  EXPECT_EQ(img.width, 16);
+  EXPECT_EQ(img.height, 12);
+}
+
+TEST_F(CommandLine, ResolutionAndFormatFromOptions) {
+  std::string scene = write("good.json", kGoodJson);
+  std::string png = (dir_ / "small.png").string(), pfm = (dir_ / "small.pfm").string();
+  ASSERT_EQ(run_cli("render " + scene + " -o " + png + " --resolution 20x10 -q").exit_code, 0);
+  ASSERT_EQ(run_cli("render " + scene + " -o " + pfm + " --resolution 20x10 -q").exit_code, 0);
+  EXPECT_EQ(read_image(png).width, 20);
+  EXPECT_EQ(read_image(pfm).height, 10);
+}
+
+TEST_F(CommandLine, HelpDocumentsEveryOption) {
+  RunResult r = run_cli("render --help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* opt : {"--output", "--spp", "--threads", "--seed", "--max-depth", "--resolution", "--integrator"})
+    EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
+}
+
+TEST_F(CommandLine, MissingSceneFile) { expect_failure("render " + (dir_ / "nope.json").string() + " -o " + out(), "nope\\.json"); }
+
+TEST_F(CommandLine, MalformedJsonNamesLine) {
+  std::string scene = write("bad.json", "{\n  \"camera\": {\n    \"fov\": 40,\n  }\n}\n");
+  expect_failure("render " + scene + " -o " + out(), "bad\\.json:4:");
+}
+
+TEST_F(CommandLine, UnknownJsonKeyNamesPath) {
+  std::string scene = write("bad.json", R"({"camera": {"fov": 40}, "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "colour": 1}]})");
+  expect_failure("render " + scene + " -o " + out(), "bad\\.json.*/shapes/0/colour");
+}
+
+TEST_F(CommandLine, WrongJsonTypeNamesPath) {
+  std::string scene = write("bad.json", R"({"shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": "big"}]})");
+  expect_failure("render " + scene + " -o " + out(), "bad\\.json.*/shapes/0/radius");
+}
+
+TEST_F(CommandLine, NegativeRadius) {
+  std::string scene = write("bad.json", R"({"shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": -1}]})");
+  expect_failure("render " + scene + " -o " + out(), "bad\\.json.*/shapes/0/radius");
+}
+
+TEST_F(CommandLine, MissingMeshFile) {
+  std::string scene = write("bad.json", R"({"shapes": [{"type": "mesh", "file": "missing.obj"}]})");
+  expect_failure("render " + scene + " -o " + out(), "missing\\.obj");
+}
+
+TEST_F(CommandLine, UnknownPbrtDirectiveNamesLine) {
+  std::string scene = write("bad.pbrt", "LookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\"\nFrobnicate 3\n");
+  expect_failure("render " + scene + " -o " + out(), "bad\\.pbrt:3:");
+}
+
+TEST_F(CommandLine, WrongPbrtParameterTypeNamesLine) {
+  std::string scene = write("bad.pbrt", "WorldBegin\nShape \"sphere\"\n  \"string radius\" \"one\"\n");
+  expect_failure("render " + scene + " -o " + out(), "bad\\.pbrt:[23]:");
+}
+
+TEST_F(CommandLine, MissingPbrtInclude) {
+  std::string scene = write("bad.pbrt", "WorldBegin\nInclude \"nowhere.pbrt\"\n");
+  expect_failure("render " + scene + " -o " + out(), "bad\\.pbrt:2.*nowhere\\.pbrt");
+}
+
+TEST_F(CommandLine, ZeroAndAbsurdResolution) {
+  std::string scene = write("good.json", kGoodJson);
+  expect_failure("render " + scene + " -o " + out() + " --resolution 0x0", "resolution");
+  expect_failure("render " + scene + " -o " + out() + " --resolution 100000x100000", "resolution");
+  std::string bad = write("bad.json", R"({"camera": {"width": 0, "height": 10}})");
+  expect_failure("render " + bad + " -o " + out(), "bad\\.json.*/camera/width");
+}
+
+TEST_F(CommandLine, UnsupportedOutputAndIntegrator) {
+  std::string scene = write("good.json", kGoodJson);
+  expect_failure("render " + scene + " -o " + (dir_ / "out.bmp").string(), "out\\.bmp.*unsupported");
+  expect_failure("render " + scene + " -o " + out() + " --integrator teleport", "teleport");
+}
+
+}  // namespace
+}  // namespace candela
