@@ -643,5 +643,34 @@ TEST(JsonReader, ReadsTheRoomScene) {
   EXPECT_EQ(scene.settings.spp, 64);
 }
 
+
+// Keeps docs/scene-format.md honest: each of its json blocks is a complete scene that reads.
+TEST(JsonReader, EveryExampleInTheFormatDocumentReads) {
+  std::ifstream in(kSourceDir / "docs/scene-format.md");
+  ASSERT_TRUE(in) << "docs/scene-format.md not found";
+  std::string line, example;
+  bool in_example = false;
+  int examples = 0;
+  for (int line_number = 1; std::getline(in, line); ++line_number) {
+    if (!in_example && line == "```json") {
+      in_example = true;
+      example.clear();
+    } else if (in_example && line == "```") {
+      in_example = false;
+      ++examples;
+      // Mesh file examples are written as if the scene file were in scenes/.
+      try {
+        read_json_scene(example, "scene-format.md example ending on line " + std::to_string(line_number),
+                        kSourceDir / "scenes");
+      } catch (const SceneError& e) {
+        ADD_FAILURE() << e.what();
+      }
+    } else if (in_example) {
+      example += line + "\n";
+    }
+  }
+  EXPECT_GE(examples, 20);
+}
+
 }  // namespace
 }  // namespace candela

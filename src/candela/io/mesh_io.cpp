@@ -77,6 +77,19 @@ std::string read_whole_file(const std::filesystem::path& file) {
   return bytes;
 }
 
+// Whitespace-separated words of one line (both OBJ and PLY headers are word based).
+std::vector<std::string_view> split_words(std::string_view line) {
+  std::vector<std::string_view> words;
+  size_t at = 0;
+  while (true) {
+    at = line.find_first_not_of(" \t\r", at);
+    if (at == std::string_view::npos) return words;
+    const size_t end = std::min(line.find_first_of(" \t\r", at), line.size());
+    words.push_back(line.substr(at, end - at));
+    at = end;
+  }
+}
+
 // ---------------------------------------------------------------- OBJ
 
 // One corner of an OBJ face: OBJ indexes positions, uvs and normals separately.
@@ -132,6 +145,29 @@ void fail_on_dropped_obj_faces(const std::string& warnings) {
     if (at == std::string::npos) continue;
     const size_t line_start = warnings.rfind('\n', at);
     fail("malformed OBJ: {}", first_line(std::string_view(warnings).substr(line_start == std::string::npos ? 0 : line_start)));
+  }
+}
+
+bool starts_like_a_number(std::string_view token) {
+  if (!token.empty() && (token.front() == '-' || token.front() == '+')) token.remove_prefix(1);
+  return !token.empty() && (std::isdigit(static_cast<unsigned char>(token.front())) || token.front() == '.');
+}
+
+// tinyobjloader reads "nan", "inf" or any other word where a number belongs as 0 without a word, which
+// would quietly move a vertex; so the values of v, vt and vn lines are checked here first.
+void check_obj_vertex_numbers(std::string_view text) {
+  size_t line_number = 0, at = 0;
+  while (at < text.size()) {
+    const size_t end = std::min(text.find('\n', at), text.size());
+    std::string_view line = text.substr(at, end - at);
+    at = end + 1;
+    ++line_number;
+    line = line.substr(0, line.find('#'));
+    const std::vector<std::string_view> words = split_words(line);
+    if (words.empty() || (words[0] != "v" && words[0] != "vt" && words[0] != "vn")) continue;
+    for (size_t k = 1; k < words.size(); ++k)
+      if (!starts_like_a_number(words[k]))
+        fail("malformed OBJ: line {}: '{}' is not a finite number", line_number, words[k]);
   }
 }
 
@@ -195,6 +231,7 @@ TriangleMesh load_obj(const std::string& text) {
   tinyobj::ObjReader reader;
   // Parsing from a string makes tinyobjloader ignore `mtllib`: materials are not used yet, and a
   // missing or misplaced .mtl file must not fail the load.
+  check_obj_vertex_numbers(text);
   if (!reader.ParseFromString(text, "", config)) fail("malformed OBJ: {}", first_line(reader.Error()));
 
   const tinyobj::attrib_t& attrib = reader.GetAttrib();
@@ -219,58 +256,75 @@ TriangleMesh load_obj(const std::string& text) {
 }
 
 // ---------------------------------------------------------------- PLY
+// Assimp's PLY reader trusts the file: it loops forever on a header cut short, allocates whatever
+// counts the header declares, and reads past the end of (or asserts on) data cut short. So the header
+// is parsed and the data measured against it here first; Assimp only sees files that hold everything
+// their header declares.
 
-// Bytes one value of a PLY scalar type takes in a binary file; nullopt for a name that is no PLY type.
-std::optional<uint64_t> ply_type_size(std::string_view type) {
-  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
-  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
-  if (type == "int" || type == "uint" || type == "int32" || type == "uint32") return 4;
-  if (type == "float" || type == "float32") return 4;
-  if (type == "double" || type == "float64") return 8;
+struct PlyScalarType {
+  uint8_t size = 0;  // bytes in a binary file
+  bool is_signed = false;
+  bool is_integer = false;
+};
+
+std::optional<PlyScalarType> ply_scalar_type(std::string_view name) {
+  if (name == "char" || name == "int8") return PlyScalarType{1, true, true};
+  if (name == "uchar" || name == "uint8") return PlyScalarType{1, false, true};
+  if (name == "short" || name == "int16") return PlyScalarType{2, true, true};
+  if (name == "ushort" || name == "uint16") return PlyScalarType{2, false, true};
+  if (name == "int" || name == "int32") return PlyScalarType{4, true, true};
+  if (name == "uint" || name == "uint32") return PlyScalarType{4, false, true};
+  if (name == "float" || name == "float32") return PlyScalarType{4, true, false};
+  if (name == "double" || name == "float64") return PlyScalarType{8, true, false};
   return std::nullopt;
 }
 
-std::vector<std::string_view> split_words(std::string_view line) {
-  std::vector<std::string_view> words;
-  size_t at = 0;
-  while (true) {
-    at = line.find_first_not_of(" \t\r", at);
-    if (at == std::string_view::npos) return words;
-    const size_t end = std::min(line.find_first_of(" \t\r", at), line.size());
-    words.push_back(line.substr(at, end - at));
-    at = end;
-  }
-}
+struct PlyProperty {
+  PlyScalarType value;                       // the property's, or each list item's
+  std::optional<PlyScalarType> list_length;  // set for list properties
+};
 
-struct PlyElementDeclaration {
+struct PlyElement {
   std::string name;
   uint64_t count = 0;
-  uint64_t min_binary_bytes = 0;  // per element: fixed-size properties plus each list's length field
-  uint64_t property_count = 0;
+  std::vector<PlyProperty> properties;
+
+  bool has_lists() const {
+    return std::any_of(properties.begin(), properties.end(), [](const PlyProperty& p) { return p.list_length; });
+  }
+  uint64_t scalar_bytes() const {
+    uint64_t bytes = 0;
+    for (const PlyProperty& property : properties) bytes += property.value.size;
+    return bytes;
+  }
 };
+
+enum class PlyEncoding { Ascii, BinaryLittleEndian, BinaryBigEndian };
 
 struct PlyHeader {
-  bool binary = false;
+  std::optional<PlyEncoding> encoding;
   size_t data_offset = 0;  // first byte after the "end_header" line
-  std::vector<PlyElementDeclaration> elements;
+  size_t line_count = 0;   // lines up to and including "end_header"
+  std::vector<PlyElement> elements;
 };
 
-uint64_t ply_type_size_or_fail(std::string_view type) {
-  const std::optional<uint64_t> size = ply_type_size(type);
-  if (!size) fail("malformed PLY: unknown property type '{}' in the header", type);
-  return *size;
+PlyScalarType ply_scalar_type_or_fail(std::string_view name) {
+  const std::optional<PlyScalarType> type = ply_scalar_type(name);
+  if (!type) fail("malformed PLY: unknown property type '{}' in the header", name);
+  return *type;
 }
 
 void read_ply_format(const std::vector<std::string_view>& words, PlyHeader& header) {
-  if (words.size() != 3 || (words[1] != "ascii" && words[1] != "binary_little_endian" &&
-                            words[1] != "binary_big_endian"))
-    fail("malformed PLY: unknown format line '{}'", fmt::join(words, " "));
-  header.binary = words[1] != "ascii";
+  if (words.size() == 3 && words[1] == "ascii") header.encoding = PlyEncoding::Ascii;
+  else if (words.size() == 3 && words[1] == "binary_little_endian") header.encoding = PlyEncoding::BinaryLittleEndian;
+  else if (words.size() == 3 && words[1] == "binary_big_endian") header.encoding = PlyEncoding::BinaryBigEndian;
+  else fail("malformed PLY: unknown format line '{}'", fmt::join(words, " "));
 }
 
 void read_ply_element(const std::vector<std::string_view>& words, PlyHeader& header) {
   if (words.size() != 3) fail("malformed PLY: bad element line '{}'", fmt::join(words, " "));
-  PlyElementDeclaration element{std::string(words[1])};
+  PlyElement element;
+  element.name = words[1];
   const char* end = words[2].data() + words[2].size();
   const auto [stop, error] = std::from_chars(words[2].data(), end, element.count);
   if (error != std::errc() || stop != end)
@@ -280,88 +334,169 @@ void read_ply_element(const std::vector<std::string_view>& words, PlyHeader& hea
 
 void read_ply_property(const std::vector<std::string_view>& words, PlyHeader& header) {
   if (header.elements.empty()) fail("malformed PLY: a property comes before any element");
-  PlyElementDeclaration& element = header.elements.back();
   const bool list = words.size() >= 2 && words[1] == "list";
   if (words.size() != (list ? 5u : 3u)) fail("malformed PLY: bad property line '{}'", fmt::join(words, " "));
+  PlyProperty property;
   if (list) {
-    element.min_binary_bytes += ply_type_size_or_fail(words[2]);  // the length; the list may be empty
-    ply_type_size_or_fail(words[3]);
+    property.list_length = ply_scalar_type_or_fail(words[2]);
+    if (!property.list_length->is_integer) fail("malformed PLY: list length type '{}' is not an integer", words[2]);
+    property.value = ply_scalar_type_or_fail(words[3]);
   } else {
-    element.min_binary_bytes += ply_type_size_or_fail(words[1]);
+    property.value = ply_scalar_type_or_fail(words[1]);
   }
-  ++element.property_count;
+  header.elements.back().properties.push_back(property);
 }
 
-// Reads and checks the whole header. Assimp only ever sees headers that pass: it loops forever on a
-// header cut short before "end_header".
+void check_ply_header_complete(const PlyHeader& header) {
+  if (!header.encoding) fail("malformed PLY: the header has no format line");
+  for (const PlyElement& element : header.elements)
+    if (element.count > 0 && element.properties.empty())
+      fail("malformed PLY: element '{}' has no properties", element.name);
+}
+
 PlyHeader read_ply_header(std::string_view bytes) {
   PlyHeader header;
-  bool seen_magic = false, seen_format = false;
+  bool seen_magic = false;
   size_t line_start = 0;
   while (line_start < bytes.size()) {
     const size_t newline = bytes.find('\n', line_start);
     if (newline == std::string_view::npos) break;
     const std::vector<std::string_view> words = split_words(bytes.substr(line_start, newline - line_start));
     line_start = newline + 1;
+    ++header.line_count;
     if (words.empty()) continue;
     if (!seen_magic) {
-      if (words.size() != 1 || words[0] != "ply") fail("malformed PLY: the file does not start with 'ply'");
+      if (words.size() != 1 || words[0] != "ply") break;
       seen_magic = true;
-    } else if (words[0] == "comment" || words[0] == "obj_info") {
-      continue;
     } else if (words[0] == "format") {
       read_ply_format(words, header);
-      seen_format = true;
     } else if (words[0] == "element") {
       read_ply_element(words, header);
     } else if (words[0] == "property") {
       read_ply_property(words, header);
     } else if (words[0] == "end_header") {
-      if (!seen_format) fail("malformed PLY: the header has no format line");
+      check_ply_header_complete(header);
       header.data_offset = line_start;
       return header;
-    } else {
-      fail("malformed PLY: unexpected header line '{}'", fmt::join(words, " "));
     }
+    // Anything else (comment, obj_info, a comment broken over two lines) is skipped, as Assimp does.
   }
   fail("{}", seen_magic ? "truncated PLY: the header has no 'end_header' line"
                         : "malformed PLY: the file does not start with 'ply'");
 }
 
-// The fewest bytes one element can take: binary files as declared (lists may be empty); in ASCII every
-// value is at least one digit and a separator. At least one byte, so that a count is never free.
-uint64_t min_bytes_per_element(const PlyElementDeclaration& element, bool binary) {
-  return std::max<uint64_t>(1, binary ? element.min_binary_bytes : 2 * element.property_count);
+[[noreturn]] void fail_ply_data_short(const PlyElement& element, uint64_t complete, size_t data_size) {
+  if (element.count > data_size)
+    fail("corrupt PLY header: it declares {} '{}' elements but only {} bytes of data follow it", element.count,
+         element.name, data_size);
+  fail("truncated PLY: the data ends after {} of the {} '{}' elements the header declares", complete, element.count,
+       element.name);
 }
 
-// Assimp allocates for the element counts a header declares before it reads the data, so a corrupt
-// count of billions would exhaust memory; a count the data cannot possibly hold is rejected first.
-void check_ply_counts_fit_data(const PlyHeader& header, size_t file_size) {
-  const uint64_t data_size = file_size - header.data_offset;
-  // The last ASCII value may lack its trailing separator.
-  const uint64_t available = data_size + (header.binary ? 0 : 1);
-  uint64_t needed = 0;
-  for (const PlyElementDeclaration& element : header.elements) {
-    const uint64_t each = min_bytes_per_element(element, header.binary);
-    if (element.count > (available - needed) / each)
-      fail("{} PLY: the header declares {} '{}' elements, which need at least {} bytes, but only {} bytes of "
-           "data follow the header",
-           element.count > available ? "corrupt" : "truncated", element.count, element.name,
-           element.count > std::numeric_limits<uint64_t>::max() / each ? std::string("more than 2^64")
-                                                                       : std::to_string(element.count * each),
-           data_size);
-    needed += element.count * each;
+bool fits(uint64_t at, uint64_t bytes, size_t size) { return at <= size && size - at >= bytes; }
+
+uint64_t read_binary_list_length(std::string_view data, uint64_t at, PlyScalarType type, bool big_endian) {
+  uint64_t bits = 0;
+  for (unsigned k = 0; k < type.size; ++k)
+    bits = bits << 8 | static_cast<uint8_t>(data[at + (big_endian ? k : type.size - 1u - k)]);
+  if (type.is_signed && (bits >> (8 * type.size - 1)) != 0) fail("malformed PLY: negative list length");
+  return bits;
+}
+
+void check_binary_ply_data(const PlyHeader& header, std::string_view data) {
+  const bool big_endian = header.encoding == PlyEncoding::BinaryBigEndian;
+  uint64_t at = 0;
+  for (const PlyElement& element : header.elements) {
+    if (!element.has_lists()) {  // fixed size: no need to visit every element
+      const uint64_t fitting = (data.size() - at) / element.scalar_bytes();
+      if (element.count > fitting) fail_ply_data_short(element, fitting, data.size());
+      at += element.count * element.scalar_bytes();
+      continue;
+    }
+    for (uint64_t i = 0; i < element.count; ++i) {
+      for (const PlyProperty& property : element.properties) {
+        if (!property.list_length) {
+          at += property.value.size;
+          continue;
+        }
+        if (!fits(at, property.list_length->size, data.size())) fail_ply_data_short(element, i, data.size());
+        const uint64_t length = read_binary_list_length(data, at, *property.list_length, big_endian);
+        at += property.list_length->size;
+        if (!fits(at, 0, data.size()) || length > (data.size() - at) / property.value.size)
+          fail_ply_data_short(element, i, data.size());
+        at += length * property.value.size;
+      }
+      if (!fits(at, 0, data.size())) fail_ply_data_short(element, i, data.size());
+    }
+  }
+}
+
+// Assimp reads ASCII PLY one element per line; a line with fewer values than the header declares
+// would be read as zeros (or make Assimp assert).
+bool ascii_ply_line_holds(const PlyElement& element, std::string_view line, size_t line_number) {
+  const std::vector<std::string_view> values = split_words(line);
+  size_t next = 0;
+  for (const PlyProperty& property : element.properties) {
+    if (next >= values.size()) return false;
+    const std::string_view value = values[next++];
+    if (!property.list_length) continue;
+    uint64_t length = 0;
+    const auto [stop, error] = std::from_chars(value.data(), value.data() + value.size(), length);
+    if (error != std::errc() || stop != value.data() + value.size())
+      fail("malformed PLY: line {}: '{}' is not a list length", line_number, value);
+    if (length > values.size() - next) return false;
+    next += length;
+  }
+  return true;
+}
+
+void check_ascii_ply_data(const PlyHeader& header, std::string_view data) {
+  size_t at = 0, line_number = header.line_count;
+  // The next line that holds anything; Assimp skips blank ones too.
+  const auto next_line = [&]() -> std::optional<std::string_view> {
+    while (at < data.size()) {
+      const size_t end = std::min(data.find('\n', at), data.size());
+      const std::string_view line = data.substr(at, end - at);
+      at = end + 1;
+      ++line_number;
+      if (line.find_first_not_of(" \t\r") != std::string_view::npos) return line;
+    }
+    return std::nullopt;
+  };
+  for (const PlyElement& element : header.elements) {
+    for (uint64_t i = 0; i < element.count; ++i) {
+      const std::optional<std::string_view> line = next_line();
+      if (!line) fail_ply_data_short(element, i, data.size());
+      if (!ascii_ply_line_holds(element, *line, line_number))
+        fail("malformed PLY: line {} has fewer values than the header declares for a '{}' element", line_number,
+             element.name);
+    }
   }
 }
 
 std::string describe_elements(const PlyHeader& header) {
   std::string list;
-  for (const PlyElementDeclaration& element : header.elements)
+  for (const PlyElement& element : header.elements)
     list += fmt::format("{}{} '{}'", list.empty() ? "" : ", ", element.count, element.name);
   return fmt::format(" (the header declares {})", list.empty() ? "no elements" : list);
 }
 
 bool has_triangles(const aiMesh& mesh) { return (mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) != 0; }
+
+// Triangulation reads the positions of a polygon's corners, so indices are checked before it runs.
+void check_assimp_face_indices(const aiScene& scene) {
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh& mesh = *scene.mMeshes[m];
+    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+      const aiFace& face = mesh.mFaces[f];
+      if (face.mNumIndices == 0) fail("malformed PLY: face {} has no vertices", f);
+      for (unsigned k = 0; k < face.mNumIndices; ++k)
+        if (face.mIndices[k] >= mesh.mNumVertices)
+          fail("malformed PLY: face {} refers to vertex {} but there are {} vertices", f, face.mIndices[k],
+               mesh.mNumVertices);
+    }
+  }
+}
 
 void append_assimp_mesh(const aiMesh& source, bool with_normals, bool with_uvs, TriangleMesh& mesh) {
   const uint64_t base = mesh.positions.size();
@@ -382,21 +517,22 @@ void append_assimp_mesh(const aiMesh& source, bool with_normals, bool with_uvs, 
   for (unsigned f = 0; f < source.mNumFaces; ++f) {
     const aiFace& face = source.mFaces[f];
     if (face.mNumIndices != 3) continue;  // points and lines: not surfaces
-    for (unsigned k = 0; k < 3; ++k) {
-      if (face.mIndices[k] >= source.mNumVertices)
-        fail("malformed PLY: face {} refers to vertex {} but there are {} vertices", f, face.mIndices[k],
-             source.mNumVertices);
-      mesh.indices.push_back(static_cast<uint32_t>(base + face.mIndices[k]));
-    }
+    for (unsigned k = 0; k < 3; ++k) mesh.indices.push_back(static_cast<uint32_t>(base + face.mIndices[k]));
   }
 }
 
 TriangleMesh load_ply(const std::string& bytes) {
   const PlyHeader header = read_ply_header(bytes);
-  check_ply_counts_fit_data(header, bytes.size());
+  const std::string_view data = std::string_view(bytes).substr(header.data_offset);
+  if (header.encoding == PlyEncoding::Ascii) check_ascii_ply_data(header, data);
+  else check_binary_ply_data(header, data);
+
   Assimp::Importer importer;
+  if (!importer.ReadFileFromMemory(bytes.data(), bytes.size(), 0, "ply"))
+    fail("malformed PLY: {}", importer.GetErrorString());
+  check_assimp_face_indices(*importer.GetScene());
   // No normal generation and no vertex joining: the mesh is exactly what the file holds.
-  const aiScene* scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), aiProcess_Triangulate, "ply");
+  const aiScene* scene = importer.ApplyPostProcessing(aiProcess_Triangulate);
   if (!scene) fail("malformed PLY: {}", importer.GetErrorString());
 
   bool with_normals = true, with_uvs = true, any_triangles = false;
