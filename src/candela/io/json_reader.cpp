@@ -39,9 +39,12 @@ constexpr int64_t kMaxPixels = int64_t(1) << 28;
 std::string escape_pointer_token(std::string_view key) {
   std::string token;
   for (char c : key) {
-    if (c == '~') token += "~0";
-    else if (c == '/') token += "~1";
-    else token += c;
+    if (c == '~')
+      token += "~0";
+    else if (c == '/')
+      token += "~1";
+    else
+      token += c;
   }
   return token;
 }
@@ -50,9 +53,7 @@ std::string child_pointer(const std::string& parent, std::string_view key) {
   return parent + "/" + escape_pointer_token(key);
 }
 
-std::string child_pointer(const std::string& parent, size_t index) {
-  return parent + "/" + std::to_string(index);
-}
+std::string child_pointer(const std::string& parent, size_t index) { return parent + "/" + std::to_string(index); }
 
 struct TextPosition {
   int line = 1, column = 1;
@@ -124,8 +125,10 @@ class SourceScanner {
     ++pos_;  // opening quote
     while (pos_ < text_.size()) {
       char c = text_[pos_++];
-      if (c == '\\') ++pos_;
-      else if (c == '"') return;
+      if (c == '\\')
+        ++pos_;
+      else if (c == '"')
+        return;
     }
   }
   std::string read_string() {
@@ -150,8 +153,10 @@ class SourceScanner {
         continue;
       }
       ++pos_;
-      if (c == '{' || c == '[') ++depth;
-      else if ((c == '}' || c == ']') && --depth == 0) return;
+      if (c == '{' || c == '[')
+        ++depth;
+      else if ((c == '}' || c == ']') && --depth == 0)
+        return;
     }
   }
 
@@ -161,8 +166,10 @@ class SourceScanner {
     skip_whitespace();
     if (depth_ >= kMaxDepth || (!at('{') && !at('['))) return skip_value();
     ++depth_;
-    if (at('{')) walk_object(pointer, enter);
-    else walk_array(pointer, enter);
+    if (at('{'))
+      walk_object(pointer, enter);
+    else
+      walk_array(pointer, enter);
     --depth_;
   }
 
@@ -182,8 +189,10 @@ class SourceScanner {
         stop_ = true;
         return;
       }
-      if (enter(pointer, key_offset)) walk_value(pointer, enter);
-      else skip_value();
+      if (enter(pointer, key_offset))
+        walk_value(pointer, enter);
+      else
+        skip_value();
       pointer.resize(parent_length);
       skip_whitespace();
       if (at(',')) ++pos_;
@@ -198,8 +207,10 @@ class SourceScanner {
     for (skip_whitespace(); !stop_ && pos_ < text_.size() && !at(']'); skip_whitespace(), ++index) {
       size_t parent_length = pointer.size();
       pointer += '/' + std::to_string(index);
-      if (enter(pointer, pos_)) walk_value(pointer, enter);
-      else skip_value();
+      if (enter(pointer, pos_))
+        walk_value(pointer, enter);
+      else
+        skip_value();
       pointer.resize(parent_length);
       skip_whitespace();
       if (at(',')) ++pos_;
@@ -227,7 +238,8 @@ class ErrorReporter {
     return {file_name_, position.line, position.column, std::move(pointer)};
   }
 
-  // Lines are looked up only here, when something is wrong, so correct scenes never pay for it.
+  // The text is scanned again only when a location is needed (an error, or a mesh file that may
+  // report one), so reading a correct scene stays a single pass over its values.
   SourceLocation location(const std::string& pointer) const {
     if (auto offset = SourceScanner(text_).offset_of(pointer)) return location_of_offset(*offset, pointer);
     return {file_name_, 0, 0, pointer};
@@ -264,6 +276,17 @@ float read_float(const ErrorReporter& report, const Json& value, const std::stri
   return float(x);
 }
 
+// Reads array[index] without building its pointer unless there is something to report (meshes
+// have millions of coordinates).
+float read_float_element(const ErrorReporter& report, const Json& array, size_t index, const std::string& pointer) {
+  const Json& value = array[index];
+  if (value.is_number()) {
+    double x = value.get<double>();
+    if (std::isfinite(x) && std::abs(x) <= double(FLT_MAX)) return float(x);
+  }
+  return read_float(report, value, child_pointer(pointer, index));  // fails with the reason
+}
+
 int64_t read_int64(const ErrorReporter& report, const Json& value, const std::string& pointer) {
   if (!value.is_number()) report.fail(pointer, "expected an integer, got {}", describe(value));
   if (value.is_number_unsigned()) {
@@ -289,22 +312,20 @@ Vec3 read_vec3(const ErrorReporter& report, const Json& value, const std::string
   if (!value.is_array() || value.size() != 3)
     report.fail(pointer, "expected an array of 3 numbers, got {}", describe(value));
   Vec3 v;
-  for (int i = 0; i < 3; ++i) v[i] = read_float(report, value[i], child_pointer(pointer, size_t(i)));
+  for (size_t i = 0; i < 3; ++i) v[int(i)] = read_float_element(report, value, i, pointer);
   return v;
 }
 
 Vec2 read_vec2(const ErrorReporter& report, const Json& value, const std::string& pointer) {
   if (!value.is_array() || value.size() != 2)
     report.fail(pointer, "expected an array of 2 numbers, got {}", describe(value));
-  return {read_float(report, value[0], child_pointer(pointer, size_t(0))),
-          read_float(report, value[1], child_pointer(pointer, size_t(1)))};
+  return {read_float_element(report, value, 0, pointer), read_float_element(report, value, 1, pointer)};
 }
 
 // Reflectances and albedos cannot exceed 1 without creating energy; emission can.
 enum class ColorKind { Albedo, Emission };
 
-float read_color_component(const ErrorReporter& report, const Json& value, const std::string& pointer,
-                           ColorKind kind) {
+float read_color_component(const ErrorReporter& report, const Json& value, const std::string& pointer, ColorKind kind) {
   float c = read_float(report, value, pointer);
   if (c < 0) report.fail(pointer, "colour components must be >= 0, got {}", c);
   if (kind == ColorKind::Albedo && c > 1)
@@ -392,7 +413,8 @@ class CheckedObject {
     if (!value) return fallback;
     int64_t n = read_int64(report_, *value, pointer_of(key));
     if (n < min || n > max) {
-      if (max == std::numeric_limits<int>::max()) report_.fail(pointer_of(key), "expected an integer >= {}, got {}", min, n);
+      if (max == std::numeric_limits<int>::max())
+        report_.fail(pointer_of(key), "expected an integer >= {}, got {}", min, n);
       report_.fail(pointer_of(key), "expected an integer in [{}, {}], got {}", min, max, n);
     }
     return int(n);
@@ -553,12 +575,19 @@ class JsonSceneReader {
     CheckedObject m(report_, value, pointer);
     std::string type = m.string("type");
     MaterialDesc material;
-    if (type == "diffuse") material = read_diffuse(m);
-    else if (type == "phong") material = read_phong(m);
-    else if (type == "mirror") material = MirrorMaterial{m.rgb_or("reflectance", ColorKind::Albedo, MirrorMaterial{}.reflectance)};
-    else if (type == "glass") material = read_glass(m);
-    else if (type == "black") material = BlackMaterial{};
-    else report_.fail(m.pointer_of("type"), "unknown material type \"{}\"; expected one of: diffuse, phong, mirror, glass, black", type);
+    if (type == "diffuse")
+      material = read_diffuse(m);
+    else if (type == "phong")
+      material = read_phong(m);
+    else if (type == "mirror")
+      material = MirrorMaterial{m.rgb_or("reflectance", ColorKind::Albedo, MirrorMaterial{}.reflectance)};
+    else if (type == "glass")
+      material = read_glass(m);
+    else if (type == "black")
+      material = BlackMaterial{};
+    else
+      report_.fail(m.pointer_of("type"),
+                   "unknown material type \"{}\"; expected one of: diffuse, phong, mirror, glass, black", type);
     m.finish();
     return material;
   }
@@ -634,7 +663,8 @@ class JsonSceneReader {
     if (type == "box") return read_box(s);
     if (type == "rectangle") return read_rectangle(s);
     if (type == "mesh") return read_mesh(s);
-    report_.fail(s.pointer_of("type"), "unknown shape type \"{}\"; expected one of: sphere, plane, box, rectangle, mesh", type);
+    report_.fail(s.pointer_of("type"),
+                 "unknown shape type \"{}\"; expected one of: sphere, plane, box, rectangle, mesh", type);
   }
 
   static SphereShape read_sphere(CheckedObject& s) { return {s.vec3("center"), s.number("radius", Bound::Positive)}; }
@@ -695,9 +725,13 @@ class JsonSceneReader {
     mesh.positions = read_vec3_list(s.require("positions"), s.pointer_of("positions"), "positions [x, y, z]");
     if (mesh.positions.size() < 3)
       report_.fail(s.pointer_of("positions"), "a mesh needs at least 3 positions, got {}", mesh.positions.size());
-    if (const Json* indices = s.find("indices")) mesh.indices = read_indices(*indices, s.pointer_of("indices"), mesh.positions.size());
-    else if (mesh.positions.size() == 3) mesh.indices = {0, 1, 2};
-    else report_.fail(s.pointer(), "missing required key \"indices\" (only a single triangle of 3 positions may leave it out)");
+    if (const Json* indices = s.find("indices"))
+      mesh.indices = read_indices(*indices, s.pointer_of("indices"), mesh.positions.size());
+    else if (mesh.positions.size() == 3)
+      mesh.indices = {0, 1, 2};
+    else
+      report_.fail(s.pointer(),
+                   "missing required key \"indices\" (only a single triangle of 3 positions may leave it out)");
     if (const Json* normals = s.find("normals")) {
       mesh.normals = read_vec3_list(*normals, s.pointer_of("normals"), "normals [x, y, z]");
       check_per_vertex_count(mesh.normals.size(), mesh.positions.size(), s.pointer_of("normals"));
@@ -735,7 +769,8 @@ class JsonSceneReader {
     for (size_t i = 0; i < value.size(); ++i) {
       int64_t index = read_int64(report_, value[i], child_pointer(pointer, i));
       if (index < 0 || uint64_t(index) >= vertex_count)
-        report_.fail(child_pointer(pointer, i), "index {} is out of range: the mesh has {} positions", index, vertex_count);
+        report_.fail(child_pointer(pointer, i), "index {} is out of range: the mesh has {} positions", index,
+                     vertex_count);
       indices.push_back(uint32_t(index));
     }
     return indices;
@@ -762,7 +797,8 @@ class JsonSceneReader {
   Transform read_transform(const Json& value, const std::string& pointer) const {
     check_is_array(report_, value, pointer, "transform steps such as {\"translate\": [x, y, z]}");
     Transform to_world;
-    for (size_t i = 0; i < value.size(); ++i) to_world = read_transform_step(value[i], child_pointer(pointer, i)) * to_world;
+    for (size_t i = 0; i < value.size(); ++i)
+      to_world = read_transform_step(value[i], child_pointer(pointer, i)) * to_world;
     return to_world;
   }
 
@@ -778,10 +814,14 @@ class JsonSceneReader {
     }
     Transform transform;
     std::string op_pointer = step.pointer_of(operations[0]);
-    if (operations[0] == "translate") transform = Transform::translate(step.vec3("translate"));
-    else if (operations[0] == "rotate") transform = read_rotation(step.require("rotate"), op_pointer);
-    else if (operations[0] == "scale") transform = read_scale(step.require("scale"), op_pointer);
-    else transform = read_matrix(step.require("matrix"), op_pointer);
+    if (operations[0] == "translate")
+      transform = Transform::translate(step.vec3("translate"));
+    else if (operations[0] == "rotate")
+      transform = read_rotation(step.require("rotate"), op_pointer);
+    else if (operations[0] == "scale")
+      transform = read_scale(step.require("scale"), op_pointer);
+    else
+      transform = read_matrix(step.require("matrix"), op_pointer);
     step.finish();
     return transform;
   }
@@ -824,11 +864,17 @@ class JsonSceneReader {
   void read_light(const Json& value, const std::string& pointer) {
     CheckedObject light(report_, value, pointer);
     std::string type = light.string("type");
-    if (type == "point") scene_.lights.push_back(PointLight{light.vec3("position"), light.rgb("intensity", ColorKind::Emission)});
-    else if (type == "sky") scene_.lights.push_back(read_sky(light));
-    else if (type == "sphere") scene_.shapes.push_back(read_shape_light(light, read_sphere(light)));
-    else if (type == "rectangle") scene_.shapes.push_back(read_shape_light(light, read_rectangle(light)));
-    else report_.fail(light.pointer_of("type"), "unknown light type \"{}\"; expected one of: point, sky, sphere, rectangle", type);
+    if (type == "point")
+      scene_.lights.push_back(PointLight{light.vec3("position"), light.rgb("intensity", ColorKind::Emission)});
+    else if (type == "sky")
+      scene_.lights.push_back(read_sky(light));
+    else if (type == "sphere")
+      scene_.shapes.push_back(read_shape_light(light, read_sphere(light)));
+    else if (type == "rectangle")
+      scene_.shapes.push_back(read_shape_light(light, read_rectangle(light)));
+    else
+      report_.fail(light.pointer_of("type"),
+                   "unknown light type \"{}\"; expected one of: point, sky, sphere, rectangle", type);
     light.finish();
   }
 

@@ -242,9 +242,9 @@ TEST(JsonReader, ReadsEveryMaterialType) {
 }
 
 TEST(JsonReader, InlineMaterialIsAppended) {
-  SceneDesc scene = read(with_shape(
-      R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": {"type": "mirror"}})",
-      R"({"red": {"type": "diffuse", "reflectance": [0.8, 0.1, 0.1]}})"));
+  SceneDesc scene =
+      read(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": {"type": "mirror"}})",
+                      R"({"red": {"type": "diffuse", "reflectance": [0.8, 0.1, 0.1]}})"));
   ASSERT_EQ(scene.materials.size(), 2u);
   EXPECT_EQ(scene.shapes[0].material, 1);
   EXPECT_EQ(std::get<MirrorMaterial>(scene.materials[1]).reflectance, RGB(1));
@@ -297,7 +297,8 @@ TEST(JsonReader, ShapeLightsBecomeEmittersWithOneSharedBlackMaterial) {
 // ---------------------------------------------------------------- transforms
 
 Transform transform_of(const std::string& steps) {
-  SceneDesc scene = read(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "transform": )" + steps + "}"));
+  SceneDesc scene =
+      read(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "transform": )" + steps + "}"));
   return scene.shapes[0].to_world;
 }
 
@@ -342,13 +343,15 @@ TEST(JsonReader, UnknownKeyNamesItsJsonPointer) {
       "{\"shapes\": [\n"
       "  {\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1},\n"
       "  {\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"radiuss\": 2}]}");
-  EXPECT_EQ(message, "test.json:3:56: at /shapes/1/radiuss: unknown key; expected one of: type, center, radius, "
-                     "material, emission, transform, name, reverse_orientation");
+  EXPECT_EQ(message,
+            "test.json:3:56: at /shapes/1/radiuss: unknown key; expected one of: type, center, radius, "
+            "material, emission, transform, name, reverse_orientation");
   EXPECT_NE(error_of(R"({"camera": {"fov": 40, "zoom": 2}})").find("at /camera/zoom: unknown key"), std::string::npos);
   EXPECT_NE(error_of(R"({"scene": {}})").find("at /scene: unknown key"), std::string::npos);
   EXPECT_NE(error_of(R"({"render": {"samples": 4}})").find("at /render/samples: unknown key"), std::string::npos);
-  EXPECT_NE(error_of(with_material(R"({"type": "diffuse", "albedo": 0.5})")).find("at /materials/m/albedo: unknown key"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(with_material(R"({"type": "diffuse", "albedo": 0.5})")).find("at /materials/m/albedo: unknown key"),
+      std::string::npos);
   EXPECT_NE(error_of(with_light(R"({"type": "point", "position": [0, 0, 0], "intensity": 1, "radius": 1})"))
                 .find("at /lights/0/radius: unknown key"),
             std::string::npos);
@@ -365,13 +368,13 @@ TEST(JsonReader, PointerEscapesSlashAndTildeInMaterialNames) {
 }
 
 TEST(JsonReader, DuplicateKeyIsAnError) {
-  std::string message = error_of("{\"shapes\": [{\"type\": \"sphere\", \"center\": [0, 0, 0],\n \"radius\": 1, \"radius\": 2}]}");
+  std::string message =
+      error_of("{\"shapes\": [{\"type\": \"sphere\", \"center\": [0, 0, 0],\n \"radius\": 1, \"radius\": 2}]}");
   EXPECT_NE(message.find("test.json:2:15: at /shapes/0/radius: duplicate key"), std::string::npos) << message;
 }
 
 TEST(JsonReader, WrongTypeIsAnError) {
-  std::string radius_message =
-      error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": "big"})"));
+  std::string radius_message = error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": "big"})"));
   EXPECT_NE(radius_message.find("at /shapes/0/radius: expected a number, got string"), std::string::npos)
       << radius_message;
   EXPECT_NE(error_of(with_shape(R"({"type": "sphere", "center": [0, 0], "radius": 1})"))
@@ -380,9 +383,11 @@ TEST(JsonReader, WrongTypeIsAnError) {
   EXPECT_NE(error_of(with_shape(R"({"type": "sphere", "center": [0, null, 0], "radius": 1})"))
                 .find("at /shapes/0/center/1: expected a number, got null"),
             std::string::npos);
-  EXPECT_NE(error_of(R"({"render": {"spp": 2.5}})").find("at /render/spp: expected an integer, got 2.5"), std::string::npos);
+  EXPECT_NE(error_of(R"({"render": {"spp": 2.5}})").find("at /render/spp: expected an integer, got 2.5"),
+            std::string::npos);
   EXPECT_NE(error_of(R"({"render": {"output": 3}})").find("expected a string, got number"), std::string::npos);
-  EXPECT_NE(error_of(R"({"shapes": {}})").find("at /shapes: expected an array of shapes, got object"), std::string::npos);
+  EXPECT_NE(error_of(R"({"shapes": {}})").find("at /shapes: expected an array of shapes, got object"),
+            std::string::npos);
   EXPECT_NE(error_of(R"({"materials": []})").find("at /materials: expected an object"), std::string::npos);
   EXPECT_NE(error_of(R"({"camera": 5})").find("at /camera: expected an object, got number"), std::string::npos);
   EXPECT_NE(error_of("[]").find("expected an object, got an array of 0 elements"), std::string::npos);
@@ -403,8 +408,9 @@ TEST(JsonReader, MissingRequiredKeyIsAnError) {
             std::string::npos);
   EXPECT_NE(error_of(with_shape(R"({"center": [0, 0, 0], "radius": 1})")).find("missing required key \"type\""),
             std::string::npos);
-  EXPECT_NE(error_of(with_light(R"({"type": "point", "position": [0, 0, 0]})")).find("missing required key \"intensity\""),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(with_light(R"({"type": "point", "position": [0, 0, 0]})")).find("missing required key \"intensity\""),
+      std::string::npos);
   EXPECT_NE(error_of(with_shape(R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]]})"))
                 .find("missing required key \"indices\""),
             std::string::npos);
@@ -413,7 +419,8 @@ TEST(JsonReader, MissingRequiredKeyIsAnError) {
   EXPECT_NE(error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "emission": {}})"))
                 .find("at /shapes/0/emission: missing required key \"radiance\""),
             std::string::npos);
-  EXPECT_NE(error_of(with_light(R"({"type": "sky", "ground": 1})")).find("a sky needs \"radiance\""), std::string::npos);
+  EXPECT_NE(error_of(with_light(R"({"type": "sky", "ground": 1})")).find("a sky needs \"radiance\""),
+            std::string::npos);
 }
 
 TEST(JsonReader, NonPositiveSizesAreErrors) {
@@ -428,9 +435,10 @@ TEST(JsonReader, NonPositiveSizesAreErrors) {
   EXPECT_NE(error_of(with_shape(R"({"type": "plane", "point": [0, 0, 0], "normal": [0, 0, 0]})"))
                 .find("at /shapes/0/normal: expected a non-zero vector"),
             std::string::npos);
-  EXPECT_NE(error_of(with_shape(R"({"type": "rectangle", "corner": [0, 0, 0], "edge_u": [1, 0, 0], "edge_v": [2, 0, 0]})"))
-                .find("edge_u and edge_v are parallel"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(with_shape(R"({"type": "rectangle", "corner": [0, 0, 0], "edge_u": [1, 0, 0], "edge_v": [2, 0, 0]})"))
+          .find("edge_u and edge_v are parallel"),
+      std::string::npos);
   EXPECT_NE(error_of(with_light(R"({"type": "sphere", "center": [0, 0, 0], "radius": -2, "radiance": 1})"))
                 .find("at /lights/0/radius: expected a positive number, got -2"),
             std::string::npos);
@@ -449,7 +457,8 @@ TEST(JsonReader, BadResolutionIsAnError) {
 }
 
 TEST(JsonReader, BadRenderSettingsAreErrors) {
-  EXPECT_NE(error_of(R"({"render": {"spp": 0}})").find("at /render/spp: expected an integer >= 1, got 0"), std::string::npos);
+  EXPECT_NE(error_of(R"({"render": {"spp": 0}})").find("at /render/spp: expected an integer >= 1, got 0"),
+            std::string::npos);
   EXPECT_NE(error_of(R"({"render": {"max_depth": 0}})").find("expected an integer >= 1"), std::string::npos);
   EXPECT_NE(error_of(R"({"render": {"rr_start_depth": -1}})").find("expected an integer >= 0"), std::string::npos);
   EXPECT_NE(error_of(R"({"render": {"seed": -1}})").find("expected a non-negative integer, got -1"), std::string::npos);
@@ -473,8 +482,9 @@ TEST(JsonReader, DegenerateCameraIsAnError) {
 }
 
 TEST(JsonReader, UnknownMaterialNameIsAnError) {
-  std::string message = error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "gold"})",
-                                            R"({"red": {"type": "diffuse"}, "blue": {"type": "diffuse"}})"));
+  std::string message =
+      error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "gold"})",
+                          R"({"red": {"type": "diffuse"}, "blue": {"type": "diffuse"}})"));
   EXPECT_NE(message.find("at /shapes/0/material: unknown material \"gold\"; defined: blue, red"), std::string::npos)
       << message;
   EXPECT_NE(error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "gold"})"))
@@ -483,12 +493,14 @@ TEST(JsonReader, UnknownMaterialNameIsAnError) {
 }
 
 TEST(JsonReader, UnknownTypesAreErrors) {
-  EXPECT_NE(error_of(with_shape(R"({"type": "torus"})"))
-                .find("at /shapes/0/type: unknown shape type \"torus\"; expected one of: sphere, plane, box, rectangle, mesh"),
-            std::string::npos);
-  EXPECT_NE(error_of(with_material(R"({"type": "velvet"})"))
-                .find("at /materials/m/type: unknown material type \"velvet\""),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(with_shape(R"({"type": "torus"})"))
+          .find(
+              "at /shapes/0/type: unknown shape type \"torus\"; expected one of: sphere, plane, box, rectangle, mesh"),
+      std::string::npos);
+  EXPECT_NE(
+      error_of(with_material(R"({"type": "velvet"})")).find("at /materials/m/type: unknown material type \"velvet\""),
+      std::string::npos);
   EXPECT_NE(error_of(with_light(R"({"type": "spot"})")).find("at /lights/0/type: unknown light type \"spot\""),
             std::string::npos);
 }
@@ -515,26 +527,31 @@ TEST(JsonReader, BadMaterialValuesAreErrors) {
 }
 
 TEST(JsonReader, BadMeshDataIsAnError) {
-  std::string out_of_range = error_of(with_shape(
-      R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [0, 1, 3]})"));
+  std::string out_of_range =
+      error_of(with_shape(R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [0, 1, 3]})"));
   EXPECT_NE(out_of_range.find("at /shapes/0/indices/2: index 3 is out of range: the mesh has 3 positions"),
             std::string::npos)
       << out_of_range;
-  EXPECT_NE(error_of(with_shape(R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [0, -1, 2]})"))
-                .find("index -1 is out of range"),
-            std::string::npos);
-  EXPECT_NE(error_of(with_shape(R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [0, 1]})"))
-                .find("expected a non-zero multiple of 3 indices"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(with_shape(R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [0, -1, 2]})"))
+          .find("index -1 is out of range"),
+      std::string::npos);
+  EXPECT_NE(
+      error_of(with_shape(R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [0, 1]})"))
+          .find("expected a non-zero multiple of 3 indices"),
+      std::string::npos);
   EXPECT_NE(error_of(with_shape(R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0]]})"))
                 .find("a mesh needs at least 3 positions"),
             std::string::npos);
-  EXPECT_NE(error_of(with_shape(R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "normals": [[0, 0, 1]]})"))
+  EXPECT_NE(error_of(with_shape(
+                         R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "normals": [[0, 0, 1]]})"))
                 .find("at /shapes/0/normals: expected one entry per position (3), got 1"),
             std::string::npos);
-  EXPECT_NE(error_of(with_shape(R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "uvs": [[0, 0], [1, 0], [0]]})"))
-                .find("at /shapes/0/uvs/2: expected an array of 2 numbers"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(with_shape(
+                   R"({"type": "mesh", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "uvs": [[0, 0], [1, 0], [0]]})"))
+          .find("at /shapes/0/uvs/2: expected an array of 2 numbers"),
+      std::string::npos);
   EXPECT_NE(error_of(with_shape(R"({"type": "mesh", "file": "a.obj", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]]})"))
                 .find("either \"file\" or inline \"positions\", not both"),
             std::string::npos);
@@ -553,12 +570,14 @@ TEST(JsonReader, BadTransformsAreErrors) {
   auto transform_error = [](const std::string& steps) {
     return error_of(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "transform": )" + steps + "}"));
   };
-  EXPECT_NE(transform_error(R"([{"scale": [1, 0, 1]}])").find("at /shapes/0/transform/0/scale: scale factors must be non-zero"),
+  EXPECT_NE(transform_error(R"([{"scale": [1, 0, 1]}])")
+                .find("at /shapes/0/transform/0/scale: scale factors must be non-zero"),
             std::string::npos);
-  EXPECT_NE(transform_error(R"([{"translate": [1, 0, 0], "scale": 2}])")
-                .find("at /shapes/0/transform/0: a transform step needs exactly one of: translate, rotate, scale, matrix; "
-                      "got translate, scale"),
-            std::string::npos);
+  EXPECT_NE(
+      transform_error(R"([{"translate": [1, 0, 0], "scale": 2}])")
+          .find("at /shapes/0/transform/0: a transform step needs exactly one of: translate, rotate, scale, matrix; "
+                "got translate, scale"),
+      std::string::npos);
   EXPECT_NE(transform_error(R"([{"translat": [1, 0, 0]}])").find("at /shapes/0/transform/0/translat: unknown key"),
             std::string::npos);
   EXPECT_NE(transform_error(R"([{}])").find("needs exactly one of"), std::string::npos);
@@ -642,7 +661,6 @@ TEST(JsonReader, ReadsTheRoomScene) {
   EXPECT_TRUE(has_light);
   EXPECT_EQ(scene.settings.spp, 64);
 }
-
 
 // Keeps docs/scene-format.md honest: each of its json blocks is a complete scene that reads.
 TEST(JsonReader, EveryExampleInTheFormatDocumentReads) {

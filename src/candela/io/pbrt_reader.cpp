@@ -344,8 +344,10 @@ class ParamList {
       if (p.used) continue;
       std::string known;
       for (const std::string& name : queried_) known += (known.empty() ? "" : ", ") + name;
-      if (known.empty()) throw_scene_error(p.where, "{}: unused parameter {} (it takes no parameters)", owner_, p.declaration());
-      throw_scene_error(p.where, "{}: unused parameter {} (parameters read here: {})", owner_, p.declaration(), known);
+      if (known.empty())
+        throw_scene_error(p.where, "{}: unused parameter {} (it takes no parameters)", owner_, p.declaration());
+      throw_scene_error(p.where, "{}: unused parameter {} (parameters read here: {})", owner_, p.declaration(),
+                        known);
     }
   }
 
@@ -599,7 +601,8 @@ std::string read_file_text(const fs::path& file, const SourceLocation& where) {
 SourceLocation PbrtParser::parse_file(const fs::path& file, const SourceLocation* included_from) {
   SourceLocation blame = included_from ? *included_from : location(file.string(), 0, 0);
   if (!included_from && !fs::is_regular_file(file)) throw_scene_error(blame, "no such scene file");
-  if (open_files_.size() >= kMaxIncludeDepth) throw_scene_error(blame, "files are included more than {} deep", kMaxIncludeDepth);
+  if (open_files_.size() >= kMaxIncludeDepth)
+    throw_scene_error(blame, "files are included more than {} deep", kMaxIncludeDepth);
   std::error_code error;
   fs::path canonical = fs::weakly_canonical(file, error);
   if (error) canonical = fs::absolute(file).lexically_normal();
@@ -1071,7 +1074,8 @@ void PbrtParser::named_material(const Token& d) {
   Token name = expect_string(d, "the material name");
   auto named = named_materials_.find(name.text);
   if (named == named_materials_.end())
-    throw_scene_error(at(name), "NamedMaterial: no material named \"{}\" is defined (MakeNamedMaterial must come first)",
+    throw_scene_error(at(name),
+                      "NamedMaterial: no material named \"{}\" is defined (MakeNamedMaterial must come first)",
                       name.text);
   state_.material = named->second.first;
 }
@@ -1099,7 +1103,8 @@ void PbrtParser::light_source(const Token& d) {
   } else if (type.text == "infinite") {
     if (params.has("filename")) params.fail("filename", "names an image: environment maps are not supported yet");
     if (params.has("portal")) params.fail("portal", "is not supported yet");
-    if (params.has("illuminance")) params.fail("illuminance", "is not supported yet; give \"rgb L\" and \"float scale\"");
+    if (params.has("illuminance"))
+      params.fail("illuminance", "is not supported yet; give \"rgb L\" and \"float scale\"");
     RGB radiance = params.get_rgb("L", RGB(1.0f), false);
     radiance = read_emission_scale(params, "L", radiance);
     params.reject_unused();
@@ -1179,7 +1184,8 @@ void PbrtParser::add_shape(ShapeDesc shape, const Token& directive) {
     return;
   }
   if (shape.emission)
-    throw_scene_error(at(directive), "Shape inside ObjectBegin \"{}\": area lights in object instances are not supported",
+    throw_scene_error(at(directive),
+                      "Shape inside ObjectBegin \"{}\": area lights in object instances are not supported",
                       open_object_->name);
   open_object_->shapes.push_back(std::move(shape));
 }
@@ -1281,7 +1287,8 @@ void PbrtParser::unsupported(const Token& d) {
 }
 
 void PbrtParser::world_end(const Token& d) {
-  throw_scene_error(at(d), "WorldEnd is pbrt-v3 syntax; pbrt-v4 files simply end (\"pbrt --upgrade\" converts old files)");
+  throw_scene_error(at(d),
+                    "WorldEnd is pbrt-v3 syntax; pbrt-v4 files simply end (\"pbrt --upgrade\" converts old files)");
 }
 
 }  // namespace

@@ -175,7 +175,8 @@ TEST(PbrtReader, SceneWithOnlyWorldBeginGetsTheDefaults) {
 
 TEST(PbrtReader, KeepsOtherIntegratorNamesAndStratifiedSampleCounts) {
   SceneDesc scene = read_lines({"Integrator \"bdpt\" \"integer maxdepth\" 7",
-                                "Sampler \"stratified\" \"integer xsamples\" 3 \"integer ysamples\" 5 \"bool jitter\" false",
+                                "Sampler \"stratified\" \"integer xsamples\" 3 \"integer ysamples\" 5 "
+                                "\"bool jitter\" false",
                                 "WorldBegin"});
   EXPECT_EQ(scene.settings.integrator, "bdpt");
   EXPECT_EQ(scene.settings.max_depth, 7);
@@ -287,7 +288,8 @@ TEST(PbrtReader, ReadsDiffuseAndSmoothDielectricMaterials) {
   SceneDesc scene = read_lines({"WorldBegin",
                                 "Material \"dielectric\" \"float eta\" 1.33 \"float roughness\" 0",
                                 "Shape \"sphere\"",
-                                "MakeNamedMaterial \"paint\" \"string type\" \"diffuse\" \"color reflectance\" [ 0.2 0.3 0.4 ]",
+                                "MakeNamedMaterial \"paint\" \"string type\" \"diffuse\" "
+                                "\"color reflectance\" [ 0.2 0.3 0.4 ]",
                                 "Shape \"sphere\"",
                                 "NamedMaterial \"paint\"",
                                 "Shape \"sphere\""});
@@ -299,7 +301,8 @@ TEST(PbrtReader, ReadsDiffuseAndSmoothDielectricMaterials) {
 
 TEST(PbrtReader, PointLightIsPlacedByTheTransform) {
   SceneDesc scene = read_lines({"WorldBegin", "Translate 1 0 0",
-                                "LightSource \"point\" \"rgb I\" [ 1 2 3 ] \"point3 from\" [ 0 1 0 ] \"float scale\" 2"});
+                                "LightSource \"point\" \"rgb I\" [ 1 2 3 ] \"point3 from\" [ 0 1 0 ] "
+                                "\"float scale\" 2"});
   const auto& light = std::get<PointLight>(scene.lights.at(0));
   expect_near(light.position, Point3(1, 1, 0));
   EXPECT_EQ(light.intensity, RGB(2, 4, 6));
@@ -315,7 +318,8 @@ TEST(PbrtReader, InfiniteLightIsAConstantSky) {
 TEST(PbrtReader, AreaLightScaleAndTwoSided) {
   SceneDesc scene = read_lines({"WorldBegin",
                                 "AttributeBegin",
-                                "AreaLightSource \"diffuse\" \"rgb L\" [ 1 1 2 ] \"float scale\" 3 \"bool twosided\" true",
+                                "AreaLightSource \"diffuse\" \"rgb L\" [ 1 1 2 ] \"float scale\" 3 "
+                                "\"bool twosided\" true",
                                 "Shape \"sphere\"",
                                 "AttributeEnd"});
   ASSERT_TRUE(scene.shapes.at(0).emission.has_value());
@@ -411,7 +415,8 @@ TEST(PbrtReader, ImportedGraphicsStateDoesNotLeak) {
 }
 
 TEST(PbrtReader, MissingIncludeFile) {
-  expect_error({"WorldBegin", "Include \"no/such/file.pbrt\""}, 2, "\"no/such", "Include: cannot find \"no/such/file.pbrt\"");
+  expect_error({"WorldBegin", "Include \"no/such/file.pbrt\""}, 2, "\"no/such",
+               "Include: cannot find \"no/such/file.pbrt\"");
 }
 
 TEST(PbrtReader, MissingPlyFile) {
@@ -497,14 +502,17 @@ TEST(PbrtReader, WrongNumberOfValues) {
 }
 
 TEST(PbrtReader, ValuesThatDoNotMatchTheDeclaredType) {
-  expect_error({"Sampler \"halton\" \"integer pixelsamples\" 1.5", "WorldBegin"}, 1, "1.5", "expects integers, got 1.5");
-  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" \"big\""}, 2, "\"big\"", "expects numbers, got \"big\"");
+  expect_error({"Sampler \"halton\" \"integer pixelsamples\" 1.5", "WorldBegin"}, 1, "1.5",
+               "expects integers, got 1.5");
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" \"big\""}, 2, "\"big\"",
+               "expects numbers, got \"big\"");
   expect_error({"Film \"rgb\" \"string filename\" out.exr", "WorldBegin"}, 1, "out.exr", "expects quoted strings");
   expect_error({"WorldBegin", "AreaLightSource \"diffuse\" \"bool twosided\" 1"}, 2, "1", "expects true or false");
 }
 
 TEST(PbrtReader, MalformedParameterDeclarations) {
-  expect_error({"Camera \"perspective\" \"floot fov\" 30", "WorldBegin"}, 1, "\"floot", "unknown parameter type \"floot\"");
+  expect_error({"Camera \"perspective\" \"floot fov\" 30", "WorldBegin"}, 1, "\"floot",
+               "unknown parameter type \"floot\"");
   expect_error({"Camera \"perspective\" \"fov\" 30", "WorldBegin"}, 1, "\"fov\"", "declared as \"type name\"");
   expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" [ ]"}, 2, "\"float radius\"", "has no values");
   expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" [ 1"}, 2, "[", "never closed");
@@ -550,8 +558,9 @@ TEST(PbrtReader, BadTriangleIndices) {
                "\"integer indices\"", "not a multiple of 3");
   expect_error({"WorldBegin", "Shape \"trianglemesh\" " + points}, 2, "Shape", "\"indices\" is required");
   expect_error({"WorldBegin", "Shape \"trianglemesh\""}, 2, "Shape", "\"P\" is required");
-  expect_error({"WorldBegin", "Shape \"trianglemesh\" " + points + " \"integer indices\" [ 0 1 2 ] \"normal N\" [ 0 0 1 ]"},
-               2, "\"normal N\"", "one normal per point");
+  const std::string one_triangle = " \"integer indices\" [ 0 1 2 ] \"normal N\" [ 0 0 1 ]";
+  expect_error({"WorldBegin", "Shape \"trianglemesh\" " + points + one_triangle}, 2, "\"normal N\"",
+               "one normal per point");
 }
 
 TEST(PbrtReader, BadResolution) {
@@ -614,7 +623,8 @@ TEST(PbrtReader, UnbalancedAttributeBlocks) {
   expect_error({"WorldBegin", "AttributeEnd"}, 2, "AttributeEnd", "AttributeEnd without a matching AttributeBegin");
   expect_error({"WorldBegin", "AttributeBegin", "Shape \"sphere\""}, 2, "AttributeBegin",
                "AttributeBegin is never closed");
-  expect_error({"WorldBegin", "ObjectBegin \"o\"", "AttributeEnd"}, 3, "AttributeEnd", "does not match the open ObjectBegin");
+  expect_error({"WorldBegin", "ObjectBegin \"o\"", "AttributeEnd"}, 3, "AttributeEnd",
+               "does not match the open ObjectBegin");
   expect_error({"WorldBegin", "ObjectEnd"}, 2, "ObjectEnd", "without a matching ObjectBegin");
 }
 

@@ -1,4 +1,6 @@
 // read_scene_file: picks the reader by the file's extension.
+#include "candela/io/scene_reader.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -9,7 +11,6 @@
 #include <system_error>
 
 #include "candela/io/error.h"
-#include "candela/io/scene_reader.h"
 
 namespace candela {
 namespace {
@@ -48,8 +49,10 @@ SceneDesc read_scene_file(const std::filesystem::path& file) {
   check_is_readable_file(file);
   std::string extension = lowercase_extension(file);
   SceneDesc scene;
-  if (extension == ".json") scene = read_json_scene(read_text_file(file), file.string(), file.parent_path());
-  else if (extension == ".pbrt") scene = read_pbrt_scene(file);
+  if (extension == ".json")
+    scene = read_json_scene(read_text_file(file), file.string(), file.parent_path());
+  else if (extension == ".pbrt")
+    scene = read_pbrt_scene(file);
   else
     throw_scene_error(location_of_file(file), "unsupported scene file extension {}; supported: .json, .pbrt",
                       extension.empty() ? std::string("(none)") : "\"" + extension + "\"");

@@ -61,7 +61,7 @@ double chi_square_p_value(const std::vector<double>& observed, const std::vector
 
 double spherical_chi_square_p_value(const std::function<Vec3(Vec2)>& sample,
                                     const std::function<float(const Vec3&)>& pdf, int samples, uint64_t seed,
-                                    float z_min, int theta_bins, int phi_bins) {
+                                    float z_min, int theta_bins, int phi_bins, int integration_resolution) {
   const size_t below_cell = size_t(theta_bins * phi_bins);
   const double z_range = 1.0 - z_min;
   auto cell_of = [&](const Vec3& w) -> size_t {
@@ -97,7 +97,7 @@ double spherical_chi_square_p_value(const std::function<Vec3(Vec2)>& sample,
     for (int pi = 0; pi < phi_bins; ++pi)
       expected[size_t(ti * phi_bins + pi)] =
           samples * integrate(z_min + z_range * ti / theta_bins, z_min + z_range * (ti + 1) / theta_bins,
-                              2 * kPi * pi / phi_bins, 2 * kPi * (pi + 1) / phi_bins, 12);
+                              2 * kPi * pi / phi_bins, 2 * kPi * (pi + 1) / phi_bins, integration_resolution);
   if (z_min > -1) expected[below_cell] = samples * integrate(-1, z_min, 0, 2 * kPi, 200);
   return chi_square_p_value(observed, expected);
 }

@@ -14,10 +14,12 @@ double chi_square_p_value(const std::vector<double>& observed, const std::vector
 
 // Draws `samples` directions from `sample(u)` (u uniform on [0,1)^2, seeded by `seed`), bins them
 // on a grid uniform in cos(theta) over [z_min, 1] and in phi (directions with z < z_min share one
-// extra cell, so narrow lobes can be resolved), and compares with the pdf integrated numerically per cell.
+// extra cell, so narrow lobes can be resolved), and compares with the pdf integrated numerically per cell
+// (midpoint rule on integration_resolution^2 points: raise it for pdfs with sharp edges).
 double spherical_chi_square_p_value(const std::function<Vec3(Vec2)>& sample,
                                     const std::function<float(const Vec3&)>& pdf, int samples, uint64_t seed,
-                                    float z_min = -1, int theta_bins = 20, int phi_bins = 40);
+                                    float z_min = -1, int theta_bins = 20, int phi_bins = 40,
+                                    int integration_resolution = 12);
 
 // Regularised upper incomplete gamma Q(a, x): the chi-square survival function is Q(k/2, x/2).
 double gamma_q(double a, double x);

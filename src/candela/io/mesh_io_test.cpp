@@ -1,0 +1,464 @@
+#include "candela/io/mesh_io.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace candela {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kShared = fs::path(CANDELA_SHARED_DIR) / "meshes";
+const fs::path kTestData = fs::path(CANDELA_SOURCE_DIR) / "tests" / "data" / "meshes";
+
+const SourceLocation kWhere{"scene.json", 0, 0, "/shapes/2/file"};
+
+TriangleMesh load(const fs::path& file) { return load_mesh_file(file, kWhere); }
+
+// The message of the SceneError that loading `file` throws; fails the test if nothing is thrown.
+std::string load_error(const fs::path& file) {
+  try {
+    load(file);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "loading " << file << " did not throw";
+  return "";
+}
+
+void expect_error_mentions(const fs::path& file, const std::vector<std::string>& parts) {
+  const std::string message = load_error(file);
+  EXPECT_EQ(message.rfind("scene.json: at /shapes/2/file: cannot read mesh '" + file.string() + "'", 0), 0u)
+      << message;
+  for (const std::string& part : parts) EXPECT_NE(message.find(part), std::string::npos) << message;
+}
+
+Bounds3 bounds_of(const TriangleMesh& mesh) {
+  Bounds3 bounds;
+  for (const Point3& p : mesh.positions) bounds.extend(p);
+  return bounds;
+}
+
+void expect_bounds_near(const TriangleMesh& mesh, Vec3 lo, Vec3 hi, float tolerance = 1e-4f) {
+  const Bounds3 bounds = bounds_of(mesh);
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_NEAR(bounds.lo[axis], lo[axis], tolerance) << "axis " << axis;
+    EXPECT_NEAR(bounds.hi[axis], hi[axis], tolerance) << "axis " << axis;
+  }
+}
+
+double surface_area(const TriangleMesh& mesh) {
+  double area = 0;
+  for (size_t i = 0; i < mesh.indices.size(); i += 3) {
+    const Point3& a = mesh.positions[mesh.indices[i]];
+    const Point3& b = mesh.positions[mesh.indices[i + 1]];
+    const Point3& c = mesh.positions[mesh.indices[i + 2]];
+    area += 0.5 * length(cross(b - a, c - a));
+  }
+  return area;
+}
+
+// The triangles as position triples, each rotated to start at its smallest corner (winding kept) and
+// sorted, so meshes that index the same triangles differently compare equal.
+using PositionTriangle = std::array<std::array<float, 3>, 3>;
+std::vector<PositionTriangle> triangle_set(const TriangleMesh& mesh) {
+  std::vector<PositionTriangle> triangles;
+  for (size_t i = 0; i < mesh.indices.size(); i += 3) {
+    PositionTriangle t;
+    for (int k = 0; k < 3; ++k) {
+      const Point3& p = mesh.positions[mesh.indices[i + k]];
+      t[k] = {p.x, p.y, p.z};
+    }
+    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+    triangles.push_back(t);
+  }
+  std::sort(triangles.begin(), triangles.end());
+  return triangles;
+}
+
+// What every loaded mesh must satisfy, whatever the file.
+void expect_well_formed(const TriangleMesh& mesh) {
+  ASSERT_EQ(mesh.indices.size() % 3, 0u);
+  EXPECT_GT(mesh.triangle_count(), 0u);
+  EXPECT_TRUE(mesh.normals.empty() || mesh.normals.size() == mesh.positions.size());
+  EXPECT_TRUE(mesh.uvs.empty() || mesh.uvs.size() == mesh.positions.size());
+  for (uint32_t index : mesh.indices) ASSERT_LT(index, mesh.positions.size());
+  for (const Point3& p : mesh.positions) ASSERT_TRUE(is_finite(p));
+}
+
+// A scratch directory per test for files written on the fly.
+class MeshIoFiles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() / ("candela_mesh_io_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path write(const std::string& name, const std::string& contents) const {
+    const fs::path file = dir_ / name;
+    std::ofstream(file, std::ios::binary) << contents;
+    return file;
+  }
+  static std::string read(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }
+
+  fs::path dir_;
+};
+
+const std::string kPlyTriangleHeader =
+    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+    "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+
+// ---------------------------------------------------------------- OBJ files of the shared meshes
+
+TEST(MeshIo, SpotObjHasAllTrianglesWithUvs) {
+  const TriangleMesh spot = load(kShared / "spot" / "spot.obj");
+  expect_well_formed(spot);
+  EXPECT_EQ(spot.triangle_count(), 5856u);
+  EXPECT_EQ(spot.uvs.size(), spot.positions.size());
+  EXPECT_TRUE(spot.normals.empty());
+  // 2,930 positions and 3,225 uvs: vertices on uv seams are split, the rest stay shared.
+  EXPECT_EQ(spot.positions.size(), 3225u);
+  for (const Vec2& uv : spot.uvs) {
+    EXPECT_TRUE(uv.x >= 0 && uv.x <= 1 && uv.y >= 0 && uv.y <= 1) << uv.x << " " << uv.y;
+  }
+  expect_bounds_near(spot, {-0.471552f, -0.736784f, -0.668909f}, {0.471552f, 0.953646f, 1.049f});
+}
+
+TEST(MeshIo, SpotQuadrangulatedObjGivesTheSameTriangleCount) {
+  const TriangleMesh quads = load(kShared / "spot" / "spot" / "spot_quadrangulated.obj");
+  const TriangleMesh triangles = load(kShared / "spot" / "spot" / "spot_triangulated.obj");
+  EXPECT_EQ(quads.triangle_count(), 5856u);
+  EXPECT_EQ(triangles.triangle_count(), 5856u);
+  EXPECT_NEAR(surface_area(quads), surface_area(triangles), 1e-3 * surface_area(triangles));
+}
+
+TEST(MeshIo, TeapotObjKeepsSharedVertices) {
+  const TriangleMesh teapot = load(kShared / "teapot" / "teapot.obj");
+  expect_well_formed(teapot);
+  EXPECT_EQ(teapot.triangle_count(), 6320u);
+  EXPECT_EQ(teapot.positions.size(), 3644u);  // one vertex per 'v' line: nothing duplicated
+  EXPECT_TRUE(teapot.normals.empty());
+  EXPECT_TRUE(teapot.uvs.empty());
+  expect_bounds_near(teapot, {-3, 0, -2}, {3.434f, 3.15f, 2});
+}
+
+// ---------------------------------------------------------------- PLY files of the shared meshes
+
+TEST(MeshIo, StanfordBunnyPly) {
+  const TriangleMesh bunny = load(kShared / "bunny" / "stanford-original" / "bun_zipper.ply");
+  expect_well_formed(bunny);
+  EXPECT_EQ(bunny.triangle_count(), 69451u);
+  EXPECT_EQ(bunny.positions.size(), 35947u);
+  EXPECT_TRUE(bunny.normals.empty());  // none in the file, and none are made up
+  EXPECT_TRUE(bunny.uvs.empty());
+  expect_bounds_near(bunny, {-0.0946899f, 0.0329874f, -0.0618736f}, {0.0610091f, 0.187321f, 0.0587997f}, 1e-6f);
+}
+
+TEST(MeshIo, StanfordBunnyLowResolutionPly) {
+  const TriangleMesh bunny = load(kShared / "bunny" / "stanford-original" / "bun_zipper_res4.ply");
+  expect_well_formed(bunny);
+  EXPECT_EQ(bunny.triangle_count(), 948u);
+  EXPECT_EQ(bunny.positions.size(), 453u);
+  expect_bounds_near(bunny, {-0.0931466f, 0.0336204f, -0.056644f}, {0.0581591f, 0.181897f, 0.0578008f}, 1e-6f);
+}
+
+TEST(MeshIo, BunnyObjAndPlyHoldTheSameSurface) {
+  const TriangleMesh ply = load(kShared / "bunny" / "stanford-original" / "bun_zipper.ply");
+  const TriangleMesh obj = load(kShared / "bunny" / "stanford-bunny.obj");
+  EXPECT_EQ(obj.triangle_count(), ply.triangle_count());
+  EXPECT_NEAR(surface_area(obj), surface_area(ply), 1e-4 * surface_area(ply));
+  const Bounds3 a = bounds_of(obj), b = bounds_of(ply);
+  EXPECT_LT(length(a.lo - b.lo) + length(a.hi - b.hi), 1e-5f);
+}
+
+TEST(MeshIo, DragonPlyHasNormals) {
+  const TriangleMesh dragon = load(kShared / "dragon" / "dragon_100k.ply");
+  expect_well_formed(dragon);
+  EXPECT_EQ(dragon.triangle_count(), 100000u);
+  EXPECT_EQ(dragon.positions.size(), 50000u);
+  ASSERT_EQ(dragon.normals.size(), dragon.positions.size());
+  for (const Normal3& n : dragon.normals) ASSERT_NEAR(length(n), 1.0f, 1e-3f);
+  EXPECT_TRUE(dragon.uvs.empty());
+  expect_bounds_near(dragon, {-1.35294f, -0.954207f, -0.605046f}, {1.35294f, 0.954207f, 0.605046f});
+}
+
+// ---------------------------------------------------------------- Assimp's PLY test files
+
+TEST(MeshIo, AsciiAndBinaryPlyGiveTheSameTriangles) {
+  const TriangleMesh ascii = load(kShared / "ply-tests" / "cube.ply");  // quads
+  const TriangleMesh binary = load(kShared / "ply-tests" / "cube_binary.ply");  // triangles
+  expect_well_formed(ascii);
+  expect_well_formed(binary);
+  EXPECT_EQ(ascii.triangle_count(), 12u);
+  EXPECT_EQ(binary.triangle_count(), 12u);
+  EXPECT_EQ(triangle_set(ascii), triangle_set(binary));
+}
+
+TEST(MeshIo, PlyQuadsBecomeTwoTrianglesEach) {
+  const TriangleMesh cube = load(kShared / "ply-tests" / "cube.ply");
+  EXPECT_EQ(cube.triangle_count(), 2u * 6u);
+  EXPECT_EQ(cube.positions.size(), 8u);
+  EXPECT_NEAR(surface_area(cube), 6.0, 1e-6);
+  expect_bounds_near(cube, {0, 0, 0}, {1, 1, 1}, 0);
+}
+
+TEST(MeshIo, PlyUvsAndNormalsAreRead) {
+  const TriangleMesh cube = load(kShared / "ply-tests" / "cube_uv.ply");
+  expect_well_formed(cube);
+  EXPECT_EQ(cube.triangle_count(), 12u);
+  ASSERT_EQ(cube.positions.size(), 24u);
+  ASSERT_EQ(cube.uvs.size(), 24u);
+  ASSERT_EQ(cube.normals.size(), 24u);
+  // The first vertices as written in the file: u, v = s, t, not flipped.
+  EXPECT_EQ(cube.positions[0], Vec3(1, 1, -1));
+  EXPECT_EQ(cube.normals[0], Vec3(0, 0, -1));
+  EXPECT_EQ(cube.uvs[0].x, 0.0f);
+  EXPECT_EQ(cube.uvs[0].y, 0.0f);
+  EXPECT_EQ(cube.uvs[2].x, 1.0f);
+  EXPECT_EQ(cube.uvs[2].y, 1.0f);
+  EXPECT_NEAR(surface_area(cube), 24.0, 1e-4);
+
+  const TriangleMesh wuson = load(kShared / "ply-tests" / "Wuson.ply");
+  expect_well_formed(wuson);
+  EXPECT_EQ(wuson.triangle_count(), 3732u);
+  EXPECT_EQ(wuson.uvs.size(), wuson.positions.size());
+  EXPECT_EQ(wuson.normals.size(), wuson.positions.size());
+}
+
+TEST(MeshIo, PlyColoursAreIgnored) {
+  const TriangleMesh triangle = load(kShared / "ply-tests" / "float-color.ply");
+  ASSERT_EQ(triangle.triangle_count(), 1u);
+  ASSERT_EQ(triangle.positions.size(), 3u);
+  EXPECT_EQ(triangle.positions[triangle.indices[0]], Vec3(0, 0, 0));
+  EXPECT_EQ(triangle.positions[triangle.indices[1]], Vec3(100, 0, 0));
+  EXPECT_EQ(triangle.positions[triangle.indices[2]], Vec3(200, 200, 0));
+  EXPECT_TRUE(triangle.normals.empty());
+  EXPECT_TRUE(triangle.uvs.empty());
+}
+
+TEST(MeshIo, PlyPointCloudHasNoTriangles) {
+  expect_error_mentions(kShared / "ply-tests" / "points.ply", {"no triangles", "4 'vertex'"});
+}
+
+TEST(MeshIo, TruncatedPlyIsAnError) {
+  // pond.0.ply declares 70,051 vertices of 31 bytes but holds 69 bytes less than that.
+  expect_error_mentions(kShared / "ply-tests" / "pond.0.ply", {"truncated PLY", "70048 of the 70051 'vertex'"});
+}
+
+TEST(MeshIo, MalformedPlyIsAnError) {
+  // issue623.ply declares a list property on its vertices that the vertex lines do not hold.
+  expect_error_mentions(kShared / "ply-tests" / "issue623.ply", {"malformed PLY", "line 13", "'vertex'"});
+}
+
+// ---------------------------------------------------------------- OBJ test data of this repository
+
+TEST(MeshIo, ObjQuadsWithNormalsAndUvs) {
+  const TriangleMesh cube = load(kTestData / "cube_quads_normals.obj");  // its .mtl is missing
+  expect_well_formed(cube);
+  EXPECT_EQ(cube.triangle_count(), 12u);  // both objects of the file, in one mesh
+  // Each corner differs from the others in normal or uv: 6 faces x 4 corners.
+  ASSERT_EQ(cube.positions.size(), 24u);
+  ASSERT_EQ(cube.normals.size(), 24u);
+  ASSERT_EQ(cube.uvs.size(), 24u);
+  EXPECT_NEAR(surface_area(cube), 6.0, 1e-6);
+  expect_bounds_near(cube, {0, 0, 0}, {1, 1, 1}, 0);
+  // Winding and normals agree: counter-clockwise seen from outside.
+  for (size_t i = 0; i < cube.indices.size(); i += 3) {
+    const Point3& a = cube.positions[cube.indices[i]];
+    const Vec3 geometric = normalize(cross(cube.positions[cube.indices[i + 1]] - a, cube.positions[cube.indices[i + 2]] - a));
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(dot(geometric, cube.normals[cube.indices[i + k]]), 1.0f, 1e-6f);
+  }
+}
+
+TEST(MeshIo, MalformedObjIsAnError) {
+  expect_error_mentions(kTestData / "malformed.obj", {"malformed OBJ", "line 5"});
+}
+
+TEST(MeshIo, ObjIndexOutOfRangeIsAnError) {
+  expect_error_mentions(kTestData / "index_out_of_range.obj", {"malformed OBJ", "face 2", "vertex 9", "4 of them"});
+}
+
+// ---------------------------------------------------------------- OBJ cases written on the fly
+
+TEST_F(MeshIoFiles, ObjPolygonsAreTriangulated) {
+  const TriangleMesh pentagon = load(write("pentagon.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0.5 1.5 0\nv 0 1 0\nf 1 2 3 4 5\n"));
+  EXPECT_EQ(pentagon.triangle_count(), 3u);
+  EXPECT_EQ(pentagon.positions.size(), 5u);
+  EXPECT_NEAR(surface_area(pentagon), 1.25, 1e-6);
+}
+
+TEST_F(MeshIoFiles, ObjNormalsOnSomeCornersOnlyAreDropped) {
+  const TriangleMesh mesh =
+      load(write("mixed.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\nf 2 4 3\n"));
+  EXPECT_EQ(mesh.triangle_count(), 2u);
+  EXPECT_TRUE(mesh.normals.empty());
+  EXPECT_EQ(mesh.positions.size(), 4u);  // dropped normals do not split the shared vertices
+}
+
+TEST_F(MeshIoFiles, ObjRelativeIndicesWork) {
+  const TriangleMesh mesh = load(write("relative.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n"));
+  ASSERT_EQ(mesh.triangle_count(), 1u);
+  EXPECT_EQ(mesh.positions[mesh.indices[1]], Vec3(1, 0, 0));
+}
+
+TEST_F(MeshIoFiles, ObjIndicesOutOfRangeAreAnError) {
+  expect_error_mentions(write("before_first.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -5 1 2\n"),
+                        {"malformed OBJ", "before the first one"});
+  // tinyobjloader drops such a quad with only a warning.
+  expect_error_mentions(write("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 7\n"),
+                        {"malformed OBJ", "out of bounds"});
+  expect_error_mentions(write("uv.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n"),
+                        {"texture coordinate 2"});
+  expect_error_mentions(write("normal.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//3\n"),
+                        {"normal 3"});
+}
+
+TEST_F(MeshIoFiles, ObjNonFiniteCoordinatesAreAnError) {
+  expect_error_mentions(write("nan.obj", "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n"), {"line 2", "'nan'"});
+  expect_error_mentions(write("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 -inf 0\nf 1 2 3\n"), {"line 3", "'-inf'"});
+  expect_error_mentions(write("overflow.obj", "v 0 0 0\nv 1e999 0 0\nv 0 1 0\nf 1 2 3\n"),
+                        {"non-finite position"});
+  expect_error_mentions(write("normal.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 NaN\nf 1//1 2//1 3//1\n"),
+                        {"'NaN'"});
+}
+
+TEST_F(MeshIoFiles, ObjWithoutFacesIsAnError) {
+  expect_error_mentions(write("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\np 1 2 3\nl 1 2\n"), {"no triangles"});
+  expect_error_mentions(write("empty.obj", ""), {"no triangles"});
+  expect_error_mentions(write("binary.obj", std::string("\x7f" "ELF\x02\x01\x01\0\0\0", 10)), {"no triangles"});
+}
+
+// ---------------------------------------------------------------- PLY cases written on the fly
+
+TEST_F(MeshIoFiles, BigEndianPlyGivesTheSameTriangles) {
+  // cube_binary.ply rewritten big-endian: 8 vertices of 3 floats, 12 faces of a uchar and 3 ints.
+  const std::string little = read(kShared / "ply-tests" / "cube_binary.ply");
+  const size_t data = little.find("end_header\n") + 11;
+  std::string big = little.substr(0, data);
+  big.replace(big.find("binary_little_endian"), 20, "binary_big_endian");
+  const auto append_reversed = [&](size_t at, size_t bytes) {
+    for (size_t k = bytes; k-- > 0;) big += little[at + k];
+  };
+  for (size_t v = 0; v < 24; ++v) append_reversed(data + 4 * v, 4);
+  for (size_t f = 0; f < 12; ++f) {
+    const size_t at = data + 96 + 13 * f;
+    big += little[at];
+    for (size_t k = 0; k < 3; ++k) append_reversed(at + 1 + 4 * k, 4);
+  }
+  ASSERT_EQ(big.size(), little.size() - 9);  // "little" -> "big" in the format line
+  EXPECT_EQ(triangle_set(load(write("cube_be.ply", big))), triangle_set(load(kShared / "ply-tests" / "cube_binary.ply")));
+}
+
+TEST_F(MeshIoFiles, PlyHeaderClaimingBillionsOfElementsFailsFast) {
+  const auto start = std::chrono::steady_clock::now();
+  expect_error_mentions(write("huge_binary.ply",
+                              "ply\nformat binary_little_endian 1.0\nelement vertex 3000000000\nproperty float x\n"
+                              "property float y\nproperty float z\nelement face 1\n"
+                              "property list uchar int vertex_indices\nend_header\n" +
+                                  std::string(100, '\0')),
+                        {"corrupt PLY header", "3000000000 'vertex'", "100 bytes"});
+  expect_error_mentions(write("huge_faces.ply",
+                              "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+                              "property float y\nproperty float z\nelement face 4294967295\n"
+                              "property list uchar int vertex_indices\nend_header\n" +
+                                  std::string(36, '\0') + std::string(13 * 2, '\3')),
+                        {"4294967295 'face'"});
+  expect_error_mentions(write("huge_ascii.ply",
+                              "ply\nformat ascii 1.0\nelement vertex 18446744073709551615\nproperty float x\n"
+                              "property float y\nproperty float z\nend_header\n0 0 0\n"),
+                        {"18446744073709551615 'vertex'"});
+  expect_error_mentions(write("overflow.ply",
+                              "ply\nformat ascii 1.0\nelement vertex 99999999999999999999999\nproperty float x\n"
+                              "end_header\n0\n"),
+                        {"invalid count"});
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
+}
+
+TEST_F(MeshIoFiles, PlyCutShortAnywhereIsAnErrorNotACrash) {
+  // Assimp alone loops forever on a header without "end_header" and reads past the end of (or
+  // asserts on) data cut short; every prefix must either load completely or fail with a SceneError.
+  for (const char* name : {"cube_binary.ply", "cube_uv.ply", "cube.ply"}) {
+    const std::string whole = read(kShared / "ply-tests" / name);
+    const TriangleMesh complete = load(kShared / "ply-tests" / name);
+    for (size_t cut = 0; cut < whole.size(); ++cut) {
+      const fs::path file = write("cut.ply", whole.substr(0, cut));
+      try {
+        const TriangleMesh mesh = load(file);
+        EXPECT_EQ(triangle_set(mesh), triangle_set(complete)) << name << " cut at " << cut;
+      } catch (const SceneError& e) {
+        EXPECT_NE(std::string(e.what()).find("PLY"), std::string::npos) << e.what();
+      }
+    }
+  }
+}
+
+TEST_F(MeshIoFiles, PlyBadFaceIndexIsAnError) {
+  expect_error_mentions(write("index.ply", kPlyTriangleHeader + "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"),
+                        {"malformed PLY", "refers to vertex 3", "3 vertices"});
+  // Out of range in a polygon: triangulating it would read outside the vertices.
+  expect_error_mentions(write("polygon.ply", kPlyTriangleHeader + "0 0 0\n1 0 0\n0 1 0\n5 0 1 2 1000000 2000000\n"),
+                        {"refers to vertex 1000000"});
+}
+
+TEST_F(MeshIoFiles, PlyNonFiniteCoordinatesAreAnError) {
+  expect_error_mentions(write("nan.ply", kPlyTriangleHeader + "0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n"),
+                        {"vertex 1", "non-finite position"});
+  expect_error_mentions(write("inf.ply", kPlyTriangleHeader + "0 0 0\n1 0 0\n0 1e999 0\n3 0 1 2\n"),
+                        {"vertex 2", "non-finite position"});
+}
+
+TEST_F(MeshIoFiles, PlyMalformedHeaderIsAnError) {
+  expect_error_mentions(write("magic.ply", "solid cube\nfacet normal 0 0 1\n"), {"does not start with 'ply'"});
+  expect_error_mentions(write("format.ply", "ply\nformat json 1.0\nend_header\n"), {"unknown format"});
+  expect_error_mentions(write("type.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty quaternion q\nend_header\n1\n"),
+                        {"unknown property type 'quaternion'"});
+  expect_error_mentions(write("no_end.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"),
+                        {"no 'end_header'"});
+}
+
+// ---------------------------------------------------------------- file names and places
+
+TEST(MeshIo, MissingFileNamesBothPlaces) {
+  const fs::path missing = kTestData / "no_such_mesh.obj";
+  EXPECT_EQ(load_error(missing), "scene.json: at /shapes/2/file: cannot read mesh '" + missing.string() + "': no such file");
+  const SourceLocation pbrt{"scene.pbrt", 12, 5, ""};
+  try {
+    load_mesh_file("meshes/cow.ply", pbrt);
+    ADD_FAILURE() << "no error";
+  } catch (const SceneError& e) {
+    EXPECT_STREQ(e.what(), "scene.pbrt:12:5: cannot read mesh 'meshes/cow.ply': no such file");
+  }
+}
+
+TEST(MeshIo, UnsupportedExtensionListsTheSupportedOnes) {
+  expect_error_mentions(kTestData / "cow.stl", {"unsupported mesh format '.stl'", ".obj", ".ply"});
+  expect_error_mentions(kTestData / "cow", {"no extension", ".obj", ".ply"});
+}
+
+TEST_F(MeshIoFiles, DirectoryNamedLikeAMeshIsAnError) {
+  fs::create_directory(dir_ / "folder.obj");
+  expect_error_mentions(dir_ / "folder.obj", {"directory"});
+}
+
+TEST_F(MeshIoFiles, ExtensionIsMatchedIgnoringCase) {
+  EXPECT_EQ(load(write("TRIANGLE.OBJ", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")).triangle_count(), 1u);
+  EXPECT_EQ(load(write("Cube.Ply", read(kShared / "ply-tests" / "cube.ply"))).triangle_count(), 12u);
+}
+
+}  // namespace
+}  // namespace candela
