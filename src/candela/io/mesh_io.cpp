@@ -5,7 +5,6 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
@@ -148,26 +147,48 @@ void fail_on_dropped_obj_faces(const std::string& warnings) {
   }
 }
 
-bool starts_like_a_number(std::string_view token) {
-  if (!token.empty() && (token.front() == '-' || token.front() == '+')) token.remove_prefix(1);
-  return !token.empty() && (std::isdigit(static_cast<unsigned char>(token.front())) || token.front() == '.');
+// A decimal number, as both formats write them: no nan, inf or hexadecimal, nothing after it.
+bool is_plain_number(std::string_view word) {
+  if (!word.empty() && word.front() == '+') word.remove_prefix(1);
+  const size_t first_digit = !word.empty() && word.front() == '-' ? 1 : 0;
+  if (word.size() <= first_digit || !(std::isdigit(static_cast<unsigned char>(word[first_digit])) || word[first_digit] == '.'))
+    return false;
+  double value = 0;
+  const auto [stop, error] = std::from_chars(word.data(), word.data() + word.size(), value);
+  // Out of range (1e999) is still a number; it fails later as non-finite.
+  return (error == std::errc() || error == std::errc::result_out_of_range) && stop == word.data() + word.size();
 }
 
-// tinyobjloader reads "nan", "inf" or any other word where a number belongs as 0 without a word, which
-// would quietly move a vertex; so the values of v, vt and vn lines are checked here first.
-void check_obj_vertex_numbers(std::string_view text) {
+// Words from the file for messages: non-printable bytes of a broken or binary file shown as '?'.
+std::string printable(std::string_view text, size_t limit = 40) {
+  std::string shown;
+  for (const char c : text.substr(0, limit)) shown += (c >= 0x20 && c < 0x7f) ? c : '?';
+  if (text.size() > limit) shown += "...";
+  return shown;
+}
+
+// tinyobjloader reads "nan", "inf" or any other word where a number belongs, and a missing coordinate,
+// as 0 without a word, which would quietly move a vertex; so v, vt and vn lines are checked here first.
+void check_obj_vertex_line(const std::vector<std::string_view>& words, size_t line_number) {
+  const size_t needed = words[0] == "vt" ? 1 : 3;
+  if (words.size() - 1 < needed)
+    fail("malformed OBJ: line {}: a '{}' line needs {} numbers, it has {}", line_number, words[0], needed,
+         words.size() - 1);
+  for (size_t k = 1; k < words.size(); ++k)
+    if (!is_plain_number(words[k]))
+      fail("malformed OBJ: line {}: '{}' is not a finite number", line_number, printable(words[k]));
+}
+
+void check_obj_vertex_lines(std::string_view text) {
   size_t line_number = 0, at = 0;
   while (at < text.size()) {
     const size_t end = std::min(text.find('\n', at), text.size());
-    std::string_view line = text.substr(at, end - at);
+    const std::string_view line = text.substr(at, end - at);
     at = end + 1;
     ++line_number;
-    line = line.substr(0, line.find('#'));
-    const std::vector<std::string_view> words = split_words(line);
-    if (words.empty() || (words[0] != "v" && words[0] != "vt" && words[0] != "vn")) continue;
-    for (size_t k = 1; k < words.size(); ++k)
-      if (!starts_like_a_number(words[k]))
-        fail("malformed OBJ: line {}: '{}' is not a finite number", line_number, words[k]);
+    const std::vector<std::string_view> words = split_words(line.substr(0, line.find('#')));
+    if (!words.empty() && (words[0] == "v" || words[0] == "vt" || words[0] == "vn"))
+      check_obj_vertex_line(words, line_number);
   }
 }
 
@@ -229,10 +250,10 @@ TriangleMesh load_obj(const std::string& text) {
   config.triangulate = true;
   config.vertex_color = false;
   tinyobj::ObjReader reader;
+  check_obj_vertex_lines(text);
   // Parsing from a string makes tinyobjloader ignore `mtllib`: materials are not used yet, and a
   // missing or misplaced .mtl file must not fail the load.
-  check_obj_vertex_numbers(text);
-  if (!reader.ParseFromString(text, "", config)) fail("malformed OBJ: {}", first_line(reader.Error()));
+  if (!reader.ParseFromString(text, "", config)) fail("malformed OBJ: {}", printable(first_line(reader.Error()), 200));
 
   const tinyobj::attrib_t& attrib = reader.GetAttrib();
   const std::vector<tinyobj::shape_t>& shapes = reader.GetShapes();
@@ -280,6 +301,7 @@ std::optional<PlyScalarType> ply_scalar_type(std::string_view name) {
 }
 
 struct PlyProperty {
+  std::string name;
   PlyScalarType value;                       // the property's, or each list item's
   std::optional<PlyScalarType> list_length;  // set for list properties
 };
@@ -291,6 +313,10 @@ struct PlyElement {
 
   bool has_lists() const {
     return std::any_of(properties.begin(), properties.end(), [](const PlyProperty& p) { return p.list_length; });
+  }
+  bool has_scalar(std::string_view property_name) const {
+    return std::any_of(properties.begin(), properties.end(),
+                       [&](const PlyProperty& p) { return p.name == property_name && !p.list_length; });
   }
   uint64_t scalar_bytes() const {
     uint64_t bytes = 0;
@@ -308,9 +334,15 @@ struct PlyHeader {
   std::vector<PlyElement> elements;
 };
 
+std::string line_of(const std::vector<std::string_view>& words) {
+  std::string line;
+  for (const std::string_view word : words) (line += line.empty() ? "" : " ") += word;
+  return line;
+}
+
 PlyScalarType ply_scalar_type_or_fail(std::string_view name) {
   const std::optional<PlyScalarType> type = ply_scalar_type(name);
-  if (!type) fail("malformed PLY: unknown property type '{}' in the header", name);
+  if (!type) fail("malformed PLY: unknown property type '{}' in the header", printable(name));
   return *type;
 }
 
@@ -318,28 +350,29 @@ void read_ply_format(const std::vector<std::string_view>& words, PlyHeader& head
   if (words.size() == 3 && words[1] == "ascii") header.encoding = PlyEncoding::Ascii;
   else if (words.size() == 3 && words[1] == "binary_little_endian") header.encoding = PlyEncoding::BinaryLittleEndian;
   else if (words.size() == 3 && words[1] == "binary_big_endian") header.encoding = PlyEncoding::BinaryBigEndian;
-  else fail("malformed PLY: unknown format line '{}'", fmt::join(words, " "));
+  else fail("malformed PLY: unknown format line '{}'", printable(line_of(words)));
 }
 
 void read_ply_element(const std::vector<std::string_view>& words, PlyHeader& header) {
-  if (words.size() != 3) fail("malformed PLY: bad element line '{}'", fmt::join(words, " "));
+  if (words.size() != 3) fail("malformed PLY: bad element line '{}'", printable(line_of(words)));
   PlyElement element;
-  element.name = words[1];
+  element.name = printable(words[1]);  // kept for messages only
   const char* end = words[2].data() + words[2].size();
   const auto [stop, error] = std::from_chars(words[2].data(), end, element.count);
   if (error != std::errc() || stop != end)
-    fail("malformed PLY: element '{}' has an invalid count '{}'", words[1], words[2]);
+    fail("malformed PLY: element '{}' has an invalid count '{}'", element.name, printable(words[2]));
   header.elements.push_back(element);
 }
 
 void read_ply_property(const std::vector<std::string_view>& words, PlyHeader& header) {
   if (header.elements.empty()) fail("malformed PLY: a property comes before any element");
   const bool list = words.size() >= 2 && words[1] == "list";
-  if (words.size() != (list ? 5u : 3u)) fail("malformed PLY: bad property line '{}'", fmt::join(words, " "));
+  if (words.size() != (list ? 5u : 3u)) fail("malformed PLY: bad property line '{}'", printable(line_of(words)));
   PlyProperty property;
+  property.name = words.back();
   if (list) {
     property.list_length = ply_scalar_type_or_fail(words[2]);
-    if (!property.list_length->is_integer) fail("malformed PLY: list length type '{}' is not an integer", words[2]);
+    if (!property.list_length->is_integer) fail("malformed PLY: list length type '{}' is not an integer", printable(words[2]));
     property.value = ply_scalar_type_or_fail(words[3]);
   } else {
     property.value = ply_scalar_type_or_fail(words[1]);
@@ -349,9 +382,16 @@ void read_ply_property(const std::vector<std::string_view>& words, PlyHeader& he
 
 void check_ply_header_complete(const PlyHeader& header) {
   if (!header.encoding) fail("malformed PLY: the header has no format line");
-  for (const PlyElement& element : header.elements)
+  for (const PlyElement& element : header.elements) {
     if (element.count > 0 && element.properties.empty())
       fail("malformed PLY: element '{}' has no properties", element.name);
+    // Assimp would read vertices without coordinates as all zero.
+    if (element.name == "vertex" && !(element.has_scalar("x") && element.has_scalar("y") && element.has_scalar("z")))
+      fail("malformed PLY: the 'vertex' element lacks an x, y or z property");
+    // Assimp 5.2 turns a strip into the wrong triangles.
+    if (element.name == "tristrips" && element.count > 0)
+      fail("unsupported PLY: triangle strips (a 'tristrips' element) are not supported; use a 'face' element");
+  }
 }
 
 PlyHeader read_ply_header(std::string_view bytes) {
@@ -407,6 +447,7 @@ void check_binary_ply_data(const PlyHeader& header, std::string_view data) {
   const bool big_endian = header.encoding == PlyEncoding::BinaryBigEndian;
   uint64_t at = 0;
   for (const PlyElement& element : header.elements) {
+    if (element.count == 0) continue;
     if (!element.has_lists()) {  // fixed size: no need to visit every element
       const uint64_t fitting = (data.size() - at) / element.scalar_bytes();
       if (element.count > fitting) fail_ply_data_short(element, fitting, data.size());
@@ -435,6 +476,10 @@ void check_binary_ply_data(const PlyHeader& header, std::string_view data) {
 // would be read as zeros (or make Assimp assert).
 bool ascii_ply_line_holds(const PlyElement& element, std::string_view line, size_t line_number) {
   const std::vector<std::string_view> values = split_words(line);
+  // Assimp would stop at a word that is no number with a message quoting raw bytes (and leak).
+  for (const std::string_view value : values)
+    if (!is_plain_number(value))
+      fail("malformed PLY: line {}: '{}' is not a finite number", line_number, printable(value));
   size_t next = 0;
   for (const PlyProperty& property : element.properties) {
     if (next >= values.size()) return false;
@@ -443,7 +488,7 @@ bool ascii_ply_line_holds(const PlyElement& element, std::string_view line, size
     uint64_t length = 0;
     const auto [stop, error] = std::from_chars(value.data(), value.data() + value.size(), length);
     if (error != std::errc() || stop != value.data() + value.size())
-      fail("malformed PLY: line {}: '{}' is not a list length", line_number, value);
+      fail("malformed PLY: line {}: '{}' is not a list length", line_number, printable(value));
     if (length > values.size() - next) return false;
     next += length;
   }
@@ -529,11 +574,11 @@ TriangleMesh load_ply(const std::string& bytes) {
 
   Assimp::Importer importer;
   if (!importer.ReadFileFromMemory(bytes.data(), bytes.size(), 0, "ply"))
-    fail("malformed PLY: {}", importer.GetErrorString());
+    fail("malformed PLY: {}", printable(importer.GetErrorString(), 200));
   check_assimp_face_indices(*importer.GetScene());
   // No normal generation and no vertex joining: the mesh is exactly what the file holds.
   const aiScene* scene = importer.ApplyPostProcessing(aiProcess_Triangulate);
-  if (!scene) fail("malformed PLY: {}", importer.GetErrorString());
+  if (!scene) fail("malformed PLY: {}", printable(importer.GetErrorString(), 200));
 
   bool with_normals = true, with_uvs = true, any_triangles = false;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
@@ -543,7 +588,7 @@ TriangleMesh load_ply(const std::string& bytes) {
     with_normals = with_normals && source.HasNormals();
     with_uvs = with_uvs && source.HasTextureCoords(0);
   }
-  if (!any_triangles) fail("the PLY file contains no triangles, only points{}", describe_elements(header));
+  if (!any_triangles) fail("the PLY file contains no triangles{}", describe_elements(header));
 
   TriangleMesh mesh;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m)

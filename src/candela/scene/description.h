@@ -101,6 +101,9 @@ struct ShapeDesc {
   Transform to_world;
   int material = -1;  // index into SceneDesc::materials; -1 = the default diffuse 0.5
   std::optional<AreaEmission> emission;
+  // A moving shape: its transform at SceneDesc::transform_times[1] (to_world holds the one at
+  // transform_times[0]); in between the matrix is interpolated linearly, as Embree does.
+  std::optional<Transform> to_world_end;
   // Flips the surface normal (pbrt's ReverseOrientation): which side a one-sided emitter lights.
   // Independently of this, a to_world that swaps handedness keeps normals equal to the object-space
   // normals transformed as normals (pbrt-v4's convention).
@@ -137,6 +140,11 @@ struct CameraDesc {
   Transform world_from_camera;
   float fov_degrees = 40;
   FovAxis fov_axis = FovAxis::Y;  // JSON gives a vertical fov; pbrt-v4 gives it on the smaller axis
+  // Thin lens (depth of field): 0 = pinhole. Points at focus_distance along +z are sharp.
+  float lens_radius = 0;
+  float focus_distance = 1e6f;
+  // Each camera path gets a time uniformly in [shutter_open, shutter_close] (motion blur).
+  float shutter_open = 0, shutter_close = 1;
 };
 
 struct FilmDesc {
@@ -145,12 +153,60 @@ struct FilmDesc {
   std::string filename;  // empty = the command line's default
 };
 
+// How pixel samples are placed (Häkkinen 2002, sec. 4.3).
+enum class SamplerType {
+  Independent,  // uniform random numbers
+  Stratified,   // jittered strata in every dimension, shuffled per pixel (pbrt-v4's StratifiedSampler)
+  Poisson,      // Poisson-disc pixel positions with a minimum distance; other dimensions independent
+  ZSobol        // Owen-scrambled Sobol' points in Morton order over the image (pbrt-v4's ZSobolSampler)
+};
+struct SamplerDesc {
+  SamplerType type = SamplerType::Independent;
+  bool jitter = true;  // stratified: false puts each sample at its stratum's centre
+};
+
+// Pixel reconstruction filters; every sample contributes to its own pixel only, with the weight
+// f(offset) / pdf(offset) of filter importance sampling (pbrt-v4).
+enum class FilterType { Box, Tent, Gaussian, Mitchell };
+struct FilterDesc {
+  FilterType type = FilterType::Box;
+  Vec2 radius{0.5f, 0.5f};    // in pixels; pbrt's defaults: box 0.5, triangle 2, gaussian 1.5, mitchell 2
+  float gaussian_sigma = 0.5f;
+  float mitchell_b = 1.0f / 3, mitchell_c = 1.0f / 3;
+};
+
+// How the next direction is chosen at non-delta vertices (sec. 4.7).
+enum class DirectionSampling {
+  Bsdf,     // importance-sample the BSDF's lobes
+  Cosine,   // cosine-weighted hemisphere, weighted by the BSDF
+  Uniform   // uniform hemisphere (the paper's eq. 11), weighted by the BSDF
+};
+
+// How shadow rays are spent at each vertex (sec. 4.5).
+enum class LightSelection {
+  Power,   // `shadow_rays` rays, each to one light chosen with probability proportional to its power
+  Paper    // every light gets a share of `shadow_rays` proportional to power x projected solid angle
+           // as seen from the vertex (stratified over rectangles), kept unbiased
+};
+
 struct RenderSettings {
   int spp = 16;
   int max_depth = 16;  // maximum number of scattering events; 1 = direct lighting only
   uint64_t seed = 0;
   std::string integrator = "path";
   int rr_start_depth = 3;  // Russian roulette on throughput starts after this many bounces
+  SamplerDesc sampler;
+  FilterDesc filter;
+  DirectionSampling direction_sampling = DirectionSampling::Bsdf;
+  bool mis = true;  // false: light sampling for direct light, emission found by bounces ignored
+  LightSelection light_selection = LightSelection::Power;
+  int shadow_rays = 1;
+  // Adaptive sampling (sec. 4.3): after every batch of `adaptive_batch` samples (a power of two),
+  // pixels whose relative standard error exceeds the threshold get another batch, up to
+  // `adaptive_max_spp`. 0 = off: every pixel gets `spp`.
+  float adaptive_threshold = 0;
+  int adaptive_batch = 16;
+  int adaptive_max_spp = 1024;
 };
 
 struct SceneDesc {
@@ -160,6 +216,8 @@ struct SceneDesc {
   std::vector<MaterialDesc> materials;
   std::vector<ShapeDesc> shapes;
   std::vector<LightDesc> lights;
+  // The times at which ShapeDesc::to_world and to_world_end hold (pbrt's TransformTimes).
+  float transform_start_time = 0, transform_end_time = 1;
   std::string source_file;  // the file it was read from, for messages and image metadata
 };
 
