@@ -20,7 +20,7 @@ void BM_CameraRays(benchmark::State& state) {
   Rng rng(1, 2);
   int64_t hits = 0;
   for (auto _ : state) {
-    Ray ray = scene.camera().generate_ray({rng.next_float() * 512, rng.next_float() * 512}, 0);
+    Ray ray = scene.camera().generate_ray({rng.next_float() * 512, rng.next_float() * 512}, {0.5f, 0.5f}, 0);
     SurfaceHit hit;
     hits += scene.intersect(ray, hit);
   }

@@ -30,7 +30,7 @@ std::vector<int> region_labels(const Scene& scene, int width, int height) {
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
       SurfaceHit hit;
-      Ray ray = scene.camera().generate_ray({x + 0.5f, y + 0.5f}, 0);
+      Ray ray = scene.camera().generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}, 0);
       if (scene.intersect(ray, hit)) label[size_t(y) * width + x] = int(hit.shape * 100 + hit.primitive / 2);
     }
   std::vector<int> interior(label.size(), -1);

@@ -55,7 +55,7 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
               // Jitter the camera ray uniformly over the pixel (the paper's eq. 9).
               sampler.start_pixel_sample(x, y, uint64_t(s));
               Vec2 jitter = sampler.get_pixel_2d();
-              Ray ray = camera.generate_ray({float(x) + jitter.x, float(y) + jitter.y}, 0.0f);
+              Ray ray = camera.generate_ray({float(x) + jitter.x, float(y) + jitter.y}, {0.5f, 0.5f}, 0.0f);
               RGB L = integrator.radiance(ray, sampler, counts);
               film.add_sample(x, y, L);
             }
