@@ -55,7 +55,10 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
               // Jitter the camera ray uniformly over the pixel (the paper's eq. 9).
               sampler.start_pixel_sample(x, y, uint64_t(s));
               Vec2 jitter = sampler.get_pixel_2d();
-              Ray ray = camera.generate_ray({float(x) + jitter.x, float(y) + jitter.y}, {0.5f, 0.5f}, 0.0f);
+              Vec2 lens = sampler.get_2d();
+              // Pick the path's time in the shutter interval (sec. 4.2); every object is seen at it.
+              float time = lerp(sampler.get_1d(), camera.shutter_open(), camera.shutter_close());
+              Ray ray = camera.generate_ray({float(x) + jitter.x, float(y) + jitter.y}, lens, time);
               RGB L = integrator.radiance(ray, sampler, counts);
               film.add_sample(x, y, L);
             }
