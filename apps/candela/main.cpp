@@ -26,6 +26,10 @@ constexpr int kExitBadInput = 1;
 constexpr int kMaxResolution = 65536;
 constexpr long long kMaxPixels = 1LL << 28;
 
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 struct RenderCommand {
   std::string scene_file;  // empty = built-in scene
   std::string output;
@@ -33,18 +37,59 @@ struct RenderCommand {
   std::optional<uint64_t> seed;
   std::string resolution;
   std::string integrator;
+  std::string sampler, filter, direction_sampling, light_selection, spp_map;
+  std::optional<int> shadow_rays, max_spp, adaptive_batch;
+  std::optional<float> adaptive_threshold;
+  bool no_mis = false;
   bool quiet = false;
 };
 
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+template <typename Enum>
+Enum parse_choice(const std::string& option, const std::string& value,
+                  std::initializer_list<std::pair<const char*, Enum>> choices) {
+  std::string names;
+  for (const auto& [name, e] : choices) {
+    if (value == name) return e;
+    names += (names.empty() ? "" : ", ") + std::string(name);
+  }
+  throw UsageError(fmt::format("{}: unknown value '{}' (expected one of: {})", option, value, names));
+}
 
 void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
   if (cmd.spp) scene.settings.spp = *cmd.spp;
   if (cmd.max_depth) scene.settings.max_depth = *cmd.max_depth;
   if (cmd.seed) scene.settings.seed = *cmd.seed;
   if (!cmd.integrator.empty()) scene.settings.integrator = cmd.integrator;
+  RenderSettings& rs = scene.settings;
+  if (!cmd.sampler.empty())
+    rs.sampler.type = parse_choice<SamplerType>("--sampler", cmd.sampler,
+                                                {{"random", SamplerType::Independent},
+                                                 {"independent", SamplerType::Independent},
+                                                 {"stratified", SamplerType::Stratified},
+                                                 {"poisson", SamplerType::Poisson},
+                                                 {"zsobol", SamplerType::ZSobol}});
+  if (!cmd.filter.empty())
+    rs.filter = default_filter(parse_choice<FilterType>(
+        "--filter", cmd.filter,
+        {{"box", FilterType::Box}, {"tent", FilterType::Tent}, {"gaussian", FilterType::Gaussian},
+         {"mitchell", FilterType::Mitchell}}));
+  if (!cmd.direction_sampling.empty())
+    rs.direction_sampling = parse_choice<DirectionSampling>(
+        "--direction-sampling", cmd.direction_sampling,
+        {{"bsdf", DirectionSampling::Bsdf}, {"cosine", DirectionSampling::Cosine},
+         {"uniform", DirectionSampling::Uniform}});
+  if (!cmd.light_selection.empty())
+    rs.light_selection = parse_choice<LightSelection>("--light-selection", cmd.light_selection,
+                                                      {{"power", LightSelection::Power}, {"paper", LightSelection::Paper}});
+  if (cmd.no_mis) rs.mis = false;
+  if (cmd.shadow_rays) rs.shadow_rays = *cmd.shadow_rays;
+  if (cmd.adaptive_threshold) rs.adaptive_threshold = *cmd.adaptive_threshold;
+  if (cmd.adaptive_batch) rs.adaptive_batch = *cmd.adaptive_batch;
+  if (cmd.max_spp) rs.adaptive_max_spp = *cmd.max_spp;
+  if (rs.adaptive_threshold > 0 && (rs.adaptive_batch & (rs.adaptive_batch - 1)) != 0)
+    throw UsageError(fmt::format("--adaptive-batch: must be a power of two, got {}", rs.adaptive_batch));
+  if (!cmd.spp_map.empty() && !is_supported_output(cmd.spp_map))
+    throw UsageError(fmt::format("--spp-map '{}': unsupported image format (use .exr, .png or .pfm)", cmd.spp_map));
   if (!cmd.resolution.empty()) {
     std::smatch m;
     static const std::regex pattern(R"((\d{1,9})[xX](\d{1,9}))");
@@ -81,6 +126,24 @@ void check_outputs(const std::vector<fs::path>& files) {
   }
 }
 
+// Per-pixel sample counts: raw counts for .exr/.pfm, a black-red-yellow-white heat map scaled to the
+// largest count for .png.
+Image spp_heat_map(const Film& film, const fs::path& file) {
+  Image counts = film.sample_count_image();
+  if (file.extension() != ".png") return counts;
+  float most = 1;
+  for (float v : counts.rgb) most = std::max(most, v);
+  Image heat(counts.width, counts.height);
+  for (int y = 0; y < counts.height; ++y)
+    for (int x = 0; x < counts.width; ++x) {
+      float t = counts.at(x, y).r / most;
+      // Linear values that the PNG writer's sRGB encoding turns into a perceptually even ramp.
+      RGB c(std::clamp(3 * t, 0.0f, 1.0f), std::clamp(3 * t - 1, 0.0f, 1.0f), std::clamp(3 * t - 2, 0.0f, 1.0f));
+      heat.set(x, y, RGB(c.r * c.r, c.g * c.g, c.b * c.b));
+    }
+  return heat;
+}
+
 int run_render(const RenderCommand& cmd) {
   SceneDesc desc = cmd.scene_file.empty() ? read_json_scene(builtin_scene_json(), "<built-in cornell-box.json>", ".")
                                           : read_scene_file(cmd.scene_file);
@@ -97,7 +160,10 @@ int run_render(const RenderCommand& cmd) {
 
   std::map<std::string, std::string> metadata = {
       {"candela:scene", cmd.scene_file.empty() ? "<built-in cornell-box.json>" : cmd.scene_file},
-      {"candela:spp", std::to_string(desc.settings.spp)},
+      {"candela:spp", desc.settings.adaptive_threshold > 0
+                          ? fmt::format("adaptive, {:.2f} on average", double(stats.samples) /
+                                                                          (double(film.width()) * film.height()))
+                          : std::to_string(desc.settings.spp)},
       {"candela:render_time_seconds", fmt::format("{:.3f}", stats.seconds)},
       {"candela:integrator", desc.settings.integrator},
       {"candela:max_depth", std::to_string(desc.settings.max_depth)},
@@ -105,6 +171,10 @@ int run_render(const RenderCommand& cmd) {
       {"Software", "candela " CANDELA_VERSION}};
   Image image = film.mean_image();
   for (const auto& f : outputs) write_image(f, image, metadata);
+  if (!cmd.spp_map.empty()) write_image(cmd.spp_map, spp_heat_map(film, fs::path(cmd.spp_map)), metadata);
+  if (stats.non_finite_samples > 0)
+    std::fprintf(stderr, "candela: warning: %llu samples were NaN or infinite and counted as black\n",
+                 (unsigned long long)stats.non_finite_samples);
 
   double seconds = std::max(stats.seconds, 1e-9);
   std::string written;
@@ -136,6 +206,32 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 100000));
   render_cmd->add_option("--resolution", cmd.resolution, "Image size WIDTHxHEIGHT (overrides the scene)");
   render_cmd->add_option("--integrator", cmd.integrator, "Integrator: path");
+  render_cmd->add_option("--sampler", cmd.sampler,
+                         "Pixel sampler: random (independent), stratified (jittered, every dimension), "
+                         "poisson (Poisson-disc pixel positions), zsobol (Owen-scrambled Sobol' in Morton order)");
+  render_cmd->add_option("--filter", cmd.filter,
+                         "Reconstruction filter with pbrt-v4's default size: box (radius 0.5), tent (2), "
+                         "gaussian (1.5, sigma 0.5), mitchell (2, B = C = 1/3)");
+  render_cmd->add_option("--direction-sampling", cmd.direction_sampling,
+                         "Next-direction sampling at non-delta surfaces: bsdf (importance), cosine, uniform "
+                         "(the paper's eq. 11)");
+  render_cmd->add_flag("--no-mis", cmd.no_mis,
+                       "Turn off multiple importance sampling: direct light from shadow rays only");
+  render_cmd->add_option("--light-selection", cmd.light_selection,
+                         "How shadow rays pick lights: power (each ray one light, chosen by power), paper "
+                         "(every light a share proportional to power x projected solid angle)");
+  render_cmd->add_option("--shadow-rays", cmd.shadow_rays, "Shadow rays per path vertex")->check(CLI::Range(1, 1024));
+  render_cmd->add_option("--adaptive-threshold", cmd.adaptive_threshold,
+                         "Adaptive sampling: keep adding batches to pixels whose relative standard error "
+                         "(per channel, se / sqrt(mean^2 + 0.01)) exceeds this")
+      ->check(CLI::PositiveNumber);
+  render_cmd->add_option("--adaptive-batch", cmd.adaptive_batch,
+                         "Adaptive sampling: samples per batch, a power of two (default 16)")
+      ->check(CLI::Range(1, 1 << 16));
+  render_cmd->add_option("--max-spp", cmd.max_spp, "Adaptive sampling: most samples a pixel gets (default 1024)")
+      ->check(CLI::Range(1, 1 << 24));
+  render_cmd->add_option("--spp-map", cmd.spp_map,
+                         "Also write the per-pixel sample counts: a heat map (.png) or raw counts (.exr, .pfm)");
   render_cmd->add_flag("-q,--quiet", cmd.quiet, "No progress bar");
 
   try {

@@ -1,15 +1,31 @@
 #include "candela/film/film.h"
 
+#include <cmath>
+
 namespace candela {
+
+RGB PixelSums::mean() const {
+  if (weight == 0) return RGB(0.0f);
+  return {float(weighted[0] / weight), float(weighted[1] / weight), float(weighted[2] / weight)};
+}
+
+RGB PixelSums::standard_error() const {
+  RGB se(0.0f);
+  if (count < 2 || weight == 0) return se;
+  double n = double(count), mean_weight = weight / n;
+  for (int c = 0; c < 3; ++c) {
+    // Sample variance of w L, scaled to the ratio estimator sum(w L) / sum(w).
+    double m = weighted[c] / n;
+    double var = std::max(0.0, (weighted_sq[c] - n * m * m) / (n - 1));
+    se[c] = float(std::sqrt(var / n) / std::abs(mean_weight));
+  }
+  return se;
+}
 
 Image Film::mean_image() const {
   Image img(width_, height_);
   for (int y = 0; y < height_; ++y)
-    for (int x = 0; x < width_; ++x) {
-      const PixelSums& px = pixel(x, y);
-      double inv = px.count ? 1.0 / double(px.count) : 0.0;
-      img.set(x, y, RGB(float(px.sum[0] * inv), float(px.sum[1] * inv), float(px.sum[2] * inv)));
-    }
+    for (int x = 0; x < width_; ++x) img.set(x, y, pixel(x, y).mean());
   return img;
 }
 
@@ -17,18 +33,16 @@ Image Film::variance_of_mean_image() const {
   Image img(width_, height_);
   for (int y = 0; y < height_; ++y)
     for (int x = 0; x < width_; ++x) {
-      const PixelSums& px = pixel(x, y);
-      RGB v(0.0f);
-      if (px.count > 1) {
-        double n = double(px.count);
-        for (int c = 0; c < 3; ++c) {
-          double mean = px.sum[c] / n;
-          double var = std::max(0.0, (px.sum_sq[c] - n * mean * mean) / (n - 1));
-          v[c] = float(var / n);
-        }
-      }
-      img.set(x, y, v);
+      RGB se = pixel(x, y).standard_error();
+      img.set(x, y, se * se);
     }
+  return img;
+}
+
+Image Film::sample_count_image() const {
+  Image img(width_, height_);
+  for (int y = 0; y < height_; ++y)
+    for (int x = 0; x < width_; ++x) img.set(x, y, RGB(float(pixel(x, y).count)));
   return img;
 }
 

@@ -1,14 +1,35 @@
 #include "candela/integrators/path_integrator.h"
 
+#include "candela/sampling/samplers.h"
+#include "candela/sampling/warp.h"
+
 namespace candela {
 
-RGB PathIntegrator::radiance(Ray ray, IndependentSampler& sampler, RayCounts& counts) const {
+struct PathIntegrator::Vertex {
+  const SurfaceHit& hit;
+  const Bsdf& bsdf;
+  const Frame& frame;
+  Vec3 wo_local;
+  LightSampleContext ctx;
+  float time;
+};
+
+PathIntegrator::PathIntegrator(const Scene& scene, const RenderSettings& settings)
+    : scene_(scene),
+      max_depth_(settings.max_depth),
+      rr_start_depth_(settings.rr_start_depth),
+      direction_sampling_(settings.direction_sampling),
+      mis_(settings.mis),
+      light_selection_(settings.light_selection),
+      shadow_rays_(std::max(1, settings.shadow_rays)) {}
+
+template <typename Sampler>
+RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const {
   RGB L(0.0f), beta(1.0f);
   bool specular_bounce = false;
   float eta_scale = 1;
-  float prev_bsdf_pdf = 0;
+  float prev_bsdf_pdf = 0, prev_total_importance = 0;
   LightSampleContext prev_ctx;
-  const Distribution1D& light_choice = scene_.light_distribution();
   ++counts.camera;
 
   for (int depth = 0;; ++depth) {
@@ -20,12 +41,12 @@ RGB PathIntegrator::radiance(Ray ray, IndependentSampler& sampler, RayCounts& co
       if (sky >= 0) {
         const auto& light = std::get<SkyLightSource>(scene_.lights()[sky]);
         RGB Le = light.radiance(ray.direction);
-        if (depth == 0 || specular_bounce) {
+        if (depth == 0 || specular_bounce)
           L += beta * Le;
-        } else {
-          float light_pdf = light_choice.pmf(sky) * light.pdf_li(prev_ctx, ray.direction, {}, {});
-          L += beta * Le * power_heuristic(prev_bsdf_pdf, light_pdf);
-        }
+        else
+          L += beta * Le *
+               emitter_mis_weight(size_t(sky), prev_bsdf_pdf, light.pdf_li(prev_ctx, ray.direction, {}, {}), prev_ctx,
+                                  prev_total_importance);
       }
       break;
     }
@@ -37,10 +58,9 @@ RGB PathIntegrator::radiance(Ray ray, IndependentSampler& sampler, RayCounts& co
       if (depth == 0 || specular_bounce) {
         L += beta * Le;
       } else {
-        int li = scene_.light_index(hit);
-        float light_pdf = light_choice.pmf(size_t(li)) *
-                          light_pdf_li(scene_.lights()[li], prev_ctx, ray.direction, hit.p, hit.ng);
-        L += beta * Le * power_heuristic(prev_bsdf_pdf, light_pdf);
+        size_t li = size_t(scene_.light_index(hit));
+        float pdf_li = light_pdf_li(scene_.lights()[li], prev_ctx, ray.direction, hit.p, hit.ng);
+        L += beta * Le * emitter_mis_weight(li, prev_bsdf_pdf, pdf_li, prev_ctx, prev_total_importance);
       }
     }
 
@@ -53,23 +73,23 @@ RGB PathIntegrator::radiance(Ray ray, IndependentSampler& sampler, RayCounts& co
     Vec3 wo_local = frame.to_local(wo);
     if (wo_local.z == 0) break;
     // Light is gathered on the side the path arrived from.
-    LightSampleContext ctx{hit.p, wo_local.z > 0 ? hit.ns : -hit.ns};
+    Vertex vertex{hit, bsdf, frame, wo_local, {hit.p, wo_local.z > 0 ? hit.ns : -hit.ns}, ray.time};
 
-    // Sample direct illumination from one light chosen by power (next-event estimation).
-    if (bsdf_has_non_delta(bsdf) && !light_choice.empty())
-      L += beta * sample_direct(hit, bsdf, frame, wo_local, ctx, ray.time, sampler, counts);
+    // Sample direct illumination with shadow rays (next-event estimation).
+    float total_importance = 0;
+    if (bsdf_has_non_delta(bsdf) && !scene_.lights().empty())
+      L += beta * direct_light(vertex, sampler, counts, total_importance);
 
-    // Sample the BSDF for the next direction; the material's Russian roulette over its modes
-    // happens inside (the paper's d, s, t).
-    float u_lobe = sampler.get_1d();
-    Vec2 u_dir = sampler.get_2d();
-    auto bs = bsdf_sample(bsdf, wo_local, u_lobe, u_dir);
+    // Choose the next direction; the material's Russian roulette over its modes happens inside
+    // (the paper's d, s, t).
+    auto bs = sample_direction(bsdf, wo_local, sampler);
     if (!bs || bs->weight.is_black()) break;
     beta *= bs->weight;
     Vec3 wi = normalize(frame.to_world(bs->wi));
     specular_bounce = bs->is_delta;
     prev_bsdf_pdf = bs->pdf;
-    prev_ctx = ctx;
+    prev_ctx = vertex.ctx;
+    prev_total_importance = total_importance;
     if (bs->eta != 1) eta_scale *= bs->eta * bs->eta;
     ray = Ray{offset_ray_origin(hit.p, hit.ng, wi), wi, std::numeric_limits<float>::infinity(), ray.time};
     ++counts.bounce;
@@ -87,33 +107,108 @@ RGB PathIntegrator::radiance(Ray ray, IndependentSampler& sampler, RayCounts& co
   return L;
 }
 
-RGB PathIntegrator::sample_direct(const SurfaceHit& hit, const Bsdf& bsdf, const Frame& frame, const Vec3& wo_local,
-                                  const LightSampleContext& ctx, float time, IndependentSampler& sampler,
-                                  RayCounts& counts) const {
-  const Distribution1D& light_choice = scene_.light_distribution();
-  float u_light = sampler.get_1d();
+template <typename Sampler>
+std::optional<BsdfSample> PathIntegrator::sample_direction(const Bsdf& bsdf, const Vec3& wo, Sampler& sampler) const {
+  float u_lobe = sampler.get_1d();
   Vec2 u = sampler.get_2d();
-  size_t li = light_choice.sample(u_light);
-  const Light& light = scene_.lights()[li];
-  LightSample ls = light_sample_li(light, ctx, u);
-  if (ls.pdf <= 0 || ls.radiance.is_black()) return RGB(0.0f);
+  float p_non_delta = bsdf_non_delta_probability(bsdf);
+  if (direction_sampling_ == DirectionSampling::Bsdf || u_lobe >= p_non_delta)
+    return bsdf_sample(bsdf, wo, u_lobe, u);
+  // A non-delta lobe was chosen: draw the direction from the hemisphere on wo's side instead of the
+  // lobe, and weight it by the BSDF (sec. 4.7).
+  Vec3 wi = direction_sampling_ == DirectionSampling::Cosine ? square_to_cosine_hemisphere(u)
+                                                              : square_to_uniform_hemisphere(u);
+  if (wo.z < 0) wi.z = -wi.z;
+  float pdf = direction_pdf(bsdf, wo, wi);
+  if (pdf <= 0) return std::nullopt;
+  return BsdfSample{wi, bsdf_eval(bsdf, wo, wi) * (std::abs(wi.z) / pdf), pdf, false, 1};
+}
 
-  Vec3 wi_local = frame.to_local(ls.wi);
-  RGB f = bsdf_eval(bsdf, wo_local, wi_local) * std::abs(wi_local.z);
+float PathIntegrator::direction_pdf(const Bsdf& bsdf, const Vec3& wo, const Vec3& wi) const {
+  switch (direction_sampling_) {
+    case DirectionSampling::Bsdf: return bsdf_pdf(bsdf, wo, wi);
+    case DirectionSampling::Cosine:
+      return wo.z * wi.z > 0 ? bsdf_non_delta_probability(bsdf) * std::abs(wi.z) * kInvPi : 0.0f;
+    case DirectionSampling::Uniform:
+      return wo.z * wi.z > 0 ? bsdf_non_delta_probability(bsdf) * kInv2Pi : 0.0f;
+  }
+  return 0;
+}
+
+float PathIntegrator::total_light_importance(const LightSampleContext& ctx) const {
+  float total = 0;
+  for (const Light& l : scene_.lights()) total += light_importance(l, ctx);
+  return total;
+}
+
+float PathIntegrator::expected_shadow_rays(size_t li, const LightSampleContext& ctx, float total_importance) const {
+  if (light_selection_ == LightSelection::Power) return float(shadow_rays_) * scene_.light_distribution().pmf(li);
+  // The paper's rule, mixed with a uniform share so that every light keeps a non-zero expected
+  // number of rays (which keeps the estimator unbiased where the heuristic says "nothing here").
+  float uniform = 1.0f / float(scene_.lights().size());
+  float share = total_importance > 0
+                    ? 0.9f * light_importance(scene_.lights()[li], ctx) / total_importance + 0.1f * uniform
+                    : uniform;
+  return float(shadow_rays_) * share;
+}
+
+float PathIntegrator::emitter_mis_weight(size_t li, float bsdf_pdf, float light_pdf_li, const LightSampleContext& prev,
+                                         float prev_total_importance) const {
+  if (!mis_) return 0;  // without MIS, light found by bounces is left to the shadow rays
+  float light_pdf = expected_shadow_rays(li, prev, prev_total_importance) * light_pdf_li;
+  return power_heuristic(bsdf_pdf, light_pdf);
+}
+
+template <typename Sampler>
+RGB PathIntegrator::direct_light(const Vertex& v, Sampler& sampler, RayCounts& counts, float& total_importance) const {
+  RGB sum(0.0f);
+  if (light_selection_ == LightSelection::Power) {
+    // Each shadow ray goes to one light chosen with probability proportional to its power.
+    const Distribution1D& choice = scene_.light_distribution();
+    for (int k = 0; k < shadow_rays_; ++k) {
+      size_t li = choice.sample(sampler.get_1d());
+      Vec2 u = sampler.get_2d();
+      sum += shadow_ray_estimate(v, li, u, expected_shadow_rays(li, v.ctx, 0), counts);
+    }
+    return sum;
+  }
+  // The paper's rule: each light gets a number of rays proportional to its importance here, rounded
+  // randomly to an integer n with E[n] = x; dividing by x (not n) keeps the estimate unbiased.
+  total_importance = total_light_importance(v.ctx);
+  for (size_t li = 0; li < scene_.lights().size(); ++li) {
+    float x = expected_shadow_rays(li, v.ctx, total_importance);
+    int n = int(x) + (sampler.get_1d() < x - std::floor(x) ? 1 : 0);
+    for (int k = 0; k < n; ++k) sum += shadow_ray_estimate(v, li, sampler.get_2d(), x, counts);
+  }
+  return sum;
+}
+
+RGB PathIntegrator::shadow_ray_estimate(const Vertex& v, size_t li, const Vec2& u, float expected_rays,
+                                        RayCounts& counts) const {
+  const Light& light = scene_.lights()[li];
+  LightSample ls = light_sample_li(light, v.ctx, u);
+  if (ls.pdf <= 0 || ls.radiance.is_black()) return RGB(0.0f);
+  Vec3 wi_local = v.frame.to_local(ls.wi);
+  RGB f = bsdf_eval(v.bsdf, v.wo_local, wi_local) * std::abs(wi_local.z);
   if (f.is_black()) return RGB(0.0f);
 
   // Trace the shadow ray; it stops just short of the sampled point on the light.
-  Point3 origin = offset_ray_origin(hit.p, hit.ng, ls.wi);
-  Ray shadow = std::isinf(ls.distance)
-                   ? Ray{origin, ls.wi, std::numeric_limits<float>::infinity(), time}
-                   : Ray{origin, ls.p_light - origin, 1 - 1e-4f, time};
+  Point3 origin = offset_ray_origin(v.hit.p, v.hit.ng, ls.wi);
+  Ray shadow = std::isinf(ls.distance) ? Ray{origin, ls.wi, std::numeric_limits<float>::infinity(), v.time}
+                                       : Ray{origin, ls.p_light - origin, 1 - 1e-4f, v.time};
   ++counts.shadow;
   if (scene_.occluded(shadow)) return RGB(0.0f);
 
-  float light_pdf = light_choice.pmf(li) * ls.pdf;
-  if (ls.is_delta) return f * ls.radiance / light_pdf;
-  float w = power_heuristic(light_pdf, bsdf_pdf(bsdf, wo_local, wi_local));
+  // One sample of the light strategy, of which `expected_rays` are taken on average here.
+  float light_pdf = expected_rays * ls.pdf;
+  if (ls.is_delta || !mis_) return f * ls.radiance / light_pdf;
+  float w = power_heuristic(light_pdf, direction_pdf(v.bsdf, v.wo_local, wi_local));
   return f * ls.radiance * (w / light_pdf);
 }
+
+// One instantiation per sampler type of the variant.
+#define CANDELA_INSTANTIATE(S) template RGB PathIntegrator::radiance<S>(Ray, S&, RayCounts&) const;
+CANDELA_FOR_EACH_SAMPLER(CANDELA_INSTANTIATE)
+#undef CANDELA_INSTANTIATE
 
 }  // namespace candela

@@ -1,13 +1,16 @@
 #pragma once
 // The path tracer (Häkkinen 2002, sec. 4.1; pbrt-v4's PathIntegrator): one path per camera sample,
-// never split; next-event estimation at every vertex with a non-delta BSDF, combined with BSDF
-// sampling by multiple importance sampling (power heuristic); Russian roulette on the throughput
-// after a few bounces.
+// never split. At every vertex with a non-delta BSDF, direct light is estimated with shadow rays
+// (sec. 4.5) and combined with the BSDF-sampled continuation by multiple importance sampling (power
+// heuristic, optional). The continuation direction is chosen by BSDF importance sampling, or, as in
+// the paper's sec. 4.7, cosine-weighted or uniformly over the hemisphere and weighted by the BSDF.
+// Russian roulette on the throughput ends paths after a few bounces.
+//
+// The integrator is a template over the sampler type: the render loop dispatches once per tile.
 #include <cstdint>
 
 #include "candela/geometry/ray.h"
 #include "candela/math/color.h"
-#include "candela/sampling/sampler.h"
 #include "candela/scene/scene.h"
 
 namespace candela {
@@ -25,19 +28,38 @@ struct RayCounts {
 
 class PathIntegrator {
  public:
-  PathIntegrator(const Scene& scene, const RenderSettings& settings)
-      : scene_(scene), max_depth_(settings.max_depth), rr_start_depth_(settings.rr_start_depth) {}
+  PathIntegrator(const Scene& scene, const RenderSettings& settings);
 
   // Radiance arriving along the camera ray.
-  RGB radiance(Ray ray, IndependentSampler& sampler, RayCounts& counts) const;
+  template <typename Sampler>
+  RGB radiance(Ray ray, Sampler& sampler, RayCounts& counts) const;
 
  private:
-  RGB sample_direct(const SurfaceHit& hit, const Bsdf& bsdf, const Frame& frame, const Vec3& wo_local,
-                    const LightSampleContext& ctx, float time, IndependentSampler& sampler, RayCounts& counts) const;
+  struct Vertex;  // what direct lighting needs to know about the current path vertex
+
+  template <typename Sampler>
+  RGB direct_light(const Vertex& v, Sampler& sampler, RayCounts& counts, float& total_importance) const;
+  RGB shadow_ray_estimate(const Vertex& v, size_t light, const Vec2& u, float expected_rays,
+                          RayCounts& counts) const;
+  // Expected number of shadow rays that light `li` receives at a vertex: the light-sampling
+  // strategy's sample count for MIS (Veach's multi-sample model).
+  float expected_shadow_rays(size_t li, const LightSampleContext& ctx, float total_importance) const;
+  float total_light_importance(const LightSampleContext& ctx) const;
+  // Weight of a light found by BSDF sampling (hit or escaped to the sky), against light sampling.
+  float emitter_mis_weight(size_t li, float bsdf_pdf, float light_pdf_li, const LightSampleContext& prev,
+                           float prev_total_importance) const;
+
+  template <typename Sampler>
+  std::optional<BsdfSample> sample_direction(const Bsdf& bsdf, const Vec3& wo, Sampler& sampler) const;
+  float direction_pdf(const Bsdf& bsdf, const Vec3& wo, const Vec3& wi) const;
 
   const Scene& scene_;
   int max_depth_;
   int rr_start_depth_;
+  DirectionSampling direction_sampling_;
+  bool mis_;
+  LightSelection light_selection_;
+  int shadow_rays_;
 };
 
 inline float power_heuristic(float pdf_a, float pdf_b) {

@@ -43,6 +43,16 @@ struct TriangleLight {
     return area_to_solid_angle_pdf(1 / area, ctx.p, p, n);
   }
   float power() const { return radiance.luminance() * area * kPi * (two_sided ? 2 : 1); }
+  // Estimated irradiance at ctx: L times the projected solid angle, from the centroid (at most pi).
+  float importance(const LightSampleContext& ctx) const {
+    Point3 c = (p0 + p1 + p2) / 3.0f;
+    Vec3 d = c - ctx.p;
+    float d2 = std::max(length_squared(d), 1e-12f);
+    Vec3 w = d / std::sqrt(d2);
+    float cos_l = two_sided ? std::abs(dot(n, w)) : std::max(0.0f, -dot(n, w));
+    float cos_p = ctx.n == Normal3(0.0f) ? 1.0f : std::max(0.0f, dot(ctx.n, w));
+    return radiance.luminance() * std::min(kPi, area * cos_l * cos_p / d2);
+  }
 };
 
 // A sphere seen from outside is sampled uniformly in the cone it subtends (every sample hits it);
@@ -97,6 +107,14 @@ struct SphereLight {
     return area_to_solid_angle_pdf(1 / (4 * kPi * radius * radius), ctx.p, p, normalize(p - center));
   }
   float power() const { return radiance.luminance() * 4 * kPi * radius * radius * kPi * (two_sided ? 2 : 1); }
+  // Estimated irradiance at ctx: L times the projected solid angle of the subtended cone.
+  float importance(const LightSampleContext& ctx) const {
+    if (!outside(ctx.p)) return radiance.luminance() * kPi;
+    Vec3 w = normalize(center - ctx.p);
+    float cos_max = cone_cos_max(ctx.p);
+    float cos_p = ctx.n == Normal3(0.0f) ? 1.0f : std::max(0.0f, dot(ctx.n, w));
+    return radiance.luminance() * kPi * (1 - cos_max * cos_max) * cos_p;
+  }
 };
 
 }  // namespace candela

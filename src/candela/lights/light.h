@@ -27,6 +27,11 @@ inline float light_pdf_li(const Light& l, const LightSampleContext& ctx, const V
 inline float light_power(const Light& l) {
   return std::visit([](const auto& x) { return x.power(); }, l);
 }
+// Estimated irradiance the light gives at ctx (radiance x projected solid angle): the paper's rule
+// for spending shadow rays (sec. 4.5). Only a heuristic: estimators stay unbiased whatever it says.
+inline float light_importance(const Light& l, const LightSampleContext& ctx) {
+  return std::visit([&](const auto& x) { return x.importance(ctx); }, l);
+}
 inline bool light_is_delta(const Light& l) { return std::holds_alternative<PointLightSource>(l); }
 
 }  // namespace candela

@@ -16,6 +16,13 @@ struct PointLightSource {
   }
   float pdf_li(const LightSampleContext&, const Vec3&, const Point3&, const Normal3&) const { return 0; }
   float power() const { return 4 * kPi * intensity.luminance(); }
+  // Estimated irradiance at ctx: I cos / d^2 (for spending shadow rays where lights matter).
+  float importance(const LightSampleContext& ctx) const {
+    Vec3 d = position - ctx.p;
+    float d2 = length_squared(d);
+    float cos_p = ctx.n == Normal3(0.0f) ? 1.0f : std::max(0.0f, dot(ctx.n, d) / std::sqrt(d2));
+    return intensity.luminance() * cos_p / std::max(d2, 1e-12f);
+  }
 };
 
 }  // namespace candela

@@ -43,6 +43,10 @@ struct SkyLightSource {
   }
   // pi R^2 times the integral of radiance over the sphere (pbrt's definition for infinite lights),
   // integrated exactly for the piecewise-linear profile: the upper hemisphere averages (zenith+horizon)/2.
+  // Estimated irradiance: average radiance times pi (the hemisphere's projected solid angle).
+  float importance(const LightSampleContext&) const {
+    return kPi * (0.5f * ground.luminance() + 0.25f * (zenith.luminance() + horizon.luminance()));
+  }
   float power() const {
     float avg = 0.5f * ground.luminance() + 0.5f * (0.5f * (zenith.luminance() + horizon.luminance()));
     return kPi * scene_radius * scene_radius * 4 * kPi * avg;

@@ -5,6 +5,9 @@
 //   pdf(wo, wi)             solid-angle density with which sample() produces wi (non-delta parts)
 //   sample(wo, u_lobe, u)   a direction with weight f |cos| / pdf, or nothing when the path is absorbed
 //   has_non_delta()         whether light sampling can help at all
+//   non_delta_probability() the probability that sample() picks a non-delta lobe; a BSDF picks its
+//                           non-delta lobes exactly when u_lobe < non_delta_probability(), which lets
+//                           the integrator swap in another direction-sampling strategy for them
 // The closed list of BSDFs is the variant `Bsdf`; dispatch happens once, here.
 #include <optional>
 #include <variant>
@@ -28,6 +31,9 @@ inline std::optional<BsdfSample> bsdf_sample(const Bsdf& b, const Vec3& wo, floa
 }
 inline bool bsdf_has_non_delta(const Bsdf& b) {
   return std::visit([](const auto& x) { return x.has_non_delta(); }, b);
+}
+inline float bsdf_non_delta_probability(const Bsdf& b) {
+  return std::visit([](const auto& x) { return x.non_delta_probability(); }, b);
 }
 inline bool bsdf_is_black(const Bsdf& b) { return std::holds_alternative<BlackBsdf>(b); }
 

@@ -24,6 +24,7 @@ struct DiffuseBsdf {
     return BsdfSample{wi, reflectance, p, false, 1};
   }
   bool has_non_delta() const { return true; }
+  float non_delta_probability() const { return 1; }
 };
 
 }  // namespace candela

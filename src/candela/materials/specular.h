@@ -50,6 +50,7 @@ struct MirrorBsdf {
     return BsdfSample{reflect_local(wo), reflectance, 1, true, 1};
   }
   bool has_non_delta() const { return false; }
+  float non_delta_probability() const { return 0; }
 };
 
 // Glass: reflects with the Fresnel probability F, else refracts. Radiance is scaled by 1/eta^2 on
@@ -69,6 +70,7 @@ struct GlassBsdf {
     return BsdfSample{wt, transmittance / (eta_rel * eta_rel), 1 - f, true, eta_rel};
   }
   bool has_non_delta() const { return false; }
+  float non_delta_probability() const { return 0; }
 };
 
 struct BlackBsdf {
@@ -76,6 +78,7 @@ struct BlackBsdf {
   float pdf(const Vec3&, const Vec3&) const { return 0; }
   std::optional<BsdfSample> sample(const Vec3&, float, Vec2) const { return std::nullopt; }
   bool has_non_delta() const { return false; }
+  float non_delta_probability() const { return 0; }
 };
 
 }  // namespace candela

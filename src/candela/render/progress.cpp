@@ -34,7 +34,7 @@ void ProgressBar::advance(uint64_t work) {
 void ProgressBar::finish() {
   if (!enabled_) return;
   std::lock_guard lock(draw_mutex_);
-  draw(done_.load(), true);
+  draw(total_, true);
   std::fputc('\n', stderr);
 }
 

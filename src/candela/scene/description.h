@@ -175,6 +175,15 @@ struct FilterDesc {
   float mitchell_b = 1.0f / 3, mitchell_c = 1.0f / 3;
 };
 
+// A filter of the given type with pbrt-v4's default parameters.
+inline FilterDesc default_filter(FilterType type) {
+  FilterDesc f;
+  f.type = type;
+  float r = type == FilterType::Box ? 0.5f : type == FilterType::Gaussian ? 1.5f : 2.0f;
+  f.radius = {r, r};
+  return f;
+}
+
 // How the next direction is chosen at non-delta vertices (sec. 4.7).
 enum class DirectionSampling {
   Bsdf,     // importance-sample the BSDF's lobes

@@ -1,0 +1,33 @@
+#pragma once
+// The pixel samplers (the paper's sec. 4.3 plus pbrt-v4's ZSobol) as one closed set: the integrator
+// is a template over the sampler type and the render loop dispatches with std::visit once per tile.
+#include <cstdint>
+#include <variant>
+
+#include "candela/sampling/poisson_sampler.h"
+#include "candela/sampling/sampler.h"
+#include "candela/sampling/stratified_sampler.h"
+#include "candela/sampling/zsobol_sampler.h"
+#include "candela/scene/description.h"
+
+namespace candela {
+
+using Sampler = std::variant<IndependentSampler, StratifiedSampler, PoissonSampler, ZSobolSampler>;
+
+// Applies X to every alternative of Sampler, e.g. for explicit instantiations of sampler templates.
+#define CANDELA_FOR_EACH_SAMPLER(X) X(IndependentSampler) X(StratifiedSampler) X(PoissonSampler) X(ZSobolSampler)
+
+// `samples_per_set` n: stratification holds within each block of n consecutive sample indices (the
+// spp of a plain render, the batch size of adaptive sampling); ZSobol rounds n up to a power of two.
+// `width` x `height` is the image resolution (ZSobol's Morton order).
+inline Sampler make_sampler(const SamplerDesc& desc, int samples_per_set, uint64_t seed, int width, int height) {
+  switch (desc.type) {
+    case SamplerType::Stratified: return StratifiedSampler(samples_per_set, desc.jitter, seed);
+    case SamplerType::Poisson: return PoissonSampler(samples_per_set, seed);
+    case SamplerType::ZSobol: return ZSobolSampler(samples_per_set, seed, width, height);
+    case SamplerType::Independent: break;
+  }
+  return IndependentSampler(seed);
+}
+
+}  // namespace candela

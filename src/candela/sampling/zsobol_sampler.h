@@ -1,0 +1,191 @@
+#pragma once
+// Owen-scrambled Sobol' samples in Morton (Z) order over the image (Ahmed & Wonka 2020, "Screen-space
+// blue-noise diffusion of Monte Carlo sampling error via hierarchical ordering of pixels"; pbrt-v4's
+// ZSobolSampler). Pixel (x, y)'s samples are one aligned block of 2^m consecutive indices of the
+// Sobol' (0,2)-sequence, at block number Morton(x, y), so they form a (0,m,2)-net, and neighbouring
+// pixels' blocks are neighbours in the sequence, so their union is a net too. The index's base-4
+// digits are randomly permuted level by level (each permutation chosen by the digits above it, so
+// aligned blocks still map onto aligned blocks) to decorrelate pixels and dimensions, and each
+// dimension gets its own Owen scrambling. Every dimension, the pixel position included, uses Sobol'
+// dimensions 0 and 1 only, with those two different randomisations.
+//
+// All pixels share each dimension's scramble (that is what lets neighbouring pixels' samples form a
+// joint net), so within one image the pixels' sets take only a few coarse shapes: one image's error
+// depends more on its seed than with per-pixel randomisation; over seeds it is that of Owen-scrambled
+// nets, and unbiased.
+//
+// Sample indices >= n (the set size, rounded up to a power of two) continue in set k = index / n:
+// the same construction with every permutation and scramble reseeded by k, so each set is an
+// independently randomised (0,m,2)-net and sets are statistically independent of one another.
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cstdint>
+
+#include "candela/math/vec.h"
+#include "candela/sampling/rng.h"
+
+namespace candela {
+
+namespace sobol {
+
+inline constexpr int kMatrixColumns = 64;  // one column per bit of a 64-bit sample index
+using GeneratorMatrix = std::array<uint32_t, kMatrixColumns>;
+
+// Sobol' dimension 0: the van der Corput sequence, i.e. the bit-reversal matrix (column j = 2^-(j+1)).
+constexpr GeneratorMatrix van_der_corput_matrix() {
+  GeneratorMatrix m{};
+  for (int j = 0; j < 32; ++j) m[size_t(j)] = 1u << (31 - j);
+  return m;
+}
+
+// Sobol' dimension 1: primitive polynomial x + 1 (degree 1) with initial direction number m_1 = 1;
+// Bratley & Fox's recurrence m_k = 2 m_{k-1} xor m_{k-1} gives the direction numbers v_k = m_k / 2^k
+// (Pascal's triangle mod 2). Column j holds v_{j+1} as a 0.32 fixed-point fraction; its bits below
+// 2^-32 are dropped.
+constexpr GeneratorMatrix pascal_matrix() {
+  GeneratorMatrix m{};
+  uint64_t direction = 1;  // m_1; bit b of m_{j+1} weighs 2^(b - j - 1)
+  for (int j = 0; j < kMatrixColumns; ++j) {
+    m[size_t(j)] = j <= 31 ? uint32_t(direction << (31 - j)) : uint32_t(direction >> (j - 31));
+    direction = (direction << 1) ^ direction;
+  }
+  return m;
+}
+
+inline constexpr std::array<GeneratorMatrix, 2> kMatrices = {van_der_corput_matrix(), pascal_matrix()};
+
+// The unscrambled sample as a 0.32 fixed-point fraction: the product of the generator matrix with
+// the index's bits over GF(2).
+constexpr uint32_t sample_bits(uint64_t index, int dimension) {
+  uint32_t v = 0;
+  for (int j = 0; index != 0; index >>= 1, ++j)
+    if (index & 1) v ^= kMatrices[size_t(dimension)][size_t(j)];
+  return v;
+}
+
+constexpr uint32_t reverse_bits32(uint32_t v) {
+  v = (v << 16) | (v >> 16);
+  v = ((v & 0x00ff00ffu) << 8) | ((v & 0xff00ff00u) >> 8);
+  v = ((v & 0x0f0f0f0fu) << 4) | ((v & 0xf0f0f0f0u) >> 4);
+  v = ((v & 0x33333333u) << 2) | ((v & 0xccccccccu) >> 2);
+  v = ((v & 0x55555555u) << 1) | ((v & 0xaaaaaaaau) >> 1);
+  return v;
+}
+
+// Hash-based Owen scrambling (Laine & Karras 2011; Burley 2020 "Practical Hash-based Owen
+// Scrambling", pbrt-v4's FastOwenScrambler). After reversing the bits, each step (adding or
+// multiplying, v ^= v * even) changes a bit only as a function of the bits below it, which, reversed
+// back, flips each digit as a function of the digits above it: a nested (Owen) scramble, which
+// maps elementary intervals onto elementary intervals and so keeps the net property.
+constexpr uint32_t fast_owen_scramble(uint32_t v, uint32_t seed) {
+  v = reverse_bits32(v);
+  v ^= v * 0x3d20adeau;
+  v += seed;
+  v *= (seed >> 16) | 1u;
+  v ^= v * 0x05526c56u;
+  v ^= v * 0x53a22864u;
+  return reverse_bits32(v);
+}
+
+// 24 high bits to a float in [0, 1): exact, so never rounds up to 1.
+constexpr float bits_to_unit_float(uint32_t v) { return float(v >> 8) * 0x1p-24f; }
+
+}  // namespace sobol
+
+// Interleaves the bits of x (even positions) and y (odd positions).
+constexpr uint64_t encode_morton2(uint32_t x, uint32_t y) {
+  auto spread = [](uint64_t v) {
+    v = (v | (v << 16)) & 0x0000ffff0000ffffULL;
+    v = (v | (v << 8)) & 0x00ff00ff00ff00ffULL;
+    v = (v | (v << 4)) & 0x0f0f0f0f0f0f0f0fULL;
+    v = (v | (v << 2)) & 0x3333333333333333ULL;
+    v = (v | (v << 1)) & 0x5555555555555555ULL;
+    return v;
+  };
+  return spread(x) | (spread(y) << 1);
+}
+
+// All 24 permutations of {0, 1, 2, 3}, permutation p decoded from its Lehmer code (p / 6, p / 2 % 3, p % 2).
+constexpr std::array<std::array<uint8_t, 4>, 24> base4_digit_permutations() {
+  std::array<std::array<uint8_t, 4>, 24> table{};
+  for (int p = 0; p < 24; ++p) {
+    std::array<uint8_t, 4> remaining = {0, 1, 2, 3};
+    int choices[3] = {p / 6, p / 2 % 3, p % 2};
+    for (int slot = 0; slot < 4; ++slot) {
+      int pick = slot < 3 ? choices[slot] : 0;
+      table[size_t(p)][size_t(slot)] = remaining[size_t(pick)];
+      for (int k = pick; k < 3 - slot; ++k) remaining[size_t(k)] = remaining[size_t(k + 1)];
+    }
+  }
+  return table;
+}
+inline constexpr auto kBase4DigitPermutations = base4_digit_permutations();
+
+class ZSobolSampler {
+ public:
+  // `width` x `height` sets the Morton resolution (the next power of two of the larger side); pixels
+  // outside it still get valid samples (their extra Morton bits pass through unpermuted).
+  ZSobolSampler(int samples_per_set, uint64_t seed, int width, int height);
+
+  void start_pixel_sample(int x, int y, uint64_t sample_index) {
+    uint64_t set = sample_index >> log2_n_;
+    uint64_t index_in_set = sample_index & ((uint64_t(1) << log2_n_) - 1);
+    morton_index_ = (encode_morton2(uint32_t(x), uint32_t(y)) << log2_n_) | index_in_set;
+    set_seed_ = hash_values(seed_, set);
+    dimension_ = 0;
+  }
+
+  float get_1d() {
+    uint64_t dimension_hash = hash_values(set_seed_, uint64_t(dimension_));
+    dimension_ += 1;
+    return scrambled_sample(sobol_index(dimension_hash), 0, uint32_t(scramble_seeds(dimension_hash)));
+  }
+
+  Vec2 get_2d() {
+    uint64_t dimension_hash = hash_values(set_seed_, uint64_t(dimension_));
+    dimension_ += 2;
+    uint64_t index = sobol_index(dimension_hash);
+    uint64_t seeds = scramble_seeds(dimension_hash);
+    return {scrambled_sample(index, 0, uint32_t(seeds)), scrambled_sample(index, 1, uint32_t(seeds >> 32))};
+  }
+
+  Vec2 get_pixel_2d() { return get_2d(); }
+
+  int samples_per_set() const { return 1 << log2_n_; }
+
+ private:
+  // Owen scrambling seeds of a dimension (pair), hashed apart from the digit permutations' hashes.
+  static uint64_t scramble_seeds(uint64_t dimension_hash) { return hash_values(dimension_hash); }
+  static float scrambled_sample(uint64_t index, int sobol_dimension, uint32_t seed) {
+    return sobol::bits_to_unit_float(sobol::fast_owen_scramble(sobol::sample_bits(index, sobol_dimension), seed));
+  }
+
+  // The Morton index with its base-4 digits randomly permuted, top digit first, each by one of the 24
+  // permutations of {0,1,2,3} chosen by hashing the dimension and the digits above it. For odd log2(n)
+  // the lowest digit is a single bit, randomly flipped the same way.
+  uint64_t sobol_index(uint64_t dimension_hash) const {
+    const bool odd_log2 = (log2_n_ & 1) != 0;
+    const int lowest_digit = odd_log2 ? 1 : 0;
+    const int permuted_bits = 2 * base4_digits_ - (odd_log2 ? 1 : 0);
+    uint64_t index = permuted_bits >= 64 ? 0 : (morton_index_ >> permuted_bits) << permuted_bits;
+    for (int i = base4_digits_ - 1; i >= lowest_digit; --i) {
+      int shift = 2 * i - (odd_log2 ? 1 : 0);
+      uint32_t digit = uint32_t(morton_index_ >> shift) & 3u;
+      uint64_t higher_digits = shift + 2 >= 64 ? 0 : morton_index_ >> (shift + 2);
+      const auto& permutation = kBase4DigitPermutations[mix_bits(higher_digits ^ dimension_hash) % 24];
+      index |= uint64_t(permutation[digit]) << shift;
+    }
+    if (odd_log2) index |= (morton_index_ & 1) ^ (mix_bits((morton_index_ >> 1) ^ dimension_hash) & 1);
+    return index;
+  }
+
+  int log2_n_;
+  int base4_digits_;  // permuted digits: log2(resolution) + ceil(log2(n) / 2)
+  uint64_t seed_;
+  uint64_t morton_index_ = 0;
+  uint64_t set_seed_ = 0;
+  int dimension_ = 0;
+};
+
+}  // namespace candela
