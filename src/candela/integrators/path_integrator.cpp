@@ -159,26 +159,48 @@ float PathIntegrator::emitter_mis_weight(size_t li, float bsdf_pdf, float light_
   return power_heuristic(bsdf_pdf, light_pdf);
 }
 
+namespace {
+
+// Maps u into cell (k + rotation) mod (nx ny) of an nx x ny grid over [0,1)^2, nx ny >= n: the n
+// samples of one vertex land in distinct strata, and each is still uniform on its own (the random
+// rotation picks its cell uniformly), which is what keeps the estimate unbiased for any n.
+Vec2 stratified_square(Vec2 u, int k, int n, float rotation) {
+  if (n <= 1) return u;
+  int nx = int(std::ceil(std::sqrt(float(n)))), ny = (n + nx - 1) / nx;
+  int cells = nx * ny;
+  int cell = (k + std::min(int(rotation * float(cells)), cells - 1)) % cells;
+  return {std::min((float(cell % nx) + u.x) / float(nx), 0x1.fffffep-1f),
+          std::min((float(cell / nx) + u.y) / float(ny), 0x1.fffffep-1f)};
+}
+
+}  // namespace
+
 template <typename Sampler>
 RGB PathIntegrator::direct_light(const Vertex& v, Sampler& sampler, RayCounts& counts, float& total_importance) const {
   RGB sum(0.0f);
   if (light_selection_ == LightSelection::Power) {
-    // Each shadow ray goes to one light chosen with probability proportional to its power.
+    // Each shadow ray goes to one light chosen with probability proportional to its power; with
+    // several rays, the light choices and the points on the lights are stratified.
     const Distribution1D& choice = scene_.light_distribution();
+    float rotation = shadow_rays_ > 1 ? sampler.get_1d() : 0.0f;
     for (int k = 0; k < shadow_rays_; ++k) {
-      size_t li = choice.sample(sampler.get_1d());
-      Vec2 u = sampler.get_2d();
+      float u_choice = (float(k) + sampler.get_1d()) / float(shadow_rays_);
+      size_t li = choice.sample(std::min(u_choice, 0x1.fffffep-1f));
+      Vec2 u = stratified_square(sampler.get_2d(), k, shadow_rays_, rotation);
       sum += shadow_ray_estimate(v, li, u, expected_shadow_rays(li, v.ctx, 0), counts);
     }
     return sum;
   }
   // The paper's rule: each light gets a number of rays proportional to its importance here, rounded
-  // randomly to an integer n with E[n] = x; dividing by x (not n) keeps the estimate unbiased.
+  // randomly to an integer n with E[n] = x; dividing by x (not n) keeps the estimate unbiased. The
+  // n points on one light are stratified over it (the paper's stratified rectangular lights).
   total_importance = total_light_importance(v.ctx);
   for (size_t li = 0; li < scene_.lights().size(); ++li) {
     float x = expected_shadow_rays(li, v.ctx, total_importance);
     int n = int(x) + (sampler.get_1d() < x - std::floor(x) ? 1 : 0);
-    for (int k = 0; k < n; ++k) sum += shadow_ray_estimate(v, li, sampler.get_2d(), x, counts);
+    float rotation = n > 1 ? sampler.get_1d() : 0.0f;
+    for (int k = 0; k < n; ++k)
+      sum += shadow_ray_estimate(v, li, stratified_square(sampler.get_2d(), k, n, rotation), x, counts);
   }
   return sum;
 }

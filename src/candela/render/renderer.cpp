@@ -121,8 +121,10 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
 
   if (!adaptive) {
-    for (int pass = 0; pass < settings.spp; pass += kPassSpp)
-      run_pass(pc, tiles, arena, std::min(kPassSpp, settings.spp - pass), [&](int, int) { return int64_t(pass); },
+    // A Poisson-disc set is built per pixel: render it in one pass rather than rebuilding it per pass.
+    const int pass_spp = settings.sampler.type == SamplerType::Poisson ? settings.spp : kPassSpp;
+    for (int pass = 0; pass < settings.spp; pass += pass_spp)
+      run_pass(pc, tiles, arena, std::min(pass_spp, settings.spp - pass), [&](int, int) { return int64_t(pass); },
                progress);
   } else {
     // Batches of F samples; a pixel continues while its own samples say it is too noisy, so the
