@@ -1,5 +1,6 @@
 #include "candela/geometry/embree_scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -24,13 +25,19 @@ Vec3d apply(const Matrix4& m, double x, double y, double z, double w) {
           m.m[2][0] * x + m.m[2][1] * y + m.m[2][2] * z + m.m[2][3] * w};
 }
 
-// Nearest root of the ray-sphere quadratic in (t_near, t_far), solved in object space in double
-// precision with the cancellation-free form of the quadratic formula.
-bool intersect_sphere(const SphereGeometry& s, const Vec3d& o_world, const Vec3d& d_world, double t_near,
-                      double t_far, double& t_hit) {
-  const Matrix4& inv = s.to_world.inverse_matrix();
-  Vec3d o = apply(inv, o_world.x, o_world.y, o_world.z, 1);
-  Vec3d d = apply(inv, d_world.x, d_world.y, d_world.z, 0);
+// A ray as a user-geometry callback sees it; time is Embree's, in [0,1].
+struct UserRay {
+  Vec3d o, d;
+  double t_near, t_far;
+  float time;
+};
+
+// Nearest root of the ray-sphere quadratic in (t_near, t_far), solved in object space (reached with
+// `inv`, the world-to-object matrix) in double precision with the cancellation-free quadratic formula.
+bool intersect_sphere_in_object_space(const SphereGeometry& s, const Matrix4& inv, const UserRay& ray, double& t_hit) {
+  const double t_near = ray.t_near, t_far = ray.t_far;
+  Vec3d o = apply(inv, ray.o.x, ray.o.y, ray.o.z, 1);
+  Vec3d d = apply(inv, ray.d.x, ray.d.y, ray.d.z, 0);
   Vec3d f{o.x - s.center.x, o.y - s.center.y, o.z - s.center.z};
   double a = dot(d, d);
   double b_half = dot(f, d);
@@ -51,8 +58,20 @@ bool intersect_sphere(const SphereGeometry& s, const Vec3d& o_world, const Vec3d
   return false;
 }
 
-bool intersect_plane(const PlaneGeometry& pl, float extent, const Vec3d& o, const Vec3d& d, double t_near,
-                     double t_far, double& t_hit) {
+bool intersect_sphere(const SphereGeometry& s, const UserRay& ray, double& t_hit) {
+  return intersect_sphere_in_object_space(s, s.to_world.inverse_matrix(), ray, t_hit);
+}
+
+// A moving sphere is intersected with its transform at the ray's time (a per-ray inverse that static
+// spheres do not pay for).
+bool intersect_moving_sphere(const SphereGeometry& s, const UserRay& ray, double& t_hit) {
+  std::optional<Transform> to_world = interpolate_transform(s.to_world, *s.to_world_end, ray.time);
+  return to_world && intersect_sphere_in_object_space(s, to_world->inverse_matrix(), ray, t_hit);
+}
+
+bool intersect_plane(const PlaneGeometry& pl, float extent, const UserRay& ray, double& t_hit) {
+  const Vec3d &o = ray.o, &d = ray.d;
+  const double t_near = ray.t_near, t_far = ray.t_far;
   Vec3d n{pl.normal.x, pl.normal.y, pl.normal.z};
   double denom = dot(d, n);
   if (denom == 0) return false;
@@ -67,17 +86,18 @@ bool intersect_plane(const PlaneGeometry& pl, float extent, const Vec3d& o, cons
 }
 
 template <typename Args>
-void read_ray(const Args* args, unsigned i, Vec3d& o, Vec3d& d, double& t_near, double& t_far) {
+UserRay read_ray(const Args* args, unsigned i) {
   RTCRayN* ray = nullptr;
   if constexpr (std::is_same_v<Args, RTCIntersectFunctionNArguments>)
     ray = RTCRayHitN_RayN(args->rayhit, args->N);
   else
     ray = args->ray;
   unsigned N = args->N;
-  o = {RTCRayN_org_x(ray, N, i), RTCRayN_org_y(ray, N, i), RTCRayN_org_z(ray, N, i)};
-  d = {RTCRayN_dir_x(ray, N, i), RTCRayN_dir_y(ray, N, i), RTCRayN_dir_z(ray, N, i)};
-  t_near = RTCRayN_tnear(ray, N, i);
-  t_far = RTCRayN_tfar(ray, N, i);
+  return {{RTCRayN_org_x(ray, N, i), RTCRayN_org_y(ray, N, i), RTCRayN_org_z(ray, N, i)},
+          {RTCRayN_dir_x(ray, N, i), RTCRayN_dir_y(ray, N, i), RTCRayN_dir_z(ray, N, i)},
+          RTCRayN_tnear(ray, N, i),
+          RTCRayN_tfar(ray, N, i),
+          RTCRayN_time(ray, N, i)};
 }
 
 void write_hit(const RTCIntersectFunctionNArguments* args, unsigned i, double t) {
@@ -99,10 +119,8 @@ template <typename Shape, typename IntersectFn>
 void user_intersect(const RTCIntersectFunctionNArguments* args, const Shape& shape, IntersectFn fn) {
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
-    Vec3d o, d;
-    double t_near, t_far, t;
-    read_ray(args, i, o, d, t_near, t_far);
-    if (fn(shape, o, d, t_near, t_far, t)) write_hit(args, i, t);
+    double t;
+    if (fn(shape, read_ray(args, i), t)) write_hit(args, i, t);
   }
 }
 
@@ -110,14 +128,12 @@ template <typename Shape, typename IntersectFn>
 void user_occluded(const RTCOccludedFunctionNArguments* args, const Shape& shape, IntersectFn fn) {
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
-    Vec3d o, d;
-    double t_near, t_far, t;
-    read_ray(args, i, o, d, t_near, t_far);
-    if (fn(shape, o, d, t_near, t_far, t)) RTCRayN_tfar(args->ray, args->N, i) = -std::numeric_limits<float>::infinity();
+    double t;
+    if (fn(shape, read_ray(args, i), t)) RTCRayN_tfar(args->ray, args->N, i) = -std::numeric_limits<float>::infinity();
   }
 }
 
-RTCRay make_rtc_ray(const Ray& r) {
+RTCRay make_rtc_ray(const Ray& r, float embree_time) {
   RTCRay ray;
   ray.org_x = r.origin.x;
   ray.org_y = r.origin.y;
@@ -126,7 +142,7 @@ RTCRay make_rtc_ray(const Ray& r) {
   ray.dir_x = r.direction.x;
   ray.dir_y = r.direction.y;
   ray.dir_z = r.direction.z;
-  ray.time = r.time;
+  ray.time = embree_time;
   ray.tfar = r.t_max;
   ray.mask = 0xffffffffu;
   ray.id = 0;
@@ -134,9 +150,29 @@ RTCRay make_rtc_ray(const Ray& r) {
   return ray;
 }
 
+// Bounds of a sphere under `to_world`: the transformed corners of its object-space box.
+Bounds3 sphere_world_bounds(const SphereGeometry& s, const Transform& to_world) {
+  Bounds3 b;
+  for (int i = 0; i < 8; ++i) {
+    Vec3 corner(i & 1 ? s.radius : -s.radius, i & 2 ? s.radius : -s.radius, i & 4 ? s.radius : -s.radius);
+    b.extend(to_world.point(s.center + corner));
+  }
+  return b;
+}
+
 }  // namespace
 
-EmbreeScene::EmbreeScene() {
+std::optional<Transform> interpolate_transform(const Transform& start, const Transform& end, float t) {
+  Matrix4 m;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) m.m[r][c] = (1 - double(t)) * start.matrix().m[r][c] + double(t) * end.matrix().m[r][c];
+  return Transform::from_matrix(m);
+}
+
+EmbreeScene::EmbreeScene(float transform_start_time, float transform_end_time)
+    : time_start_(transform_start_time),
+      // A zero-length interval leaves every shape at its start transform.
+      time_scale_(transform_end_time > transform_start_time ? 1 / (transform_end_time - transform_start_time) : 0) {
   device_ = rtcNewDevice(nullptr);
   if (!device_) throw std::runtime_error("cannot create an Embree device");
   rtcSetDeviceErrorFunction(device_, report_embree_error, nullptr);
@@ -149,19 +185,45 @@ EmbreeScene::~EmbreeScene() {
   if (device_) rtcReleaseDevice(device_);
 }
 
-void EmbreeScene::add_triangles(uint32_t id, const std::vector<Point3>& positions, const std::vector<uint32_t>& indices) {
-  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-  // Embree reads vertices with 16-byte SSE loads: a shared buffer needs one float of padding at the end,
-  // so give it its own copy with the padding rather than aliasing the std::vector.
-  auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
+namespace {
+
+// Embree reads vertices with 16-byte SSE loads: a shared buffer needs one float of padding at the end,
+// so each time step gets its own copy with the padding rather than aliasing the std::vector.
+void set_vertex_buffer(RTCGeometry geom, unsigned slot, const std::vector<Point3>& positions) {
+  auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, slot,
                                                                RTC_FORMAT_FLOAT3, sizeof(Point3), positions.size()));
   std::copy_n(&positions[0].x, positions.size() * 3, vertices);
+}
+
+}  // namespace
+
+RTCGeometry EmbreeScene::new_triangle_geometry(const std::vector<uint32_t>& indices) {
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* tris = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                               3 * sizeof(uint32_t), indices.size() / 3));
   std::copy(indices.begin(), indices.end(), tris);
+  return geom;
+}
+
+void EmbreeScene::attach(RTCGeometry geom, uint32_t id) {
   rtcCommitGeometry(geom);
   rtcAttachGeometryByID(scene_, geom, id);
   rtcReleaseGeometry(geom);
+}
+
+void EmbreeScene::add_triangles(uint32_t id, const std::vector<Point3>& positions, const std::vector<uint32_t>& indices) {
+  RTCGeometry geom = new_triangle_geometry(indices);
+  set_vertex_buffer(geom, 0, positions);
+  attach(geom, id);
+}
+
+void EmbreeScene::add_moving_triangles(uint32_t id, const std::vector<Point3>& positions,
+                                       const std::vector<Point3>& positions_end, const std::vector<uint32_t>& indices) {
+  RTCGeometry geom = new_triangle_geometry(indices);
+  rtcSetGeometryTimeStepCount(geom, 2);
+  set_vertex_buffer(geom, 0, positions);
+  set_vertex_buffer(geom, 1, positions_end);
+  attach(geom, id);
 }
 
 void EmbreeScene::add_sphere(uint32_t id, const SphereGeometry& sphere) {
@@ -170,11 +232,17 @@ void EmbreeScene::add_sphere(uint32_t id, const SphereGeometry& sphere) {
   rtcSetGeometryUserPrimitiveCount(geom, 1);
   rtcSetGeometryUserData(geom, spheres_.back().get());
   rtcSetGeometryBoundsFunction(geom, sphere_bounds, nullptr);
-  rtcSetGeometryIntersectFunction(geom, sphere_intersect);
-  rtcSetGeometryOccludedFunction(geom, sphere_occluded);
-  rtcCommitGeometry(geom);
-  rtcAttachGeometryByID(scene_, geom, id);
-  rtcReleaseGeometry(geom);
+  if (sphere.to_world_end) {
+    // Embree interpolates the two time steps' boxes linearly; they contain the sphere at every time
+    // in between because each point of it moves linearly.
+    rtcSetGeometryTimeStepCount(geom, 2);
+    rtcSetGeometryIntersectFunction(geom, moving_sphere_intersect);
+    rtcSetGeometryOccludedFunction(geom, moving_sphere_occluded);
+  } else {
+    rtcSetGeometryIntersectFunction(geom, sphere_intersect);
+    rtcSetGeometryOccludedFunction(geom, sphere_occluded);
+  }
+  attach(geom, id);
 }
 
 void EmbreeScene::add_plane(uint32_t id, const PlaneGeometry& plane, float extent) {
@@ -185,18 +253,20 @@ void EmbreeScene::add_plane(uint32_t id, const PlaneGeometry& plane, float exten
   rtcSetGeometryBoundsFunction(geom, plane_bounds, nullptr);
   rtcSetGeometryIntersectFunction(geom, plane_intersect);
   rtcSetGeometryOccludedFunction(geom, plane_occluded);
-  rtcCommitGeometry(geom);
-  rtcAttachGeometryByID(scene_, geom, id);
-  rtcReleaseGeometry(geom);
+  attach(geom, id);
 }
 
 void EmbreeScene::commit() { rtcCommitScene(scene_); }
+
+float EmbreeScene::normalized_time(float time) const {
+  return std::clamp((time - time_start_) * time_scale_, 0.0f, 1.0f);
+}
 
 bool EmbreeScene::intersect(const Ray& r, EmbreeHit& hit) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rayhit;
-  rayhit.ray = make_rtc_ray(r);
+  rayhit.ray = make_rtc_ray(r, normalized_time(r.time));
   rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(scene_, &context, &rayhit);
@@ -208,19 +278,14 @@ bool EmbreeScene::intersect(const Ray& r, EmbreeHit& hit) const {
 bool EmbreeScene::occluded(const Ray& r) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  RTCRay ray = make_rtc_ray(r);
+  RTCRay ray = make_rtc_ray(r, normalized_time(r.time));
   rtcOccluded1(scene_, &context, &ray);
   return ray.tfar < 0;
 }
 
 void EmbreeScene::sphere_bounds(const RTCBoundsFunctionArguments* args) {
   const auto& s = *static_cast<const SphereGeometry*>(args->geometryUserPtr);
-  // Bounds of the transformed sphere: transform the 8 corners of its object-space box.
-  Bounds3 b;
-  for (int i = 0; i < 8; ++i) {
-    Vec3 corner(i & 1 ? s.radius : -s.radius, i & 2 ? s.radius : -s.radius, i & 4 ? s.radius : -s.radius);
-    b.extend(s.to_world.point(s.center + corner));
-  }
+  Bounds3 b = sphere_world_bounds(s, args->timeStep == 0 ? s.to_world : *s.to_world_end);
   // Pad by a relative epsilon: the box is in float and the intersection in double.
   Vec3 pad = Vec3(1e-5f) * (1.0f + max_component(max(b.hi, -b.lo)));
   args->bounds_o->lower_x = b.lo.x - pad.x;
@@ -239,6 +304,14 @@ void EmbreeScene::sphere_occluded(const RTCOccludedFunctionNArguments* args) {
   user_occluded(args, *static_cast<const SphereGeometry*>(args->geometryUserPtr), intersect_sphere);
 }
 
+void EmbreeScene::moving_sphere_intersect(const RTCIntersectFunctionNArguments* args) {
+  user_intersect(args, *static_cast<const SphereGeometry*>(args->geometryUserPtr), intersect_moving_sphere);
+}
+
+void EmbreeScene::moving_sphere_occluded(const RTCOccludedFunctionNArguments* args) {
+  user_occluded(args, *static_cast<const SphereGeometry*>(args->geometryUserPtr), intersect_moving_sphere);
+}
+
 void EmbreeScene::plane_bounds(const RTCBoundsFunctionArguments* args) {
   const auto& r = *static_cast<const PlaneRecord*>(args->geometryUserPtr);
   const Point3& p = r.plane.point;
@@ -252,14 +325,16 @@ void EmbreeScene::plane_bounds(const RTCBoundsFunctionArguments* args) {
 
 void EmbreeScene::plane_intersect(const RTCIntersectFunctionNArguments* args) {
   const auto& r = *static_cast<const PlaneRecord*>(args->geometryUserPtr);
-  user_intersect(args, r, [](const PlaneRecord& rec, const Vec3d& o, const Vec3d& d, double tn, double tf,
-                             double& t) { return intersect_plane(rec.plane, rec.extent, o, d, tn, tf, t); });
+  user_intersect(args, r, [](const PlaneRecord& rec, const UserRay& ray, double& t) {
+    return intersect_plane(rec.plane, rec.extent, ray, t);
+  });
 }
 
 void EmbreeScene::plane_occluded(const RTCOccludedFunctionNArguments* args) {
   const auto& r = *static_cast<const PlaneRecord*>(args->geometryUserPtr);
-  user_occluded(args, r, [](const PlaneRecord& rec, const Vec3d& o, const Vec3d& d, double tn, double tf,
-                            double& t) { return intersect_plane(rec.plane, rec.extent, o, d, tn, tf, t); });
+  user_occluded(args, r, [](const PlaneRecord& rec, const UserRay& ray, double& t) {
+    return intersect_plane(rec.plane, rec.extent, ray, t);
+  });
 }
 
 }  // namespace candela

@@ -2,10 +2,13 @@
 // The acceleration structure: every intersection and occlusion query goes through Embree.
 // Triangle meshes are Embree triangle geometry; spheres and infinite planes are Embree user
 // geometry intersected analytically in double precision (exact, not tessellated).
+// Moving shapes (motion blur, the paper's sec. 4.2) have two Embree time steps: their transform is
+// interpolated linearly between the start and end transforms, as Embree interpolates vertices.
 #include <embree3/rtcore.h>
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "candela/geometry/ray.h"
@@ -20,11 +23,17 @@ struct EmbreeHit {
   float u, v;          // Embree barycentrics: p = (1-u-v) p0 + u p1 + v p2
 };
 
+// The transform (1-t) start + t end, t in [0,1]; nullopt where the interpolated matrix is singular.
+// For affine maps this moves every point linearly, exactly as Embree's vertex motion blur does.
+std::optional<Transform> interpolate_transform(const Transform& start, const Transform& end, float t);
+
 // Analytic shapes kept in object space with both transforms, so non-uniform scales work.
 struct SphereGeometry {
   Transform to_world;
   Point3 center;
   float radius;
+  // A moving sphere: its transform at Embree time 1 (to_world is the one at time 0).
+  std::optional<Transform> to_world_end;
 };
 struct PlaneGeometry {
   Point3 point;
@@ -33,7 +42,9 @@ struct PlaneGeometry {
 
 class EmbreeScene {
  public:
-  EmbreeScene();
+  // Ray::time is absolute: shapes move between transform_start_time (Embree time 0) and
+  // transform_end_time (Embree time 1), and stand still outside.
+  explicit EmbreeScene(float transform_start_time = 0, float transform_end_time = 1);
   ~EmbreeScene();
   EmbreeScene(const EmbreeScene&) = delete;
   EmbreeScene& operator=(const EmbreeScene&) = delete;
@@ -41,17 +52,24 @@ class EmbreeScene {
   // Each attaches a geometry under the caller's id, reported back in hits. Vertex and index data
   // are copied into Embree.
   void add_triangles(uint32_t id, const std::vector<Point3>& positions, const std::vector<uint32_t>& indices);
-  void add_sphere(uint32_t id, const SphereGeometry& sphere);
+  // Triangles whose vertices move linearly from `positions` at time 0 to `positions_end` at time 1.
+  void add_moving_triangles(uint32_t id, const std::vector<Point3>& positions, const std::vector<Point3>& positions_end,
+                            const std::vector<uint32_t>& indices);
+  void add_sphere(uint32_t id, const SphereGeometry& sphere);  // moving when sphere.to_world_end is set
   void add_plane(uint32_t id, const PlaneGeometry& plane, float extent);
   void commit();
 
   bool intersect(const Ray& ray, EmbreeHit& hit) const;
   bool occluded(const Ray& ray) const;  // any hit in (0, ray.t_max)
+  // Embree's time in [0,1] for an absolute ray time: where between the two transforms shapes are.
+  float normalized_time(float time) const;
 
  private:
   static void sphere_bounds(const RTCBoundsFunctionArguments* args);
   static void sphere_intersect(const RTCIntersectFunctionNArguments* args);
   static void sphere_occluded(const RTCOccludedFunctionNArguments* args);
+  static void moving_sphere_intersect(const RTCIntersectFunctionNArguments* args);
+  static void moving_sphere_occluded(const RTCOccludedFunctionNArguments* args);
   static void plane_bounds(const RTCBoundsFunctionArguments* args);
   static void plane_intersect(const RTCIntersectFunctionNArguments* args);
   static void plane_occluded(const RTCOccludedFunctionNArguments* args);
@@ -61,6 +79,10 @@ class EmbreeScene {
     float extent;
   };
 
+  RTCGeometry new_triangle_geometry(const std::vector<uint32_t>& indices);
+  void attach(RTCGeometry geom, uint32_t id);
+
+  float time_start_ = 0, time_scale_ = 1;  // Embree time = (time - time_start_) * time_scale_
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
   // Stable storage for user-geometry data (Embree keeps raw pointers to it).

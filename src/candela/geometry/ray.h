@@ -9,7 +9,7 @@ struct Ray {
   Point3 origin;
   Vec3 direction;  // not necessarily normalised; t is measured in its units
   float t_max = std::numeric_limits<float>::infinity();
-  float time = 0;  // in [0,1] over the shutter interval
+  float time = 0;  // absolute, in [shutter open, shutter close]; moving shapes are seen at this time
   Point3 at(float t) const { return origin + direction * t; }
 };
 

@@ -32,6 +32,7 @@ using Json = nlohmann::ordered_json;  // ordered: materials keep the file's orde
 
 constexpr int kMaxResolution = 65536;
 constexpr int64_t kMaxPixels = int64_t(1) << 28;
+constexpr float kMaxFilterRadius = 64;  // pixels; the filter is tabulated per unit of radius
 
 // ---------------------------------------------------------------- JSON pointers and source positions
 
@@ -360,6 +361,18 @@ std::string read_string(const ErrorReporter& report, const Json& value, const st
   return value.get<std::string>();
 }
 
+// One of a fixed set of names, e.g. "bsdf" for DirectionSampling::Bsdf.
+template <typename E>
+E read_name(const ErrorReporter& report, const Json& value, const std::string& pointer, std::string_view what,
+            std::initializer_list<std::pair<std::string_view, E>> names) {
+  std::string name = read_string(report, value, pointer);
+  for (const auto& [known, result] : names)
+    if (name == known) return result;
+  std::vector<std::string_view> known;
+  for (const auto& entry : names) known.push_back(entry.first);
+  report.fail(pointer, "unknown {} \"{}\"; expected one of: {}", what, name, fmt::join(known, ", "));
+}
+
 void check_is_array(const ErrorReporter& report, const Json& value, const std::string& pointer,
                     std::string_view of_what) {
   if (!value.is_array()) report.fail(pointer, "expected an array of {}, got {}", of_what, describe(value));
@@ -524,6 +537,7 @@ class JsonSceneReader {
       report_.fail(camera.pointer_of("fov"), "the vertical field of view must be in (0, 180) degrees, got {}", fov);
     scene_.film.width = camera.integer_or("width", scene_.film.width, 1, kMaxResolution);
     scene_.film.height = camera.integer_or("height", scene_.film.height, 1, kMaxResolution);
+    read_lens_and_shutter(camera);
     camera.finish();
     if (int64_t(scene_.film.width) * scene_.film.height > kMaxPixels)
       report_.fail(pointer, "{} x {} pixels exceeds the limit of 2^28 pixels", scene_.film.width, scene_.film.height);
@@ -531,6 +545,20 @@ class JsonSceneReader {
     scene_.camera.world_from_camera = Transform::look_at_right_handed(position, look_at, up);
     scene_.camera.fov_degrees = fov;
     scene_.camera.fov_axis = FovAxis::Y;
+  }
+
+  void read_lens_and_shutter(CheckedObject& camera) {
+    CameraDesc& desc = scene_.camera;
+    desc.lens_radius = camera.number_or("lens_radius", desc.lens_radius, Bound::NonNegative);
+    desc.focus_distance = camera.number_or("focus_distance", desc.focus_distance, Bound::Positive);
+    if (const Json* shutter = camera.find("shutter")) {
+      Vec2 open_close = read_vec2(report_, *shutter, camera.pointer_of("shutter"));
+      if (!(open_close.x <= open_close.y))
+        report_.fail(camera.pointer_of("shutter"), "the shutter must not close before it opens, got [{}, {}]",
+                     open_close.x, open_close.y);
+      desc.shutter_open = open_close.x;
+      desc.shutter_close = open_close.y;
+    }
   }
 
   void check_view_direction(const CheckedObject& camera, Point3 position, Point3 look_at, Vec3 up) const {
@@ -552,7 +580,99 @@ class JsonSceneReader {
     if (settings.integrator.empty()) report_.fail(render.pointer_of("integrator"), "the integrator name is empty");
     scene_.film.filename = render.string_or("output", "");
     settings.rr_start_depth = render.integer_or("rr_start_depth", settings.rr_start_depth, 0, kIntMax);
+    if (const Json* times = render.find("transform_times"))
+      read_transform_times(*times, render.pointer_of("transform_times"));
+    if (const Json* sampler = render.find("sampler"))
+      settings.sampler = read_sampler(*sampler, render.pointer_of("sampler"));
+    if (const Json* filter = render.find("filter")) settings.filter = read_filter(*filter, render.pointer_of("filter"));
+    read_integrator_strategies(render, settings);
+    if (const Json* adaptive = render.find("adaptive"))
+      read_adaptive(*adaptive, render.pointer_of("adaptive"), settings);
     render.finish();
+  }
+
+  void read_transform_times(const Json& value, const std::string& pointer) {
+    Vec2 times = read_vec2(report_, value, pointer);
+    // Shapes are interpolated between the two times, so they must span an interval.
+    if (!(times.x < times.y))
+      report_.fail(pointer, "the start time must be less than the end time, got [{}, {}]", times.x, times.y);
+    scene_.transform_start_time = times.x;
+    scene_.transform_end_time = times.y;
+  }
+
+  SamplerDesc read_sampler(const Json& value, const std::string& pointer) const {
+    CheckedObject object(report_, value, pointer);
+    SamplerDesc sampler;
+    sampler.type = read_name<SamplerType>(report_, object.require("type"), object.pointer_of("type"), "sampler type",
+                                          {{"independent", SamplerType::Independent},
+                                           {"stratified", SamplerType::Stratified},
+                                           {"poisson", SamplerType::Poisson},
+                                           {"zsobol", SamplerType::ZSobol}});
+    if (sampler.type == SamplerType::Stratified) sampler.jitter = object.boolean_or("jitter", sampler.jitter);
+    object.finish();
+    return sampler;
+  }
+
+  // Each type starts from pbrt-v4's defaults; only the keys of that type's parameters are allowed.
+  FilterDesc read_filter(const Json& value, const std::string& pointer) const {
+    CheckedObject object(report_, value, pointer);
+    FilterType type = read_name<FilterType>(report_, object.require("type"), object.pointer_of("type"), "filter type",
+                                            {{"box", FilterType::Box},
+                                             {"tent", FilterType::Tent},
+                                             {"gaussian", FilterType::Gaussian},
+                                             {"mitchell", FilterType::Mitchell}});
+    FilterDesc filter = default_filter(type);
+    if (const Json* radius = object.find("radius"))
+      filter.radius = read_filter_radius(*radius, object.pointer_of("radius"));
+    if (type == FilterType::Gaussian)
+      filter.gaussian_sigma = object.number_or("sigma", filter.gaussian_sigma, Bound::Positive);
+    if (type == FilterType::Mitchell) {
+      filter.mitchell_b = object.number_or("b", filter.mitchell_b);
+      filter.mitchell_c = object.number_or("c", filter.mitchell_c);
+    }
+    object.finish();
+    return filter;
+  }
+
+  // One number for both axes, or [x, y].
+  Vec2 read_filter_radius(const Json& value, const std::string& pointer) const {
+    Vec2 radius = value.is_number() ? Vec2(read_float(report_, value, pointer), read_float(report_, value, pointer))
+                                    : read_vec2(report_, value, pointer);
+    for (float r : {radius.x, radius.y})
+      if (!(r > 0 && r <= kMaxFilterRadius))
+        report_.fail(pointer, "a filter radius must be in (0, {}] pixels, got {}", kMaxFilterRadius, r);
+    return radius;
+  }
+
+  void read_integrator_strategies(CheckedObject& render, RenderSettings& settings) const {
+    if (const Json* value = render.find("direction_sampling"))
+      settings.direction_sampling = read_name<DirectionSampling>(
+          report_, *value, render.pointer_of("direction_sampling"), "direction sampling",
+          {{"bsdf", DirectionSampling::Bsdf}, {"cosine", DirectionSampling::Cosine},
+           {"uniform", DirectionSampling::Uniform}});
+    settings.mis = render.boolean_or("mis", settings.mis);
+    if (const Json* value = render.find("light_selection"))
+      settings.light_selection =
+          read_name<LightSelection>(report_, *value, render.pointer_of("light_selection"), "light selection",
+                                    {{"power", LightSelection::Power}, {"paper", LightSelection::Paper}});
+    settings.shadow_rays = render.integer_or("shadow_rays", settings.shadow_rays, 1, std::numeric_limits<int>::max());
+  }
+
+  // Present = on: pixels get batches of `batch` samples until their relative error is below `threshold`.
+  void read_adaptive(const Json& value, const std::string& pointer, RenderSettings& settings) const {
+    CheckedObject adaptive(report_, value, pointer);
+    constexpr int64_t kIntMax = std::numeric_limits<int>::max();
+    settings.adaptive_threshold = adaptive.number("threshold", Bound::Positive);
+    settings.adaptive_batch = adaptive.integer_or("batch", settings.adaptive_batch, 1, kIntMax);
+    // Batches of a power of two keep every sampler's stratification within a batch.
+    if ((settings.adaptive_batch & (settings.adaptive_batch - 1)) != 0)
+      report_.fail(adaptive.pointer_of("batch"), "expected a power of two, got {}", settings.adaptive_batch);
+    settings.adaptive_max_spp = adaptive.integer_or("max_spp", settings.adaptive_max_spp, 1, kIntMax);
+    if (settings.adaptive_max_spp < settings.adaptive_batch)
+      report_.fail(adaptive.has("max_spp") ? adaptive.pointer_of("max_spp") : pointer,
+                   "max_spp ({}) must be at least the batch size ({})", settings.adaptive_max_spp,
+                   settings.adaptive_batch);
+    adaptive.finish();
   }
 
   // ---- materials
@@ -650,6 +770,7 @@ class JsonSceneReader {
     shape.material = read_shape_material(s);
     if (const Json* emission = s.find("emission")) shape.emission = read_emission(*emission, s.pointer_of("emission"));
     shape.to_world = read_transform_key(s);
+    if (const Json* end = s.find("transform_end")) shape.to_world_end = read_moving_transform(*end, s, shape);
     shape.name = s.string_or("name", "");
     shape.reverse_orientation = s.boolean_or("reverse_orientation", false);
     s.finish();
@@ -787,6 +908,16 @@ class JsonSceneReader {
   }
 
   // ---- transforms
+
+  // A moving shape's transform at the end time (render.transform_times); lights and infinite planes
+  // cannot move.
+  Transform read_moving_transform(const Json& value, CheckedObject& s, const ShapeDesc& shape) const {
+    std::string pointer = s.pointer_of("transform_end");
+    if (shape.emission) report_.fail(pointer, "area lights must not move: an emissive shape cannot have transform_end");
+    if (std::holds_alternative<PlaneShape>(shape.geometry))
+      report_.fail(pointer, "an infinite plane must not move: it cannot have transform_end");
+    return read_transform(value, pointer);
+  }
 
   Transform read_transform_key(CheckedObject& object) const {
     const Json* steps = object.find("transform");

@@ -99,6 +99,19 @@ TEST(JsonReader, EmptySceneGetsDefaults) {
   EXPECT_EQ(scene.settings.seed, 0u);
   EXPECT_EQ(scene.settings.integrator, "path");
   EXPECT_EQ(scene.settings.rr_start_depth, 3);
+  EXPECT_EQ(scene.settings.sampler.type, SamplerType::Independent);
+  EXPECT_EQ(scene.settings.filter.type, FilterType::Box);
+  EXPECT_FLOAT_EQ(scene.settings.filter.radius.x, 0.5f);
+  EXPECT_EQ(scene.settings.direction_sampling, DirectionSampling::Bsdf);
+  EXPECT_TRUE(scene.settings.mis);
+  EXPECT_EQ(scene.settings.light_selection, LightSelection::Power);
+  EXPECT_EQ(scene.settings.shadow_rays, 1);
+  EXPECT_EQ(scene.settings.adaptive_threshold, 0);  // off
+  EXPECT_FLOAT_EQ(scene.transform_start_time, 0);
+  EXPECT_FLOAT_EQ(scene.transform_end_time, 1);
+  EXPECT_FLOAT_EQ(scene.camera.lens_radius, 0);
+  EXPECT_FLOAT_EQ(scene.camera.shutter_open, 0);
+  EXPECT_FLOAT_EQ(scene.camera.shutter_close, 1);
   EXPECT_FLOAT_EQ(scene.camera.fov_degrees, 40);
   EXPECT_EQ(scene.camera.world_from_camera, Transform::look_at_right_handed({0, 0, 0}, {0, 0, 1}, {0, 1, 0}));
   EXPECT_TRUE(scene.shapes.empty());
@@ -122,6 +135,82 @@ TEST(JsonReader, ReadsCameraAndRenderSettings) {
   EXPECT_EQ(scene.settings.integrator, "direct");
   EXPECT_EQ(scene.film.filename, "out.exr");
   EXPECT_EQ(scene.settings.rr_start_depth, 0);
+}
+
+TEST(JsonReader, ReadsLensShutterAndMotion) {
+  SceneDesc scene = read(R"({
+    "camera": {"lens_radius": 0.05, "focus_distance": 4, "shutter": [0.25, 0.75]},
+    "render": {"transform_times": [0, 2]},
+    "shapes": [{"type": "box", "min": [0, 0, 0], "max": [1, 1, 1], "transform": [{"translate": [1, 0, 0]}],
+                "transform_end": [{"scale": 2}, {"translate": [0, 1, 0]}]},
+               {"type": "sphere", "center": [0, 0, 0], "radius": 1}]})");
+  EXPECT_FLOAT_EQ(scene.camera.lens_radius, 0.05f);
+  EXPECT_FLOAT_EQ(scene.camera.focus_distance, 4);
+  EXPECT_FLOAT_EQ(scene.camera.shutter_open, 0.25f);
+  EXPECT_FLOAT_EQ(scene.camera.shutter_close, 0.75f);
+  EXPECT_FLOAT_EQ(scene.transform_start_time, 0);
+  EXPECT_FLOAT_EQ(scene.transform_end_time, 2);
+  expect_near(scene.shapes[0].to_world.point({1, 1, 1}), {2, 1, 1});
+  ASSERT_TRUE(scene.shapes[0].to_world_end.has_value());
+  expect_near(scene.shapes[0].to_world_end->point({1, 1, 1}), {2, 3, 2});
+  EXPECT_FALSE(scene.shapes[1].to_world_end.has_value());
+  // A zero-length shutter is an instant.
+  EXPECT_FLOAT_EQ(read(R"({"camera": {"shutter": [0.5, 0.5]}})").camera.shutter_close, 0.5f);
+}
+
+TEST(JsonReader, ReadsSamplerAndFilter) {
+  SceneDesc scene = read(R"({"render": {"sampler": {"type": "stratified", "jitter": false},
+                                         "filter": {"type": "gaussian", "radius": [1, 2], "sigma": 0.3}}})");
+  EXPECT_EQ(scene.settings.sampler.type, SamplerType::Stratified);
+  EXPECT_FALSE(scene.settings.sampler.jitter);
+  EXPECT_EQ(scene.settings.filter.type, FilterType::Gaussian);
+  EXPECT_FLOAT_EQ(scene.settings.filter.radius.x, 1);
+  EXPECT_FLOAT_EQ(scene.settings.filter.radius.y, 2);
+  EXPECT_FLOAT_EQ(scene.settings.filter.gaussian_sigma, 0.3f);
+  EXPECT_EQ(read(R"({"render": {"sampler": {"type": "poisson"}}})").settings.sampler.type, SamplerType::Poisson);
+  EXPECT_EQ(read(R"({"render": {"sampler": {"type": "zsobol"}}})").settings.sampler.type, SamplerType::ZSobol);
+  EXPECT_EQ(read(R"({"render": {"sampler": {"type": "independent"}}})").settings.sampler.type,
+            SamplerType::Independent);
+  // pbrt-v4's default radius per type; a single number sets both axes.
+  auto filter_of = [](const std::string& filter) {
+    return read(R"({"render": {"filter": )" + filter + "}}").settings.filter;
+  };
+  EXPECT_FLOAT_EQ(filter_of(R"({"type": "box"})").radius.y, 0.5f);
+  EXPECT_FLOAT_EQ(filter_of(R"({"type": "tent"})").radius.x, 2);
+  FilterDesc gaussian = filter_of(R"({"type": "gaussian"})");
+  EXPECT_FLOAT_EQ(gaussian.radius.x, 1.5f);
+  EXPECT_FLOAT_EQ(gaussian.gaussian_sigma, 0.5f);
+  FilterDesc mitchell = filter_of(R"({"type": "mitchell", "radius": 1.5, "b": 0, "c": 0.5})");
+  EXPECT_EQ(mitchell.type, FilterType::Mitchell);
+  EXPECT_FLOAT_EQ(mitchell.radius.x, 1.5f);
+  EXPECT_FLOAT_EQ(mitchell.radius.y, 1.5f);
+  EXPECT_FLOAT_EQ(mitchell.mitchell_b, 0);
+  EXPECT_FLOAT_EQ(mitchell.mitchell_c, 0.5f);
+  FilterDesc mitchell_defaults = filter_of(R"({"type": "mitchell"})");
+  EXPECT_FLOAT_EQ(mitchell_defaults.radius.x, 2);
+  EXPECT_FLOAT_EQ(mitchell_defaults.mitchell_b, 1.0f / 3);
+  EXPECT_FLOAT_EQ(mitchell_defaults.mitchell_c, 1.0f / 3);
+}
+
+TEST(JsonReader, ReadsIntegratorStrategiesAndAdaptiveSampling) {
+  SceneDesc scene = read(R"({"render": {"direction_sampling": "uniform", "mis": false, "light_selection": "paper",
+                                         "shadow_rays": 4,
+                                         "adaptive": {"threshold": 0.02, "batch": 8, "max_spp": 512}}})");
+  EXPECT_EQ(scene.settings.direction_sampling, DirectionSampling::Uniform);
+  EXPECT_FALSE(scene.settings.mis);
+  EXPECT_EQ(scene.settings.light_selection, LightSelection::Paper);
+  EXPECT_EQ(scene.settings.shadow_rays, 4);
+  EXPECT_FLOAT_EQ(scene.settings.adaptive_threshold, 0.02f);
+  EXPECT_EQ(scene.settings.adaptive_batch, 8);
+  EXPECT_EQ(scene.settings.adaptive_max_spp, 512);
+  EXPECT_EQ(read(R"({"render": {"direction_sampling": "cosine"}})").settings.direction_sampling,
+            DirectionSampling::Cosine);
+  EXPECT_EQ(read(R"({"render": {"direction_sampling": "bsdf"}})").settings.direction_sampling, DirectionSampling::Bsdf);
+  EXPECT_EQ(read(R"({"render": {"light_selection": "power"}})").settings.light_selection, LightSelection::Power);
+  // Only the threshold is required: batch and max_spp keep their defaults (16, 1024).
+  SceneDesc defaults = read(R"({"render": {"adaptive": {"threshold": 0.1}}})");
+  EXPECT_EQ(defaults.settings.adaptive_batch, 16);
+  EXPECT_EQ(defaults.settings.adaptive_max_spp, 1024);
 }
 
 TEST(JsonReader, AcceptsIntegralFloatsAndComments) {
@@ -345,7 +434,7 @@ TEST(JsonReader, UnknownKeyNamesItsJsonPointer) {
       "  {\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"radiuss\": 2}]}");
   EXPECT_EQ(message,
             "test.json:3:56: at /shapes/1/radiuss: unknown key; expected one of: type, center, radius, "
-            "material, emission, transform, name, reverse_orientation");
+            "material, emission, transform, transform_end, name, reverse_orientation");
   EXPECT_NE(error_of(R"({"camera": {"fov": 40, "zoom": 2}})").find("at /camera/zoom: unknown key"), std::string::npos);
   EXPECT_NE(error_of(R"({"scene": {}})").find("at /scene: unknown key"), std::string::npos);
   EXPECT_NE(error_of(R"({"render": {"samples": 4}})").find("at /render/samples: unknown key"), std::string::npos);
@@ -465,6 +554,90 @@ TEST(JsonReader, BadRenderSettingsAreErrors) {
   EXPECT_NE(error_of(R"({"render": {"spp": 3000000000}})").find("expected an integer >= 1, got 3000000000"),
             std::string::npos);
   EXPECT_NE(error_of(R"({"render": {"integrator": ""}})").find("the integrator name is empty"), std::string::npos);
+}
+
+// The message for `text` contains `fragment`.
+void expect_error_containing(const std::string& text, const std::string& fragment) {
+  std::string message = error_of(text);
+  EXPECT_NE(message.find(fragment), std::string::npos) << "expected \"" << fragment << "\" in: " << message;
+}
+
+TEST(JsonReader, BadLensShutterAndMotionAreErrors) {
+  expect_error_containing(R"({"camera": {"lens_radius": -1}})", "at /camera/lens_radius: expected a number >= 0");
+  expect_error_containing(R"({"camera": {"focus_distance": 0}})", "at /camera/focus_distance: expected a positive");
+  expect_error_containing(R"({"camera": {"shutter": [1, 0]}})",
+                          "at /camera/shutter: the shutter must not close before it opens, got [1, 0]");
+  expect_error_containing(R"({"camera": {"shutter": 1}})", "at /camera/shutter: expected an array of 2 numbers");
+  expect_error_containing(R"({"render": {"transform_times": [1, 1]}})",
+                          "at /render/transform_times: the start time must be less than the end time");
+  expect_error_containing(R"({"render": {"transform_times": [0, 1, 2]}})", "expected an array of 2 numbers");
+  expect_error_containing(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1,
+                                         "emission": {"radiance": 1}, "transform_end": []})"),
+                          "at /shapes/0/transform_end: area lights must not move");
+  expect_error_containing(with_shape(R"({"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0],
+                                         "transform_end": [{"translate": [0, 1, 0]}]})"),
+                          "at /shapes/0/transform_end: an infinite plane must not move");
+  expect_error_containing(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1,
+                                         "transform_end": [{"scale": 0}]})"),
+                          "at /shapes/0/transform_end/0/scale: scale factors must be non-zero");
+  expect_error_containing(with_shape(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1,
+                                         "transform_end": {"scale": 2}})"),
+                          "at /shapes/0/transform_end: expected an array of transform steps");
+  // Lights are not shapes that can be given an end transform.
+  expect_error_containing(with_light(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "radiance": 1,
+                                         "transform_end": []})"),
+                          "at /lights/0/transform_end: unknown key");
+}
+
+TEST(JsonReader, BadSamplerAndFilterAreErrors) {
+  expect_error_containing(R"({"render": {"sampler": {"type": "halton"}}})",
+                          "at /render/sampler/type: unknown sampler type \"halton\"; expected one of: independent, "
+                          "stratified, poisson, zsobol");
+  expect_error_containing(R"({"render": {"sampler": {}}})", "at /render/sampler: missing required key \"type\"");
+  expect_error_containing(R"({"render": {"sampler": "zsobol"}})", "at /render/sampler: expected an object");
+  expect_error_containing(R"({"render": {"sampler": {"type": "zsobol", "jitter": false}}})",
+                          "at /render/sampler/jitter: unknown key");
+  expect_error_containing(R"({"render": {"sampler": {"type": "stratified", "jitter": 0}}})",
+                          "at /render/sampler/jitter: expected true or false");
+  expect_error_containing(R"({"render": {"filter": {"type": "triangle"}}})",
+                          "at /render/filter/type: unknown filter type \"triangle\"; expected one of: box, tent, "
+                          "gaussian, mitchell");
+  expect_error_containing(R"({"render": {"filter": {"type": "box", "radius": 0}}})",
+                          "at /render/filter/radius: a filter radius must be in (0, 64] pixels, got 0");
+  expect_error_containing(R"({"render": {"filter": {"type": "tent", "radius": [1, 100]}}})",
+                          "a filter radius must be in (0, 64] pixels, got 100");
+  expect_error_containing(R"({"render": {"filter": {"type": "tent", "radius": [1]}}})", "expected an array of 2");
+  expect_error_containing(R"({"render": {"filter": {"type": "gaussian", "sigma": 0}}})",
+                          "at /render/filter/sigma: expected a positive number");
+  expect_error_containing(R"({"render": {"filter": {"type": "box", "sigma": 1}}})",
+                          "at /render/filter/sigma: unknown key");
+  expect_error_containing(R"({"render": {"filter": {"type": "gaussian", "b": 1}}})",
+                          "at /render/filter/b: unknown key");
+  expect_error_containing(R"({"render": {"filter": {"type": "mitchell", "c": "half"}}})",
+                          "at /render/filter/c: expected a number");
+}
+
+TEST(JsonReader, BadStrategiesAndAdaptiveSettingsAreErrors) {
+  expect_error_containing(R"({"render": {"direction_sampling": "cos"}})",
+                          "at /render/direction_sampling: unknown direction sampling \"cos\"; expected one of: bsdf, "
+                          "cosine, uniform");
+  expect_error_containing(R"({"render": {"light_selection": "uniform"}})",
+                          "unknown light selection \"uniform\"; expected one of: power, paper");
+  expect_error_containing(R"({"render": {"mis": "yes"}})", "at /render/mis: expected true or false");
+  expect_error_containing(R"({"render": {"shadow_rays": 0}})", "at /render/shadow_rays: expected an integer >= 1");
+  expect_error_containing(R"({"render": {"adaptive": {}}})",
+                          "at /render/adaptive: missing required key \"threshold\"");
+  expect_error_containing(R"({"render": {"adaptive": {"threshold": 0}}})",
+                          "at /render/adaptive/threshold: expected a positive number");
+  expect_error_containing(R"({"render": {"adaptive": {"threshold": 0.1, "batch": 12}}})",
+                          "at /render/adaptive/batch: expected a power of two, got 12");
+  expect_error_containing(R"({"render": {"adaptive": {"threshold": 0.1, "batch": 0}}})", "expected an integer >= 1");
+  expect_error_containing(R"({"render": {"adaptive": {"threshold": 0.1, "batch": 32, "max_spp": 16}}})",
+                          "at /render/adaptive/max_spp: max_spp (16) must be at least the batch size (32)");
+  expect_error_containing(R"({"render": {"adaptive": {"threshold": 0.1, "batch": 2048}}})",
+                          "at /render/adaptive: max_spp (1024) must be at least the batch size (2048)");
+  expect_error_containing(R"({"render": {"adaptive": {"threshold": 0.1, "batches": 2}}})",
+                          "at /render/adaptive/batches: unknown key");
 }
 
 TEST(JsonReader, DegenerateCameraIsAnError) {

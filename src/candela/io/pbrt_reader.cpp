@@ -45,6 +45,7 @@ SourceLocation location(const std::string& file, int line, int column) {
 constexpr int kMaxResolutionPerSide = 65536;
 constexpr int64_t kMaxPixels = int64_t{1} << 28;
 constexpr int kMaxIncludeDepth = 64;
+constexpr float kMaxFilterRadius = 64;  // pixels; the filter is tabulated per unit of radius
 
 // ---------------------------------------------------------------- tokens
 
@@ -397,22 +398,34 @@ class ParamList {
   std::vector<std::string> queried_;
 };
 
-// "unknown shape type" for a misspelling, "not supported yet" for a pbrt-v4 type candela lacks.
+// "unknown shape type" for a misspelling, "not supported yet" for a pbrt-v4 type candela lacks;
+// both list the types that are supported.
 [[noreturn]] void reject_type(const SourceLocation& where, std::string_view what, std::string_view type,
                               std::initializer_list<std::string_view> supported,
                               std::initializer_list<std::string_view> known_unsupported) {
-  if (std::find(known_unsupported.begin(), known_unsupported.end(), type) != known_unsupported.end())
-    throw_scene_error(where, "{} type \"{}\" is not supported yet", what, type);
   std::string list;
   for (std::string_view name : supported) list += fmt::format("{}\"{}\"", list.empty() ? "" : ", ", name);
+  if (std::find(known_unsupported.begin(), known_unsupported.end(), type) != known_unsupported.end())
+    throw_scene_error(where, "{} type \"{}\" is not supported yet (supported: {})", what, type, list);
   throw_scene_error(where, "unknown {} type \"{}\" (supported: {})", what, type, list);
 }
 
 // ---------------------------------------------------------------- the parser
 
+// pbrt keeps two CTMs: the transform at TransformTimes' start time and at its end time. They differ
+// only where ActiveTransform made the transform directives change one of them: an animated shape.
+struct TransformSet {
+  Transform start, end;
+  bool is_animated() const { return start != end; }
+};
+
+// Which of the two CTMs the transform directives change (ActiveTransform StartTime / EndTime / All).
+enum ActiveTransforms : uint8_t { kStartTransform = 1, kEndTransform = 2, kAllTransforms = 3 };
+
 // pbrt's per-attribute-block state.
 struct GraphicsState {
-  Transform ctm;
+  TransformSet ctm;
+  uint8_t active_transforms = kAllTransforms;
   int material = -1;  // -1: pbrt's default material, diffuse 0.5
   std::optional<AreaEmission> area_light;
   bool reverse_orientation = false;
@@ -464,9 +477,21 @@ class PbrtParser {
   void push_block(const Token& directive, BlockKind kind);
   void pop_block(const Token& directive, BlockKind kind);
 
+  // the CTMs that ActiveTransform selects become f(CTM)
+  template <typename F>
+  void update_active_ctms(F f) {
+    if (state_.active_transforms & kStartTransform) state_.ctm.start = f(state_.ctm.start);
+    if (state_.active_transforms & kEndTransform) state_.ctm.end = f(state_.ctm.end);
+  }
+  void post_multiply_ctm(const Transform& t) {
+    update_active_ctms([&](const Transform& ctm) { return ctm * t; });
+  }
+
   // directives
-  void identity(const Token&) { state_.ctm = Transform(); }
-  void translate(const Token& d) { state_.ctm = state_.ctm * Transform::translate(read_vec3(d)); }
+  void identity(const Token&) {
+    update_active_ctms([](const Transform&) { return Transform(); });
+  }
+  void translate(const Token& d) { post_multiply_ctm(Transform::translate(read_vec3(d))); }
   void scale(const Token& d);
   void rotate(const Token& d);
   void look_at(const Token& d);
@@ -474,6 +499,8 @@ class PbrtParser {
   void concat_transform(const Token& d);
   void coordinate_system(const Token& d);
   void coord_sys_transform(const Token& d);
+  void active_transform(const Token& d);
+  void transform_times(const Token& d);
   void attribute_begin(const Token& d);
   void attribute_end(const Token& d);
   void reverse_orientation(const Token& d);
@@ -482,6 +509,7 @@ class PbrtParser {
   void sampler(const Token& d);
   void integrator(const Token& d);
   void pixel_filter(const Token& d);
+  void read_light_sampler(ParamList& params);
   void option(const Token& d);
   void color_space(const Token& d);
   void world_begin(const Token& d);
@@ -513,7 +541,7 @@ class PbrtParser {
   SourceLocation world_begin_;
   std::vector<OpenBlock> blocks_;
   size_t block_floor_ = 0;  // blocks below this belong to the file that Imported the current one
-  std::map<std::string, Transform> coordinate_systems_;
+  std::map<std::string, TransformSet> coordinate_systems_;
   std::map<std::string, std::pair<int, SourceLocation>> named_materials_;
   std::optional<ObjectDefinition> open_object_;
   std::map<std::string, ObjectDefinition> objects_;
@@ -561,8 +589,8 @@ const std::unordered_map<std::string_view, PbrtParser::Handler>& PbrtParser::han
       {"MakeNamedMedium", &PbrtParser::unsupported},
       {"MediumInterface", &PbrtParser::unsupported},
       {"Attribute", &PbrtParser::unsupported},
-      {"ActiveTransform", &PbrtParser::unsupported},
-      {"TransformTimes", &PbrtParser::unsupported},
+      {"ActiveTransform", &PbrtParser::active_transform},
+      {"TransformTimes", &PbrtParser::transform_times},
       {"Accelerator", &PbrtParser::unsupported},
       {"WorldEnd", &PbrtParser::world_end},
   };
@@ -579,6 +607,8 @@ SceneDesc PbrtParser::parse(const fs::path& file) {
   scene_.film.width = 1280;
   scene_.film.height = 720;
   scene_.settings.spp = 16;
+  scene_.settings.sampler.type = SamplerType::ZSobol;
+  scene_.settings.filter = default_filter(FilterType::Gaussian);
   scene_.settings.max_depth = 5;
   scene_.settings.integrator = "path";
 
@@ -833,14 +863,14 @@ void PbrtParser::scale(const Token& d) {
   Vec3 s = read_vec3(d);
   if (s.x == 0 || s.y == 0 || s.z == 0)
     throw_scene_error(at(d), "Scale: the factors must be non-zero, got {} {} {}", s.x, s.y, s.z);
-  state_.ctm = state_.ctm * Transform::scale(s);
+  post_multiply_ctm(Transform::scale(s));
 }
 
 void PbrtParser::rotate(const Token& d) {
   float degrees = static_cast<float>(expect_number(d, 0, 4));
   Vec3 axis = read_vec3(d, 1, 4);
   if (axis == Vec3(0.0f)) throw_scene_error(at(d), "Rotate: the rotation axis must not be zero");
-  state_.ctm = state_.ctm * Transform::rotate(degrees, axis);
+  post_multiply_ctm(Transform::rotate(degrees, axis));
 }
 
 void PbrtParser::look_at(const Token& d) {
@@ -851,19 +881,19 @@ void PbrtParser::look_at(const Token& d) {
   float sine = up == Vec3(0.0f) ? 0.0f : length(cross(normalize(up), normalize(target - eye)));
   if (!(sine >= 1e-6f))
     throw_scene_error(at(d), "LookAt: the up vector is zero or parallel to the viewing direction");
-  state_.ctm = state_.ctm * Transform::look_at_pbrt(eye, target, up);
+  post_multiply_ctm(Transform::look_at_pbrt(eye, target, up));
 }
 
 void PbrtParser::transform(const Token& d) {
   std::optional<Transform> t = Transform::from_matrix(read_bracketed_matrix(d));
   if (!t) throw_scene_error(at(d), "Transform: the matrix is singular (it has no inverse)");
-  state_.ctm = *t;
+  update_active_ctms([&](const Transform&) { return *t; });
 }
 
 void PbrtParser::concat_transform(const Token& d) {
   std::optional<Transform> t = Transform::from_matrix(read_bracketed_matrix(d));
   if (!t) throw_scene_error(at(d), "ConcatTransform: the matrix is singular (it has no inverse)");
-  state_.ctm = state_.ctm * *t;
+  post_multiply_ctm(*t);
 }
 
 void PbrtParser::coordinate_system(const Token& d) {
@@ -879,6 +909,30 @@ void PbrtParser::coord_sys_transform(const Token& d) {
                       "\"world\" after WorldBegin, others after CoordinateSystem)",
                       name.text);
   state_.ctm = system->second;
+}
+
+void PbrtParser::active_transform(const Token& d) {
+  Token which = tokens_->next();
+  bool is_word = which.kind == TokenKind::Word;
+  if (is_word && which.text == "StartTime")
+    state_.active_transforms = kStartTransform;
+  else if (is_word && which.text == "EndTime")
+    state_.active_transforms = kEndTransform;
+  else if (is_word && which.text == "All")
+    state_.active_transforms = kAllTransforms;
+  else
+    throw_scene_error(at(which), "{}: expected StartTime, EndTime or All, got {}", d.text, describe(which));
+}
+
+void PbrtParser::transform_times(const Token& d) {
+  require_options(d);
+  double start = expect_number(d, 0, 2), end = expect_number(d, 1, 2);
+  // Shapes are interpolated between the two times, so they must span an interval.
+  if (!(start < end))
+    throw_scene_error(at(d), "TransformTimes: the start time must be less than the end time, got {} and {}", start,
+                      end);
+  scene_.transform_start_time = static_cast<float>(start);
+  scene_.transform_end_time = static_cast<float>(end);
 }
 
 // ---------------------------------------------------------------- attribute blocks
@@ -908,16 +962,31 @@ void PbrtParser::camera(const Token& d) {
   ParamList params = read_params(d, "Camera \"perspective\"");
   float fov = params.get_float("fov", 90);
   if (!(fov > 0 && fov < 180)) params.fail("fov", "must be between 0 and 180 degrees, got {}", fov);
-  if (params.get_float("lensradius", 0) != 0)
-    params.fail("lensradius", "must be 0: depth of field is not supported yet");
-  if (!(params.get_float("focaldistance", 1e6f) > 0)) params.fail("focaldistance", "must be positive");
+  float lens_radius = params.get_float("lensradius", 0);
+  if (lens_radius < 0) params.fail("lensradius", "must not be negative, got {}", lens_radius);
+  float focus_distance = params.get_float("focaldistance", 1e6f);
+  if (!(focus_distance > 0)) params.fail("focaldistance", "must be positive, got {}", focus_distance);
+  float shutter_open = params.get_float("shutteropen", 0);
+  float shutter_close = params.get_float("shutterclose", 1);
+  // pbrt swaps the two with a warning; candela has no warnings, so this is an error.
+  if (shutter_close < shutter_open)
+    params.fail("shutterclose", "must not be less than \"shutteropen\" ({}), got {}", shutter_open, shutter_close);
   params.reject_unused();
+  if (state_.ctm.is_animated())
+    throw_scene_error(at(d),
+                      "Camera: the camera transform is animated (ActiveTransform made the start and end CTMs "
+                      "differ); a moving camera is not supported");
 
   // The CTM maps world space to camera space here; pbrt names the inverse "camera".
-  scene_.camera.world_from_camera = state_.ctm.inverse();
-  scene_.camera.fov_degrees = fov;
-  scene_.camera.fov_axis = FovAxis::Smaller;
-  coordinate_systems_["camera"] = scene_.camera.world_from_camera;
+  CameraDesc& camera = scene_.camera;
+  camera.world_from_camera = state_.ctm.start.inverse();
+  camera.fov_degrees = fov;
+  camera.fov_axis = FovAxis::Smaller;
+  camera.lens_radius = lens_radius;
+  camera.focus_distance = focus_distance;
+  camera.shutter_open = shutter_open;
+  camera.shutter_close = shutter_close;
+  coordinate_systems_["camera"] = {camera.world_from_camera, camera.world_from_camera};
 }
 
 void PbrtParser::film(const Token& d) {
@@ -944,24 +1013,39 @@ void PbrtParser::film(const Token& d) {
 void PbrtParser::sampler(const Token& d) {
   require_options(d);
   Token type = expect_string(d, "the sampler type");
+  if (type.text != "independent" && type.text != "stratified" && type.text != "zsobol")
+    reject_type(at(type), "sampler", type.text, {"independent", "stratified", "zsobol"},
+                {"halton", "paddedsobol", "pmj02bn", "sobol"});
   ParamList params = read_params(d, fmt::format("Sampler \"{}\"", type.text));
+  SamplerDesc sampler;
   int64_t spp = 0;
-  if (type.text == "stratified") {
+  if (type.text == "independent") {
+    sampler.type = SamplerType::Independent;
+    spp = params.get_int("pixelsamples", 4);
+  } else if (type.text == "stratified") {
     // The stratified sampler takes a grid of xsamples x ysamples per pixel instead of pixelsamples.
+    sampler.type = SamplerType::Stratified;
     int x = params.get_int("xsamples", 4), y = params.get_int("ysamples", 4);
     if (x < 1) params.fail("xsamples", "must be positive, got {}", x);
     if (y < 1) params.fail("ysamples", "must be positive, got {}", y);
-    params.get_bool("jitter", true);  // the sample pattern is candela's own choice
+    sampler.jitter = params.get_bool("jitter", true);
     spp = int64_t{x} * y;
     if (spp > INT_MAX) params.fail("ysamples", "makes {} samples per pixel, too many", spp);
   } else {
+    sampler.type = SamplerType::ZSobol;
     spp = params.get_int("pixelsamples", 16);
-    if (spp < 1) params.fail("pixelsamples", "must be positive, got {}", spp);
+    // candela's ZSobol is always Owen-scrambled; the other choices only change the sample pattern.
+    std::string randomization = params.get_string("randomization", "fastowen");
+    if (randomization != "none" && randomization != "permutedigits" && randomization != "fastowen" &&
+        randomization != "owen")
+      params.fail("randomization", "must be \"none\", \"permutedigits\", \"fastowen\" or \"owen\", got \"{}\"",
+                  randomization);
   }
-  params.get_string("randomization", "");  // only changes the sample pattern, not the estimate
+  if (spp < 1) params.fail("pixelsamples", "must be positive, got {}", spp);
   int seed = params.get_int("seed", 0);
   if (seed < 0) params.fail("seed", "must not be negative, got {}", seed);
   params.reject_unused();
+  scene_.settings.sampler = sampler;
   scene_.settings.spp = static_cast<int>(spp);
   if (params.has("seed")) scene_.settings.seed = static_cast<uint64_t>(seed);
 }
@@ -974,9 +1058,7 @@ void PbrtParser::integrator(const Token& d) {
   if (max_depth < 0) params.fail("maxdepth", "must not be negative, got {}", max_depth);
   if (type.text == "path") {
     if (params.get_bool("regularize", false)) params.fail("regularize", "is not supported yet");
-    std::string light_sampler = params.get_string("lightsampler", "bvh");
-    if (light_sampler != "bvh" && light_sampler != "uniform" && light_sampler != "power")
-      params.fail("lightsampler", "must be \"bvh\", \"uniform\" or \"power\", got \"{}\"", light_sampler);
+    read_light_sampler(params);
   }
   params.reject_unused();
   // Other integrators are kept by name; the renderer decides which it can run.
@@ -984,16 +1066,48 @@ void PbrtParser::integrator(const Token& d) {
   scene_.settings.max_depth = max_depth;
 }
 
+// pbrt's "power" chooses lights by power, as candela does. Its default "bvh" also weighs each light
+// by its distance and orientation from the shading point; candela has no light BVH and uses "power"
+// for it too, which changes only the noise.
+void PbrtParser::read_light_sampler(ParamList& params) {
+  std::string light_sampler = params.get_string("lightsampler", "bvh");
+  if (light_sampler == "uniform" || light_sampler == "exhaustive")
+    params.fail("lightsampler", "\"{}\" is not supported yet (supported: \"power\", \"bvh\")", light_sampler);
+  if (light_sampler != "bvh" && light_sampler != "power")
+    params.fail("lightsampler", "must be \"bvh\", \"power\", \"uniform\" or \"exhaustive\", got \"{}\"",
+                light_sampler);
+  scene_.settings.light_selection = LightSelection::Power;
+}
+
 void PbrtParser::pixel_filter(const Token& d) {
   require_options(d);
   Token type = expect_string(d, "the filter type");
-  if (type.text != "box")
-    reject_type(at(type), "pixel filter", type.text, {"box"}, {"gaussian", "mitchell", "sinc", "triangle"});
-  ParamList params = read_params(d, "PixelFilter \"box\"");
-  for (std::string_view radius : {"xradius", "yradius"})
-    if (params.get_float(radius, 0.5f) != 0.5f)
-      params.fail(radius, "must be 0.5: candela's box filter covers exactly one pixel");
+  FilterDesc filter;
+  if (type.text == "box")
+    filter = default_filter(FilterType::Box);
+  else if (type.text == "triangle")
+    filter = default_filter(FilterType::Tent);
+  else if (type.text == "gaussian")
+    filter = default_filter(FilterType::Gaussian);
+  else if (type.text == "mitchell")
+    filter = default_filter(FilterType::Mitchell);
+  else
+    reject_type(at(type), "pixel filter", type.text, {"box", "triangle", "gaussian", "mitchell"}, {"sinc"});
+  ParamList params = read_params(d, fmt::format("PixelFilter \"{}\"", type.text));
+  filter.radius = {params.get_float("xradius", filter.radius.x), params.get_float("yradius", filter.radius.y)};
+  for (auto [name, radius] : {std::pair{"xradius", filter.radius.x}, std::pair{"yradius", filter.radius.y}})
+    if (!(radius > 0 && radius <= kMaxFilterRadius))
+      params.fail(name, "must be in (0, {}] pixels, got {}", kMaxFilterRadius, radius);
+  if (filter.type == FilterType::Gaussian) {
+    filter.gaussian_sigma = params.get_float("sigma", filter.gaussian_sigma);
+    if (!(filter.gaussian_sigma > 0)) params.fail("sigma", "must be positive, got {}", filter.gaussian_sigma);
+  }
+  if (filter.type == FilterType::Mitchell) {
+    filter.mitchell_b = params.get_float("B", filter.mitchell_b);
+    filter.mitchell_c = params.get_float("C", filter.mitchell_c);
+  }
   params.reject_unused();
+  scene_.settings.filter = filter;
 }
 
 void PbrtParser::option(const Token& d) {
@@ -1009,8 +1123,9 @@ void PbrtParser::world_begin(const Token& d) {
   require_options(d);
   section_ = Section::World;
   world_begin_ = at(d);
-  state_.ctm = Transform();
-  coordinate_systems_["world"] = Transform();
+  state_.ctm = {};
+  state_.active_transforms = kAllTransforms;
+  coordinate_systems_["world"] = {};
 }
 
 // ---------------------------------------------------------------- materials
@@ -1099,7 +1214,9 @@ void PbrtParser::light_source(const Token& d) {
     intensity = read_emission_scale(params, "I", intensity);
     Point3 from = params.get_point3("from", Point3(0.0f));
     params.reject_unused();
-    scene_.lights.push_back(PointLight{state_.ctm.point(from), intensity});
+    if (state_.ctm.is_animated())
+      throw_scene_error(at(d), "LightSource \"point\": lights must not move (the CTM is animated)");
+    scene_.lights.push_back(PointLight{state_.ctm.start.point(from), intensity});
   } else if (type.text == "infinite") {
     if (params.has("filename")) params.fail("filename", "names an image: environment maps are not supported yet");
     if (params.has("portal")) params.fail("portal", "is not supported yet");
@@ -1205,7 +1322,13 @@ void PbrtParser::shape(const Token& d) {
     reject_type(at(type), "shape", type.text, {"sphere", "trianglemesh", "plymesh"},
                 {"bilinearmesh", "curve", "cylinder", "disk", "loopsubdiv"});
   params.reject_unused();
-  desc.to_world = state_.ctm;
+  desc.to_world = state_.ctm.start;
+  if (state_.ctm.is_animated()) {
+    // Area lights are sampled at fixed positions.
+    if (state_.area_light)
+      throw_scene_error(at(d), "Shape: area lights must not move (the CTM is animated inside an AreaLightSource)");
+    desc.to_world_end = state_.ctm.end;
+  }
   desc.material = state_.material;
   desc.emission = state_.area_light;
   desc.reverse_orientation = state_.reverse_orientation;
@@ -1250,7 +1373,10 @@ void PbrtParser::object_instance(const Token& d) {
                       name.text);
   for (const ShapeDesc& shape : object->second.shapes) {
     ShapeDesc copy = shape;
-    copy.to_world = state_.ctm * shape.to_world;
+    TransformSet placed{state_.ctm.start * shape.to_world,
+                        state_.ctm.end * shape.to_world_end.value_or(shape.to_world)};
+    copy.to_world = placed.start;
+    copy.to_world_end = placed.is_animated() ? std::optional(placed.end) : std::nullopt;
     copy.name = fmt::format("{} (instance of \"{}\" at {})", shape.name, name.text, at(d).to_string());
     scene_.shapes.push_back(std::move(copy));
   }

@@ -184,9 +184,208 @@ TEST(PbrtReader, KeepsOtherIntegratorNamesAndStratifiedSampleCounts) {
 }
 
 TEST(PbrtReader, SamplerSeedSetsTheRenderSeed) {
-  SceneDesc scene = read_lines({"Sampler \"halton\" \"integer pixelsamples\" 8 \"integer seed\" 42", "WorldBegin"});
+  SceneDesc scene = read_lines({"Sampler \"zsobol\" \"integer pixelsamples\" 8 \"integer seed\" 42", "WorldBegin"});
   EXPECT_EQ(scene.settings.spp, 8);
   EXPECT_EQ(scene.settings.seed, 42u);
+}
+
+// ---------------------------------------------------------------- samplers, filters, light sampler
+
+TEST(PbrtReader, DefaultSamplerAndFilterArePbrtsZSobolAndGaussian) {
+  SceneDesc scene = read_lines({"WorldBegin"});
+  EXPECT_EQ(scene.settings.sampler.type, SamplerType::ZSobol);
+  EXPECT_EQ(scene.settings.spp, 16);
+  EXPECT_EQ(scene.settings.filter.type, FilterType::Gaussian);
+  EXPECT_FLOAT_EQ(scene.settings.filter.radius.x, 1.5f);
+  EXPECT_FLOAT_EQ(scene.settings.filter.radius.y, 1.5f);
+  EXPECT_FLOAT_EQ(scene.settings.filter.gaussian_sigma, 0.5f);
+  EXPECT_EQ(scene.settings.light_selection, LightSelection::Power);
+}
+
+TEST(PbrtReader, ReadsTheThreeSamplerTypes) {
+  SceneDesc independent = read_lines({"Sampler \"independent\"", "WorldBegin"});
+  EXPECT_EQ(independent.settings.sampler.type, SamplerType::Independent);
+  EXPECT_EQ(independent.settings.spp, 4);  // pbrt-v4's default for this sampler
+  SceneDesc stratified = read_lines(
+      {"Sampler \"stratified\" \"integer xsamples\" 2 \"integer ysamples\" 3 \"bool jitter\" false", "WorldBegin"});
+  EXPECT_EQ(stratified.settings.sampler.type, SamplerType::Stratified);
+  EXPECT_FALSE(stratified.settings.sampler.jitter);
+  EXPECT_EQ(stratified.settings.spp, 6);
+  EXPECT_TRUE(read_lines({"Sampler \"stratified\"", "WorldBegin"}).settings.sampler.jitter);
+  SceneDesc zsobol = read_lines(
+      {"Sampler \"zsobol\" \"integer pixelsamples\" 64 \"string randomization\" \"owen\"", "WorldBegin"});
+  EXPECT_EQ(zsobol.settings.sampler.type, SamplerType::ZSobol);
+  EXPECT_EQ(zsobol.settings.spp, 64);
+}
+
+TEST(PbrtReader, BadSamplers) {
+  expect_error({"Sampler \"halton\"", "WorldBegin"}, 1, "\"halton\"",
+               "sampler type \"halton\" is not supported yet (supported: \"independent\", \"stratified\", \"zsobol\")");
+  for (std::string type : {"sobol", "paddedsobol", "pmj02bn"})
+    expect_error({"Sampler \"" + type + "\"", "WorldBegin"}, 1, "\"" + type + "\"", "is not supported yet");
+  expect_error({"Sampler \"random\"", "WorldBegin"}, 1, "\"random\"", "unknown sampler type \"random\"");
+  expect_error({"Sampler \"zsobol\" \"string randomization\" \"scrambled\"", "WorldBegin"}, 1,
+               "\"string randomization\"", "must be \"none\", \"permutedigits\", \"fastowen\" or \"owen\"");
+  expect_error({"Sampler \"independent\" \"string randomization\" \"owen\"", "WorldBegin"}, 1,
+               "\"string randomization\"", "unused parameter");
+  expect_error({"Sampler \"stratified\" \"integer pixelsamples\" 4", "WorldBegin"}, 1, "\"integer pixelsamples\"",
+               "unused parameter");
+  expect_error({"Sampler \"independent\" \"integer pixelsamples\" 0", "WorldBegin"}, 1, "\"integer pixelsamples\"",
+               "must be positive");
+  expect_error({"Sampler \"stratified\" \"integer xsamples\" 0", "WorldBegin"}, 1, "\"integer xsamples\"",
+               "must be positive");
+  expect_error({"Sampler \"zsobol\" \"integer seed\" -1", "WorldBegin"}, 1, "\"integer seed\"", "must not be negative");
+}
+
+void expect_radius(const FilterDesc& filter, float x, float y) {
+  EXPECT_FLOAT_EQ(filter.radius.x, x);
+  EXPECT_FLOAT_EQ(filter.radius.y, y);
+}
+
+TEST(PbrtReader, ReadsTheFourPixelFiltersWithPbrtDefaults) {
+  auto filter_of = [](const std::string& directive) { return read_lines({directive, "WorldBegin"}).settings.filter; };
+  FilterDesc box = filter_of("PixelFilter \"box\"");
+  EXPECT_EQ(box.type, FilterType::Box);
+  expect_radius(box, 0.5f, 0.5f);
+  FilterDesc triangle = filter_of("PixelFilter \"triangle\"");
+  EXPECT_EQ(triangle.type, FilterType::Tent);
+  expect_radius(triangle, 2, 2);
+  FilterDesc gaussian = filter_of("PixelFilter \"gaussian\" \"float sigma\" 0.7 \"float yradius\" 2.5");
+  EXPECT_EQ(gaussian.type, FilterType::Gaussian);
+  expect_radius(gaussian, 1.5f, 2.5f);
+  EXPECT_FLOAT_EQ(gaussian.gaussian_sigma, 0.7f);
+  FilterDesc mitchell = filter_of("PixelFilter \"mitchell\"");
+  EXPECT_EQ(mitchell.type, FilterType::Mitchell);
+  expect_radius(mitchell, 2, 2);
+  EXPECT_FLOAT_EQ(mitchell.mitchell_b, 1.0f / 3);
+  EXPECT_FLOAT_EQ(mitchell.mitchell_c, 1.0f / 3);
+  FilterDesc catmull_rom = filter_of("PixelFilter \"mitchell\" \"float B\" 0 \"float C\" 0.5 \"float xradius\" 1");
+  expect_radius(catmull_rom, 1, 2);
+  EXPECT_FLOAT_EQ(catmull_rom.mitchell_b, 0);
+  EXPECT_FLOAT_EQ(catmull_rom.mitchell_c, 0.5f);
+  expect_radius(filter_of("PixelFilter \"box\" \"float xradius\" 1"), 1, 0.5f);
+}
+
+TEST(PbrtReader, BadPixelFilters) {
+  expect_error({"PixelFilter \"sinc\"", "WorldBegin"}, 1, "\"sinc\"",
+               "pixel filter type \"sinc\" is not supported yet (supported: \"box\", \"triangle\", \"gaussian\", "
+               "\"mitchell\")");
+  expect_error({"PixelFilter \"tent\"", "WorldBegin"}, 1, "\"tent\"", "unknown pixel filter type \"tent\"");
+  expect_error({"PixelFilter \"box\" \"float xradius\" 0", "WorldBegin"}, 1, "\"float xradius\"",
+               "\"xradius\" must be in (0, 64] pixels, got 0");
+  expect_error({"PixelFilter \"triangle\" \"float yradius\" 1000", "WorldBegin"}, 1, "\"float yradius\"",
+               "must be in (0, 64] pixels");
+  expect_error({"PixelFilter \"gaussian\" \"float sigma\" -1", "WorldBegin"}, 1, "\"float sigma\"",
+               "\"sigma\" must be positive");
+  expect_error({"PixelFilter \"gaussian\" \"float B\" 0", "WorldBegin"}, 1, "\"float B\"", "unused parameter");
+  expect_error({"PixelFilter \"box\" \"float sigma\" 1", "WorldBegin"}, 1, "\"float sigma\"", "unused parameter");
+}
+
+TEST(PbrtReader, LightSamplerPowerAndBvhChooseLightsByPower) {
+  for (std::string name : {"power", "bvh"}) {
+    SceneDesc scene = read_lines({"Integrator \"path\" \"string lightsampler\" \"" + name + "\"", "WorldBegin"});
+    EXPECT_EQ(scene.settings.light_selection, LightSelection::Power) << name;
+  }
+  expect_error({"Integrator \"path\" \"string lightsampler\" \"uniform\"", "WorldBegin"}, 1,
+               "\"string lightsampler\"", "\"uniform\" is not supported yet");
+  expect_error({"Integrator \"path\" \"string lightsampler\" \"nearest\"", "WorldBegin"}, 1,
+               "\"string lightsampler\"", "must be \"bvh\", \"power\", \"uniform\" or \"exhaustive\"");
+}
+
+// ---------------------------------------------------------------- camera lens and shutter
+
+TEST(PbrtReader, CameraLensAndShutter) {
+  SceneDesc defaults = read_lines({"Camera \"perspective\"", "WorldBegin"});
+  EXPECT_FLOAT_EQ(defaults.camera.lens_radius, 0);
+  EXPECT_FLOAT_EQ(defaults.camera.focus_distance, 1e6f);
+  EXPECT_FLOAT_EQ(defaults.camera.shutter_open, 0);
+  EXPECT_FLOAT_EQ(defaults.camera.shutter_close, 1);
+  SceneDesc scene = read_lines({"Camera \"perspective\" \"float lensradius\" 0.1 \"float focaldistance\" 7 "
+                                "\"float shutteropen\" 0.25 \"float shutterclose\" 0.75",
+                                "WorldBegin"});
+  EXPECT_FLOAT_EQ(scene.camera.lens_radius, 0.1f);
+  EXPECT_FLOAT_EQ(scene.camera.focus_distance, 7);
+  EXPECT_FLOAT_EQ(scene.camera.shutter_open, 0.25f);
+  EXPECT_FLOAT_EQ(scene.camera.shutter_close, 0.75f);
+}
+
+TEST(PbrtReader, BadLensAndShutter) {
+  expect_error({"Camera \"perspective\" \"float lensradius\" -0.1", "WorldBegin"}, 1, "\"float lensradius\"",
+               "\"lensradius\" must not be negative");
+  expect_error({"Camera \"perspective\" \"float focaldistance\" 0", "WorldBegin"}, 1, "\"float focaldistance\"",
+               "\"focaldistance\" must be positive");
+  expect_error({"Camera \"perspective\" \"float shutteropen\" 0.5 \"float shutterclose\" 0.2", "WorldBegin"}, 1,
+               "\"float shutterclose\"", "must not be less than \"shutteropen\" (0.5), got 0.2");
+}
+
+// ---------------------------------------------------------------- animated transforms
+
+TEST(PbrtReader, ActiveTransformMakesAnimatedShapes) {
+  SceneDesc scene = read_lines({"TransformTimes 2 5", "WorldBegin", "Translate 1 0 0", "ActiveTransform EndTime",
+                                "Translate 0 3 0", "ActiveTransform All", "Scale 2 2 2", "Shape \"sphere\"",
+                                "ActiveTransform StartTime", "Identity", "ActiveTransform All", "Shape \"sphere\""});
+  EXPECT_FLOAT_EQ(scene.transform_start_time, 2);
+  EXPECT_FLOAT_EQ(scene.transform_end_time, 5);
+  ASSERT_EQ(scene.shapes.size(), 2u);
+  const ShapeDesc& first = scene.shapes[0];
+  expect_near(first.to_world.point(Point3(1, 0, 0)), Point3(3, 0, 0));
+  ASSERT_TRUE(first.to_world_end.has_value());
+  expect_near(first.to_world_end->point(Point3(1, 0, 0)), Point3(3, 3, 0));
+  // Identity on the start CTM only: the second sphere moves from the origin to its end place.
+  const ShapeDesc& second = scene.shapes[1];
+  EXPECT_TRUE(second.to_world.is_identity());
+  ASSERT_TRUE(second.to_world_end.has_value());
+  expect_near(second.to_world_end->point(Point3(0, 0, 0)), Point3(1, 3, 0));
+}
+
+TEST(PbrtReader, StaticShapesHaveNoEndTransform) {
+  SceneDesc scene = read_lines({"WorldBegin", "ActiveTransform EndTime", "ActiveTransform All", "Translate 1 2 3",
+                                "Shape \"sphere\""});
+  EXPECT_FALSE(scene.shapes.at(0).to_world_end.has_value());
+  EXPECT_FLOAT_EQ(scene.transform_start_time, 0);
+  EXPECT_FLOAT_EQ(scene.transform_end_time, 1);
+}
+
+TEST(PbrtReader, ActiveTransformIsScopedByAttributeBlocksAndResetByWorldBegin) {
+  SceneDesc scene = read_lines({"ActiveTransform EndTime", "WorldBegin", "AttributeBegin", "ActiveTransform EndTime",
+                                "AttributeEnd", "Translate 0 1 0", "Shape \"sphere\""});
+  EXPECT_FALSE(scene.shapes.at(0).to_world_end.has_value());
+  expect_near(scene.shapes[0].to_world.point(Point3(0, 0, 0)), Point3(0, 1, 0));
+}
+
+TEST(PbrtReader, CoordinateSystemsKeepBothTransforms) {
+  SceneDesc scene = read_lines({"WorldBegin", "ActiveTransform EndTime", "Translate 1 0 0", "ActiveTransform All",
+                                "CoordinateSystem \"moving\"", "Identity", "CoordSysTransform \"moving\"",
+                                "Shape \"sphere\""});
+  ASSERT_TRUE(scene.shapes.at(0).to_world_end.has_value());
+  expect_near(scene.shapes[0].to_world_end->point(Point3(0, 0, 0)), Point3(1, 0, 0));
+}
+
+TEST(PbrtReader, AnimatedObjectInstances) {
+  SceneDesc scene = read_lines({"WorldBegin", "ObjectBegin \"ball\"", "Shape \"sphere\"", "ObjectEnd",
+                                "ActiveTransform EndTime", "Translate 0 0 4", "ActiveTransform All",
+                                "ObjectInstance \"ball\"", "Identity", "ObjectInstance \"ball\""});
+  ASSERT_EQ(scene.shapes.size(), 2u);
+  ASSERT_TRUE(scene.shapes[0].to_world_end.has_value());
+  expect_near(scene.shapes[0].to_world_end->point(Point3(0, 0, 0)), Point3(0, 0, 4));
+  EXPECT_FALSE(scene.shapes[1].to_world_end.has_value());
+}
+
+TEST(PbrtReader, BadAnimatedTransforms) {
+  expect_error({"ActiveTransform Later", "WorldBegin"}, 1, "Later",
+               "ActiveTransform: expected StartTime, EndTime or All, got Later");
+  expect_error({"ActiveTransform \"All\"", "WorldBegin"}, 1, "\"All\"", "expected StartTime, EndTime or All");
+  expect_error({"TransformTimes 1 1", "WorldBegin"}, 1, "TransformTimes",
+               "the start time must be less than the end time, got 1 and 1");
+  expect_error({"TransformTimes 0", "WorldBegin"}, 2, "WorldBegin", "TransformTimes: expected 2 numbers");
+  expect_error({"WorldBegin", "TransformTimes 0 1"}, 2, "TransformTimes", "not allowed after WorldBegin");
+  expect_error({"ActiveTransform EndTime", "Translate 0 0 1", "Camera \"perspective\"", "WorldBegin"}, 3, "Camera",
+               "a moving camera is not supported");
+  expect_error({"WorldBegin", "AreaLightSource \"diffuse\"", "ActiveTransform EndTime", "Translate 1 0 0",
+                "Shape \"sphere\""},
+               5, "Shape", "area lights must not move");
+  expect_error({"WorldBegin", "ActiveTransform StartTime", "Translate 1 0 0", "LightSource \"point\""}, 4,
+               "LightSource", "lights must not move");
 }
 
 // ---------------------------------------------------------------- transforms
@@ -502,7 +701,7 @@ TEST(PbrtReader, WrongNumberOfValues) {
 }
 
 TEST(PbrtReader, ValuesThatDoNotMatchTheDeclaredType) {
-  expect_error({"Sampler \"halton\" \"integer pixelsamples\" 1.5", "WorldBegin"}, 1, "1.5",
+  expect_error({"Sampler \"zsobol\" \"integer pixelsamples\" 1.5", "WorldBegin"}, 1, "1.5",
                "expects integers, got 1.5");
   expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" \"big\""}, 2, "\"big\"",
                "expects numbers, got \"big\"");
@@ -594,8 +793,6 @@ TEST(PbrtReader, UnknownAndUnsupportedTypes) {
   expect_error({"WorldBegin", "AreaLightSource \"glow\""}, 2, "\"glow\"", "unknown area light type");
   expect_error({"Camera \"orthographic\"", "WorldBegin"}, 1, "\"orthographic\"", "not supported yet");
   expect_error({"Film \"gbuffer\"", "WorldBegin"}, 1, "\"gbuffer\"", "not supported yet");
-  expect_error({"PixelFilter \"gaussian\"", "WorldBegin"}, 1, "\"gaussian\"",
-               "pixel filter type \"gaussian\" is not supported yet");
 }
 
 TEST(PbrtReader, UnsupportedFeaturesOfSupportedTypes) {
@@ -603,9 +800,6 @@ TEST(PbrtReader, UnsupportedFeaturesOfSupportedTypes) {
                "environment maps are not supported yet");
   expect_error({"WorldBegin", "Material \"dielectric\" \"float roughness\" 0.1"}, 2, "\"float roughness\"",
                "only smooth dielectrics");
-  expect_error({"Camera \"perspective\" \"float lensradius\" 0.1", "WorldBegin"}, 1, "\"float lensradius\"",
-               "depth of field");
-  expect_error({"PixelFilter \"box\" \"float xradius\" 1", "WorldBegin"}, 1, "\"float xradius\"", "must be 0.5");
   expect_error({"WorldBegin", "MakeNamedMaterial \"m\" \"rgb reflectance\" [ 1 1 1 ]"}, 2, "MakeNamedMaterial",
                "missing the \"string type\" parameter");
 }

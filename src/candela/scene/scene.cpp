@@ -43,9 +43,25 @@ std::string shape_label(const ShapeDesc& desc, size_t index) {
   return desc.name.empty() ? fmt::format("shape {}", index) : fmt::format("shape {} (\"{}\")", index, desc.name);
 }
 
+// The shape's end transform when it really moves; an end transform equal to the start is static.
+const Transform* moving_end_transform(const ShapeDesc& desc) {
+  return desc.to_world_end && *desc.to_world_end != desc.to_world ? &*desc.to_world_end : nullptr;
+}
+
+Vec3 lerp(float t, const Vec3& a, const Vec3& b) { return a * (1 - t) + b * t; }
+
+std::vector<Normal3> world_normals(const std::vector<Normal3>& normals, const Transform& T, bool reverse) {
+  std::vector<Normal3> world;
+  world.reserve(normals.size());
+  for (const auto& n : normals) world.push_back(normalize(T.normal(n)) * (reverse ? -1.0f : 1.0f));
+  return world;
+}
+
 }  // namespace
 
-Scene::Scene(const SceneDesc& desc) : source_file_(desc.source_file.empty() ? "scene" : desc.source_file) {
+Scene::Scene(const SceneDesc& desc)
+    : source_file_(desc.source_file.empty() ? "scene" : desc.source_file),
+      embree_(desc.transform_start_time, desc.transform_end_time) {
   for (const auto& m : desc.materials) materials_.push_back(make_bsdf(m));
   materials_.push_back(DiffuseBsdf{RGB(0.5f)});  // the default material, index materials.size()
   int material_count = int(desc.materials.size());
@@ -83,36 +99,23 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int material_count) {
   rec.material = uint32_t(desc.material >= 0 && desc.material < material_count ? desc.material : material_count);
   rec.flip_normal = desc.reverse_orientation;
   const Transform& T = desc.to_world;
+  const Transform* T_end = moving_end_transform(desc);
+  // Lights are sampled at fixed positions, so emitters stay put.
+  if (T_end && desc.emission)
+    throw SceneError(fmt::format("{}: {}: area lights must not move (an emissive shape has an end transform)",
+                                 source_file_, rec.name));
 
   if (const auto* s = std::get_if<SphereShape>(&desc.geometry)) {
-    rec.kind = ShapeRecord::Kind::Sphere;
-    rec.sphere = SphereGeometry{T, s->center, s->radius};
-    for (int i = 0; i < 8; ++i) {
-      Vec3 c(i & 1 ? s->radius : -s->radius, i & 2 ? s->radius : -s->radius, i & 4 ? s->radius : -s->radius);
-      bounds_.extend(T.point(s->center + c));
-    }
-    if (desc.emission) {
-      // Sampling by solid angle needs a true sphere in world space: allow only similarity transforms.
-      Vec3 ex = T.vector({1, 0, 0}), ey = T.vector({0, 1, 0}), ez = T.vector({0, 0, 1});
-      float lx = length(ex), ly = length(ey), lz = length(ez);
-      if (std::abs(lx - ly) > 1e-4f * lx || std::abs(lx - lz) > 1e-4f * lx || std::abs(dot(ex, ey)) > 1e-4f * lx * ly ||
-          std::abs(dot(ex, ez)) > 1e-4f * lx * lz || std::abs(dot(ey, ez)) > 1e-4f * ly * lz)
-        throw SceneError(fmt::format("{}: {}: an emissive sphere must not be scaled non-uniformly or sheared",
-                                     source_file_, rec.name));
-      rec.first_light = int(lights_.size());
-      rec.radiance = desc.emission->radiance;
-      rec.two_sided_emission = desc.emission->two_sided;
-      lights_.push_back(SphereLight{T.point(s->center), s->radius * lx, rec.radiance, rec.two_sided_emission,
-                                    desc.reverse_orientation});
-    }
-    embree_.add_sphere(uint32_t(shapes_.size()), rec.sphere);
-    shapes_.push_back(std::move(rec));
+    add_sphere(std::move(rec), *s, T, T_end, desc.reverse_orientation, desc.emission);
     return;
   }
   if (const auto* p = std::get_if<PlaneShape>(&desc.geometry)) {
     if (desc.emission)
       throw SceneError(fmt::format("{}: {}: an infinite plane cannot emit light (its power would be infinite)",
                                    source_file_, rec.name));
+    if (T_end)
+      throw SceneError(fmt::format("{}: {}: an infinite plane must not move (it has an end transform)", source_file_,
+                                   rec.name));
     rec.kind = ShapeRecord::Kind::Plane;
     rec.plane = PlaneGeometry{T.point(p->point), normalize(T.normal(p->normal))};
     // Its Embree geometry is added once the size of everything else is known (see the constructor).
@@ -123,18 +126,59 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int material_count) {
   if (const auto* b = std::get_if<BoxShape>(&desc.geometry)) mesh = box_mesh(*b);
   else if (const auto* r = std::get_if<RectangleShape>(&desc.geometry)) mesh = rectangle_mesh(*r);
   else mesh = std::get<MeshShape>(desc.geometry).mesh;
-  add_triangles(std::move(rec), mesh, T, desc.reverse_orientation, desc.emission);
+  add_triangles(std::move(rec), mesh, T, T_end, desc.reverse_orientation, desc.emission);
 }
 
-void Scene::add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Transform& T, bool reverse,
-                          const std::optional<AreaEmission>& emission) {
+void Scene::add_sphere(ShapeRecord rec, const SphereShape& s, const Transform& T, const Transform* T_end,
+                       bool reverse, const std::optional<AreaEmission>& emission) {
+  rec.kind = ShapeRecord::Kind::Sphere;
+  rec.sphere = SphereGeometry{T, s.center, s.radius, T_end ? std::optional<Transform>(*T_end) : std::nullopt};
+  for (const Transform* X : {&T, T_end}) {
+    if (!X) continue;
+    for (int i = 0; i < 8; ++i) {
+      Vec3 c(i & 1 ? s.radius : -s.radius, i & 2 ? s.radius : -s.radius, i & 4 ? s.radius : -s.radius);
+      bounds_.extend(X->point(s.center + c));
+    }
+  }
+  if (emission) {
+    // Sampling by solid angle needs a true sphere in world space: allow only similarity transforms.
+    Vec3 ex = T.vector({1, 0, 0}), ey = T.vector({0, 1, 0}), ez = T.vector({0, 0, 1});
+    float lx = length(ex), ly = length(ey), lz = length(ez);
+    if (std::abs(lx - ly) > 1e-4f * lx || std::abs(lx - lz) > 1e-4f * lx || std::abs(dot(ex, ey)) > 1e-4f * lx * ly ||
+        std::abs(dot(ex, ez)) > 1e-4f * lx * lz || std::abs(dot(ey, ez)) > 1e-4f * ly * lz)
+      throw SceneError(fmt::format("{}: {}: an emissive sphere must not be scaled non-uniformly or sheared",
+                                   source_file_, rec.name));
+    rec.first_light = int(lights_.size());
+    rec.radiance = emission->radiance;
+    rec.two_sided_emission = emission->two_sided;
+    lights_.push_back(SphereLight{T.point(s.center), s.radius * lx, rec.radiance, rec.two_sided_emission, reverse});
+  }
+  embree_.add_sphere(uint32_t(shapes_.size()), rec.sphere);
+  shapes_.push_back(std::move(rec));
+}
+
+void Scene::add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Transform& T, const Transform* T_end,
+                          bool reverse, const std::optional<AreaEmission>& emission) {
   rec.kind = ShapeRecord::Kind::Triangles;
   rec.positions.reserve(mesh.positions.size());
   for (const auto& p : mesh.positions) {
     rec.positions.push_back(T.point(p));
     bounds_.extend(rec.positions.back());
   }
-  for (const auto& n : mesh.normals) rec.normals.push_back(normalize(T.normal(n)) * (reverse ? -1.0f : 1.0f));
+  rec.normals = world_normals(mesh.normals, T, reverse);
+  if (T_end) {
+    // The winding below is baked once from the start transform: an end transform of the other
+    // handedness would turn the shape inside out on the way (flattening it at some time).
+    if (T_end->swaps_handedness() != T.swaps_handedness())
+      throw SceneError(fmt::format("{}: {}: the end transform mirrors the shape relative to the start transform",
+                                   source_file_, rec.name));
+    rec.positions_end.reserve(mesh.positions.size());
+    for (const auto& p : mesh.positions) {
+      rec.positions_end.push_back(T_end->point(p));
+      bounds_.extend(rec.positions_end.back());
+    }
+    rec.normals_end = world_normals(mesh.normals, *T_end, reverse);
+  }
   rec.uvs = mesh.uvs;
   rec.indices = mesh.indices;
   // Keep cross(p1-p0, p2-p0) equal to the object-space normal transformed as a normal: a mirroring
@@ -161,7 +205,12 @@ void Scene::add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Trans
       lights_.push_back(TriangleLight{p0, p1, p2, n, len / 2, rec.radiance, rec.two_sided_emission});
     }
   }
-  if (!rec.indices.empty()) embree_.add_triangles(uint32_t(shapes_.size()), rec.positions, rec.indices);
+  if (!rec.indices.empty()) {
+    if (rec.is_moving())
+      embree_.add_moving_triangles(uint32_t(shapes_.size()), rec.positions, rec.positions_end, rec.indices);
+    else
+      embree_.add_triangles(uint32_t(shapes_.size()), rec.positions, rec.indices);
+  }
   shapes_.push_back(std::move(rec));
 }
 
@@ -173,39 +222,12 @@ bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {
   hit.shape = eh.geometry;
   hit.primitive = eh.primitive;
   switch (rec.kind) {
-    case ShapeRecord::Kind::Triangles: {
-      uint32_t i0 = rec.indices[3 * eh.primitive], i1 = rec.indices[3 * eh.primitive + 1],
-               i2 = rec.indices[3 * eh.primitive + 2];
-      float b0 = 1 - eh.u - eh.v;
-      const Point3 &p0 = rec.positions[i0], &p1 = rec.positions[i1], &p2 = rec.positions[i2];
-      hit.p = p0 * b0 + p1 * eh.u + p2 * eh.v;
-      hit.ng = normalize(cross(p1 - p0, p2 - p0));
-      if (!rec.normals.empty()) {
-        Normal3 ns = rec.normals[i0] * b0 + rec.normals[i1] * eh.u + rec.normals[i2] * eh.v;
-        float len = length(ns);
-        hit.ns = len > 0 ? ns / len : hit.ng;
-        hit.ng = face_forward(hit.ng, hit.ns);
-      } else {
-        hit.ns = hit.ng;
-      }
-      hit.uv = rec.uvs.empty() ? Vec2(eh.u, eh.v) : rec.uvs[i0] * b0 + rec.uvs[i1] * eh.u + rec.uvs[i2] * eh.v;
+    case ShapeRecord::Kind::Triangles:
+      reconstruct_triangle_hit(rec, eh, ray.time, hit);
       break;
-    }
-    case ShapeRecord::Kind::Sphere: {
-      const SphereGeometry& s = rec.sphere;
-      hit.p = ray.at(eh.t);
-      // Re-project onto the surface in object space to remove the error of o + t d, then map back.
-      Point3 po = s.to_world.inverse().point(hit.p) - s.center;
-      po = po * (s.radius / length(po));
-      hit.p = s.to_world.point(s.center + po);
-      hit.ng = normalize(s.to_world.normal(po));
-      if (rec.flip_normal) hit.ng = -hit.ng;
-      hit.ns = hit.ng;
-      float phi = std::atan2(po.y, po.x);
-      if (phi < 0) phi += 2 * kPi;
-      hit.uv = {phi * kInv2Pi, std::acos(std::clamp(po.z / s.radius, -1.0f, 1.0f)) * kInvPi};
+    case ShapeRecord::Kind::Sphere:
+      reconstruct_sphere_hit(rec, ray, eh.t, hit);
       break;
-    }
     case ShapeRecord::Kind::Plane: {
       hit.p = ray.at(eh.t);
       hit.ng = rec.flip_normal ? -rec.plane.normal : rec.plane.normal;
@@ -215,6 +237,61 @@ bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {
     }
   }
   return true;
+}
+
+void Scene::reconstruct_triangle_hit(const ShapeRecord& rec, const EmbreeHit& eh, float time, SurfaceHit& hit) const {
+  uint32_t i0 = rec.indices[3 * eh.primitive], i1 = rec.indices[3 * eh.primitive + 1],
+           i2 = rec.indices[3 * eh.primitive + 2];
+  float b0 = 1 - eh.u - eh.v;
+  Point3 p0 = rec.positions[i0], p1 = rec.positions[i1], p2 = rec.positions[i2];
+  const bool moving = rec.is_moving();
+  // A moving triangle is where Embree found it: its vertices interpolated at the ray's time.
+  const float t = moving ? embree_.normalized_time(time) : 0;
+  if (moving) {
+    p0 = lerp(t, p0, rec.positions_end[i0]);
+    p1 = lerp(t, p1, rec.positions_end[i1]);
+    p2 = lerp(t, p2, rec.positions_end[i2]);
+  }
+  hit.p = p0 * b0 + p1 * eh.u + p2 * eh.v;
+  hit.ng = normalize(cross(p1 - p0, p2 - p0));
+  if (!rec.normals.empty()) {
+    Normal3 n0 = rec.normals[i0], n1 = rec.normals[i1], n2 = rec.normals[i2];
+    if (moving) {
+      n0 = lerp(t, n0, rec.normals_end[i0]);
+      n1 = lerp(t, n1, rec.normals_end[i1]);
+      n2 = lerp(t, n2, rec.normals_end[i2]);
+    }
+    Normal3 ns = n0 * b0 + n1 * eh.u + n2 * eh.v;
+    float len = length(ns);
+    hit.ns = len > 0 ? ns / len : hit.ng;
+    hit.ng = face_forward(hit.ng, hit.ns);
+  } else {
+    hit.ns = hit.ng;
+  }
+  hit.uv = rec.uvs.empty() ? Vec2(eh.u, eh.v) : rec.uvs[i0] * b0 + rec.uvs[i1] * eh.u + rec.uvs[i2] * eh.v;
+}
+
+void Scene::reconstruct_sphere_hit(const ShapeRecord& rec, const Ray& ray, float t, SurfaceHit& hit) const {
+  const SphereGeometry& s = rec.sphere;
+  // A moving sphere is where Embree found it: under its transform at the ray's time (invertible
+  // there, or it would not have been hit).
+  const Transform* to_world = &s.to_world;
+  std::optional<Transform> at_time;
+  if (s.to_world_end) {
+    at_time = interpolate_transform(s.to_world, *s.to_world_end, embree_.normalized_time(ray.time));
+    if (at_time) to_world = &*at_time;
+  }
+  hit.p = ray.at(t);
+  // Re-project onto the surface in object space to remove the error of o + t d, then map back.
+  Point3 po = to_world->inverse().point(hit.p) - s.center;
+  po = po * (s.radius / length(po));
+  hit.p = to_world->point(s.center + po);
+  hit.ng = normalize(to_world->normal(po));
+  if (rec.flip_normal) hit.ng = -hit.ng;
+  hit.ns = hit.ng;
+  float phi = std::atan2(po.y, po.x);
+  if (phi < 0) phi += 2 * kPi;
+  hit.uv = {phi * kInv2Pi, std::acos(std::clamp(po.z / s.radius, -1.0f, 1.0f)) * kInvPi};
 }
 
 RGB Scene::emitted(const SurfaceHit& hit, const Vec3& wo) const {

@@ -26,12 +26,17 @@ struct ShapeRecord {
   // Triangles, in world space, winding baked so cross(p1-p0, p2-p0) is the oriented normal.
   std::vector<Point3> positions;
   std::vector<Normal3> normals;
+  // Moving triangles: the same at the end of the motion (empty when static); positions and
+  // unit normals are interpolated linearly in between.
+  std::vector<Point3> positions_end;
+  std::vector<Normal3> normals_end;
   std::vector<Vec2> uvs;
   std::vector<uint32_t> indices;
   SphereGeometry sphere;
   PlaneGeometry plane;
   std::string name;
   bool is_emissive() const { return first_light >= 0; }
+  bool is_moving() const { return !positions_end.empty() || sphere.to_world_end.has_value(); }
 };
 
 class Scene {
@@ -58,8 +63,12 @@ class Scene {
 
  private:
   void add_shape(const ShapeDesc& desc, size_t index, int material_count);
-  void add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Transform& to_world, bool reverse,
-                     const std::optional<AreaEmission>& emission);
+  void add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Transform& to_world,
+                     const Transform* to_world_end, bool reverse, const std::optional<AreaEmission>& emission);
+  void add_sphere(ShapeRecord rec, const SphereShape& sphere, const Transform& to_world,
+                  const Transform* to_world_end, bool reverse, const std::optional<AreaEmission>& emission);
+  void reconstruct_triangle_hit(const ShapeRecord& rec, const EmbreeHit& eh, float time, SurfaceHit& hit) const;
+  void reconstruct_sphere_hit(const ShapeRecord& rec, const Ray& ray, float t, SurfaceHit& hit) const;
 
   std::string source_file_;  // for messages
   EmbreeScene embree_;
