@@ -16,6 +16,18 @@ inline float area_to_solid_angle_pdf(float pdf_area, const Point3& p, const Poin
   return cos_l > 0 ? pdf_area * dist2 / cos_l : 0.0f;
 }
 
+// Estimated irradiance at ctx from a flat emitter: L times its projected solid angle, measured from
+// its centroid (at most pi).
+inline float flat_light_importance(const Point3& centroid, const Normal3& n, float area, const RGB& radiance,
+                                   bool two_sided, const LightSampleContext& ctx) {
+  Vec3 d = centroid - ctx.p;
+  float d2 = std::max(length_squared(d), 1e-12f);
+  Vec3 w = d / std::sqrt(d2);
+  float cos_l = two_sided ? std::abs(dot(n, w)) : std::max(0.0f, -dot(n, w));
+  float cos_p = ctx.n == Normal3(0.0f) ? 1.0f : std::max(0.0f, dot(ctx.n, w));
+  return radiance.luminance() * std::min(kPi, area * cos_l * cos_p / d2);
+}
+
 struct TriangleLight {
   Point3 p0, p1, p2;
   Normal3 n;  // unit, the emitting side
@@ -43,15 +55,40 @@ struct TriangleLight {
     return area_to_solid_angle_pdf(1 / area, ctx.p, p, n);
   }
   float power() const { return radiance.luminance() * area * kPi * (two_sided ? 2 : 1); }
-  // Estimated irradiance at ctx: L times the projected solid angle, from the centroid (at most pi).
   float importance(const LightSampleContext& ctx) const {
-    Point3 c = (p0 + p1 + p2) / 3.0f;
-    Vec3 d = c - ctx.p;
-    float d2 = std::max(length_squared(d), 1e-12f);
-    Vec3 w = d / std::sqrt(d2);
-    float cos_l = two_sided ? std::abs(dot(n, w)) : std::max(0.0f, -dot(n, w));
-    float cos_p = ctx.n == Normal3(0.0f) ? 1.0f : std::max(0.0f, dot(ctx.n, w));
-    return radiance.luminance() * std::min(kPi, area * cos_l * cos_p / d2);
+    return flat_light_importance((p0 + p1 + p2) / 3.0f, n, area, radiance, two_sided, ctx);
+  }
+};
+
+// A parallelogram corner + s edge_u + t edge_v, (s, t) in [0,1]^2, sampled uniformly by area with
+// the 2D sample mapped straight onto it, so stratified samples are stratified over the light (the
+// paper's stratified rectangular lights, sec. 4.5).
+struct RectangleLight {
+  Point3 corner;
+  Vec3 edge_u, edge_v;
+  Normal3 n;  // unit, the emitting side
+  float area;
+  RGB radiance;
+  bool two_sided;
+
+  LightSample sample_li(const LightSampleContext& ctx, Vec2 u) const {
+    Point3 p = corner + edge_u * u.x + edge_v * u.y;
+    Vec3 d = p - ctx.p;
+    float dist2 = length_squared(d);
+    if (dist2 == 0) return {};
+    float dist = std::sqrt(dist2);
+    Vec3 wi = d / dist;
+    if (!two_sided && dot(n, -wi) <= 0) return {};
+    float pdf = area_to_solid_angle_pdf(1 / area, ctx.p, p, n);
+    if (pdf <= 0 || !std::isfinite(pdf)) return {};
+    return {radiance, wi, dist, pdf, p, n, false};
+  }
+  float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const {
+    return area_to_solid_angle_pdf(1 / area, ctx.p, p, n);
+  }
+  float power() const { return radiance.luminance() * area * kPi * (two_sided ? 2 : 1); }
+  float importance(const LightSampleContext& ctx) const {
+    return flat_light_importance(corner + (edge_u + edge_v) * 0.5f, n, area, radiance, two_sided, ctx);
   }
 };
 

@@ -15,7 +15,7 @@
 
 namespace candela {
 
-using Light = std::variant<PointLightSource, TriangleLight, SphereLight, SkyLightSource>;
+using Light = std::variant<PointLightSource, TriangleLight, RectangleLight, SphereLight, SkyLightSource>;
 
 inline LightSample light_sample_li(const Light& l, const LightSampleContext& ctx, Vec2 u) {
   return std::visit([&](const auto& x) { return x.sample_li(ctx, u); }, l);

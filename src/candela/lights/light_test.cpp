@@ -115,3 +115,29 @@ TEST(Lights, SkyGradientAndPower) {
 
 }  // namespace
 }  // namespace candela
+
+namespace candela {
+namespace {
+
+TEST(Lights, RectangleLightSamplesByAreaAndStratifies) {
+  RectangleLight light{{-1, 2, -1}, {2, 0, 0}, {0, 0, 1.5f}, {0, -1, 0}, 3.0f, RGB(2.0f), false};
+  LightSampleContext ctx{{0.3f, 0, 0.2f}, {0, 1, 0}};
+  auto sample = [&](Vec2 u) {
+    LightSample s = light.sample_li(ctx, u);
+    return s.pdf > 0 ? s.wi : Vec3(0.0f);
+  };
+  auto pdf = [&](const Vec3& w) {
+    if (w.y <= 0) return 0.0f;
+    Point3 p = ctx.p + w * ((2 - ctx.p.y) / w.y);
+    if (p.x < -1 || p.x > 1 || p.z < -1 || p.z > 0.5f) return 0.0f;
+    return light.pdf_li(ctx, w, p, light.n);
+  };
+  EXPECT_GT(light_chi_square(sample, pdf, {0, 1, 0}, 0.3f, 64), 1e-3);
+  // The 2D sample maps straight onto the parallelogram: strata of u are strata of the light.
+  LightSample s = light.sample_li(ctx, {0.25f, 0.5f});
+  EXPECT_NEAR(s.p_light.x, -0.5f, 1e-5f);
+  EXPECT_NEAR(s.p_light.z, -0.25f, 1e-5f);
+}
+
+}  // namespace
+}  // namespace candela

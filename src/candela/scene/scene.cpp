@@ -126,7 +126,8 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int material_count) {
   if (const auto* b = std::get_if<BoxShape>(&desc.geometry)) mesh = box_mesh(*b);
   else if (const auto* r = std::get_if<RectangleShape>(&desc.geometry)) mesh = rectangle_mesh(*r);
   else mesh = std::get<MeshShape>(desc.geometry).mesh;
-  add_triangles(std::move(rec), mesh, T, T_end, desc.reverse_orientation, desc.emission);
+  add_triangles(std::move(rec), mesh, T, T_end, desc.reverse_orientation, desc.emission,
+                std::holds_alternative<RectangleShape>(desc.geometry));
 }
 
 void Scene::add_sphere(ShapeRecord rec, const SphereShape& s, const Transform& T, const Transform* T_end,
@@ -158,7 +159,7 @@ void Scene::add_sphere(ShapeRecord rec, const SphereShape& s, const Transform& T
 }
 
 void Scene::add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Transform& T, const Transform* T_end,
-                          bool reverse, const std::optional<AreaEmission>& emission) {
+                          bool reverse, const std::optional<AreaEmission>& emission, bool rectangle) {
   rec.kind = ShapeRecord::Kind::Triangles;
   rec.positions.reserve(mesh.positions.size());
   for (const auto& p : mesh.positions) {
@@ -191,6 +192,18 @@ void Scene::add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Trans
     rec.first_light = int(lights_.size());
     rec.radiance = emission->radiance;
     rec.two_sided_emission = emission->two_sided;
+  }
+  if (emission && rectangle) {
+    // One light for the whole parallelogram (its two triangles share it), so that light samples
+    // stratify over all of it. Corner p0, edges to p1 and p3 as rectangle_mesh lays them out.
+    const Point3 &p0 = rec.positions[0], &p1 = rec.positions[1], &p3 = rec.positions[3];
+    const Point3 &a = rec.positions[rec.indices[0]], &b = rec.positions[rec.indices[1]], &c = rec.positions[rec.indices[2]];
+    Vec3 oriented = cross(b - a, c - a);  // after the winding was baked: the emitting side
+    float area = length(cross(p1 - p0, p3 - p0));
+    rec.light_per_triangle = false;
+    lights_.push_back(RectangleLight{p0, p1 - p0, p3 - p0, normalize(oriented), area, rec.radiance,
+                                     rec.two_sided_emission});
+  } else if (emission) {
     for (size_t i = 0; i < rec.indices.size(); i += 3) {
       const Point3 &p0 = rec.positions[rec.indices[i]], &p1 = rec.positions[rec.indices[i + 1]],
                    &p2 = rec.positions[rec.indices[i + 2]];
@@ -304,7 +317,8 @@ RGB Scene::emitted(const SurfaceHit& hit, const Vec3& wo) const {
 int Scene::light_index(const SurfaceHit& hit) const {
   const ShapeRecord& rec = shapes_[hit.shape];
   if (!rec.is_emissive()) return -1;
-  return rec.kind == ShapeRecord::Kind::Triangles ? rec.first_light + int(hit.primitive) : rec.first_light;
+  return rec.kind == ShapeRecord::Kind::Triangles && rec.light_per_triangle ? rec.first_light + int(hit.primitive)
+                                                                           : rec.first_light;
 }
 
 }  // namespace candela

@@ -19,7 +19,8 @@ struct ShapeRecord {
   enum class Kind : uint8_t { Triangles, Sphere, Plane };
   Kind kind = Kind::Triangles;
   uint32_t material = 0;
-  int first_light = -1;  // index of the light of primitive 0 when emissive (one light per triangle)
+  int first_light = -1;  // index of the light of primitive 0 when emissive
+  bool light_per_triangle = true;  // meshes: one light per triangle; rectangles: one light
   RGB radiance;          // emitted radiance when emissive
   bool two_sided_emission = false;
   bool flip_normal = false;  // spheres and planes: reverse orientation
@@ -64,7 +65,8 @@ class Scene {
  private:
   void add_shape(const ShapeDesc& desc, size_t index, int material_count);
   void add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Transform& to_world,
-                     const Transform* to_world_end, bool reverse, const std::optional<AreaEmission>& emission);
+                     const Transform* to_world_end, bool reverse, const std::optional<AreaEmission>& emission,
+                     bool rectangle);  // rectangle: one RectangleLight instead of a light per triangle
   void add_sphere(ShapeRecord rec, const SphereShape& sphere, const Transform& to_world,
                   const Transform* to_world_end, bool reverse, const std::optional<AreaEmission>& emission);
   void reconstruct_triangle_hit(const ShapeRecord& rec, const EmbreeHit& eh, float time, SurfaceHit& hit) const;
