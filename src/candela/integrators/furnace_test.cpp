@@ -84,6 +84,29 @@ TEST(Furnace, PaperTransmissionLobeIsLosslessInWhiteFurnace) {
   expect_within_standard_errors(region_mean(img, -1, inside_silhouette), 1.0, "phong t=1");
 }
 
+TEST(Furnace, WhiteMaterialsConserveEnergy) {
+  // A white, lossless object in a white furnace is invisible: diffuse with albedo 1, the paper's
+  // material with d = 1 or t = 1, a white mirror, clear glass. The normalised Phong lobe loses the
+  // part of the lobe below the surface, so a white d + s = 1 mixture may only be darker.
+  PhongMaterial diffuse_phong;
+  diffuse_phong.diffuse = RGB(1.0f);
+  diffuse_phong.d = 1;
+  diffuse_phong.s = diffuse_phong.t = 0;
+  for (const MaterialDesc& m : std::vector<MaterialDesc>{DiffuseMaterial{RGB(1.0f)}, diffuse_phong,
+                                                         MirrorMaterial{RGB(1.0f)}, GlassMaterial{1.33f, RGB(1.0f), RGB(1.0f)}})
+    expect_within_standard_errors(region_mean(render_description(sphere_under_sky(m, RGB(1.0f))).mean_image(), -1,
+                                              inside_silhouette),
+                                  1.0, "white material");
+  PhongMaterial glossy;
+  glossy.diffuse = glossy.specular = RGB(1.0f);
+  glossy.exponent = 10;
+  glossy.d = glossy.s = 0.5f;
+  glossy.t = 0;
+  auto e = region_mean(render_description(sphere_under_sky(glossy, RGB(1.0f))).mean_image(), -1, inside_silhouette);
+  EXPECT_LE(e.mean, 1.0 + 4 * e.standard_error);
+  EXPECT_GT(e.mean, 0.8);
+}
+
 TEST(Furnace, MirrorSphereReflectsItsReflectance) {
   Image img = render_description(sphere_under_sky(MirrorMaterial{RGB(0.25f, 0.5f, 0.75f)}, RGB(2.0f))).mean_image();
   for (int c = 0; c < 3; ++c)

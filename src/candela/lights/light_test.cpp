@@ -10,7 +10,7 @@
 namespace candela {
 namespace {
 
-constexpr int kSamples = 200000;
+constexpr int kSamples = testing::kChiSquareSamples;
 
 // Directions from `ctx` as seen in a frame whose +z points along `axis`, so narrow cones are binned finely.
 template <typename SampleFn, typename PdfFn>
@@ -47,7 +47,7 @@ TEST(Lights, SphereLightFromOutsideSamplesTheCone) {
     return p ? light.pdf_li(ctx, w, *p, normalize(*p - light.center)) : 0.0f;
   };
   float cos_max = light.cone_cos_max(ctx.p);
-  EXPECT_GT(light_chi_square(sample, pdf, light.center - ctx.p, cos_max - 0.01f), 1e-3);
+  EXPECT_GT(light_chi_square(sample, pdf, light.center - ctx.p, cos_max - 0.01f), testing::kChiSquareAlpha);
 }
 
 TEST(Lights, SphereLightFromInsideSamplesByArea) {
@@ -61,7 +61,7 @@ TEST(Lights, SphereLightFromInsideSamplesByArea) {
     auto p = hit_sphere(ctx.p, w, light.center, light.radius);
     return p ? light.pdf_li(ctx, w, *p, normalize(*p - light.center)) : 0.0f;
   };
-  EXPECT_GT(light_chi_square(sample, pdf, {0, 0, 1}, -1), 1e-3);
+  EXPECT_GT(light_chi_square(sample, pdf, {0, 0, 1}, -1), testing::kChiSquareAlpha);
 }
 
 TEST(Lights, TriangleLightSamplesByArea) {
@@ -83,7 +83,7 @@ TEST(Lights, TriangleLightSamplesByArea) {
     return light.pdf_li(ctx, w, p, light.n);
   };
   // The triangle's edges cut through cells: integrate its pdf finely.
-  EXPECT_GT(light_chi_square(sample, pdf, {0, 1, 0}, 0.5f, 64), 1e-3);
+  EXPECT_GT(light_chi_square(sample, pdf, {0, 1, 0}, 0.5f, 64), testing::kChiSquareAlpha);
   // One-sided: nothing from behind.
   LightSampleContext above{{0, 3, 0}, {0, -1, 0}};
   EXPECT_EQ(light.sample_li(above, {0.3f, 0.3f}).pdf, 0);
@@ -95,7 +95,7 @@ TEST(Lights, SkySamplesCosineAboutTheNormalOrUniformly) {
     LightSampleContext ctx{{0, 0, 0}, n};
     auto sample = [&](Vec2 u) { return sky.sample_li(ctx, u).wi; };
     auto pdf = [&](const Vec3& w) { return sky.pdf_li(ctx, w, {}, {}); };
-    EXPECT_GT(light_chi_square(sample, pdf, {0, 0, 1}, -1), 1e-3);
+    EXPECT_GT(light_chi_square(sample, pdf, {0, 0, 1}, -1), testing::kChiSquareAlpha);
   }
 }
 
@@ -132,7 +132,7 @@ TEST(Lights, RectangleLightSamplesByAreaAndStratifies) {
     if (p.x < -1 || p.x > 1 || p.z < -1 || p.z > 0.5f) return 0.0f;
     return light.pdf_li(ctx, w, p, light.n);
   };
-  EXPECT_GT(light_chi_square(sample, pdf, {0, 1, 0}, 0.3f, 64), 1e-3);
+  EXPECT_GT(light_chi_square(sample, pdf, {0, 1, 0}, 0.3f, 64), testing::kChiSquareAlpha);
   // The 2D sample maps straight onto the parallelogram: strata of u are strata of the light.
   LightSample s = light.sample_li(ctx, {0.25f, 0.5f});
   EXPECT_NEAR(s.p_light.x, -0.5f, 1e-5f);

@@ -10,7 +10,7 @@
 namespace candela {
 namespace {
 
-constexpr int kSamples = 300000;
+constexpr int kSamples = testing::kChiSquareSamples;
 
 Vec3 direction(float theta_degrees, float phi_degrees = 30) {
   float t = radians(theta_degrees), p = radians(phi_degrees);
@@ -30,8 +30,8 @@ double bsdf_chi_square(const Bsdf& bsdf, const Vec3& wo, float z_min = -1) {
 
 TEST(Bsdf, DiffuseSamplingMatchesPdf) {
   Bsdf b = DiffuseBsdf{RGB(0.5f)};
-  EXPECT_GT(bsdf_chi_square(b, direction(30)), 1e-3);
-  EXPECT_GT(bsdf_chi_square(b, -direction(40)), 1e-3);  // two-sided: from below
+  EXPECT_GT(bsdf_chi_square(b, direction(30)), testing::kChiSquareAlpha);
+  EXPECT_GT(bsdf_chi_square(b, -direction(40)), testing::kChiSquareAlpha);  // two-sided: from below
 }
 
 TEST(Bsdf, PhongMixtureSamplingMatchesPdf) {
@@ -44,7 +44,7 @@ TEST(Bsdf, PhongMixtureSamplingMatchesPdf) {
       p.d = 0.4f;
       p.s = 0.5f;
       p.t = 0.0f;
-      EXPECT_GT(bsdf_chi_square(p, direction(theta)), 1e-3) << "n " << exponent << " theta " << theta;
+      EXPECT_GT(bsdf_chi_square(p, direction(theta)), testing::kChiSquareAlpha) << "n " << exponent << " theta " << theta;
     }
   }
 }
@@ -55,7 +55,7 @@ TEST(Bsdf, NarrowPhongLobeSamplingMatchesPdf) {
   p.d = 0;
   p.s = 1;
   // The lobe around the mirror direction of normal incidence is narrow: bin finely near the pole.
-  EXPECT_GT(bsdf_chi_square(p, direction(0), 0.9f), 1e-3);
+  EXPECT_GT(bsdf_chi_square(p, direction(0), 0.9f), testing::kChiSquareAlpha);
 }
 
 TEST(Bsdf, SampleWeightIsEvalCosOverPdf) {
@@ -102,7 +102,7 @@ TEST(Bsdf, PhongModeProbabilitiesFollowDST) {
   // A cosine-distributed diffuse sample lands within 8 degrees of the normal with probability 1 - 0.99^2.
   double near_pole = 1 - 0.99 * 0.99;
   std::vector<double> expected = {n * 0.2 * (1 - near_pole), n * (0.3 + 0.2 * near_pole), n * 0.4, n * 0.1};
-  EXPECT_GT(testing::chi_square_p_value(observed, expected), 1e-3);
+  EXPECT_GT(testing::chi_square_p_value(observed, expected), testing::kChiSquareAlpha);
 }
 
 TEST(Bsdf, EnergyConservationAndReciprocity) {

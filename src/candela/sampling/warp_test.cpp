@@ -13,7 +13,7 @@
 namespace candela {
 namespace {
 
-constexpr int kSamples = 200000;
+constexpr int kSamples = testing::kChiSquareSamples;
 
 // Monte Carlo integral of pdf over the sphere with uniform directions: must be 1 within 5 sigma.
 void expect_pdf_integrates_to_one(const std::function<float(const Vec3&)>& pdf) {
@@ -35,7 +35,7 @@ TEST(Warp, UniformSphere) {
   for (int i = 0; i < 10000; ++i) EXPECT_NEAR(length(square_to_uniform_sphere({rng.next_float(), rng.next_float()})), 1, 1e-5);
   auto sample = [](Vec2 u) { return square_to_uniform_sphere(u); };
   auto pdf = [](const Vec3&) { return uniform_sphere_pdf(); };
-  EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 3), 1e-3);
+  EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 3), testing::kChiSquareAlpha);
 }
 
 TEST(Warp, UniformHemisphere) {
@@ -44,7 +44,7 @@ TEST(Warp, UniformHemisphere) {
   expect_pdf_integrates_to_one([](const Vec3& w) { return uniform_hemisphere_pdf(w); });
   auto sample = [](Vec2 u) { return square_to_uniform_hemisphere(u); };
   auto pdf = [](const Vec3& w) { return uniform_hemisphere_pdf(w); };
-  EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 4), 1e-3);
+  EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 4), testing::kChiSquareAlpha);
 }
 
 TEST(Warp, CosineHemisphere) {
@@ -57,7 +57,7 @@ TEST(Warp, CosineHemisphere) {
   expect_pdf_integrates_to_one([](const Vec3& w) { return cosine_hemisphere_pdf(w); });
   auto sample = [](Vec2 u) { return square_to_cosine_hemisphere(u); };
   auto pdf = [](const Vec3& w) { return cosine_hemisphere_pdf(w); };
-  EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 5), 1e-3);
+  EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 5), testing::kChiSquareAlpha);
 }
 
 TEST(Warp, UniformCone) {
@@ -68,7 +68,7 @@ TEST(Warp, UniformCone) {
     expect_pdf_integrates_to_one([&](const Vec3& w) { return w.z >= cos_max ? uniform_cone_pdf(cos_max) : 0.0f; });
     auto sample = [&](Vec2 u) { return square_to_uniform_cone(u, cos_max); };
     auto pdf = [&](const Vec3& w) { return w.z >= cos_max ? uniform_cone_pdf(cos_max) : 0.0f; };
-    EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 6, cos_max), 1e-3) << "cos_max " << cos_max;
+    EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 6, cos_max), testing::kChiSquareAlpha) << "cos_max " << cos_max;
   }
 }
 
@@ -78,7 +78,7 @@ TEST(Warp, PhongLobe) {
     auto sample = [&](Vec2 u) { return square_to_phong_lobe(u, n); };
     auto pdf = [&](const Vec3& w) { return phong_lobe_pdf(w.z, n); };
     float z_min = n > 50 ? 0.9f : -1.0f;  // resolve the narrow lobe
-    EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 7, z_min), 1e-3) << "exponent " << n;
+    EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 7, z_min), testing::kChiSquareAlpha) << "exponent " << n;
   }
 }
 
@@ -100,7 +100,7 @@ TEST(Warp, ConcentricDiskIsUniform) {
       observed.push_back(c);
       expected.push_back(kSamples / 16.0);
     }
-  EXPECT_GT(testing::chi_square_p_value(observed, expected), 1e-3);
+  EXPECT_GT(testing::chi_square_p_value(observed, expected), testing::kChiSquareAlpha);
   EXPECT_FLOAT_EQ(concentric_disk_pdf({0.5f, 0.5f}), kInvPi);
 }
 
@@ -117,7 +117,7 @@ TEST(Warp, UniformTriangle) {
     int region = b.x > 0.5f ? 0 : b.y > 0.5f ? 1 : b2 > 0.5f ? 2 : 3;
     observed[region] += 1;
   }
-  EXPECT_GT(testing::chi_square_p_value(observed, expected), 1e-3);
+  EXPECT_GT(testing::chi_square_p_value(observed, expected), testing::kChiSquareAlpha);
 }
 
 TEST(Distribution1D, SamplesProportionally) {
@@ -129,7 +129,7 @@ TEST(Distribution1D, SamplesProportionally) {
   std::vector<double> observed(4, 0), expected = {0.1 * kSamples, 0, 0.3 * kSamples, 0.6 * kSamples};
   for (int i = 0; i < kSamples; ++i) observed[d.sample(rng.next_float())] += 1;
   EXPECT_EQ(observed[1], 0);
-  EXPECT_GT(testing::chi_square_p_value(observed, expected), 1e-3);
+  EXPECT_GT(testing::chi_square_p_value(observed, expected), testing::kChiSquareAlpha);
 }
 
 }  // namespace

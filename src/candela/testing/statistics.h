@@ -9,6 +9,12 @@
 
 namespace candela::testing {
 
+// Significance of each chi-square test of a sampling routine: 1% for the whole family of about 40
+// such tests in the suite, Sidak-corrected (1 - 0.99^(1/40)), as Mitsuba and pbrt do.
+inline constexpr double kChiSquareAlpha = 2.51e-4;
+// Samples per chi-square test of a direction-sampling routine.
+inline constexpr int kChiSquareSamples = 1000000;
+
 // p-value of the chi-square statistic; cells with expected count < 5 are pooled together.
 double chi_square_p_value(const std::vector<double>& observed, const std::vector<double>& expected);
 
