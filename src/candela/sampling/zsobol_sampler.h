@@ -56,11 +56,26 @@ constexpr GeneratorMatrix pascal_matrix() {
 inline constexpr std::array<GeneratorMatrix, 2> kMatrices = {van_der_corput_matrix(), pascal_matrix()};
 
 // The unscrambled sample as a 0.32 fixed-point fraction: the product of the generator matrix with
-// the index's bits over GF(2).
-constexpr uint32_t sample_bits(uint64_t index, int dimension) {
+// the index's bits over GF(2). Done a byte of the index at a time with precomputed XORs of 8 columns
+// (8 table lookups instead of a loop over up to 64 bits: this is on the hot path).
+using ByteTables = std::array<std::array<uint32_t, 256>, kMatrixColumns / 8>;
+constexpr ByteTables byte_tables(const GeneratorMatrix& m) {
+  ByteTables t{};
+  for (int byte = 0; byte < kMatrixColumns / 8; ++byte)
+    for (int value = 0; value < 256; ++value) {
+      uint32_t v = 0;
+      for (int bit = 0; bit < 8; ++bit)
+        if (value & (1 << bit)) v ^= m[size_t(8 * byte + bit)];
+      t[size_t(byte)][size_t(value)] = v;
+    }
+  return t;
+}
+inline const std::array<ByteTables, 2> kByteTables = {byte_tables(kMatrices[0]), byte_tables(kMatrices[1])};
+
+inline uint32_t sample_bits(uint64_t index, int dimension) {
+  const ByteTables& t = kByteTables[size_t(dimension)];
   uint32_t v = 0;
-  for (int j = 0; index != 0; index >>= 1, ++j)
-    if (index & 1) v ^= kMatrices[size_t(dimension)][size_t(j)];
+  for (int byte = 0; index != 0; index >>= 8, ++byte) v ^= t[size_t(byte)][index & 0xff];
   return v;
 }
 
@@ -161,6 +176,14 @@ class ZSobolSampler {
     return sobol::bits_to_unit_float(sobol::fast_owen_scramble(sobol::sample_bits(index, sobol_dimension), seed));
   }
 
+  // One of the 24 digit permutations for a node of the digit tree: a cheap multiplicative hash (one
+  // per base-4 digit per dimension, so on the hot path), reduced to [0, 24) by multiply-shift.
+  static uint32_t permutation_choice(uint64_t key) {
+    uint64_t h = (key ^ (key >> 29)) * 0xbf58476d1ce4e5b9ULL;
+    h ^= h >> 32;
+    return uint32_t((uint64_t(uint32_t(h)) * 24) >> 32);
+  }
+
   // The Morton index with its base-4 digits randomly permuted, top digit first, each by one of the 24
   // permutations of {0,1,2,3} chosen by hashing the dimension and the digits above it. For odd log2(n)
   // the lowest digit is a single bit, randomly flipped the same way.
@@ -173,10 +196,10 @@ class ZSobolSampler {
       int shift = 2 * i - (odd_log2 ? 1 : 0);
       uint32_t digit = uint32_t(morton_index_ >> shift) & 3u;
       uint64_t higher_digits = shift + 2 >= 64 ? 0 : morton_index_ >> (shift + 2);
-      const auto& permutation = kBase4DigitPermutations[mix_bits(higher_digits ^ dimension_hash) % 24];
+      const auto& permutation = kBase4DigitPermutations[permutation_choice(higher_digits ^ dimension_hash)];
       index |= uint64_t(permutation[digit]) << shift;
     }
-    if (odd_log2) index |= (morton_index_ & 1) ^ (mix_bits((morton_index_ >> 1) ^ dimension_hash) & 1);
+    if (odd_log2) index |= (morton_index_ & 1) ^ (permutation_choice((morton_index_ >> 1) ^ dimension_hash) & 1);
     return index;
   }
 
