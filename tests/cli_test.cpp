@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -99,10 +100,36 @@ TEST_F(CommandLine, ResolutionAndFormatFromOptions) {
   EXPECT_EQ(read_image(pfm).height, 10);
 }
 
+TEST_F(CommandLine, AdaptiveSamplingWritesTheSppMap) {
+  std::string scene = write("good.json", kGoodJson);
+  std::string map = (dir_ / "spp.exr").string(), heat = (dir_ / "spp.png").string();
+  std::string image = (dir_ / "adaptive.exr").string();
+  RunResult r = run_cli("render " + scene + " -o " + image + " --adaptive-threshold 0.05 --adaptive-batch 4 " +
+                        "--max-spp 64 --sampler stratified --spp-map " + map + " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  Image counts = read_image(map);
+  float least = 1e9f, most = 0;
+  for (float c : counts.rgb) {
+    EXPECT_EQ(std::fmod(c, 4.0f), 0.0f);
+    least = std::min(least, c);
+    most = std::max(most, c);
+  }
+  EXPECT_EQ(least, 4.0f);  // the sky: one batch
+  EXPECT_GT(most, 16.0f);  // the sphere's edge: many more
+  EXPECT_LE(most, 64.0f);
+  EXPECT_NE(read_image_metadata(image)["candela:spp"].find("adaptive"), std::string::npos);
+  ASSERT_EQ(run_cli("render " + scene + " -o " + image + " --adaptive-threshold 0.05 --spp-map " + heat + " -q").exit_code, 0);
+  EXPECT_EQ(read_image(heat).width, 16);
+  expect_failure("render " + scene + " -o " + out() + " --adaptive-threshold 0.05 --adaptive-batch 6", "power of two");
+  expect_failure("render " + scene + " -o " + out() + " --sampler sobolev", "sobolev");
+}
+
 TEST_F(CommandLine, HelpDocumentsEveryOption) {
   RunResult r = run_cli("render --help");
   EXPECT_EQ(r.exit_code, 0);
-  for (const char* opt : {"--output", "--spp", "--threads", "--seed", "--max-depth", "--resolution", "--integrator"})
+  for (const char* opt : {"--output", "--spp", "--threads", "--seed", "--max-depth", "--resolution", "--integrator",
+                          "--sampler", "--filter", "--direction-sampling", "--no-mis", "--light-selection",
+                          "--shadow-rays", "--adaptive-threshold", "--adaptive-batch", "--max-spp", "--spp-map"})
     EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
 }
 
