@@ -179,8 +179,8 @@ int run_render(const RenderCommand& cmd) {
   double seconds = std::max(stats.seconds, 1e-9);
   std::string written;
   for (const auto& f : outputs) written += (written.empty() ? "" : ", ") + f.string();
-  std::printf("%dx%d, %d spp in %.2f s: %.3f Msamples/s, %.2f Mrays/s (%.3g rays/sample) -> %s\n", desc.film.width,
-              desc.film.height, desc.settings.spp, stats.seconds, double(stats.samples) / seconds * 1e-6,
+  std::printf("%dx%d, %s spp in %.2f s: %.3f Msamples/s, %.2f Mrays/s (%.3g rays/sample) -> %s\n", desc.film.width,
+              desc.film.height, metadata["candela:spp"].c_str(), stats.seconds, double(stats.samples) / seconds * 1e-6,
               double(stats.rays.total()) / seconds * 1e-6, double(stats.rays.total()) / double(stats.samples),
               written.c_str());
   return 0;

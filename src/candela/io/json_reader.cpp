@@ -584,6 +584,8 @@ class JsonSceneReader {
       read_transform_times(*times, render.pointer_of("transform_times"));
     if (const Json* sampler = render.find("sampler"))
       settings.sampler = read_sampler(*sampler, render.pointer_of("sampler"));
+    else
+      settings.sampler.type = SamplerType::ZSobol;  // the most efficient measured (docs/performance.md)
     if (const Json* filter = render.find("filter")) settings.filter = read_filter(*filter, render.pointer_of("filter"));
     read_integrator_strategies(render, settings);
     if (const Json* adaptive = render.find("adaptive"))

@@ -99,7 +99,7 @@ TEST(JsonReader, EmptySceneGetsDefaults) {
   EXPECT_EQ(scene.settings.seed, 0u);
   EXPECT_EQ(scene.settings.integrator, "path");
   EXPECT_EQ(scene.settings.rr_start_depth, 3);
-  EXPECT_EQ(scene.settings.sampler.type, SamplerType::Independent);
+  EXPECT_EQ(scene.settings.sampler.type, SamplerType::ZSobol);  // the default for scenes that name none
   EXPECT_EQ(scene.settings.filter.type, FilterType::Box);
   EXPECT_FLOAT_EQ(scene.settings.filter.radius.x, 0.5f);
   EXPECT_EQ(scene.settings.direction_sampling, DirectionSampling::Bsdf);

@@ -127,20 +127,42 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
       run_pass(pc, tiles, arena, std::min(pass_spp, settings.spp - pass), [&](int, int) { return int64_t(pass); },
                progress);
   } else {
-    // Batches of F samples; a pixel continues while its own samples say it is too noisy, so the
-    // decision (and the image) does not depend on threads or on other pixels.
+    // Batches of F samples. Between batches, every pixel's relative error is estimated from its own
+    // samples and smoothed over its 3x3 neighbourhood (one pixel's variance from a few samples is
+    // itself very noisy); pixels still above the threshold get the next batch. The decision is made
+    // while no pass runs, from the film alone, so it does not depend on threads.
+    const int w = film.width(), h = film.height();
+    std::vector<uint8_t> active(size_t(w) * h, 1);
+    std::vector<float> error(size_t(w) * h);
     for (int rendered = 0; rendered < max_spp; rendered += batch) {
-      std::atomic<bool> any{false};
       run_pass(pc, tiles, arena, batch,
-               [&](int x, int y) -> int64_t {
-                 const PixelSums& px = film.pixel(x, y);
-                 if (px.count != uint64_t(rendered)) return -1;  // stopped in an earlier batch
-                 if (rendered > 0 && relative_error(px) <= settings.adaptive_threshold) return -1;
-                 any.store(true, std::memory_order_relaxed);
-                 return int64_t(rendered);
-               },
+               [&](int x, int y) -> int64_t { return active[size_t(y) * w + x] ? int64_t(rendered) : -1; },
                progress);
-      if (!any.load()) break;
+      if (rendered + batch >= max_spp) break;
+      arena.execute([&] {
+        tbb::parallel_for(0, h, [&](int y) {
+          for (int x = 0; x < w; ++x) error[size_t(y) * w + x] = relative_error(film.pixel(x, y));
+        });
+      });
+      bool any = false;
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          uint8_t& a = active[size_t(y) * w + x];
+          if (!a) continue;
+          double sum_sq = 0;
+          int n = 0;
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              int nx = x + dx, ny = y + dy;
+              if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+              float e = error[size_t(ny) * w + nx];
+              sum_sq += double(e) * e;
+              ++n;
+            }
+          a = std::sqrt(sum_sq / n) > settings.adaptive_threshold;
+          any = any || a;
+        }
+      if (!any) break;
     }
   }
   progress.finish();
