@@ -143,25 +143,52 @@ class ZSobolSampler {
   // outside it still get valid samples (their extra Morton bits pass through unpermuted).
   ZSobolSampler(int samples_per_set, uint64_t seed, int width, int height);
 
+  // Dimensions from this one on come from a PCG stream per (pixel, sample, seed) instead: they are
+  // the deep bounces of a path, where stratification gains little and the scrambled index (one hash
+  // per base-4 digit) would cost more than the path itself. The first 16 cover the pixel, lens and
+  // time and the first two path vertices (light choice and point, lobe, direction, roulette).
+  static constexpr int kScrambledDimensions = 16;
+
   void start_pixel_sample(int x, int y, uint64_t sample_index) {
+    rng_.set_sequence(hash_values(uint64_t(x), uint64_t(y), seed_), mix_bits(sample_index));
     uint64_t set = sample_index >> log2_n_;
     uint64_t index_in_set = sample_index & ((uint64_t(1) << log2_n_) - 1);
-    morton_index_ = (encode_morton2(uint32_t(x), uint32_t(y)) << log2_n_) | index_in_set;
-    set_seed_ = hash_values(seed_, set);
+    uint64_t pixel_code = encode_morton2(uint32_t(x), uint32_t(y));
+    morton_index_ = (pixel_code << log2_n_) | index_in_set;
+    // The permuted digits above the sample index depend only on the pixel, the set and the
+    // dimension: keep them while the same pixel's samples are drawn one after another. The
+    // dimensions' hashes and scramble seeds depend on the set alone.
+    if (set != cached_set_) {
+      uint64_t set_seed = hash_values(seed_, set);
+      for (int d = 0; d < kScrambledDimensions; ++d) {
+        dimension_hashes_[size_t(d)] = hash_values(set_seed, uint64_t(d));
+        scramble_seeds_[size_t(d)] = scramble_seeds(dimension_hashes_[size_t(d)]);
+      }
+    }
+    if (pixel_code != cached_pixel_ || set != cached_set_) {
+      cached_pixel_ = pixel_code;
+      cached_set_ = set;
+      cached_dimensions_ = 0;
+    }
     dimension_ = 0;
   }
 
   float get_1d() {
-    uint64_t dimension_hash = hash_values(set_seed_, uint64_t(dimension_));
+    if (dimension_ >= kScrambledDimensions) return rng_.next_float();
+    uint64_t index = sobol_index(dimension_hashes_[size_t(dimension_)], dimension_);
+    uint64_t seeds = scramble_seeds_[size_t(dimension_)];
     dimension_ += 1;
-    return scrambled_sample(sobol_index(dimension_hash), 0, uint32_t(scramble_seeds(dimension_hash)));
+    return scrambled_sample(index, 0, uint32_t(seeds));
   }
 
   Vec2 get_2d() {
-    uint64_t dimension_hash = hash_values(set_seed_, uint64_t(dimension_));
+    if (dimension_ + 1 >= kScrambledDimensions) {
+      float a = rng_.next_float();
+      return {a, rng_.next_float()};
+    }
+    uint64_t index = sobol_index(dimension_hashes_[size_t(dimension_)], dimension_);
+    uint64_t seeds = scramble_seeds_[size_t(dimension_)];
     dimension_ += 2;
-    uint64_t index = sobol_index(dimension_hash);
-    uint64_t seeds = scramble_seeds(dimension_hash);
     return {scrambled_sample(index, 0, uint32_t(seeds)), scrambled_sample(index, 1, uint32_t(seeds >> 32))};
   }
 
@@ -187,19 +214,44 @@ class ZSobolSampler {
   // The Morton index with its base-4 digits randomly permuted, top digit first, each by one of the 24
   // permutations of {0,1,2,3} chosen by hashing the dimension and the digits above it. For odd log2(n)
   // the lowest digit is a single bit, randomly flipped the same way.
-  uint64_t sobol_index(uint64_t dimension_hash) const {
+  uint64_t sobol_index(uint64_t dimension_hash, int dimension) {
     const bool odd_log2 = (log2_n_ & 1) != 0;
     const int lowest_digit = odd_log2 ? 1 : 0;
-    const int permuted_bits = 2 * base4_digits_ - (odd_log2 ? 1 : 0);
-    uint64_t index = permuted_bits >= 64 ? 0 : (morton_index_ >> permuted_bits) << permuted_bits;
-    for (int i = base4_digits_ - 1; i >= lowest_digit; --i) {
-      int shift = 2 * i - (odd_log2 ? 1 : 0);
+    // Digits whose bits lie wholly above the sample index are the pixel's: cached per dimension.
+    const int first_pixel_digit = (log2_n_ + (odd_log2 ? 1 : 0)) / 2;  // digit i spans bits 2i - odd, 2i - odd + 1
+    uint64_t index;
+    const uint32_t bit = 1u << dimension;
+    if (dimension < kScrambledDimensions && (cached_dimensions_ & bit)) {
+      index = cached_high_[size_t(dimension)];
+    } else {
+      index = permuted_digits(dimension_hash, std::max(first_pixel_digit, lowest_digit), base4_digits_ - 1, true);
+      if (dimension < kScrambledDimensions) {
+        cached_high_[size_t(dimension)] = index;
+        cached_dimensions_ |= bit;
+      }
+    }
+    index |= permuted_digits(dimension_hash, lowest_digit, std::max(first_pixel_digit, lowest_digit) - 1, false);
+    if (odd_log2) index |= (morton_index_ & 1) ^ (permutation_choice((morton_index_ >> 1) ^ dimension_hash) & 1);
+    return index;
+  }
+
+  // Digits lo..hi (inclusive) of the Morton index, each permuted by one of the 24 permutations of
+  // {0,1,2,3} chosen by hashing the dimension and the digits above it; with `with_top`, also the
+  // bits above all permuted digits, passed through.
+  uint64_t permuted_digits(uint64_t dimension_hash, int lo, int hi, bool with_top) const {
+    const int odd = (log2_n_ & 1) != 0 ? 1 : 0;
+    uint64_t index = 0;
+    if (with_top) {
+      const int permuted_bits = 2 * base4_digits_ - odd;
+      index = permuted_bits >= 64 ? 0 : (morton_index_ >> permuted_bits) << permuted_bits;
+    }
+    for (int i = hi; i >= lo; --i) {
+      int shift = 2 * i - odd;
       uint32_t digit = uint32_t(morton_index_ >> shift) & 3u;
       uint64_t higher_digits = shift + 2 >= 64 ? 0 : morton_index_ >> (shift + 2);
       const auto& permutation = kBase4DigitPermutations[permutation_choice(higher_digits ^ dimension_hash)];
       index |= uint64_t(permutation[digit]) << shift;
     }
-    if (odd_log2) index |= (morton_index_ & 1) ^ (permutation_choice((morton_index_ >> 1) ^ dimension_hash) & 1);
     return index;
   }
 
@@ -207,8 +259,12 @@ class ZSobolSampler {
   int base4_digits_;  // permuted digits: log2(resolution) + ceil(log2(n) / 2)
   uint64_t seed_;
   uint64_t morton_index_ = 0;
-  uint64_t set_seed_ = 0;
   int dimension_ = 0;
+  Rng rng_;
+  uint64_t cached_pixel_ = ~uint64_t(0), cached_set_ = ~uint64_t(0);
+  uint32_t cached_dimensions_ = 0;  // bit d: cached_high_[d] is valid
+  std::array<uint64_t, kScrambledDimensions> cached_high_{};
+  std::array<uint64_t, kScrambledDimensions> dimension_hashes_{}, scramble_seeds_{};
 };
 
 }  // namespace candela
