@@ -145,9 +145,10 @@ class ZSobolSampler {
 
   // Dimensions from this one on come from a PCG stream per (pixel, sample, seed) instead: they are
   // the deep bounces of a path, where stratification gains little and the scrambled index (one hash
-  // per base-4 digit) would cost more than the path itself. The first 16 cover the pixel, lens and
-  // time and the first two path vertices (light choice and point, lobe, direction, roulette).
-  static constexpr int kScrambledDimensions = 16;
+  // per base-4 digit) would cost more than the path itself. The first 32 cover the pixel, lens and
+  // time and the first two path vertices (light choice and point, lobe, direction, roulette), or the
+  // first vertex with up to 8 shadow rays.
+  static constexpr int kScrambledDimensions = 32;
 
   void start_pixel_sample(int x, int y, uint64_t sample_index) {
     rng_.set_sequence(hash_values(uint64_t(x), uint64_t(y), seed_), mix_bits(sample_index));
@@ -220,7 +221,7 @@ class ZSobolSampler {
     // Digits whose bits lie wholly above the sample index are the pixel's: cached per dimension.
     const int first_pixel_digit = (log2_n_ + (odd_log2 ? 1 : 0)) / 2;  // digit i spans bits 2i - odd, 2i - odd + 1
     uint64_t index;
-    const uint32_t bit = 1u << dimension;
+    const uint64_t bit = uint64_t(1) << dimension;
     if (dimension < kScrambledDimensions && (cached_dimensions_ & bit)) {
       index = cached_high_[size_t(dimension)];
     } else {
@@ -262,7 +263,7 @@ class ZSobolSampler {
   int dimension_ = 0;
   Rng rng_;
   uint64_t cached_pixel_ = ~uint64_t(0), cached_set_ = ~uint64_t(0);
-  uint32_t cached_dimensions_ = 0;  // bit d: cached_high_[d] is valid
+  uint64_t cached_dimensions_ = 0;  // bit d: cached_high_[d] is valid
   std::array<uint64_t, kScrambledDimensions> cached_high_{};
   std::array<uint64_t, kScrambledDimensions> dimension_hashes_{}, scramble_seeds_{};
 };
