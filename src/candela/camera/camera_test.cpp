@@ -42,25 +42,32 @@ double disk_fraction_below(double t) {
   return 0.5 + (t * std::sqrt(1 - t * t) + std::asin(t)) / 3.14159265358979323846;
 }
 
-TEST(Camera, DepthOfFieldBlursAnEdgeLikeTheLensDisk) {
-  // A black half-plane x < 0 at depth z = 2 against a white sky, focus at f = 1, lens radius R.
-  // A lens ray through screen position s hits depth z at x = l (1 - z/f) + s z, so the blocker is
-  // missed when l < 2 s: the pixel value is P(l < 2 s) averaged over the pixel's s.
-  const float R = 0.05f, tan_half = 0.1f;
-  const int width = 64;
+// A black half-plane x < 0 at depth 2 in front of a white sky, seen by a camera at the origin
+// looking along +z (identity transform: +x to the image's right) with its fov on the x axis.
+SceneDesc half_plane_scene(int width, int height, float fov_degrees, float lens_radius, float focus_distance,
+                           int spp) {
   SceneDesc d;
-  d.film = {width, 4, ""};
+  d.film = {width, height, ""};
   d.camera.fov_axis = FovAxis::X;
-  d.camera.fov_degrees = 2 * std::atan(tan_half) * 180 / kPi;
-  d.camera.lens_radius = R;
-  d.camera.focus_distance = 1;
-  d.settings.spp = 256;
+  d.camera.fov_degrees = fov_degrees;
+  d.camera.lens_radius = lens_radius;
+  d.camera.focus_distance = focus_distance;
+  d.settings.spp = spp;
   d.materials = {BlackMaterial{}};
   ShapeDesc blocker;
   blocker.geometry = RectangleShape{{-100, -100, 2}, {100, 0, 0}, {0, 200, 0}};
   blocker.material = 0;
   d.shapes = {blocker};
   d.lights = {SkyLight{RGB(1.0f), RGB(1.0f), RGB(1.0f), {0, 1, 0}}};
+  return d;
+}
+
+TEST(Camera, DepthOfFieldBlursAnEdgeLikeTheLensDisk) {
+  // Focus at f = 1, lens radius R. A lens ray through screen position s hits depth z at x = l (1 - z/f) + s z, so the blocker is
+  // missed when l < 2 s: the pixel value is P(l < 2 s) averaged over the pixel's s.
+  const float R = 0.05f, tan_half = 0.1f;
+  const int width = 64;
+  SceneDesc d = half_plane_scene(width, 4, 2 * std::atan(tan_half) * 180 / kPi, R, 1, 256);
   Film film = testing::render_description(d);
   Image img = film.mean_image();
   int blurred_columns = 0;
@@ -82,19 +89,7 @@ TEST(Camera, DepthOfFieldBlursAnEdgeLikeTheLensDisk) {
 
 TEST(Camera, InFocusPlaneIsSharpWithALens) {
   // Focus on the blocker itself: the lens changes nothing, the edge is a step at the centre.
-  SceneDesc d;
-  d.film = {16, 2, ""};
-  d.camera.fov_axis = FovAxis::X;
-  d.camera.fov_degrees = 20;
-  d.camera.lens_radius = 0.3f;
-  d.camera.focus_distance = 2;
-  d.settings.spp = 64;
-  d.materials = {BlackMaterial{}};
-  ShapeDesc blocker;
-  blocker.geometry = RectangleShape{{-100, -100, 2}, {100, 0, 0}, {0, 200, 0}};
-  blocker.material = 0;
-  d.shapes = {blocker};
-  d.lights = {SkyLight{RGB(1.0f), RGB(1.0f), RGB(1.0f), {0, 1, 0}}};
+  SceneDesc d = half_plane_scene(16, 2, 20, 0.3f, 2, 64);
   Image img = testing::render_description(d).mean_image();
   for (int x = 0; x < 16; ++x) EXPECT_NEAR(img.at(x, 0).g, x < 8 ? 0.0f : 1.0f, 1e-6f) << x;
 }

@@ -28,6 +28,20 @@ inline float flat_light_importance(const Point3& centroid, const Normal3& n, flo
   return radiance.luminance() * std::min(kPi, area * cos_l * cos_p / d2);
 }
 
+// The light sample for a point p drawn uniformly by area on a flat emitter, seen from ctx.
+inline LightSample flat_light_sample(const Point3& p, const Normal3& n, float area, const RGB& radiance,
+                                     bool two_sided, const LightSampleContext& ctx) {
+  Vec3 d = p - ctx.p;
+  float dist2 = length_squared(d);
+  if (dist2 == 0) return {};
+  float dist = std::sqrt(dist2);
+  Vec3 wi = d / dist;
+  if (!two_sided && dot(n, -wi) <= 0) return {};
+  float pdf = area_to_solid_angle_pdf(1 / area, ctx.p, p, n);
+  if (pdf <= 0 || !std::isfinite(pdf)) return {};
+  return {radiance, wi, dist, pdf, p, n, false};
+}
+
 struct TriangleLight {
   Point3 p0, p1, p2;
   Normal3 n;  // unit, the emitting side
@@ -35,21 +49,10 @@ struct TriangleLight {
   RGB radiance;
   bool two_sided;
 
-  bool emits_towards(const Vec3& w) const { return two_sided || dot(n, w) > 0; }
-
   LightSample sample_li(const LightSampleContext& ctx, Vec2 u) const {
     // Uniform point on the triangle, then converted to solid angle.
     Vec2 b = square_to_uniform_triangle(u);
-    Point3 p = p0 * b.x + p1 * b.y + p2 * (1 - b.x - b.y);
-    Vec3 d = p - ctx.p;
-    float dist2 = length_squared(d);
-    if (dist2 == 0) return {};
-    float dist = std::sqrt(dist2);
-    Vec3 wi = d / dist;
-    if (!emits_towards(-wi)) return {};
-    float pdf = area_to_solid_angle_pdf(1 / area, ctx.p, p, n);
-    if (pdf <= 0 || !std::isfinite(pdf)) return {};
-    return {radiance, wi, dist, pdf, p, n, false};
+    return flat_light_sample(p0 * b.x + p1 * b.y + p2 * (1 - b.x - b.y), n, area, radiance, two_sided, ctx);
   }
   float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const {
     return area_to_solid_angle_pdf(1 / area, ctx.p, p, n);
@@ -72,16 +75,7 @@ struct RectangleLight {
   bool two_sided;
 
   LightSample sample_li(const LightSampleContext& ctx, Vec2 u) const {
-    Point3 p = corner + edge_u * u.x + edge_v * u.y;
-    Vec3 d = p - ctx.p;
-    float dist2 = length_squared(d);
-    if (dist2 == 0) return {};
-    float dist = std::sqrt(dist2);
-    Vec3 wi = d / dist;
-    if (!two_sided && dot(n, -wi) <= 0) return {};
-    float pdf = area_to_solid_angle_pdf(1 / area, ctx.p, p, n);
-    if (pdf <= 0 || !std::isfinite(pdf)) return {};
-    return {radiance, wi, dist, pdf, p, n, false};
+    return flat_light_sample(corner + edge_u * u.x + edge_v * u.y, n, area, radiance, two_sided, ctx);
   }
   float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const {
     return area_to_solid_angle_pdf(1 / area, ctx.p, p, n);
