@@ -150,7 +150,9 @@ RTCRay make_rtc_ray(const Ray& r, float embree_time) {
   return ray;
 }
 
-// Bounds of a sphere under `to_world`: the transformed corners of its object-space box.
+
+}  // namespace
+
 Bounds3 sphere_world_bounds(const SphereGeometry& s, const Transform& to_world) {
   Bounds3 b;
   for (int i = 0; i < 8; ++i) {
@@ -159,8 +161,6 @@ Bounds3 sphere_world_bounds(const SphereGeometry& s, const Transform& to_world) 
   }
   return b;
 }
-
-}  // namespace
 
 std::optional<Transform> interpolate_transform(const Transform& start, const Transform& end, float t) {
   Matrix4 m;

@@ -40,6 +40,9 @@ struct PlaneGeometry {
   Normal3 normal;  // unit length, world space
 };
 
+// Bounds of a sphere under `to_world`: the transformed corners of its object-space box.
+Bounds3 sphere_world_bounds(const SphereGeometry& sphere, const Transform& to_world);
+
 class EmbreeScene {
  public:
   // Ray::time is absolute: shapes move between transform_start_time (Embree time 0) and

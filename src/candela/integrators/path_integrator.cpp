@@ -111,8 +111,7 @@ template <typename Sampler>
 std::optional<BsdfSample> PathIntegrator::sample_direction(const Bsdf& bsdf, const Vec3& wo, Sampler& sampler) const {
   float u_lobe = sampler.get_1d();
   Vec2 u = sampler.get_2d();
-  float p_non_delta = bsdf_non_delta_probability(bsdf);
-  if (direction_sampling_ == DirectionSampling::Bsdf || u_lobe >= p_non_delta)
+  if (direction_sampling_ == DirectionSampling::Bsdf || u_lobe >= bsdf_non_delta_probability(bsdf))
     return bsdf_sample(bsdf, wo, u_lobe, u);
   // A non-delta lobe was chosen: draw the direction from the hemisphere on wo's side instead of the
   // lobe, and weight it by the BSDF (sec. 4.7).

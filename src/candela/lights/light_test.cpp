@@ -24,6 +24,15 @@ double light_chi_square(SampleFn sample_world, PdfFn pdf_world, const Vec3& axis
   return testing::spherical_chi_square_p_value(sample, pdf, kSamples, 23, z_min, 20, 40, resolution);
 }
 
+// The directions a light's sample_li produces from ctx (zero when it returns no sample).
+template <typename LightType>
+auto sampled_directions(const LightType& light, const LightSampleContext& ctx) {
+  return [&light, ctx](Vec2 u) {
+    LightSample s = light.sample_li(ctx, u);
+    return s.pdf > 0 ? s.wi : Vec3(0.0f);
+  };
+}
+
 // Nearest hit of the ray (o, w) with a sphere, or nothing.
 std::optional<Point3> hit_sphere(const Point3& o, const Vec3& w, const Point3& c, float r) {
   Vec3 f = o - c;
@@ -38,10 +47,7 @@ std::optional<Point3> hit_sphere(const Point3& o, const Vec3& w, const Point3& c
 TEST(Lights, SphereLightFromOutsideSamplesTheCone) {
   SphereLight light{{0, 0, 5}, 1.5f, RGB(1.0f), false, false};
   LightSampleContext ctx{{0.3f, -0.2f, 0}, Normal3(0.0f)};
-  auto sample = [&](Vec2 u) {
-    LightSample s = light.sample_li(ctx, u);
-    return s.pdf > 0 ? s.wi : Vec3(0.0f);
-  };
+  auto sample = sampled_directions(light, ctx);
   auto pdf = [&](const Vec3& w) {
     auto p = hit_sphere(ctx.p, w, light.center, light.radius);
     return p ? light.pdf_li(ctx, w, *p, normalize(*p - light.center)) : 0.0f;
@@ -53,10 +59,7 @@ TEST(Lights, SphereLightFromOutsideSamplesTheCone) {
 TEST(Lights, SphereLightFromInsideSamplesByArea) {
   SphereLight light{{0, 0, 0}, 2, RGB(1.0f), true, false};
   LightSampleContext ctx{{0.5f, 0.3f, -0.4f}, Normal3(0.0f)};
-  auto sample = [&](Vec2 u) {
-    LightSample s = light.sample_li(ctx, u);
-    return s.pdf > 0 ? s.wi : Vec3(0.0f);
-  };
+  auto sample = sampled_directions(light, ctx);
   auto pdf = [&](const Vec3& w) {
     auto p = hit_sphere(ctx.p, w, light.center, light.radius);
     return p ? light.pdf_li(ctx, w, *p, normalize(*p - light.center)) : 0.0f;
@@ -68,10 +71,7 @@ TEST(Lights, TriangleLightSamplesByArea) {
   TriangleLight light{{-1, 2, -1}, {1, 2, -1}, {0, 2, 1.5f}, {0, -1, 0}, 0, RGB(2.0f), false};
   light.area = length(cross(light.p1 - light.p0, light.p2 - light.p0)) / 2;
   LightSampleContext ctx{{0.2f, 0, 0.1f}, {0, 1, 0}};
-  auto sample = [&](Vec2 u) {
-    LightSample s = light.sample_li(ctx, u);
-    return s.pdf > 0 ? s.wi : Vec3(0.0f);
-  };
+  auto sample = sampled_directions(light, ctx);
   auto pdf = [&](const Vec3& w) {
     // Where the direction meets the plane y = 2, if inside the triangle.
     if (w.y <= 0) return 0.0f;
@@ -113,19 +113,10 @@ TEST(Lights, SkyGradientAndPower) {
   EXPECT_NEAR(sky.power(), kPi * integral, 0.01 * sky.power());
 }
 
-}  // namespace
-}  // namespace candela
-
-namespace candela {
-namespace {
-
 TEST(Lights, RectangleLightSamplesByAreaAndStratifies) {
   RectangleLight light{{-1, 2, -1}, {2, 0, 0}, {0, 0, 1.5f}, {0, -1, 0}, 3.0f, RGB(2.0f), false};
   LightSampleContext ctx{{0.3f, 0, 0.2f}, {0, 1, 0}};
-  auto sample = [&](Vec2 u) {
-    LightSample s = light.sample_li(ctx, u);
-    return s.pdf > 0 ? s.wi : Vec3(0.0f);
-  };
+  auto sample = sampled_directions(light, ctx);
   auto pdf = [&](const Vec3& w) {
     if (w.y <= 0) return 0.0f;
     Point3 p = ctx.p + w * ((2 - ctx.p.y) / w.y);

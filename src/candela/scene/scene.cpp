@@ -134,13 +134,8 @@ void Scene::add_sphere(ShapeRecord rec, const SphereShape& s, const Transform& T
                        bool reverse, const std::optional<AreaEmission>& emission) {
   rec.kind = ShapeRecord::Kind::Sphere;
   rec.sphere = SphereGeometry{T, s.center, s.radius, T_end ? std::optional<Transform>(*T_end) : std::nullopt};
-  for (const Transform* X : {&T, T_end}) {
-    if (!X) continue;
-    for (int i = 0; i < 8; ++i) {
-      Vec3 c(i & 1 ? s.radius : -s.radius, i & 2 ? s.radius : -s.radius, i & 4 ? s.radius : -s.radius);
-      bounds_.extend(X->point(s.center + c));
-    }
-  }
+  for (const Transform* X : {&T, T_end})
+    if (X) bounds_.extend(sphere_world_bounds(rec.sphere, *X));
   if (emission) {
     // Sampling by solid angle needs a true sphere in world space: allow only similarity transforms.
     Vec3 ex = T.vector({1, 0, 0}), ey = T.vector({0, 1, 0}), ez = T.vector({0, 0, 1});
