@@ -68,7 +68,7 @@ TEST(Furnace, PhongMaterialDiffuseLobeUnderUniformSky) {
 TEST(Furnace, LosslessGlassSphereIsInvisibleInWhiteFurnace) {
   // Fresnel reflection + refraction conserve energy, and the 1/eta^2 radiance scaling on the way in
   // cancels on the way out: every pixel sees exactly the sky.
-  Image img = render_description(sphere_under_sky(GlassMaterial{1.5f, RGB(1.0f), RGB(1.0f)}, RGB(1.0f))).mean_image();
+  Image img = render_description(sphere_under_sky(DielectricMaterial{1.5f, RGB(1.0f), RGB(1.0f)}, RGB(1.0f))).mean_image();
   expect_within_standard_errors(region_mean(img, -1, inside_silhouette), 1.0, "glass");
 }
 
@@ -93,7 +93,7 @@ TEST(Furnace, WhiteMaterialsConserveEnergy) {
   diffuse_phong.d = 1;
   diffuse_phong.s = diffuse_phong.t = 0;
   for (const MaterialDesc& m : std::vector<MaterialDesc>{DiffuseMaterial{RGB(1.0f)}, diffuse_phong,
-                                                         MirrorMaterial{RGB(1.0f)}, GlassMaterial{1.33f, RGB(1.0f), RGB(1.0f)}})
+                                                         MirrorMaterial{RGB(1.0f)}, DielectricMaterial{1.33f, RGB(1.0f), RGB(1.0f)}})
     expect_within_standard_errors(region_mean(render_description(sphere_under_sky(m, RGB(1.0f))).mean_image(), -1,
                                               inside_silhouette),
                                   1.0, "white material");

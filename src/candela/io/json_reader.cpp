@@ -736,8 +736,8 @@ class JsonSceneReader {
     return p;
   }
 
-  static GlassMaterial read_glass(CheckedObject& m) {
-    GlassMaterial g;
+  static DielectricMaterial read_glass(CheckedObject& m) {
+    DielectricMaterial g;
     g.ior = m.number_or("ior", g.ior, Bound::Positive);
     g.reflectance = m.rgb_or("reflectance", ColorKind::Albedo, g.reflectance);
     g.transmittance = m.rgb_or("transmittance", ColorKind::Albedo, g.transmittance);

@@ -318,7 +318,7 @@ TEST(JsonReader, ReadsEveryMaterialType) {
   EXPECT_FLOAT_EQ(phong.s, 0.3f);
   EXPECT_FLOAT_EQ(phong.t, 0.1f);
   EXPECT_EQ(std::get<MirrorMaterial>(scene.materials[2]).reflectance, RGB(0.9f, 0.8f, 0.7f));
-  const auto& glass = std::get<GlassMaterial>(scene.materials[3]);
+  const auto& glass = std::get<DielectricMaterial>(scene.materials[3]);
   EXPECT_FLOAT_EQ(glass.ior, 1.7f);
   EXPECT_EQ(glass.reflectance, RGB(0.95f));
   EXPECT_EQ(glass.transmittance, RGB(1, 0.9f, 0.8f));

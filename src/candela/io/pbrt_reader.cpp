@@ -1146,7 +1146,7 @@ MaterialDesc PbrtParser::make_material(const std::string& type, const SourceLoca
                                                           : "roughness";
       params.fail(which, "must be 0: only smooth dielectrics are supported yet");
     }
-    return GlassMaterial{eta};
+    return DielectricMaterial{eta};
   }
   if (type == "interface" || type == "none" || type.empty())
     throw_scene_error(type_where,

@@ -426,7 +426,7 @@ TEST(PbrtReader, AttributeBlocksScopeTheGraphicsState) {
   ASSERT_EQ(scene.shapes.size(), 3u);
   const ShapeDesc &inner = scene.shapes[0], &innermost = scene.shapes[1], &outer = scene.shapes[2];
   expect_near(inner.to_world.point(Point3(0, 0, 0)), Point3(1, 1, 0));
-  EXPECT_TRUE(std::holds_alternative<GlassMaterial>(scene.materials.at(inner.material)));
+  EXPECT_TRUE(std::holds_alternative<DielectricMaterial>(scene.materials.at(inner.material)));
   ASSERT_TRUE(inner.emission.has_value());
   EXPECT_EQ(inner.emission->radiance, RGB(1, 2, 3));
   EXPECT_TRUE(inner.reverse_orientation);
@@ -492,7 +492,7 @@ TEST(PbrtReader, ReadsDiffuseAndSmoothDielectricMaterials) {
                                 "Shape \"sphere\"",
                                 "NamedMaterial \"paint\"",
                                 "Shape \"sphere\""});
-  const auto& glass = std::get<GlassMaterial>(scene.materials.at(scene.shapes.at(0).material));
+  const auto& glass = std::get<DielectricMaterial>(scene.materials.at(scene.shapes.at(0).material));
   EXPECT_FLOAT_EQ(glass.ior, 1.33f);
   EXPECT_EQ(scene.shapes.at(1).material, scene.shapes.at(0).material);  // MakeNamedMaterial does not select
   EXPECT_EQ(reflectance_of(scene, scene.shapes.at(2)), RGB(0.2f, 0.3f, 0.4f));
@@ -572,7 +572,7 @@ TEST(PbrtReader, ObjectInstancesAreExpandedWithTheComposedTransform) {
   expect_near(scene.shapes[1].to_world.point(Point3(0, 0, 0)), Point3(1, 10, 0));
   expect_near(scene.shapes[4].to_world.point(Point3(0, 0, 0)), Point3(1, 20, 0));
   EXPECT_FLOAT_EQ(std::get<SphereShape>(scene.shapes[4].geometry).radius, 0.5f);
-  EXPECT_TRUE(std::holds_alternative<GlassMaterial>(scene.materials.at(scene.shapes[4].material)));
+  EXPECT_TRUE(std::holds_alternative<DielectricMaterial>(scene.materials.at(scene.shapes[4].material)));
 }
 
 // ---------------------------------------------------------------- Include and Import
@@ -608,7 +608,7 @@ TEST(PbrtReader, ImportedGraphicsStateDoesNotLeak) {
   SceneDesc scene = read_pbrt_scene(kTestData / "include/import_main.pbrt");
   ASSERT_EQ(scene.shapes.size(), 2u);
   expect_near(scene.shapes[0].to_world.point(Point3(0, 0, 0)), Point3(10, 0, 0));
-  EXPECT_TRUE(std::holds_alternative<GlassMaterial>(scene.materials.at(scene.shapes[0].material)));
+  EXPECT_TRUE(std::holds_alternative<DielectricMaterial>(scene.materials.at(scene.shapes[0].material)));
   EXPECT_TRUE(scene.shapes[1].to_world.is_identity());
   EXPECT_EQ(reflectance_of(scene, scene.shapes[1]), RGB(0.5f));
 }

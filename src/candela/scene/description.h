@@ -14,41 +14,147 @@
 
 namespace candela {
 
+// ---------------------------------------------------------------- textures
+
+// A material or texture parameter: a constant `value`, or the texture SceneDesc::textures[texture]
+// evaluated at the hit point (texture >= 0). Float parameters read a colour texture as the average of
+// its channels (as pbrt-v4 does for float image textures).
+template <typename T>
+struct Textured {
+  T value{};
+  int texture = -1;
+  Textured() = default;
+  Textured(T v) : value(v) {}  // NOLINT: a constant converts implicitly
+  bool is_constant() const { return texture < 0; }
+};
+using ColorInput = Textured<RGB>;
+using FloatInput = Textured<float>;
+
+// Texture coordinates (s, t) = (su * u + du, sv * v + dv) from the surface's (u, v).
+struct UVMapping {
+  float su = 1, sv = 1, du = 0, dv = 0;
+};
+
+// What happens outside [0,1]^2.
+enum class TextureWrap { Repeat, Clamp, Black, Mirror };
+// How 8-bit texel values become linear: Auto = sRGB for 8-bit files, linear for float files (EXR, HDR).
+enum class ColorEncoding { Auto, Linear, SRGB };
+
+// An image read with OpenImageIO, looked up with bilinear filtering (or nearest, `bilinear = false`).
+// t = 0 is the *bottom* row of the image (pbrt-v4 and Mitsuba flip v the same way).
+struct ImageTexture {
+  std::string filename;  // resolved by the reader (absolute or relative to the working directory)
+  TextureWrap wrap = TextureWrap::Repeat;
+  ColorEncoding encoding = ColorEncoding::Auto;
+  bool bilinear = true;
+  float scale = 1;      // texel values are multiplied by this...
+  bool invert = false;  // ...and then replaced by 1 - value when set (pbrt's "invert")
+  UVMapping mapping;
+};
+
+// Alternating tex1/tex2 on the unit squares of (s, t): tex1 where floor(s) + floor(t) is even.
+struct CheckerboardTexture {
+  ColorInput tex1{RGB(1.0f)}, tex2{RGB(0.0f)};
+  UVMapping mapping;
+};
+
+// tex * scale.
+struct ScaleTexture {
+  ColorInput tex{RGB(1.0f)};
+  FloatInput scale{1.0f};
+};
+
+// (1 - amount) * tex1 + amount * tex2.
+struct MixTexture {
+  ColorInput tex1{RGB(0.0f)}, tex2{RGB(1.0f)};
+  FloatInput amount{0.5f};
+};
+
+using TextureDesc = std::variant<ImageTexture, CheckerboardTexture, ScaleTexture, MixTexture>;
+
 // ---------------------------------------------------------------- materials
 
 // Lambertian reflector.
 struct DiffuseMaterial {
-  RGB reflectance{0.5f};
+  ColorInput reflectance{RGB(0.5f)};
 };
 
 // The paper's material model (Häkkinen 2002, sec. 4.6): a diffuse lobe, a normalised Phong lobe and
 // ideal refraction, chosen per path vertex by Russian roulette with probabilities d, s, t
 // (d + s + t <= 1; the rest absorbs). The BSDF is d*diffuse/pi + s*specular*phong + t*transmission*delta.
 struct PhongMaterial {
-  RGB diffuse{0.5f};
-  RGB specular{1.0f};
+  ColorInput diffuse{RGB(0.5f)};
+  ColorInput specular{RGB(1.0f)};
   float exponent = 32;  // Phong exponent n of cos^n around the mirror direction
-  RGB transmission{1.0f};
+  ColorInput transmission{RGB(1.0f)};
   float ior = 1.5f;  // index of refraction inside / outside, for the transmitted part
   float d = 1, s = 0, t = 0;
 };
 
 // Ideal specular reflector.
 struct MirrorMaterial {
-  RGB reflectance{1.0f};
+  ColorInput reflectance{RGB(1.0f)};
 };
 
-// Smooth dielectric interface (glass): Fresnel-weighted choice of reflection and refraction.
-struct GlassMaterial {
+// Microfacet roughness: the Trowbridge-Reitz (GGX) alpha along the shading frame's u and v axes.
+// alpha < 1e-3 on both axes is treated as perfectly smooth (a delta BSDF), as pbrt-v4 does.
+// remap = true reads u, v as pbrt's "roughness" and uses alpha = sqrt(roughness) (pbrt-v4's
+// RoughnessToAlpha); false uses them as alpha directly (Mitsuba's "alpha").
+struct Roughness {
+  FloatInput u{0.0f}, v{0.0f};
+  bool remap = false;
+};
+
+// Metal: Fresnel reflection of a conductor with complex index of refraction eta + i k (per RGB
+// channel), on a GGX microfacet surface. With `reflectance` set, eta and k are ignored and the
+// normal-incidence reflectance is given instead (pbrt-v4's artist mode: eta = 1, k = 2 sqrt(r) / sqrt(1 - r)).
+// The defaults are copper (pbrt-v4's default "metal-Cu-eta" / "metal-Cu-k", as RGB).
+struct ConductorMaterial {
+  ColorInput eta{RGB(0.200438f, 0.924033f, 1.102212f)};
+  ColorInput k{RGB(3.912949f, 2.452848f, 2.142188f)};
+  std::optional<ColorInput> reflectance;
+  ColorInput specular_tint{RGB(1.0f)};  // multiplies the reflection (Mitsuba's specular_reflectance)
+  Roughness roughness;
+};
+
+// Dielectric interface (glass, water): Fresnel-weighted reflection and refraction, smooth or GGX-rough.
+// ior = n_inside / n_outside, inside being the side opposite the geometric normal.
+struct DielectricMaterial {
   float ior = 1.5f;
-  RGB reflectance{1.0f};
-  RGB transmittance{1.0f};
+  ColorInput reflectance{RGB(1.0f)};    // tints (Mitsuba's specular_reflectance / _transmittance); 1 = physical
+  ColorInput transmittance{RGB(1.0f)};
+  Roughness roughness;
+};
+
+// Plastic / coated diffuse: a dielectric coat (smooth or GGX-rough) of index `ior` over a Lambertian
+// base. Light refracted into the coat scatters diffusely and bounces between base and coat; the
+// closed form for the infinite series of internal reflections (Mitsuba's plastic, after Weidlich and
+// Wilkie) keeps it energy-consistent.
+struct CoatedDiffuseMaterial {
+  ColorInput reflectance{RGB(0.5f)};  // the diffuse base
+  ColorInput specular{RGB(1.0f)};     // tints the coat's reflection (1 = physical)
+  float ior = 1.5f;
+  Roughness roughness;
+  bool nonlinear = false;  // Mitsuba's "nonlinear": account for the colour shift of internal bounces
+};
+
+// Lambertian reflection and Lambertian transmission to the other side (leaves, paper, lamp shades).
+struct DiffuseTransmissionMaterial {
+  ColorInput reflectance{RGB(0.25f)};
+  ColorInput transmittance{RGB(0.25f)};
 };
 
 // Absorbs everything: for pure emitters and light blockers.
 struct BlackMaterial {};
 
-using MaterialDesc = std::variant<DiffuseMaterial, PhongMaterial, MirrorMaterial, GlassMaterial, BlackMaterial>;
+// No surface at all: rays pass straight through without counting as a bounce (pbrt-v4's
+// "interface", Mitsuba's "null"). Marks the boundary of a participating medium, or hides a shape
+// while keeping it as an emitter.
+struct InterfaceMaterial {};
+
+using MaterialDesc = std::variant<DiffuseMaterial, PhongMaterial, MirrorMaterial, DielectricMaterial, BlackMaterial,
+                                  ConductorMaterial, CoatedDiffuseMaterial, DiffuseTransmissionMaterial,
+                                  InterfaceMaterial>;
 
 // ---------------------------------------------------------------- shapes
 
@@ -111,11 +217,42 @@ struct ShapeDesc {
   std::string name;  // for messages
 };
 
+// A group of shapes defined once and placed many times (pbrt's ObjectBegin/ObjectInstance): Embree
+// builds its acceleration structure once and instances share it. Emissive shapes are not allowed
+// in objects (readers expand those into ordinary shapes).
+struct ObjectDesc {
+  std::vector<ShapeDesc> shapes;  // in the object's own space; their to_world is object-relative
+  std::string name;
+};
+
+struct InstanceDesc {
+  int object = 0;  // index into SceneDesc::objects
+  Transform to_world;
+  std::optional<Transform> to_world_end;  // moving instance, as ShapeDesc::to_world_end
+};
+
 // ---------------------------------------------------------------- lights (those that are not shapes)
 
 struct PointLight {
   Point3 position{0.0f};
   RGB intensity{1.0f};  // W/sr
+};
+
+// Point light emitting into a cone around `direction`: full intensity inside cone_angle - cone_delta,
+// falling off to zero at cone_angle with pbrt-v4's smoothstep in cos(angle).
+struct SpotLight {
+  Point3 position{0.0f};
+  Vec3 direction{0, 0, 1};
+  RGB intensity{1.0f};  // W/sr on the axis
+  float cone_angle = 30;  // degrees from the axis where the light reaches zero
+  float cone_delta = 5;   // degrees over which it falls off
+};
+
+// Parallel light from infinitely far away, travelling along `direction`; `radiance` is the
+// irradiance it delivers to a surface facing it (pbrt-v4's distant "L").
+struct DistantLight {
+  Vec3 direction{0, 0, 1};
+  RGB radiance{1.0f};
 };
 
 // Light from infinitely far away in every direction. Constant when zenith == horizon == ground;
@@ -129,7 +266,24 @@ struct SkyLight {
   bool is_constant() const { return zenith == horizon && horizon == ground; }
 };
 
-using LightDesc = std::variant<PointLight, SkyLight>;
+// How an environment image covers the sphere of directions, in the light's local frame.
+enum class EnvironmentMapping {
+  // Latitude-longitude with +y up (Mitsuba's envmap): pixel (u, v) in [0,1]^2, v = 0 the top row,
+  // is the direction (sin(theta) sin(phi), cos(theta), -sin(theta) cos(phi)), phi = 2 pi u, theta = pi v.
+  Equirectangular,
+  // Clarberg's equal-area octahedral square with +z up (pbrt-v4's "infinite" light with a filename).
+  EqualAreaOctahedral
+};
+
+// An environment map: radiance from every direction read from an image, importance-sampled.
+struct EnvironmentMap {
+  std::string filename;  // resolved by the reader
+  EnvironmentMapping mapping = EnvironmentMapping::Equirectangular;
+  RGB scale{1.0f};
+  Transform to_world;  // from the map's local frame to the world (rotations only are meaningful)
+};
+
+using LightDesc = std::variant<PointLight, SkyLight, SpotLight, DistantLight, EnvironmentMap>;
 
 // ---------------------------------------------------------------- camera, film, settings
 
@@ -224,8 +378,11 @@ struct SceneDesc {
   CameraDesc camera;
   FilmDesc film;
   RenderSettings settings;
+  std::vector<TextureDesc> textures;
   std::vector<MaterialDesc> materials;
   std::vector<ShapeDesc> shapes;
+  std::vector<ObjectDesc> objects;
+  std::vector<InstanceDesc> instances;
   std::vector<LightDesc> lights;
   // The times at which ShapeDesc::to_world and to_world_end hold (pbrt's TransformTimes).
   float transform_start_time = 0, transform_end_time = 1;

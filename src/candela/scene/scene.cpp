@@ -15,7 +15,7 @@ Bsdf make_bsdf(const MaterialDesc& desc) {
         else if constexpr (std::is_same_v<T, PhongMaterial>)
           return PhongBsdf{m.diffuse, m.specular, m.exponent, m.transmission, m.ior, m.d, m.s, m.t};
         else if constexpr (std::is_same_v<T, MirrorMaterial>) return MirrorBsdf{m.reflectance};
-        else if constexpr (std::is_same_v<T, GlassMaterial>) return GlassBsdf{m.ior, m.reflectance, m.transmittance};
+        else if constexpr (std::is_same_v<T, DielectricMaterial>) return GlassBsdf{m.ior, m.reflectance, m.transmittance};
         else return BlackBsdf{};
       },
       desc);
