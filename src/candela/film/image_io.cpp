@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
+#include <vector>
 
 namespace candela {
 namespace {
@@ -93,25 +94,64 @@ void write_image(const std::filesystem::path& file, const Image& image,
   }
 }
 
-Image read_image(const std::filesystem::path& file) {
-  auto in = OIIO::ImageInput::open(file.string());
+namespace {
+
+// Integer value -> linear float for every value of a `max_value`-bit-depth image: a table keeps the
+// exact curve (computed in double) off the per-pixel path.
+std::vector<float> decode_table(int max_value, IntegerEncoding encoding) {
+  std::vector<float> table(size_t(max_value) + 1);
+  for (int i = 0; i <= max_value; ++i) {
+    double v = double(i) / max_value;
+    if (encoding == IntegerEncoding::SRGB) v = v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+    table[size_t(i)] = float(v);
+  }
+  return table;
+}
+
+// Reads all pixels as T and converts them to RGB with `to_linear`; one or two channels are grey
+// (plus alpha), so channel 0 fills R, G and B.
+template <typename T, typename ToLinear>
+bool read_pixels(OIIO::ImageInput& in, OIIO::TypeDesc type, ToLinear to_linear, Image& img) {
+  const OIIO::ImageSpec& spec = in.spec();
+  int channels = spec.nchannels;
+  std::vector<T> data(size_t(spec.width) * size_t(spec.height) * size_t(channels));
+  if (!in.read_image(0, 0, 0, channels, type, data.data())) return false;
+  const int source[3] = {0, channels < 3 ? 0 : 1, channels < 3 ? 0 : 2};
+  size_t n = size_t(spec.width) * size_t(spec.height);
+  for (size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = to_linear(data[i * channels + source[c]]);
+  return true;
+}
+
+}  // namespace
+
+Image read_image(const std::filesystem::path& file, IntegerEncoding encoding) {
+  // PNG and TGA readers premultiply colour by alpha unless told not to; alpha is ignored here, so
+  // the stored colours are wanted.
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  auto in = OIIO::ImageInput::open(file.string(), &config);
   if (!in) throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();
-  int channels = spec.nchannels;
-  std::vector<float> data(size_t(spec.width) * spec.height * channels);
-  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, data.data()))
-    throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), in->geterror()));
-  bool srgb = spec.format == OIIO::TypeDesc::UINT8 || spec.format == OIIO::TypeDesc::UINT16;
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+    throw std::runtime_error(fmt::format("{}: cannot read image: empty image", file.string()));
   Image img(spec.width, spec.height);
-  for (size_t i = 0; i < size_t(spec.width) * spec.height; ++i)
-    for (int c = 0; c < 3; ++c) {
-      float v = data[i * channels + std::min(c, channels - 1)];
-      if (srgb) v = v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
-      img.rgb[i * 3 + c] = v;
-    }
+  bool ok;
+  if (spec.format == OIIO::TypeDesc::UINT8) {
+    std::vector<float> table = decode_table(255, encoding);
+    ok = read_pixels<uint8_t>(*in, OIIO::TypeDesc::UINT8, [&](uint8_t v) { return table[v]; }, img);
+  } else if (spec.format == OIIO::TypeDesc::UINT16) {
+    std::vector<float> table = decode_table(65535, encoding);
+    ok = read_pixels<uint16_t>(*in, OIIO::TypeDesc::UINT16, [&](uint16_t v) { return table[v]; }, img);
+  } else {
+    ok = read_pixels<float>(*in, OIIO::TypeDesc::FLOAT, [](float v) { return v; }, img);
+  }
+  if (!ok) throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), in->geterror()));
   in->close();
   return img;
 }
+
+Image read_image(const std::filesystem::path& file) { return read_image(file, IntegerEncoding::SRGB); }
 
 std::map<std::string, std::string> read_image_metadata(const std::filesystem::path& file) {
   auto in = OIIO::ImageInput::open(file.string());

@@ -18,7 +18,16 @@ bool is_supported_output(const std::filesystem::path& file);
 void write_image(const std::filesystem::path& file, const Image& image,
                  const std::map<std::string, std::string>& metadata = {});
 
-// Reads any image OpenImageIO reads as linear RGB float (8-bit sRGB data is decoded).
+// How 8- and 16-bit pixel values become linear: the exact sRGB decoding curve, or value / max.
+// Float pixels (EXR, HDR, PFM) are linear either way, as in pbrt-v4 and Mitsuba, whose encoding
+// options also only apply to integer images.
+enum class IntegerEncoding { SRGB, Linear };
+
+// Reads any image OpenImageIO reads as linear RGB float, top row first. Greyscale is replicated to
+// RGB; alpha and further channels are dropped, and colours are read as stored (not premultiplied).
+// Throws std::runtime_error naming the file on failure.
+Image read_image(const std::filesystem::path& file, IntegerEncoding encoding);
+// The same with 8- and 16-bit data sRGB-decoded.
 Image read_image(const std::filesystem::path& file);
 
 // The metadata attributes of an image file (for tests and tools).

@@ -181,6 +181,7 @@ EmbreeScene::EmbreeScene(float transform_start_time, float transform_end_time)
 }
 
 EmbreeScene::~EmbreeScene() {
+  for (RTCScene object : objects_) rtcReleaseScene(object);
   if (scene_) rtcReleaseScene(scene_);
   if (device_) rtcReleaseDevice(device_);
 }
@@ -205,15 +206,43 @@ RTCGeometry EmbreeScene::new_triangle_geometry(const std::vector<uint32_t>& indi
   return geom;
 }
 
-void EmbreeScene::attach(RTCGeometry geom, uint32_t id) {
+void EmbreeScene::attach(RTCGeometry geom, uint32_t id, int object) {
   rtcCommitGeometry(geom);
-  rtcAttachGeometryByID(scene_, geom, id);
+  rtcAttachGeometryByID(object < 0 ? scene_ : objects_.at(size_t(object)), geom, id);
   rtcReleaseGeometry(geom);
 }
 
-void EmbreeScene::add_triangles(uint32_t id, const std::vector<Point3>& positions, const std::vector<uint32_t>& indices) {
+void EmbreeScene::add_triangles(uint32_t id, const std::vector<Point3>& positions, const std::vector<uint32_t>& indices,
+                                int object) {
   RTCGeometry geom = new_triangle_geometry(indices);
   set_vertex_buffer(geom, 0, positions);
+  attach(geom, id, object);
+}
+
+int EmbreeScene::add_object() {
+  RTCScene object = rtcNewScene(device_);
+  rtcSetSceneBuildQuality(object, RTC_BUILD_QUALITY_HIGH);
+  objects_.push_back(object);
+  return int(objects_.size() - 1);
+}
+
+void EmbreeScene::add_instance(uint32_t id, int object, const Transform& to_world, const Transform* to_world_end) {
+  if (!instance_ids_.empty() && id <= instance_ids_.back())
+    throw std::logic_error("EmbreeScene::add_instance: instance ids must increase");
+  RTCScene child = objects_.at(size_t(object));
+  rtcCommitScene(child);  // idempotent: each object is built once, however many instances it has
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
+  rtcSetGeometryInstancedScene(geom, child);
+  rtcSetGeometryTimeStepCount(geom, to_world_end ? 2 : 1);
+  for (unsigned step = 0; step < (to_world_end ? 2u : 1u); ++step) {
+    // Embree wants the 3x4 affine part, row-major here ("FLOAT3X4_ROW_MAJOR").
+    const Matrix4& m = (step == 0 ? to_world : *to_world_end).matrix();
+    float xfm[12];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c) xfm[r * 4 + c] = float(m.m[r][c]);
+    rtcSetGeometryTransform(geom, step, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, xfm);
+  }
+  instance_ids_.push_back(id);
   attach(geom, id);
 }
 
@@ -226,7 +255,7 @@ void EmbreeScene::add_moving_triangles(uint32_t id, const std::vector<Point3>& p
   attach(geom, id);
 }
 
-void EmbreeScene::add_sphere(uint32_t id, const SphereGeometry& sphere) {
+void EmbreeScene::add_sphere(uint32_t id, const SphereGeometry& sphere, int object) {
   spheres_.push_back(std::make_unique<SphereGeometry>(sphere));
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
   rtcSetGeometryUserPrimitiveCount(geom, 1);
@@ -242,7 +271,7 @@ void EmbreeScene::add_sphere(uint32_t id, const SphereGeometry& sphere) {
     rtcSetGeometryIntersectFunction(geom, sphere_intersect);
     rtcSetGeometryOccludedFunction(geom, sphere_occluded);
   }
-  attach(geom, id);
+  attach(geom, id, object);
 }
 
 void EmbreeScene::add_plane(uint32_t id, const PlaneGeometry& plane, float extent) {
@@ -271,7 +300,12 @@ bool EmbreeScene::intersect(const Ray& r, EmbreeHit& hit) const {
   rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(scene_, &context, &rayhit);
   if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-  hit = {rayhit.ray.tfar, rayhit.hit.geomID, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v};
+  hit = {rayhit.ray.tfar, rayhit.hit.geomID, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v, -1};
+  if (rayhit.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) {
+    // Instance ids are handed out in increasing order, so the index is a binary search away.
+    auto it = std::lower_bound(instance_ids_.begin(), instance_ids_.end(), rayhit.hit.instID[0]);
+    hit.instance = int(it - instance_ids_.begin());
+  }
   return true;
 }
 

@@ -21,6 +21,7 @@ struct EmbreeHit {
   uint32_t geometry;   // the id returned by add_*
   uint32_t primitive;  // triangle index
   float u, v;          // Embree barycentrics: p = (1-u-v) p0 + u p1 + v p2
+  int instance = -1;   // the instance the geometry was reached through (index of add_instance), or -1
 };
 
 // The transform (1-t) start + t end, t in [0,1]; nullopt where the interpolated matrix is singular.
@@ -52,14 +53,22 @@ class EmbreeScene {
   EmbreeScene(const EmbreeScene&) = delete;
   EmbreeScene& operator=(const EmbreeScene&) = delete;
 
-  // Each attaches a geometry under the caller's id, reported back in hits. Vertex and index data
-  // are copied into Embree.
-  void add_triangles(uint32_t id, const std::vector<Point3>& positions, const std::vector<uint32_t>& indices);
+  // Each attaches a geometry under the caller's id, reported back in hits; ids are unique across
+  // the world and all objects. Vertex and index data are copied into Embree. `object` is the object
+  // (from add_object) the geometry belongs to, or -1 for the world.
+  void add_triangles(uint32_t id, const std::vector<Point3>& positions, const std::vector<uint32_t>& indices,
+                     int object = -1);
   // Triangles whose vertices move linearly from `positions` at time 0 to `positions_end` at time 1.
   void add_moving_triangles(uint32_t id, const std::vector<Point3>& positions, const std::vector<Point3>& positions_end,
                             const std::vector<uint32_t>& indices);
-  void add_sphere(uint32_t id, const SphereGeometry& sphere);  // moving when sphere.to_world_end is set
+  void add_sphere(uint32_t id, const SphereGeometry& sphere, int object = -1);  // moving when sphere.to_world_end is set
   void add_plane(uint32_t id, const PlaneGeometry& plane, float extent);
+  // Objects for instancing: a separate acceleration structure, built once, placed by instances.
+  int add_object();
+  // Places `object` (complete by now) in the world under `to_world`, moving to `to_world_end` over
+  // the shutter when given. `id` must differ from every geometry id; hits report the instance's
+  // index (0, 1, ... in the order of these calls) in EmbreeHit::instance.
+  void add_instance(uint32_t id, int object, const Transform& to_world, const Transform* to_world_end);
   void commit();
 
   bool intersect(const Ray& ray, EmbreeHit& hit) const;
@@ -83,11 +92,13 @@ class EmbreeScene {
   };
 
   RTCGeometry new_triangle_geometry(const std::vector<uint32_t>& indices);
-  void attach(RTCGeometry geom, uint32_t id);
+  void attach(RTCGeometry geom, uint32_t id, int object = -1);
 
   float time_start_ = 0, time_scale_ = 1;  // Embree time = (time - time_start_) * time_scale_
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
+  std::vector<RTCScene> objects_;
+  std::vector<uint32_t> instance_ids_;  // Embree geometry id of each instance, in add_instance order
   // Stable storage for user-geometry data (Embree keeps raw pointers to it).
   std::vector<std::unique_ptr<SphereGeometry>> spheres_;
   std::vector<std::unique_ptr<PlaneRecord>> planes_;

@@ -12,6 +12,8 @@ struct SurfaceHit {
   Normal3 ng;  // geometric normal: the emitting side of one-sided emitters, the outside of dielectrics
   Normal3 ns;  // shading normal (interpolated vertex normals), same side as ng
   Vec2 uv;
+  Vec3 dpdu;  // surface tangent along u (world space, not normalised; zero when unknown): the
+              // shading frame's first axis, which anisotropic roughness is measured along
   uint32_t shape = 0;      // index into Scene::shapes
   uint32_t primitive = 0;  // triangle index within a mesh
 };

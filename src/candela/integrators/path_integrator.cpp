@@ -32,21 +32,20 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const
   LightSampleContext prev_ctx;
   ++counts.camera;
 
-  for (int depth = 0;; ++depth) {
+  for (int depth = 0;;) {
     SurfaceHit hit;
     if (!scene_.intersect(ray, hit)) {
-      // The ray escapes: add sky radiance, weighted by MIS against light sampling where that could
-      // have produced the same direction.
-      int sky = scene_.sky_light();
-      if (sky >= 0) {
-        const auto& light = std::get<SkyLightSource>(scene_.lights()[sky]);
-        RGB Le = light.radiance(ray.direction);
+      // The ray escapes: add the radiance of the lights at infinity, weighted by MIS against light
+      // sampling where that could have produced the same direction.
+      for (uint32_t li : scene_.infinite_lights()) {
+        RGB Le = scene_.escaped_radiance(li, ray.direction);
+        if (Le.is_black()) continue;
         if (depth == 0 || specular_bounce)
           L += beta * Le;
         else
           L += beta * Le *
-               emitter_mis_weight(size_t(sky), prev_bsdf_pdf, light.pdf_li(prev_ctx, ray.direction, {}, {}), prev_ctx,
-                                  prev_total_importance);
+               emitter_mis_weight(li, prev_bsdf_pdf, light_pdf_li(scene_.lights()[li], prev_ctx, ray.direction, {}, {}),
+                                  prev_ctx, prev_total_importance);
       }
       break;
     }
@@ -64,12 +63,22 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const
       }
     }
 
+    // An interface has no surface: continue the ray beyond it without counting a bounce. Light
+    // sampling cannot see through it (shadow rays stop there), so what lies behind counts in full.
+    if (scene_.is_interface(hit)) {
+      specular_bounce = true;
+      ray = Ray{offset_ray_origin(hit.p, hit.ng, ray.direction), ray.direction,
+                std::numeric_limits<float>::infinity(), ray.time};
+      continue;
+    }
+
     // Terminate the path at the maximum depth.
     if (depth == max_depth_) break;
-    const Bsdf& bsdf = scene_.bsdf(hit);
+    ++depth;
+    const Bsdf bsdf = scene_.bsdf(hit);
     if (bsdf_is_black(bsdf)) break;
 
-    Frame frame(hit.ns);
+    Frame frame = Frame::from_normal_tangent(hit.ns, hit.dpdu);
     Vec3 wo_local = frame.to_local(wo);
     if (wo_local.z == 0) break;
     // Light is gathered on the side the path arrived from.
@@ -98,7 +107,7 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const
     // stays unbiased. eta_scale undoes the radiance scaling at refractions, which says nothing about
     // the path's importance.
     RGB rr_beta = beta * eta_scale;
-    if (depth + 1 > rr_start_depth_ && rr_beta.max_component() < 1) {
+    if (depth > rr_start_depth_ && rr_beta.max_component() < 1) {
       float q = std::max(0.0f, 1 - rr_beta.max_component());
       if (sampler.get_1d() < q) break;
       beta = beta / (1 - q);
@@ -111,7 +120,7 @@ template <typename Sampler>
 std::optional<BsdfSample> PathIntegrator::sample_direction(const Bsdf& bsdf, const Vec3& wo, Sampler& sampler) const {
   float u_lobe = sampler.get_1d();
   Vec2 u = sampler.get_2d();
-  if (direction_sampling_ == DirectionSampling::Bsdf || u_lobe >= bsdf_non_delta_probability(bsdf))
+  if (direction_sampling_ == DirectionSampling::Bsdf || u_lobe >= bsdf_non_delta_probability(bsdf, wo))
     return bsdf_sample(bsdf, wo, u_lobe, u);
   // A non-delta lobe was chosen: draw the direction from the hemisphere on wo's side instead of the
   // lobe, and weight it by the BSDF (sec. 4.7).
@@ -127,9 +136,9 @@ float PathIntegrator::direction_pdf(const Bsdf& bsdf, const Vec3& wo, const Vec3
   switch (direction_sampling_) {
     case DirectionSampling::Bsdf: return bsdf_pdf(bsdf, wo, wi);
     case DirectionSampling::Cosine:
-      return wo.z * wi.z > 0 ? bsdf_non_delta_probability(bsdf) * std::abs(wi.z) * kInvPi : 0.0f;
+      return wo.z * wi.z > 0 ? bsdf_non_delta_probability(bsdf, wo) * std::abs(wi.z) * kInvPi : 0.0f;
     case DirectionSampling::Uniform:
-      return wo.z * wi.z > 0 ? bsdf_non_delta_probability(bsdf) * kInv2Pi : 0.0f;
+      return wo.z * wi.z > 0 ? bsdf_non_delta_probability(bsdf, wo) * kInv2Pi : 0.0f;
   }
   return 0;
 }

@@ -22,6 +22,7 @@
 
 #include "candela/io/error.h"
 #include "candela/io/mesh_io.h"
+#include "candela/io/named_spectra.h"
 #include "candela/io/scene_reader.h"
 
 namespace candela {
@@ -33,6 +34,7 @@ using Json = nlohmann::ordered_json;  // ordered: materials keep the file's orde
 constexpr int kMaxResolution = 65536;
 constexpr int64_t kMaxPixels = int64_t(1) << 28;
 constexpr float kMaxFilterRadius = 64;  // pixels; the filter is tabulated per unit of radius
+constexpr int kMaxTextureDepth = 64;    // textures using textures
 
 // ---------------------------------------------------------------- JSON pointers and source positions
 
@@ -323,8 +325,9 @@ Vec2 read_vec2(const ErrorReporter& report, const Json& value, const std::string
   return {read_float_element(report, value, 0, pointer), read_float_element(report, value, 1, pointer)};
 }
 
-// Reflectances and albedos cannot exceed 1 without creating energy; emission can.
-enum class ColorKind { Albedo, Emission };
+// Reflectances and albedos cannot exceed 1 without creating energy; emission can. Other colours (a
+// conductor's k, the constants inside textures, which may be used anywhere) need only be >= 0.
+enum class ColorKind { Albedo, Emission, NonNegative };
 
 float read_color_component(const ErrorReporter& report, const Json& value, const std::string& pointer, ColorKind kind) {
   float c = read_float(report, value, pointer);
@@ -386,6 +389,60 @@ float check_bound(const ErrorReporter& report, float x, Bound bound, const std::
   if (bound == Bound::UnitInterval && !(x >= 0 && x <= 1))
     report.fail(pointer, "expected a number in [0, 1], got {}", x);
   return x;
+}
+
+// ---------------------------------------------------------------- metal presets
+
+// A conductor's "metal": the complex index of refraction eta + i k of a measured metal, as RGB.
+struct MetalPreset {
+  std::string_view name;
+  RGB eta, k;
+};
+
+// Metals that pbrt-v4's named spectra (named_spectra.h: Ag, Al, Au, Cu, CuZn, ...) lack, from the
+// same source as those: the published RGB values of Tungsten's ComplexIorData.hpp (also Mitsuba's
+// conductor presets). Na, Ni and V are that table's "_palik" entries, the only ones it has for them.
+constexpr MetalPreset kMoreMetals[] = {
+    {"Be", {4.1850592788f, 3.1850604423f, 2.7840913457f}, {3.8354398268f, 3.0101260162f, 2.8690088743f}},
+    {"Cr", {4.3696828663f, 2.9167024892f, 1.6547005413f}, {5.2064337956f, 4.2313645277f, 3.7549467933f}},
+    {"Hg", {2.3989314904f, 1.4400254917f, 0.9095512090f}, {6.3276269444f, 4.3719414152f, 3.4217899270f}},
+    {"Ir", {3.0864098394f, 2.0821938440f, 1.6178866805f}, {5.5921510077f, 4.0671757150f, 3.2672611269f}},
+    {"K", {0.0640493070f, 0.0464100621f, 0.0381842017f}, {2.1042155920f, 1.3489364357f, 0.9132113889f}},
+    {"Li", {0.2657871942f, 0.1956102432f, 0.2209198538f}, {3.5401743407f, 2.3111306542f, 1.6685930000f}},
+    {"Mo", {4.4837010280f, 3.5254578255f, 2.7760769438f}, {4.1111307988f, 3.4208716252f, 3.1506031404f}},
+    {"Na", {0.0602665320f, 0.0561412435f, 0.0619909494f}, {3.1792906496f, 2.1124800781f, 1.5790940266f}},
+    {"Nb", {3.4201353595f, 2.7901921379f, 2.3955856658f}, {3.4413817900f, 2.7376437930f, 2.5799132708f}},
+    {"Ni", {2.3672753521f, 1.6633583302f, 1.4670554172f}, {4.4988329911f, 3.0501643957f, 2.3454274399f}},
+    {"Rh", {2.5857954933f, 1.8601866068f, 1.5544279524f}, {6.7822927110f, 4.7029501026f, 3.9760892461f}},
+    {"Ta", {2.0625846607f, 2.3930915569f, 2.6280684948f}, {2.4080467973f, 1.7413705864f, 1.9470377016f}},
+    {"TiN", {1.6484691607f, 1.1504482522f, 1.3797795097f}, {3.3684596226f, 1.9434888540f, 1.1020123347f}},
+    {"V", {4.2775126218f, 3.5131538236f, 2.7611257461f}, {3.4911844504f, 2.8893580874f, 3.1116965117f}},
+    {"W", {4.3707029924f, 3.3002972445f, 2.9982666528f}, {3.5006778591f, 2.6048652781f, 2.2731930614f}},
+};
+
+struct ComplexIor {
+  RGB eta, k;
+};
+
+// "Au" is pbrt-v4's "metal-Au-eta" and "metal-Au-k", or one of kMoreMetals.
+std::optional<ComplexIor> find_metal(std::string_view name) {
+  std::string prefix = fmt::format("metal-{}-", name);
+  auto eta = pbrt_spectra::find_named(prefix + "eta"), k = pbrt_spectra::find_named(prefix + "k");
+  if (eta && k && eta->kind == pbrt_spectra::NamedKind::Metal) return ComplexIor{eta->rgb, k->rgb};
+  for (const MetalPreset& metal : kMoreMetals)
+    if (metal.name == name) return ComplexIor{metal.eta, metal.k};
+  return std::nullopt;
+}
+
+// Every name find_metal() knows, sorted.
+std::vector<std::string> metal_names() {
+  std::vector<std::string> names;
+  for (std::string_view spectrum : pbrt_spectra::named_spectrum_names())
+    if (spectrum.starts_with("metal-") && spectrum.ends_with("-eta"))
+      names.emplace_back(spectrum.substr(6, spectrum.size() - 6 - 4));
+  for (const MetalPreset& metal : kMoreMetals) names.emplace_back(metal.name);
+  std::sort(names.begin(), names.end());
+  return names;
 }
 
 // ---------------------------------------------------------------- CheckedObject
@@ -481,7 +538,9 @@ class JsonSceneReader {
     read_camera(camera ? *camera : empty, root.pointer_of("camera"));
     const Json* render = root.find("render");
     read_render(render ? *render : empty, root.pointer_of("render"));
+    if (const Json* textures = root.find("textures")) read_textures(*textures, root.pointer_of("textures"));
     if (const Json* materials = root.find("materials")) read_materials(*materials, root.pointer_of("materials"));
+    if (const Json* objects = root.find("objects")) read_objects(*objects, root.pointer_of("objects"));
     if (const Json* shapes = root.find("shapes")) read_shapes(*shapes, root.pointer_of("shapes"));
     if (const Json* lights = root.find("lights")) read_lights(*lights, root.pointer_of("lights"));
     root.finish();
@@ -677,6 +736,202 @@ class JsonSceneReader {
     adaptive.finish();
   }
 
+  // ---- textures
+
+  // Named textures may refer to each other in any order. Each is read when first needed, so that
+  // SceneDesc::textures lists every texture after the textures it refers to.
+  struct NamedTexture {
+    const Json* value = nullptr;
+    std::string pointer;
+    bool reading = false;  // on the stack of textures being read: meeting it again is a cycle
+    int index = -1;        // in SceneDesc::textures, once read
+  };
+
+  void read_textures(const Json& value, const std::string& pointer) {
+    if (!value.is_object())
+      report_.fail(pointer, "expected an object mapping texture names to textures, got {}", describe(value));
+    std::vector<std::string> names;  // in the file's order
+    for (auto it = value.begin(); it != value.end(); ++it) {
+      if (it.key() == "_comment") continue;
+      names.push_back(it.key());
+      named_textures_[it.key()] = NamedTexture{&it.value(), child_pointer(pointer, it.key())};
+    }
+    for (const std::string& name : names) named_texture(name, named_textures_[name].pointer);
+  }
+
+  // The index of a named texture, read first (with what it refers to) if it has not been yet.
+  // `pointer` is where the name was given.
+  int named_texture(const std::string& name, const std::string& pointer) {
+    auto it = named_textures_.find(name);
+    if (it == named_textures_.end()) {
+      std::vector<std::string> names;
+      for (const auto& entry : named_textures_) names.push_back(entry.first);
+      if (names.empty()) report_.fail(pointer, "unknown texture \"{}\" (\"textures\" defines none)", name);
+      report_.fail(pointer, "unknown texture \"{}\"; defined: {}", name, fmt::join(names, ", "));
+    }
+    NamedTexture& texture = it->second;  // std::map: stays valid while other textures are read
+    if (texture.index >= 0) return texture.index;
+    if (texture.reading) {
+      std::vector<std::string> cycle(std::find(texture_stack_.begin(), texture_stack_.end(), name),
+                                     texture_stack_.end());
+      cycle.push_back(name);
+      report_.fail(pointer, "textures refer to each other in a cycle: {}", fmt::join(cycle, " -> "));
+    }
+    texture.reading = true;
+    texture_stack_.push_back(name);
+    TextureDesc desc = read_texture(*texture.value, texture.pointer);
+    texture_stack_.pop_back();
+    texture.reading = false;
+    texture.index = add_texture(std::move(desc));
+    return texture.index;
+  }
+
+  int add_texture(TextureDesc texture) {
+    scene_.textures.push_back(std::move(texture));
+    return int(scene_.textures.size()) - 1;
+  }
+
+  TextureDesc read_texture(const Json& value, const std::string& pointer) {
+    // Textures are read recursively: hostile nesting (inline, or a long chain of names) must not
+    // exhaust the stack.
+    if (texture_depth_ >= kMaxTextureDepth)
+      report_.fail(pointer, "textures nest too deeply: more than {} levels of textures using textures",
+                   kMaxTextureDepth);
+    struct DepthGuard {
+      int& depth;
+      explicit DepthGuard(int& d) : depth(++d) {}
+      ~DepthGuard() { --depth; }
+    } guard(texture_depth_);
+    CheckedObject t(report_, value, pointer);
+    std::string type = t.string("type");
+    TextureDesc texture;
+    // A texture may be used in any parameter, so the constants inside it are only checked to be >= 0.
+    constexpr ColorKind kAny = ColorKind::NonNegative;
+    if (type == "image") {
+      texture = read_image_texture(t);
+    } else if (type == "checkerboard") {
+      CheckerboardTexture checkerboard;
+      checkerboard.tex1 = color_input_or(t, "tex1", kAny, checkerboard.tex1);
+      checkerboard.tex2 = color_input_or(t, "tex2", kAny, checkerboard.tex2);
+      checkerboard.mapping = read_uv_mapping(t);
+      texture = checkerboard;
+    } else if (type == "scale") {
+      ScaleTexture scale;
+      scale.tex = color_input_or(t, "tex", kAny, scale.tex);
+      scale.scale = float_input_or(t, "scale", Bound::NonNegative, scale.scale);
+      texture = scale;
+    } else if (type == "mix") {
+      MixTexture mix;
+      mix.tex1 = color_input_or(t, "tex1", kAny, mix.tex1);
+      mix.tex2 = color_input_or(t, "tex2", kAny, mix.tex2);
+      mix.amount = float_input_or(t, "amount", Bound::UnitInterval, mix.amount);
+      texture = mix;
+    } else {
+      report_.fail(t.pointer_of("type"),
+                   "unknown texture type \"{}\"; expected one of: image, checkerboard, scale, mix", type);
+    }
+    t.finish();
+    return texture;
+  }
+
+  ImageTexture read_image_texture(CheckedObject& t) const {
+    ImageTexture image;
+    image.filename = existing_file(t, "filename", "image");
+    if (const Json* wrap = t.find("wrap"))
+      image.wrap = read_name<TextureWrap>(report_, *wrap, t.pointer_of("wrap"), "wrap mode",
+                                          {{"repeat", TextureWrap::Repeat},
+                                           {"clamp", TextureWrap::Clamp},
+                                           {"black", TextureWrap::Black},
+                                           {"mirror", TextureWrap::Mirror}});
+    if (const Json* encoding = t.find("encoding"))
+      image.encoding = read_name<ColorEncoding>(
+          report_, *encoding, t.pointer_of("encoding"), "colour encoding",
+          {{"auto", ColorEncoding::Auto}, {"srgb", ColorEncoding::SRGB}, {"linear", ColorEncoding::Linear}});
+    if (const Json* filter = t.find("filter"))
+      image.bilinear = read_name<bool>(report_, *filter, t.pointer_of("filter"), "texture filter",
+                                       {{"bilinear", true}, {"nearest", false}});
+    image.scale = t.number_or("scale", image.scale, Bound::NonNegative);
+    image.invert = t.boolean_or("invert", image.invert);
+    image.mapping = read_uv_mapping(t);
+    return image;
+  }
+
+  // "uv_scale": [su, sv] (or one number for both) and "uv_offset": [du, dv].
+  UVMapping read_uv_mapping(CheckedObject& t) const {
+    UVMapping mapping;
+    if (const Json* scale = t.find("uv_scale")) {
+      std::string pointer = t.pointer_of("uv_scale");
+      Vec2 s = scale->is_number() ? Vec2(read_float(report_, *scale, pointer), read_float(report_, *scale, pointer))
+                                  : read_vec2(report_, *scale, pointer);
+      if (s.x == 0 || s.y == 0) report_.fail(pointer, "uv_scale factors must be non-zero, got [{}, {}]", s.x, s.y);
+      mapping.su = s.x;
+      mapping.sv = s.y;
+    }
+    if (const Json* offset = t.find("uv_offset")) {
+      Vec2 d = read_vec2(report_, *offset, t.pointer_of("uv_offset"));
+      mapping.du = d.x;
+      mapping.dv = d.y;
+    }
+    return mapping;
+  }
+
+  // A file named relative to the scene file's directory (as mesh files are). It must exist when the
+  // scene is read, so that a typo is reported with its place in the scene file.
+  std::string existing_file(CheckedObject& object, std::string_view key, std::string_view what) const {
+    std::string name = object.string(key);
+    std::string pointer = object.pointer_of(key);
+    if (name.empty()) report_.fail(pointer, "the {} file name is empty", what);
+    fs::path path = base_dir_ / name;
+    std::error_code error;
+    fs::file_status status = fs::status(path, error);
+    if (status.type() == fs::file_type::not_found)
+      report_.fail(pointer, "cannot read {} '{}': no such file", what, path.string());
+    if (error) report_.fail(pointer, "cannot read {} '{}': {}", what, path.string(), error.message());
+    if (status.type() == fs::file_type::directory)
+      report_.fail(pointer, "cannot read {} '{}': it is a directory, not a file", what, path.string());
+    return path.string();
+  }
+
+  // ---- material and texture parameters: a constant, a texture name, or an inline texture object
+
+  ColorInput read_color_input(const Json& value, const std::string& pointer, ColorKind kind) {
+    ColorInput input;
+    if (value.is_string())
+      input.texture = named_texture(value.get<std::string>(), pointer);
+    else if (value.is_object())
+      input.texture = add_texture(read_texture(value, pointer));
+    else if (value.is_number() || value.is_array())
+      input.value = read_rgb(report_, value, pointer, kind);
+    else
+      report_.fail(pointer,
+                   "expected a colour, [r, g, b] or a single number, or a texture (a name or an object), got {}",
+                   describe(value));
+    return input;
+  }
+
+  ColorInput color_input_or(CheckedObject& object, std::string_view key, ColorKind kind, ColorInput fallback) {
+    const Json* value = object.find(key);
+    return value ? read_color_input(*value, object.pointer_of(key), kind) : fallback;
+  }
+
+  FloatInput read_float_input(const Json& value, const std::string& pointer, Bound bound) {
+    FloatInput input;
+    if (value.is_string())
+      input.texture = named_texture(value.get<std::string>(), pointer);
+    else if (value.is_object())
+      input.texture = add_texture(read_texture(value, pointer));
+    else if (value.is_number())
+      input.value = check_bound(report_, read_float(report_, value, pointer), bound, pointer);
+    else
+      report_.fail(pointer, "expected a number or a texture (a name or an object), got {}", describe(value));
+    return input;
+  }
+
+  FloatInput float_input_or(CheckedObject& object, std::string_view key, Bound bound, FloatInput fallback) {
+    const Json* value = object.find(key);
+    return value ? read_float_input(*value, object.pointer_of(key), bound) : fallback;
+  }
+
   // ---- materials
 
   void read_materials(const Json& value, const std::string& pointer) {
@@ -698,32 +953,38 @@ class JsonSceneReader {
     std::string type = m.string("type");
     MaterialDesc material;
     if (type == "diffuse")
-      material = read_diffuse(m);
+      material = DiffuseMaterial{color_input_or(m, "reflectance", ColorKind::Albedo, DiffuseMaterial{}.reflectance)};
     else if (type == "phong")
       material = read_phong(m);
     else if (type == "mirror")
-      material = MirrorMaterial{m.rgb_or("reflectance", ColorKind::Albedo, MirrorMaterial{}.reflectance)};
-    else if (type == "glass")
-      material = read_glass(m);
+      material = MirrorMaterial{color_input_or(m, "reflectance", ColorKind::Albedo, MirrorMaterial{}.reflectance)};
+    else if (type == "conductor")
+      material = read_conductor(m);
+    else if (type == "dielectric" || type == "glass")
+      material = read_dielectric(m);
+    else if (type == "coated_diffuse" || type == "plastic")
+      material = read_coated_diffuse(m);
+    else if (type == "diffuse_transmission")
+      material = read_diffuse_transmission(m);
+    else if (type == "interface" || type == "null")
+      material = InterfaceMaterial{};
     else if (type == "black")
       material = BlackMaterial{};
     else
       report_.fail(m.pointer_of("type"),
-                   "unknown material type \"{}\"; expected one of: diffuse, phong, mirror, glass, black", type);
+                   "unknown material type \"{}\"; expected one of: diffuse, phong, mirror, conductor, dielectric, "
+                   "glass, coated_diffuse, plastic, diffuse_transmission, interface, null, black",
+                   type);
     m.finish();
     return material;
   }
 
-  static DiffuseMaterial read_diffuse(CheckedObject& m) {
-    return {m.rgb_or("reflectance", ColorKind::Albedo, DiffuseMaterial{}.reflectance)};
-  }
-
-  PhongMaterial read_phong(CheckedObject& m) const {
+  PhongMaterial read_phong(CheckedObject& m) {
     PhongMaterial p;
-    p.diffuse = m.rgb_or("diffuse", ColorKind::Albedo, p.diffuse);
-    p.specular = m.rgb_or("specular", ColorKind::Albedo, p.specular);
+    p.diffuse = color_input_or(m, "diffuse", ColorKind::Albedo, p.diffuse);
+    p.specular = color_input_or(m, "specular", ColorKind::Albedo, p.specular);
     p.exponent = m.number_or("exponent", p.exponent, Bound::NonNegative);
-    p.transmission = m.rgb_or("transmission", ColorKind::Albedo, p.transmission);
+    p.transmission = color_input_or(m, "transmission", ColorKind::Albedo, p.transmission);
     p.ior = m.number_or("ior", p.ior, Bound::Positive);
     p.d = m.number_or("d", p.d, Bound::UnitInterval);
     p.s = m.number_or("s", p.s, Bound::UnitInterval);
@@ -736,12 +997,99 @@ class JsonSceneReader {
     return p;
   }
 
-  static DielectricMaterial read_glass(CheckedObject& m) {
-    DielectricMaterial g;
-    g.ior = m.number_or("ior", g.ior, Bound::Positive);
-    g.reflectance = m.rgb_or("reflectance", ColorKind::Albedo, g.reflectance);
-    g.transmittance = m.rgb_or("transmittance", ColorKind::Albedo, g.transmittance);
-    return g;
+  // GGX alpha (Roughness::remap = false): "roughness" for both axes, or "alpha_u" and "alpha_v".
+  Roughness read_roughness(CheckedObject& m) {
+    Roughness roughness;
+    roughness.remap = false;
+    const Json* isotropic = m.find("roughness");
+    const Json* alpha_u = m.find("alpha_u");
+    const Json* alpha_v = m.find("alpha_v");
+    if (isotropic && (alpha_u || alpha_v))
+      report_.fail(m.pointer_of(alpha_u ? "alpha_u" : "alpha_v"),
+                   "give either \"roughness\" or \"alpha_u\" and \"alpha_v\", not both");
+    if (bool(alpha_u) != bool(alpha_v))
+      report_.fail(m.pointer(), "missing required key \"{}\" (an anisotropic roughness needs alpha_u and alpha_v)",
+                   alpha_u ? "alpha_v" : "alpha_u");
+    if (isotropic) {
+      roughness.u = roughness.v = read_float_input(*isotropic, m.pointer_of("roughness"), Bound::NonNegative);
+    } else if (alpha_u) {
+      roughness.u = read_float_input(*alpha_u, m.pointer_of("alpha_u"), Bound::NonNegative);
+      roughness.v = read_float_input(*alpha_v, m.pointer_of("alpha_v"), Bound::NonNegative);
+    }
+    return roughness;
+  }
+
+  // eta and k (default copper), or a named metal's, or the artist-friendly normal-incidence reflectance.
+  ConductorMaterial read_conductor(CheckedObject& m) {
+    ConductorMaterial c;
+    bool has_ior = m.has("eta") || m.has("k");
+    if (int(has_ior) + int(m.has("reflectance")) + int(m.has("metal")) > 1)
+      report_.fail(m.pointer(), "a conductor takes only one of: \"eta\"/\"k\", \"reflectance\", \"metal\"");
+    if (const Json* metal = m.find("metal")) {
+      ComplexIor preset = read_metal(*metal, m.pointer_of("metal"));
+      c.eta = preset.eta;
+      c.k = preset.k;
+    }
+    if (const Json* eta = m.find("eta")) {
+      c.eta = read_color_input(*eta, m.pointer_of("eta"), ColorKind::NonNegative);
+      check_positive_color(c.eta, *eta, m.pointer_of("eta"));
+    }
+    c.k = color_input_or(m, "k", ColorKind::NonNegative, c.k);
+    if (const Json* reflectance = m.find("reflectance"))
+      c.reflectance = read_color_input(*reflectance, m.pointer_of("reflectance"), ColorKind::Albedo);
+    c.specular_tint = color_input_or(m, "specular_tint", ColorKind::Albedo, c.specular_tint);
+    c.roughness = read_roughness(m);
+    return c;
+  }
+
+  ComplexIor read_metal(const Json& value, const std::string& pointer) const {
+    std::string name = read_string(report_, value, pointer);
+    if (std::optional<ComplexIor> preset = find_metal(name)) return *preset;
+    report_.fail(pointer, "unknown metal \"{}\"; expected one of: {}", name, fmt::join(metal_names(), ", "));
+  }
+
+  // An index of refraction must be > 0 in each channel (constants; textures are not checked).
+  void check_positive_color(const ColorInput& input, const Json& value, const std::string& pointer) const {
+    if (!input.is_constant()) return;
+    for (int i = 0; i < 3; ++i)
+      if (!(input.value[i] > 0))
+        report_.fail(value.is_array() ? child_pointer(pointer, size_t(i)) : pointer,
+                     "an index of refraction must be > 0 in each channel, got {}", input.value[i]);
+  }
+
+  DielectricMaterial read_dielectric(CheckedObject& m) {
+    DielectricMaterial d;
+    d.ior = m.number_or("ior", d.ior, Bound::Positive);
+    d.reflectance = color_input_or(m, "reflectance", ColorKind::Albedo, d.reflectance);
+    d.transmittance = color_input_or(m, "transmittance", ColorKind::Albedo, d.transmittance);
+    d.roughness = read_roughness(m);
+    return d;
+  }
+
+  CoatedDiffuseMaterial read_coated_diffuse(CheckedObject& m) {
+    CoatedDiffuseMaterial c;
+    c.reflectance = color_input_or(m, "reflectance", ColorKind::Albedo, c.reflectance);
+    c.specular = color_input_or(m, "specular", ColorKind::Albedo, c.specular);
+    c.ior = m.number_or("ior", c.ior, Bound::Positive);
+    c.roughness = read_roughness(m);
+    c.nonlinear = m.boolean_or("nonlinear", c.nonlinear);
+    return c;
+  }
+
+  DiffuseTransmissionMaterial read_diffuse_transmission(CheckedObject& m) {
+    static constexpr const char* kChannelNames[] = {"red", "green", "blue"};
+    DiffuseTransmissionMaterial d;
+    d.reflectance = color_input_or(m, "reflectance", ColorKind::Albedo, d.reflectance);
+    d.transmittance = color_input_or(m, "transmittance", ColorKind::Albedo, d.transmittance);
+    // Together they may not exceed 1 (checked for constants; textures are the scene's responsibility).
+    if (d.reflectance.is_constant() && d.transmittance.is_constant())
+      for (int i = 0; i < 3; ++i)
+        if (double(d.reflectance.value[i]) + d.transmittance.value[i] > 1 + 1e-6)
+          report_.fail(m.pointer(),
+                       "reflectance + transmittance must be <= 1 in each channel (more would create energy), got "
+                       "{} + {} in the {} channel",
+                       d.reflectance.value[i], d.transmittance.value[i], kChannelNames[i]);
+    return d;
   }
 
   int material_by_name(const std::string& name, const std::string& pointer) const {
@@ -762,7 +1110,12 @@ class JsonSceneReader {
 
   void read_shapes(const Json& value, const std::string& pointer) {
     check_is_array(report_, value, pointer, "shapes");
-    for (size_t i = 0; i < value.size(); ++i) scene_.shapes.push_back(read_shape(value[i], child_pointer(pointer, i)));
+    for (size_t i = 0; i < value.size(); ++i) {
+      if (is_instance(value[i]))
+        scene_.instances.push_back(read_instance(value[i], child_pointer(pointer, i)));
+      else
+        scene_.shapes.push_back(read_shape(value[i], child_pointer(pointer, i)));
+    }
   }
 
   ShapeDesc read_shape(const Json& value, const std::string& pointer) {
@@ -787,7 +1140,7 @@ class JsonSceneReader {
     if (type == "rectangle") return read_rectangle(s);
     if (type == "mesh") return read_mesh(s);
     report_.fail(s.pointer_of("type"),
-                 "unknown shape type \"{}\"; expected one of: sphere, plane, box, rectangle, mesh", type);
+                 "unknown shape type \"{}\"; expected one of: sphere, plane, box, rectangle, mesh, instance", type);
   }
 
   static SphereShape read_sphere(CheckedObject& s) { return {s.vec3("center"), s.number("radius", Bound::Positive)}; }
@@ -822,6 +1175,81 @@ class JsonSceneReader {
     AreaEmission emission{e.rgb("radiance", ColorKind::Emission), e.boolean_or("two_sided", false)};
     e.finish();
     return emission;
+  }
+
+  // ---- objects and instances
+
+  static bool is_instance(const Json& shape) {
+    if (!shape.is_object()) return false;
+    auto type = shape.find("type");
+    return type != shape.end() && *type == "instance";
+  }
+
+  void read_objects(const Json& value, const std::string& pointer) {
+    if (!value.is_object())
+      report_.fail(pointer, "expected an object mapping object names to objects, got {}", describe(value));
+    for (auto it = value.begin(); it != value.end(); ++it) {
+      if (it.key() == "_comment") continue;
+      ObjectDesc object = read_object(it.value(), child_pointer(pointer, it.key()));
+      object.name = it.key();
+      object_index_[it.key()] = int(scene_.objects.size());
+      scene_.objects.push_back(std::move(object));
+    }
+  }
+
+  // An object's shapes are in its own space; they may not emit, move or be instances themselves.
+  ObjectDesc read_object(const Json& value, const std::string& pointer) {
+    CheckedObject o(report_, value, pointer);
+    const Json& shapes = o.require("shapes");
+    std::string shapes_pointer = o.pointer_of("shapes");
+    check_is_array(report_, shapes, shapes_pointer, "shapes");
+    if (shapes.empty()) report_.fail(shapes_pointer, "an object needs at least one shape");
+    ObjectDesc object;
+    for (size_t i = 0; i < shapes.size(); ++i) {
+      std::string shape_pointer = child_pointer(shapes_pointer, i);
+      if (is_instance(shapes[i]))
+        report_.fail(child_pointer(shape_pointer, "type"), "an object cannot contain instances (objects do not nest)");
+      ShapeDesc shape = read_shape(shapes[i], shape_pointer);
+      if (shape.emission)
+        report_.fail(child_pointer(shape_pointer, "emission"),
+                     "a shape in an object cannot emit light (instanced area lights are not supported); put it in "
+                     "the top-level \"shapes\"");
+      if (shape.to_world_end)
+        report_.fail(child_pointer(shape_pointer, "transform_end"),
+                     "a shape in an object cannot move; give the instance a transform_end instead");
+      object.shapes.push_back(std::move(shape));
+    }
+    o.finish();
+    return object;
+  }
+
+  InstanceDesc read_instance(const Json& value, const std::string& pointer) const {
+    CheckedObject s(report_, value, pointer);
+    s.string("type");
+    InstanceDesc instance;
+    instance.object = object_by_name(s.string("object"), s.pointer_of("object"));
+    instance.to_world = read_transform_key(s);
+    if (const Json* end = s.find("transform_end")) {
+      const ObjectDesc& object = scene_.objects[size_t(instance.object)];
+      for (const ShapeDesc& shape : object.shapes)
+        if (std::holds_alternative<PlaneShape>(shape.geometry))
+          report_.fail(s.pointer_of("transform_end"),
+                       "an infinite plane must not move: object \"{}\" contains one, so its instances cannot have "
+                       "transform_end",
+                       object.name);
+      instance.to_world_end = read_transform(*end, s.pointer_of("transform_end"));
+    }
+    s.finish();
+    return instance;
+  }
+
+  int object_by_name(const std::string& name, const std::string& pointer) const {
+    auto it = object_index_.find(name);
+    if (it != object_index_.end()) return it->second;
+    std::vector<std::string> names;
+    for (const auto& entry : object_index_) names.push_back(entry.first);
+    if (names.empty()) report_.fail(pointer, "unknown object \"{}\" (\"objects\" defines none)", name);
+    report_.fail(pointer, "unknown object \"{}\"; defined: {}", name, fmt::join(names, ", "));
   }
 
   // ---- meshes
@@ -999,15 +1427,24 @@ class JsonSceneReader {
     std::string type = light.string("type");
     if (type == "point")
       scene_.lights.push_back(PointLight{light.vec3("position"), light.rgb("intensity", ColorKind::Emission)});
+    else if (type == "spot")
+      scene_.lights.push_back(read_spot(light));
+    else if (type == "distant")
+      scene_.lights.push_back(
+          DistantLight{normalize(light.direction("direction")), light.rgb("radiance", ColorKind::Emission)});
     else if (type == "sky")
       scene_.lights.push_back(read_sky(light));
+    else if (type == "environment")
+      scene_.lights.push_back(read_environment(light));
     else if (type == "sphere")
       scene_.shapes.push_back(read_shape_light(light, read_sphere(light)));
     else if (type == "rectangle")
       scene_.shapes.push_back(read_shape_light(light, read_rectangle(light)));
     else
       report_.fail(light.pointer_of("type"),
-                   "unknown light type \"{}\"; expected one of: point, sky, sphere, rectangle", type);
+                   "unknown light type \"{}\"; expected one of: point, spot, distant, sky, environment, sphere, "
+                   "rectangle",
+                   type);
     light.finish();
   }
 
@@ -1044,11 +1481,97 @@ class JsonSceneReader {
     return sky;
   }
 
+  SpotLight read_spot(CheckedObject& light) const {
+    SpotLight spot;
+    spot.position = light.vec3("position");
+    bool has_direction = light.has("direction"), has_look_at = light.has("look_at");
+    if (has_direction && has_look_at)
+      report_.fail(light.pointer_of("look_at"), "a spot light takes either \"direction\" or \"look_at\", not both");
+    if (has_direction) {
+      spot.direction = normalize(light.direction("direction"));
+    } else if (has_look_at) {
+      Vec3 direction = light.vec3("look_at") - spot.position;
+      if (length_squared(direction) == 0 || !is_finite(normalize(direction)))
+        report_.fail(light.pointer_of("look_at"), "look_at must differ from position (it sets the light's direction)");
+      spot.direction = normalize(direction);
+    } else {
+      report_.fail(light.pointer(), "a spot light needs \"direction\" or \"look_at\"");
+    }
+    spot.intensity = light.rgb("intensity", ColorKind::Emission);
+    spot.cone_angle = light.number_or("cone_angle", spot.cone_angle);
+    if (!(spot.cone_angle > 0 && spot.cone_angle <= 180))
+      report_.fail(light.pointer_of("cone_angle"), "the cone angle must be in (0, 180] degrees, got {}",
+                   spot.cone_angle);
+    spot.cone_delta = light.number_or("cone_delta", std::min(spot.cone_delta, spot.cone_angle));
+    if (!(spot.cone_delta >= 0 && spot.cone_delta <= spot.cone_angle))
+      report_.fail(light.pointer_of("cone_delta"), "cone_delta must be in [0, cone_angle] = [0, {}] degrees, got {}",
+                   spot.cone_angle, spot.cone_delta);
+    return spot;
+  }
+
+  EnvironmentMap read_environment(CheckedObject& light) const {
+    EnvironmentMap environment;
+    environment.filename = existing_file(light, "filename", "environment map");
+    if (const Json* mapping = light.find("mapping"))
+      environment.mapping =
+          read_name<EnvironmentMapping>(report_, *mapping, light.pointer_of("mapping"), "environment mapping",
+                                        {{"equirectangular", EnvironmentMapping::Equirectangular},
+                                         {"equal_area", EnvironmentMapping::EqualAreaOctahedral}});
+    environment.scale = light.rgb_or("scale", ColorKind::Emission, environment.scale);
+    environment.to_world = read_environment_orientation(light, environment.mapping);
+    return environment;
+  }
+
+  // Either "up" (where the map's own up axis points) and "rotate" (degrees about it), or a "transform".
+  Transform read_environment_orientation(CheckedObject& light, EnvironmentMapping mapping) const {
+    bool has_up = light.has("up"), has_rotate = light.has("rotate");
+    if (const Json* steps = light.find("transform")) {
+      std::string pointer = light.pointer_of("transform");
+      if (has_up || has_rotate)
+        report_.fail(pointer, "an environment map takes either \"transform\" or \"up\"/\"rotate\", not both");
+      Transform transform = read_transform(*steps, pointer);
+      check_rotation(transform, pointer);
+      return transform;
+    }
+    Vec3 local_up = mapping == EnvironmentMapping::Equirectangular ? Vec3(0, 1, 0) : Vec3(0, 0, 1);
+    Vec3 up = normalize(light.direction_or("up", local_up));
+    float degrees = light.number_or("rotate", 0);
+    Transform spin = degrees == 0 ? Transform() : Transform::rotate(degrees, local_up);
+    return rotation_between(local_up, up) * spin;
+  }
+
+  // The rotation taking unit vector `from` to unit vector `to` about their common perpendicular.
+  static Transform rotation_between(Vec3 from, Vec3 to) {
+    float cosine = std::clamp(dot(from, to), -1.0f, 1.0f);
+    if (cosine >= 1 - 1e-7f) return {};
+    Vec3 axis = cross(from, to);
+    // Opposite vectors: any perpendicular axis will do; x is perpendicular to both possible local ups.
+    if (length(axis) < 1e-6f) return Transform::rotate(180, {1, 0, 0});
+    return Transform::rotate(std::acos(cosine) * (180 / kPi), axis);
+  }
+
+  // Light from infinitely far away depends on directions only: its transform may only rotate or mirror.
+  void check_rotation(const Transform& transform, const std::string& pointer) const {
+    const Matrix4& m = transform.matrix();
+    if (m.m[0][3] != 0 || m.m[1][3] != 0 || m.m[2][3] != 0)
+      report_.fail(pointer, "an environment map's transform may only rotate (or mirror) it, not translate it");
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        double column_dot = m.m[0][i] * m.m[0][j] + m.m[1][i] * m.m[1][j] + m.m[2][i] * m.m[2][j];
+        if (std::abs(column_dot - (i == j ? 1 : 0)) > 1e-4)
+          report_.fail(pointer, "an environment map's transform may only rotate (or mirror) it, not scale or shear it");
+      }
+  }
+
   std::string_view text_;
   ErrorReporter report_;
   fs::path base_dir_;
   SceneDesc scene_;
+  std::map<std::string, NamedTexture> named_textures_;
+  std::vector<std::string> texture_stack_;  // the named textures being read, outermost first
+  int texture_depth_ = 0;                   // textures being read, named or inline
   std::map<std::string, int> material_index_;
+  std::map<std::string, int> object_index_;
   std::optional<int> black_material_;
 };
 

@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "candela/io/error.h"
+#include "candela/io/named_spectra.h"
+#include "candela/io/pbrt_reader.h"
 #include "candela/io/scene_reader.h"
 #include "candela/scene/description.h"
 
@@ -25,6 +27,9 @@ const fs::path kSharedCornellBox = fs::path(CANDELA_SHARED_DIR) / "scenes/cornel
 const fs::path kRepoCornellBox = fs::path(CANDELA_SOURCE_DIR) / "scenes/cornell-box.pbrt";
 const fs::path kTestData = fs::path(CANDELA_SOURCE_DIR) / "tests/data/pbrt";
 
+// The directory of the scratch scenes and files of this test process.
+fs::path scratch_dir() { return fs::temp_directory_path() / fmt::format("candela_pbrt_reader_{}", getpid()); }
+
 // A scene written to its own file, named after the test so that tests can run in parallel
 // processes; the file is removed again when the object goes out of scope.
 class ScratchScene {
@@ -32,7 +37,7 @@ class ScratchScene {
   explicit ScratchScene(const std::vector<std::string>& lines) {
     static int counter = 0;
     const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-    fs::path dir = fs::temp_directory_path() / fmt::format("candela_pbrt_reader_{}", getpid());
+    fs::path dir = scratch_dir();
     fs::create_directories(dir);
     path_ = dir / fmt::format("{}_{}.pbrt", test->name(), counter++);
     std::ofstream out(path_);
@@ -51,12 +56,55 @@ class ScratchScene {
   fs::path path_;
 };
 
-SceneDesc read_lines(const std::vector<std::string>& lines) { return read_pbrt_scene(ScratchScene(lines).path()); }
+// An empty file beside the scratch scenes, for parameters that name files the reader only looks up
+// (images); removed again when the object goes out of scope.
+class ScratchFile {
+ public:
+  explicit ScratchFile(const std::string& name) : path_(scratch_dir() / name) {
+    fs::create_directories(path_.parent_path());
+    std::ofstream out(path_);
+  }
+  ScratchFile(const ScratchFile&) = delete;
+  ScratchFile& operator=(const ScratchFile&) = delete;
+  ~ScratchFile() {
+    std::error_code ignored;
+    fs::remove(path_, ignored);
+    fs::remove(path_.parent_path(), ignored);
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+SceneDesc read_lines(const std::vector<std::string>& lines) {
+  std::vector<std::string> warnings;
+  return read_pbrt_scene(ScratchScene(lines).path(), warnings);
+}
+
+struct Warned {
+  SceneDesc scene;
+  std::vector<std::string> warnings;
+};
+
+Warned read_warned(const std::vector<std::string>& lines) {
+  ScratchScene file(lines);
+  Warned result;
+  result.scene = read_pbrt_scene(file.path(), result.warnings);
+  return result;
+}
+
+std::string joined(const std::vector<std::string>& lines) {
+  std::string text;
+  for (const std::string& line : lines) text += line + "\n";
+  return text;
+}
 
 // The message of the error reading `file` gives, or "" when it reads without one.
 std::string error_reading(const fs::path& file) {
   try {
-    read_pbrt_scene(file);
+    std::vector<std::string> warnings;
+    read_pbrt_scene(file, warnings);
   } catch (const SceneError& error) {
     return error.what();
   }
@@ -75,6 +123,21 @@ void expect_error(const std::vector<std::string>& lines, int line, std::string_v
   EXPECT_NE(message.find(fragment), std::string::npos) << "expected \"" << fragment << "\" in: " << message;
 }
 
+// Expects the scene to read with exactly one warning, "<file>:<line>:<column>: warning: ...", where
+// the column is that of `marker` in the line, containing `fragment`.
+void expect_warning(const std::vector<std::string>& lines, int line, std::string_view marker,
+                    std::string_view fragment) {
+  ScratchScene scene(lines);
+  size_t column = lines.at(line - 1).find(marker);
+  ASSERT_NE(column, std::string::npos) << "marker " << marker << " is not in line " << line;
+  std::vector<std::string> warnings;
+  read_pbrt_scene(scene.path(), warnings);
+  ASSERT_EQ(warnings.size(), 1u) << joined(warnings);
+  std::string place = fmt::format("{}:{}:{}: warning: ", scene.path().string(), line, column + 1);
+  EXPECT_TRUE(warnings[0].starts_with(place)) << "expected the warning at " << place << "\ngot: " << warnings[0];
+  EXPECT_NE(warnings[0].find(fragment), std::string::npos) << "expected \"" << fragment << "\" in: " << warnings[0];
+}
+
 void expect_near(const Vec3& actual, const Vec3& expected, float tolerance = 1e-4f) {
   EXPECT_NEAR(actual.x, expected.x, tolerance);
   EXPECT_NEAR(actual.y, expected.y, tolerance);
@@ -84,7 +147,7 @@ void expect_near(const Vec3& actual, const Vec3& expected, float tolerance = 1e-
 const TriangleMesh& mesh_of(const ShapeDesc& shape) { return std::get<MeshShape>(shape.geometry).mesh; }
 
 RGB reflectance_of(const SceneDesc& scene, const ShapeDesc& shape) {
-  return std::get<DiffuseMaterial>(scene.materials.at(shape.material)).reflectance;
+  return std::get<DiffuseMaterial>(scene.materials.at(shape.material)).reflectance.value;
 }
 
 // ---------------------------------------------------------------- the Cornell box
@@ -173,12 +236,12 @@ TEST(PbrtReader, SceneWithOnlyWorldBeginGetsTheDefaults) {
   EXPECT_TRUE(scene.shapes.empty());
 }
 
-TEST(PbrtReader, KeepsOtherIntegratorNamesAndStratifiedSampleCounts) {
+TEST(PbrtReader, OtherIntegratorsBecomePathAndStratifiedSampleCounts) {
   SceneDesc scene = read_lines({"Integrator \"bdpt\" \"integer maxdepth\" 7",
                                 "Sampler \"stratified\" \"integer xsamples\" 3 \"integer ysamples\" 5 "
                                 "\"bool jitter\" false",
                                 "WorldBegin"});
-  EXPECT_EQ(scene.settings.integrator, "bdpt");
+  EXPECT_EQ(scene.settings.integrator, "path");
   EXPECT_EQ(scene.settings.max_depth, 7);
   EXPECT_EQ(scene.settings.spp, 15);
 }
@@ -219,11 +282,11 @@ TEST(PbrtReader, ReadsTheThreeSamplerTypes) {
 }
 
 TEST(PbrtReader, BadSamplers) {
-  expect_error({"Sampler \"halton\"", "WorldBegin"}, 1, "\"halton\"",
-               "sampler type \"halton\" is not supported yet (supported: \"independent\", \"stratified\", \"zsobol\")");
-  for (std::string type : {"sobol", "paddedsobol", "pmj02bn"})
-    expect_error({"Sampler \"" + type + "\"", "WorldBegin"}, 1, "\"" + type + "\"", "is not supported yet");
-  expect_error({"Sampler \"random\"", "WorldBegin"}, 1, "\"random\"", "unknown sampler type \"random\"");
+  expect_error({"Sampler \"random\"", "WorldBegin"}, 1, "\"random\"",
+               "unknown sampler type \"random\" (supported: \"independent\", \"stratified\", \"zsobol\", \"sobol\", "
+               "\"halton\", \"paddedsobol\", \"pmj02bn\")");
+  expect_error({"Sampler \"pmj02bn\" \"string randomization\" \"owen\"", "WorldBegin"}, 1,
+               "\"string randomization\"", "unused parameter");
   expect_error({"Sampler \"zsobol\" \"string randomization\" \"scrambled\"", "WorldBegin"}, 1,
                "\"string randomization\"", "must be \"none\", \"permutedigits\", \"fastowen\" or \"owen\"");
   expect_error({"Sampler \"independent\" \"string randomization\" \"owen\"", "WorldBegin"}, 1,
@@ -365,10 +428,13 @@ TEST(PbrtReader, AnimatedObjectInstances) {
   SceneDesc scene = read_lines({"WorldBegin", "ObjectBegin \"ball\"", "Shape \"sphere\"", "ObjectEnd",
                                 "ActiveTransform EndTime", "Translate 0 0 4", "ActiveTransform All",
                                 "ObjectInstance \"ball\"", "Identity", "ObjectInstance \"ball\""});
-  ASSERT_EQ(scene.shapes.size(), 2u);
-  ASSERT_TRUE(scene.shapes[0].to_world_end.has_value());
-  expect_near(scene.shapes[0].to_world_end->point(Point3(0, 0, 0)), Point3(0, 0, 4));
-  EXPECT_FALSE(scene.shapes[1].to_world_end.has_value());
+  EXPECT_TRUE(scene.shapes.empty());
+  ASSERT_EQ(scene.objects.size(), 1u);
+  ASSERT_EQ(scene.instances.size(), 2u);
+  ASSERT_TRUE(scene.instances[0].to_world_end.has_value());
+  EXPECT_TRUE(scene.instances[0].to_world.is_identity());
+  expect_near(scene.instances[0].to_world_end->point(Point3(0, 0, 0)), Point3(0, 0, 4));
+  EXPECT_FALSE(scene.instances[1].to_world_end.has_value());
 }
 
 TEST(PbrtReader, BadAnimatedTransforms) {
@@ -553,26 +619,44 @@ TEST(PbrtReader, AcceptsBareSingleValuesQuotedBoolsEscapesAndComments) {
   EXPECT_FLOAT_EQ(std::get<SphereShape>(scene.shapes.at(0).geometry).radius, 2.5f);
 }
 
-TEST(PbrtReader, ObjectInstancesAreExpandedWithTheComposedTransform) {
+// pbrt-v4: the shapes keep the CTM of their definition, an instance adds the CTM at ObjectInstance.
+TEST(PbrtReader, ObjectInstancesFillObjectsAndInstances) {
   SceneDesc scene = read_lines({"WorldBegin",
                                 "ObjectBegin \"pair\"",
                                 "  Material \"dielectric\"",
                                 "  Translate 1 0 0",
                                 "  Shape \"sphere\"",
+                                "  ReverseOrientation",
                                 "  Shape \"sphere\" \"float radius\" 0.5",
+                                "ObjectEnd",
+                                "ObjectBegin \"unused\"",
+                                "  Shape \"sphere\"",
                                 "ObjectEnd",
                                 "Shape \"sphere\" \"float radius\" 3",  // ObjectEnd restored the state
                                 "Translate 0 10 0",
                                 "ObjectInstance \"pair\"",
                                 "Translate 0 10 0",
+                                "Scale 2 2 2",
                                 "ObjectInstance \"pair\""});
-  ASSERT_EQ(scene.shapes.size(), 5u);
+  ASSERT_EQ(scene.shapes.size(), 1u);
   EXPECT_TRUE(scene.shapes[0].to_world.is_identity());
   EXPECT_EQ(scene.shapes[0].material, -1);
-  expect_near(scene.shapes[1].to_world.point(Point3(0, 0, 0)), Point3(1, 10, 0));
-  expect_near(scene.shapes[4].to_world.point(Point3(0, 0, 0)), Point3(1, 20, 0));
-  EXPECT_FLOAT_EQ(std::get<SphereShape>(scene.shapes[4].geometry).radius, 0.5f);
-  EXPECT_TRUE(std::holds_alternative<DielectricMaterial>(scene.materials.at(scene.shapes[4].material)));
+  EXPECT_FALSE(scene.shapes[0].reverse_orientation);
+  ASSERT_EQ(scene.objects.size(), 1u);  // "unused" is never instanced
+  const ObjectDesc& pair = scene.objects[0];
+  EXPECT_EQ(pair.name, "pair");
+  ASSERT_EQ(pair.shapes.size(), 2u);
+  expect_near(pair.shapes[0].to_world.point(Point3(0, 0, 0)), Point3(1, 0, 0));
+  EXPECT_FLOAT_EQ(std::get<SphereShape>(pair.shapes[1].geometry).radius, 0.5f);
+  EXPECT_TRUE(std::holds_alternative<DielectricMaterial>(scene.materials.at(pair.shapes[1].material)));
+  EXPECT_FALSE(pair.shapes[0].reverse_orientation);
+  EXPECT_TRUE(pair.shapes[1].reverse_orientation);
+  ASSERT_EQ(scene.instances.size(), 2u);
+  EXPECT_EQ(scene.instances[0].object, 0);
+  EXPECT_EQ(scene.instances[1].object, 0);
+  // world = instance.to_world * shape.to_world
+  expect_near((scene.instances[0].to_world * pair.shapes[0].to_world).point(Point3(0, 0, 0)), Point3(1, 10, 0));
+  expect_near((scene.instances[1].to_world * pair.shapes[0].to_world).point(Point3(0, 0, 0)), Point3(2, 20, 0));
 }
 
 // ---------------------------------------------------------------- Include and Import
@@ -638,9 +722,10 @@ TEST(PbrtReader, UnknownDirective) {
   expect_error({"WorldBegin", "", "  Sphere \"x\""}, 3, "Sphere", "unknown directive \"Sphere\"");
 }
 
-TEST(PbrtReader, UnsupportedDirectiveIsNamed) {
-  expect_error({"WorldBegin", "Texture \"t\" \"spectrum\" \"checkerboard\""}, 2, "Texture",
-               "\"Texture\" is not supported yet");
+TEST(PbrtReader, UnknownTextureTypeIsNamed) {
+  expect_error({"WorldBegin", "Texture \"t\" \"spectrum\" \"fbm\""}, 2, "\"fbm\"",
+               "texture type \"fbm\" is not supported: candela has no such texture (supported: \"imagemap\", "
+               "\"checkerboard\", \"scale\", \"mix\", \"constant\")");
 }
 
 TEST(PbrtReader, WorldEndIsExplainedAsPbrtV3) {
@@ -681,7 +766,7 @@ TEST(PbrtReader, StrayStringWhereADirectiveShouldBe) {
 
 TEST(PbrtReader, UnusedParameter) {
   expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" 1 \"float radiu\" 2"}, 2, "\"float radiu\"",
-               "unused parameter \"float radiu\" (parameters read here: radius, zmin, zmax, phimax)");
+               "unused parameter \"float radiu\" (parameters read here: radius, zmin, zmax, phimax, alpha)");
 }
 
 TEST(PbrtReader, ParameterOfTheWrongType) {
@@ -719,11 +804,28 @@ TEST(PbrtReader, MalformedParameterDeclarations) {
                "given twice");
 }
 
-TEST(PbrtReader, SpectrumAndTextureParametersAreNotSupported) {
-  expect_error({"WorldBegin", "Material \"dielectric\" \"spectrum eta\" \"glass-BK7\""}, 2, "\"spectrum eta\"",
-               "spectral values are not supported yet");
+TEST(PbrtReader, BadSpectrumAndTextureParameters) {
+  expect_error({"WorldBegin", "Material \"dielectric\" \"spectrum eta\" \"glass-XY\""}, 2, "\"spectrum eta\"",
+               "\"glass-XY\" is not one of pbrt-v4's glasses");
+  expect_error({"WorldBegin", "Material \"conductor\" \"spectrum eta\" \"metal-Xx-eta\""}, 2, "\"spectrum eta\"",
+               "unknown named spectrum \"metal-Xx-eta\" (spectrum files are not supported; the named spectra are "
+               "\"metal-Ag-eta\"");
   expect_error({"WorldBegin", "Material \"diffuse\" \"texture reflectance\" \"checks\""}, 2, "\"texture reflectance\"",
-               "textures are not supported yet");
+               "no spectrum texture named \"checks\" is defined (Texture must come first)");
+  expect_error({"WorldBegin", "Material \"conductor\" \"spectrum eta\" [ 400 1  300 2 ]"}, 2, "\"spectrum eta\"",
+               "the wavelengths must increase");
+  expect_error({"WorldBegin", "Material \"conductor\" \"spectrum k\" [ 400 1  500 ]"}, 2, "\"spectrum k\"",
+               "needs a multiple of 2 values, got 3");
+  expect_error({"WorldBegin", "Material \"conductor\" \"spectrum k\" [ 400 \"metal-Cu-k\" ]"}, 2, "\"metal-Cu-k\"",
+               "expects one spectrum name or (wavelength, value) pairs");
+  expect_error({"WorldBegin", "LightSource \"point\" \"spectrum I\" \"metal-Cu-k\""}, 2, "\"spectrum I\"",
+               "\"metal-Cu-k\" is a conductor's optical constant and does not fit here");
+  expect_error({"WorldBegin", "Material \"conductor\" \"spectrum eta\" \"stdillum-D65\""}, 2, "\"spectrum eta\"",
+               "\"stdillum-D65\" is an illuminant spectrum and does not fit here");
+  expect_error({"WorldBegin", "Material \"diffuse\" \"blackbody reflectance\" 3000"}, 2, "\"blackbody reflectance\"",
+               "must be of type \"rgb\", \"spectrum\" or \"texture\", not \"blackbody\"");
+  expect_error({"WorldBegin", "LightSource \"point\" \"blackbody I\" [ 3000 2 ]"}, 2, "\"blackbody I\"",
+               "takes one value, the temperature in kelvin, got 2");
 }
 
 TEST(PbrtReader, ReflectanceAboveOneOrNegativeColour) {
@@ -781,15 +883,21 @@ TEST(PbrtReader, BadSampleCountsAndDepth) {
 TEST(PbrtReader, UnknownAndUnsupportedTypes) {
   expect_error({"WorldBegin", "Shape \"spere\""}, 2, "\"spere\"",
                "unknown shape type \"spere\" (supported: \"sphere\", \"trianglemesh\", \"plymesh\")");
-  expect_error({"WorldBegin", "Shape \"disk\""}, 2, "\"disk\"", "shape type \"disk\" is not supported yet");
+  for (std::string type : {"cylinder", "curve", "loopsubdiv"})
+    expect_error({"WorldBegin", "Shape \"" + type + "\""}, 2, "\"" + type + "\"",
+                 "shape type \"" + type + "\" is not supported: candela has no primitive or tessellation for it");
   expect_error({"WorldBegin", "Material \"plastic\""}, 2, "\"plastic\"", "unknown material type \"plastic\"");
-  expect_error({"WorldBegin", "Material \"conductor\""}, 2, "\"conductor\"",
-               "material type \"conductor\" is not supported yet");
-  expect_error({"WorldBegin", "Material \"interface\""}, 2, "\"interface\"", "\"interface\" is not supported");
-  expect_error({"WorldBegin", "MakeNamedMaterial \"m\" \"string type\" \"coateddiffuse\""}, 2, "\"string type\"",
-               "not supported yet");
+  for (std::string type : {"coatedconductor", "hair", "measured", "subsurface"})
+    expect_error({"WorldBegin", "Material \"" + type + "\""}, 2, "\"" + type + "\"",
+                 "material type \"" + type + "\" is not supported: candela has no BSDF for it");
+  expect_error({"WorldBegin", "MakeNamedMaterial \"m\" \"string type\" \"hair\""}, 2, "\"string type\"",
+               "not supported");
   expect_error({"WorldBegin", "LightSource \"sun\""}, 2, "\"sun\"", "unknown light type \"sun\"");
-  expect_error({"WorldBegin", "LightSource \"spot\""}, 2, "\"spot\"", "light type \"spot\" is not supported yet");
+  for (std::string type : {"goniometric", "projection"})
+    expect_error({"WorldBegin", "LightSource \"" + type + "\""}, 2, "\"" + type + "\"",
+                 "light type \"" + type + "\" is not supported");
+  expect_error({"Integrator \"whitted\"", "WorldBegin"}, 1, "\"whitted\"", "unknown integrator type \"whitted\"");
+  expect_error({"Accelerator \"octree\"", "WorldBegin"}, 1, "\"octree\"", "unknown accelerator type");
   expect_error({"WorldBegin", "AreaLightSource \"glow\""}, 2, "\"glow\"", "unknown area light type");
   expect_error({"Camera \"orthographic\"", "WorldBegin"}, 1, "\"orthographic\"", "not supported yet");
   expect_error({"Film \"gbuffer\"", "WorldBegin"}, 1, "\"gbuffer\"", "not supported yet");
@@ -797,9 +905,9 @@ TEST(PbrtReader, UnknownAndUnsupportedTypes) {
 
 TEST(PbrtReader, UnsupportedFeaturesOfSupportedTypes) {
   expect_error({"WorldBegin", "LightSource \"infinite\" \"string filename\" \"sky.exr\""}, 2, "\"string filename\"",
-               "environment maps are not supported yet");
-  expect_error({"WorldBegin", "Material \"dielectric\" \"float roughness\" 0.1"}, 2, "\"float roughness\"",
-               "only smooth dielectrics");
+               "cannot find \"sky.exr\"");
+  expect_error({"WorldBegin", "LightSource \"infinite\" \"rgb L\" [ 1 1 1 ] \"string filename\" \"sky.exr\""}, 2,
+               "\"string filename\"", "cannot be given together with \"L\"");
   expect_error({"WorldBegin", "MakeNamedMaterial \"m\" \"rgb reflectance\" [ 1 1 1 ]"}, 2, "MakeNamedMaterial",
                "missing the \"string type\" parameter");
 }

@@ -5,17 +5,23 @@
 //   pdf_li(ctx, wi, p, n)     the solid-angle pdf sample_li would give for the direction wi reaching
 //                             the light at point p with normal n (for MIS on BSDF-sampled hits)
 //   power()                   emitted power (luminance), for choosing lights proportionally
+// Lights at infinity (SkyLightSource, EnvironmentLight) also offer radiance(dir) for rays that escape
+// the scene; point, spot and distant lights are delta lights, reached only by sampling them.
 // The closed list of lights is the variant `Light`; dispatch happens once, here.
 #include <limits>
 #include <variant>
 
 #include "candela/lights/area_lights.h"
+#include "candela/lights/distant_light.h"
+#include "candela/lights/environment_light.h"
 #include "candela/lights/point_light.h"
 #include "candela/lights/sky_light.h"
+#include "candela/lights/spot_light.h"
 
 namespace candela {
 
-using Light = std::variant<PointLightSource, TriangleLight, RectangleLight, SphereLight, SkyLightSource>;
+using Light = std::variant<PointLightSource, TriangleLight, RectangleLight, SphereLight, SkyLightSource,
+                           SpotLightSource, DistantLightSource, EnvironmentLight>;
 
 inline LightSample light_sample_li(const Light& l, const LightSampleContext& ctx, Vec2 u) {
   return std::visit([&](const auto& x) { return x.sample_li(ctx, u); }, l);
@@ -32,6 +38,10 @@ inline float light_power(const Light& l) {
 inline float light_importance(const Light& l, const LightSampleContext& ctx) {
   return std::visit([&](const auto& x) { return x.importance(ctx); }, l);
 }
-inline bool light_is_delta(const Light& l) { return std::holds_alternative<PointLightSource>(l); }
+// Lights of a single point or direction: found only by sampling them, never by a ray.
+inline bool light_is_delta(const Light& l) {
+  return std::holds_alternative<PointLightSource>(l) || std::holds_alternative<SpotLightSource>(l) ||
+         std::holds_alternative<DistantLightSource>(l);
+}
 
 }  // namespace candela

@@ -1,8 +1,10 @@
 // Light sampling: the directions sample_li produces follow pdf_li (chi-square), and radiance/pdf is
-// consistent for area lights.
+// consistent for area lights; spot and distant lights deliver what pbrt-v4's do.
 #include "candela/lights/light.h"
 
 #include <gtest/gtest.h>
+
+#include "candela/io/error.h"
 
 #include "candela/sampling/rng.h"
 #include "candela/testing/statistics.h"
@@ -128,6 +130,97 @@ TEST(Lights, RectangleLightSamplesByAreaAndStratifies) {
   LightSample s = light.sample_li(ctx, {0.25f, 0.5f});
   EXPECT_NEAR(s.p_light.x, -0.5f, 1e-5f);
   EXPECT_NEAR(s.p_light.z, -0.25f, 1e-5f);
+}
+
+TEST(Lights, SpotLightFallsOffBetweenItsCones) {
+  SpotLight desc;
+  desc.position = {1, 2, 3};
+  desc.direction = {0, -2, 0};  // need not be unit
+  desc.intensity = RGB(4.0f, 2.0f, 1.0f);
+  desc.cone_angle = 30;
+  desc.cone_delta = 10;
+  SpotLightSource spot = make_spot_light(desc);
+  EXPECT_NEAR(spot.cos_falloff_start, std::cos(radians(20)), 1e-6f);
+  EXPECT_NEAR(spot.cos_falloff_end, std::cos(radians(30)), 1e-6f);
+  // A receiver at distance 2 from the light, at `degrees` from the axis.
+  auto received = [&](float degrees) {
+    Vec3 w(std::sin(radians(degrees)), -std::cos(radians(degrees)), 0);  // from the light
+    LightSampleContext ctx{desc.position + w * 2.0f, Normal3(0.0f)};
+    LightSample s = spot.sample_li(ctx, {0.5f, 0.5f});
+    if (s.pdf > 0) {
+      EXPECT_TRUE(s.is_delta);
+      EXPECT_FLOAT_EQ(s.pdf, 1);
+      EXPECT_NEAR(s.distance, 2, 1e-5f);
+      EXPECT_NEAR(length(s.wi + w), 0, 1e-5f);
+    }
+    return s.pdf > 0 ? s.radiance : RGB(0.0f);
+  };
+  // Full intensity / d^2 on the axis and inside the inner cone.
+  for (float deg : {0.0f, 10.0f, 19.9f}) EXPECT_NEAR(received(deg).r, 1.0f, 1e-4f) << deg;
+  // pbrt-v4's smoothstep in cos(theta) between the cones: 1/2 where cos is half-way.
+  float mid = std::acos(0.5f * (std::cos(radians(20)) + std::cos(radians(30)))) * 180 / kPi;
+  EXPECT_NEAR(received(mid).r, 0.5f, 1e-3f);
+  EXPECT_NEAR(received(mid).g, 0.25f, 1e-3f);
+  float at25 = received(25).r, t = (std::cos(radians(25)) - spot.cos_falloff_end) /
+                                   (spot.cos_falloff_start - spot.cos_falloff_end);
+  EXPECT_NEAR(at25, t * t * (3 - 2 * t), 1e-4f);
+  // Nothing at or outside the outer cone, nor behind.
+  for (float deg : {30.0f, 31.0f, 90.0f, 180.0f}) EXPECT_NEAR(received(deg).r, 0.0f, 1e-6f) << deg;
+  EXPECT_EQ(spot.pdf_li({}, {0, 1, 0}, {}, {}), 0);
+  // A sharp cone (cone_delta 0) is a step.
+  desc.cone_delta = 0;
+  SpotLightSource sharp = make_spot_light(desc);
+  EXPECT_EQ(sharp.falloff(normalize(Vec3(std::tan(radians(29.9f)), -1, 0))), 1.0f);
+  EXPECT_EQ(sharp.falloff(normalize(Vec3(std::tan(radians(30.1f)), -1, 0))), 0.0f);
+  desc.direction = Vec3(0.0f);
+  EXPECT_THROW(make_spot_light(desc), SceneError);
+}
+
+TEST(Lights, SpotLightPowerIsItsIntensityIntegratedOverTheSphere) {
+  SpotLight desc;
+  desc.direction = {1, 1, 0};
+  desc.intensity = RGB(2.0f);
+  desc.cone_angle = 50;
+  desc.cone_delta = 20;
+  SpotLightSource spot = make_spot_light(desc);
+  // Midpoint rule in cos(theta) about the axis (the falloff depends on nothing else).
+  double sum = 0;
+  const int n = 200000;
+  for (int i = 0; i < n; ++i) {
+    float c = -1 + 2 * (i + 0.5f) / n;
+    sum += SpotLightSource::smoothstep(c, spot.cos_falloff_end, spot.cos_falloff_start);
+  }
+  double integral = sum * 2.0 / n * 2 * kPi * desc.intensity.luminance();
+  EXPECT_NEAR(spot.power(), integral, 1e-4 * integral);
+  // pbrt-v4's closed form.
+  EXPECT_NEAR(spot.power(), 2.0f * 2 * kPi * (1 - 0.5f * (std::cos(radians(30)) + std::cos(radians(50)))), 1e-4f);
+}
+
+TEST(Lights, DistantLightArrivesFromOneDirection) {
+  DistantLightSource sun = make_distant_light(DistantLight{{0, -3, 0}, RGB(3.0f, 2.0f, 1.0f)}, 5.0f);
+  LightSampleContext ctx{{1, 2, 3}, {0, 1, 0}};
+  LightSample s = sun.sample_li(ctx, {0.3f, 0.7f});
+  EXPECT_NEAR(length(s.wi - Vec3(0, 1, 0)), 0, 1e-6f);
+  EXPECT_TRUE(std::isinf(s.distance));
+  EXPECT_TRUE(s.is_delta);
+  EXPECT_EQ(s.pdf, 1);
+  EXPECT_EQ(s.radiance, RGB(3.0f, 2.0f, 1.0f));
+  EXPECT_EQ(sun.pdf_li(ctx, s.wi, {}, {}), 0);
+  EXPECT_NEAR(sun.power(), kPi * 25 * RGB(3.0f, 2.0f, 1.0f).luminance(), 1e-3f);
+  // Importance is the irradiance E cos.
+  LightSampleContext tilted{{0, 0, 0}, normalize(Vec3(1, 1, 0))};
+  EXPECT_NEAR(sun.importance(tilted), RGB(3.0f, 2.0f, 1.0f).luminance() * std::sqrt(0.5f), 1e-5f);
+  EXPECT_THROW(make_distant_light(DistantLight{Vec3(0.0f), RGB(1.0f)}, 1), SceneError);
+}
+
+TEST(Lights, SpotAndDistantLightsAreDeltaLights) {
+  EXPECT_TRUE(light_is_delta(Light(PointLightSource{})));
+  EXPECT_TRUE(light_is_delta(Light(SpotLightSource{})));
+  EXPECT_TRUE(light_is_delta(Light(DistantLightSource{})));
+  EXPECT_FALSE(light_is_delta(Light(SkyLightSource{})));
+  Image img(2, 1);
+  img.set(0, 0, RGB(1.0f));
+  EXPECT_FALSE(light_is_delta(Light(EnvironmentLight(img, EnvironmentMapping::Equirectangular, RGB(1.0f), {}, 1))));
 }
 
 }  // namespace

@@ -1,24 +1,34 @@
 #pragma once
 // The BSDF contract. Every BSDF works in the local shading frame (normal = +z, directions point away
 // from the surface: wo towards the viewer, wi towards the light) and offers
-//   eval(wo, wi)            f(wo, wi) of the non-delta parts (without the cosine)
-//   pdf(wo, wi)             solid-angle density with which sample() produces wi (non-delta parts)
-//   sample(wo, u_lobe, u)   a direction with weight f |cos| / pdf, or nothing when the path is absorbed
-//   has_non_delta()         whether light sampling can help at all
-//   non_delta_probability() the probability that sample() picks a non-delta lobe; a BSDF picks its
-//                           non-delta lobes exactly when u_lobe < non_delta_probability(), which lets
-//                           the integrator swap in another direction-sampling strategy for them
+//   eval(wo, wi)                 f(wo, wi) of the non-delta parts (without the cosine)
+//   pdf(wo, wi)                  solid-angle density with which sample() produces wi (non-delta parts)
+//   sample(wo, u_lobe, u)        a direction with weight f |cos| / pdf, or nothing when the path is absorbed
+//   has_non_delta()              whether light sampling can help at all
+//   has_non_delta_transmission() whether the non-delta parts also scatter to the side opposite wo
+//                                (rough dielectrics, diffuse transmission): then light must be sampled,
+//                                and directions drawn, on both sides of the surface
+//   non_delta_probability(wo)    the probability that sample() picks a non-delta lobe for this wo; a
+//                                BSDF picks its non-delta lobes exactly when u_lobe < non_delta_probability(wo),
+//                                which lets the integrator swap in another direction-sampling strategy for them
+// Radiance-carrying (camera) paths are assumed: refraction scales radiance by 1 / eta^2, and
+// BsdfSample::eta reports the relative IOR crossed.
 // The closed list of BSDFs is the variant `Bsdf`; dispatch happens once, here.
 #include <optional>
 #include <variant>
 
+#include "candela/materials/coated_diffuse.h"
+#include "candela/materials/conductor.h"
+#include "candela/materials/dielectric.h"
 #include "candela/materials/diffuse.h"
+#include "candela/materials/diffuse_transmission.h"
 #include "candela/materials/phong.h"
 #include "candela/materials/specular.h"
 
 namespace candela {
 
-using Bsdf = std::variant<DiffuseBsdf, PhongBsdf, MirrorBsdf, GlassBsdf, BlackBsdf>;
+using Bsdf = std::variant<DiffuseBsdf, PhongBsdf, MirrorBsdf, DielectricBsdf, BlackBsdf, ConductorBsdf,
+                          CoatedDiffuseBsdf, DiffuseTransmissionBsdf>;
 
 inline RGB bsdf_eval(const Bsdf& b, const Vec3& wo, const Vec3& wi) {
   return std::visit([&](const auto& x) { return x.eval(wo, wi); }, b);
@@ -32,8 +42,11 @@ inline std::optional<BsdfSample> bsdf_sample(const Bsdf& b, const Vec3& wo, floa
 inline bool bsdf_has_non_delta(const Bsdf& b) {
   return std::visit([](const auto& x) { return x.has_non_delta(); }, b);
 }
-inline float bsdf_non_delta_probability(const Bsdf& b) {
-  return std::visit([](const auto& x) { return x.non_delta_probability(); }, b);
+inline bool bsdf_has_non_delta_transmission(const Bsdf& b) {
+  return std::visit([](const auto& x) { return x.has_non_delta_transmission(); }, b);
+}
+inline float bsdf_non_delta_probability(const Bsdf& b, const Vec3& wo) {
+  return std::visit([&](const auto& x) { return x.non_delta_probability(wo); }, b);
 }
 inline bool bsdf_is_black(const Bsdf& b) { return std::holds_alternative<BlackBsdf>(b); }
 

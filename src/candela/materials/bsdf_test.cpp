@@ -132,7 +132,7 @@ TEST(Bsdf, EnergyConservationAndReciprocity) {
 }
 
 TEST(Bsdf, GlassChoosesReflectionWithFresnelProbability) {
-  GlassBsdf g{1.5f, RGB(1.0f), RGB(1.0f)};
+  DielectricBsdf g{1.5f, RGB(1.0f), RGB(1.0f), {}};
   for (float theta : {0.0f, 45.0f, 75.0f}) {
     Vec3 wo = direction(theta);
     float F = fresnel_dielectric(wo.z, 1.5f);

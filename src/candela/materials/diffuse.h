@@ -24,7 +24,8 @@ struct DiffuseBsdf {
     return BsdfSample{wi, reflectance, p, false, 1};
   }
   bool has_non_delta() const { return true; }
-  float non_delta_probability() const { return 1; }
+  bool has_non_delta_transmission() const { return false; }
+  float non_delta_probability(const Vec3& /*wo*/) const { return 1; }
 };
 
 }  // namespace candela

@@ -61,7 +61,8 @@ struct PhongBsdf {
     return BsdfSample{wi, eval(wo, wi) * (abs_cos_theta(wi) / p), p, false, 1};
   }
   bool has_non_delta() const { return d > 0 || s > 0; }
-  float non_delta_probability() const { return d + s; }
+  bool has_non_delta_transmission() const { return false; }
+  float non_delta_probability(const Vec3& /*wo*/) const { return d + s; }
 };
 
 }  // namespace candela

@@ -1,5 +1,6 @@
 #pragma once
-// Ideal (delta) BSDFs: a mirror and a smooth dielectric interface, plus the absorbing black BSDF.
+// Ideal (delta) BSDFs: a mirror and the absorbing black BSDF, with the Fresnel and refraction helpers
+// that the dielectric BSDFs (dielectric.h) share.
 #include <optional>
 
 #include "candela/materials/bsdf_sample.h"
@@ -50,27 +51,8 @@ struct MirrorBsdf {
     return BsdfSample{reflect_local(wo), reflectance, 1, true, 1};
   }
   bool has_non_delta() const { return false; }
-  float non_delta_probability() const { return 0; }
-};
-
-// Glass: reflects with the Fresnel probability F, else refracts. Radiance is scaled by 1/eta^2 on
-// refraction (radiance compresses into the smaller solid angle in the denser medium).
-struct GlassBsdf {
-  float ior = 1.5f;
-  RGB reflectance{1.0f};
-  RGB transmittance{1.0f};
-  RGB eval(const Vec3&, const Vec3&) const { return RGB(0.0f); }
-  float pdf(const Vec3&, const Vec3&) const { return 0; }
-  std::optional<BsdfSample> sample(const Vec3& wo, float u_lobe, Vec2) const {
-    float f = fresnel_dielectric(wo.z, ior);
-    if (u_lobe < f) return BsdfSample{reflect_local(wo), reflectance, f, true, 1};
-    Vec3 wt;
-    float eta_rel;
-    if (!refract_local(wo, ior, wt, eta_rel)) return BsdfSample{reflect_local(wo), reflectance, 1, true, 1};
-    return BsdfSample{wt, transmittance / (eta_rel * eta_rel), 1 - f, true, eta_rel};
-  }
-  bool has_non_delta() const { return false; }
-  float non_delta_probability() const { return 0; }
+  bool has_non_delta_transmission() const { return false; }
+  float non_delta_probability(const Vec3&) const { return 0; }
 };
 
 struct BlackBsdf {
@@ -78,7 +60,8 @@ struct BlackBsdf {
   float pdf(const Vec3&, const Vec3&) const { return 0; }
   std::optional<BsdfSample> sample(const Vec3&, float, Vec2) const { return std::nullopt; }
   bool has_non_delta() const { return false; }
-  float non_delta_probability() const { return 0; }
+  bool has_non_delta_transmission() const { return false; }
+  float non_delta_probability(const Vec3&) const { return 0; }
 };
 
 }  // namespace candela

@@ -16,6 +16,18 @@ struct Frame {
     s = Vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
     t = Vec3(b, sign + n.y * n.y * a, -n.y);
   }
+  // The frame around `normal` whose first axis is `tangent` made orthogonal to it (Gram-Schmidt),
+  // so anisotropic BSDFs line up with the surface's u direction; any frame when tangent is unusable.
+  static Frame from_normal_tangent(const Vec3& normal, const Vec3& tangent) {
+    Vec3 s = tangent - normal * dot(normal, tangent);
+    float len2 = length_squared(s);
+    if (!(len2 > 1e-12f * length_squared(tangent)) || !std::isfinite(len2)) return Frame(normal);
+    Frame f;
+    f.n = normal;
+    f.s = s / std::sqrt(len2);
+    f.t = cross(normal, f.s);
+    return f;
+  }
   Vec3 to_local(const Vec3& v) const { return {dot(v, s), dot(v, t), dot(v, n)}; }
   Vec3 to_world(const Vec3& v) const { return s * v.x + t * v.y + n * v.z; }
 };

@@ -81,4 +81,47 @@ inline Vec2 square_to_uniform_triangle(Vec2 u) {
   return {b0, b1};
 }
 
+// Clarberg's equal-area mapping between the unit square and the sphere ("Fast Equal-Area Mapping of
+// the (Hemi)Sphere using SIMD", 2008), the parameterisation of pbrt-v4's image infinite lights.
+// With (u', v') = 2p - 1, the inner diamond |u'| + |v'| < 1 covers the +z hemisphere and the four
+// corner triangles fold over onto -z; the edges of the square fold onto themselves ((u', +-1) and
+// (-u', +-1) are one direction, as are (+-1, v') and (+-1, -v')). Equal areas of the square map to
+// equal solid angles, so a uniform point gives a uniform direction (pdf 1 / (4 pi)).
+inline Vec3 equal_area_square_to_sphere(Vec2 p) {
+  // Work in [-1,1]^2, folded into the first quadrant; the signs pick the quadrant back at the end.
+  float u = 2 * p.x - 1, v = 2 * p.y - 1;
+  float au = std::abs(u), av = std::abs(v);
+  // Signed distance from the diamond's edge: positive inside (+z). Its complement r is the radius of
+  // the ring of directions: concentric diamonds become circles of constant z = +-(1 - r^2).
+  float signed_distance = 1 - (au + av);
+  float r = 1 - std::abs(signed_distance);
+  // Position along the diamond ring, linear in the azimuth within the quadrant.
+  float phi = (r == 0 ? 1 : (av - au) / r + 1) * (kPi / 4);
+  float z = std::copysign(1 - r * r, signed_distance);
+  // sin(theta) = sqrt(1 - z^2) = r sqrt(2 - r^2).
+  float sin_theta = r * safe_sqrt(2 - r * r);
+  return {std::copysign(std::cos(phi), u) * sin_theta, std::copysign(std::sin(phi), v) * sin_theta, z};
+}
+
+// The inverse: a unit direction to its point in [0,1]^2.
+inline Vec2 equal_area_sphere_to_square(const Vec3& d) {
+  float ax = std::abs(d.x), ay = std::abs(d.y), az = std::abs(d.z);
+  // Ring radius from |z| (inverting |z| = 1 - r^2) and the azimuth within the quadrant as a
+  // fraction t of pi/2.
+  float r = safe_sqrt(1 - az);
+  float t = std::atan2(ay, ax) * (2 / kPi);
+  // Upper hemisphere: the point on the diamond |u'| + |v'| = r at fraction t along the ring.
+  float v = t * r;
+  float u = r - v;
+  // Lower hemisphere: fold the corner triangle out (reflect across the diamond's edge).
+  if (d.z < 0) {
+    float fu = 1 - v, fv = 1 - u;
+    u = fu;
+    v = fv;
+  }
+  u = std::copysign(u, d.x);
+  v = std::copysign(v, d.y);
+  return {0.5f * (u + 1), 0.5f * (v + 1)};
+}
+
 }  // namespace candela

@@ -2,24 +2,11 @@
 
 #include <cmath>
 
+#include "candela/film/image_io.h"
 #include "candela/io/error.h"
 
 namespace candela {
 namespace {
-
-Bsdf make_bsdf(const MaterialDesc& desc) {
-  return std::visit(
-      [](const auto& m) -> Bsdf {
-        using T = std::decay_t<decltype(m)>;
-        if constexpr (std::is_same_v<T, DiffuseMaterial>) return DiffuseBsdf{m.reflectance};
-        else if constexpr (std::is_same_v<T, PhongMaterial>)
-          return PhongBsdf{m.diffuse, m.specular, m.exponent, m.transmission, m.ior, m.d, m.s, m.t};
-        else if constexpr (std::is_same_v<T, MirrorMaterial>) return MirrorBsdf{m.reflectance};
-        else if constexpr (std::is_same_v<T, DielectricMaterial>) return GlassBsdf{m.ior, m.reflectance, m.transmittance};
-        else return BlackBsdf{};
-      },
-      desc);
-}
 
 TriangleMesh box_mesh(const BoxShape& box) {
   TriangleMesh m;
@@ -62,11 +49,10 @@ std::vector<Normal3> world_normals(const std::vector<Normal3>& normals, const Tr
 Scene::Scene(const SceneDesc& desc)
     : source_file_(desc.source_file.empty() ? "scene" : desc.source_file),
       embree_(desc.transform_start_time, desc.transform_end_time) {
-  for (const auto& m : desc.materials) materials_.push_back(make_bsdf(m));
-  materials_.push_back(DiffuseBsdf{RGB(0.5f)});  // the default material, index materials.size()
-  int material_count = int(desc.materials.size());
-
-  for (size_t i = 0; i < desc.shapes.size(); ++i) add_shape(desc.shapes[i], i, material_count);
+  textures_ = TextureSet(desc.textures);
+  materials_ = MaterialTable(desc.materials, textures_);
+  for (size_t i = 0; i < desc.shapes.size(); ++i) add_shape(desc.shapes[i], i);
+  add_objects_and_instances(desc);
 
   // Infinite planes get finite bounds far beyond everything else.
   float scene_size = bounds_.empty() ? 1.0f : std::max(1.0f, length(bounds_.diagonal()));
@@ -79,9 +65,21 @@ Scene::Scene(const SceneDesc& desc)
     if (const auto* p = std::get_if<PointLight>(&l)) {
       lights_.push_back(PointLightSource{p->position, p->intensity});
     } else if (const auto* s = std::get_if<SkyLight>(&l)) {
-      if (sky_light_ >= 0) throw SceneError(fmt::format("{}: only one sky light is supported", source_file_));
-      sky_light_ = int(lights_.size());
+      infinite_lights_.push_back(uint32_t(lights_.size()));
       lights_.push_back(SkyLightSource{s->zenith, s->horizon, s->ground, normalize(s->up), radius});
+    } else if (const auto* spot = std::get_if<SpotLight>(&l)) {
+      lights_.push_back(make_spot_light(*spot));
+    } else if (const auto* distant = std::get_if<DistantLight>(&l)) {
+      lights_.push_back(make_distant_light(*distant, radius));
+    } else if (const auto* env = std::get_if<EnvironmentMap>(&l)) {
+      Image image;
+      try {
+        image = read_image(env->filename);
+      } catch (const std::exception& e) {
+        throw SceneError(fmt::format("{}: environment map: {}", source_file_, e.what()));
+      }
+      infinite_lights_.push_back(uint32_t(lights_.size()));
+      lights_.push_back(EnvironmentLight(image, env->mapping, env->scale, env->to_world, radius));
     }
   }
 
@@ -93,10 +91,59 @@ Scene::Scene(const SceneDesc& desc)
   camera_ = PerspectiveCamera(desc.camera, w, h);
 }
 
-void Scene::add_shape(const ShapeDesc& desc, size_t index, int material_count) {
+void Scene::add_objects_and_instances(const SceneDesc& desc) {
+  // Each object becomes one Embree scene; its shapes' records stay in object space.
+  std::vector<int> embree_objects;
+  std::vector<Bounds3> object_bounds;
+  Bounds3 world_bounds = bounds_;
+  for (size_t o = 0; o < desc.objects.size(); ++o) {
+    const ObjectDesc& object = desc.objects[o];
+    std::string label = object.name.empty() ? fmt::format("object {}", o) : fmt::format("object \"{}\"", object.name);
+    bounds_ = Bounds3();
+    embree_objects.push_back(embree_.add_object());
+    for (size_t i = 0; i < object.shapes.size(); ++i) {
+      const ShapeDesc& shape = object.shapes[i];
+      std::string what = fmt::format("{}: {}", label, shape_label(shape, i));
+      if (shape.emission)
+        throw SceneError(fmt::format("{}: {}: emissive shapes cannot be instanced", source_file_, what));
+      if (moving_end_transform(shape))
+        throw SceneError(fmt::format("{}: {}: shapes inside an object cannot move (move the instance instead)",
+                                     source_file_, what));
+      if (std::holds_alternative<PlaneShape>(shape.geometry))
+        throw SceneError(fmt::format("{}: {}: an infinite plane cannot be instanced", source_file_, what));
+      add_shape(shape, i, embree_objects.back());
+    }
+    object_bounds.push_back(bounds_);
+  }
+  bounds_ = world_bounds;
+
+  // Instances go into the world under ids above every shape's.
+  const uint32_t first_id = uint32_t(shapes_.size());
+  for (size_t i = 0; i < desc.instances.size(); ++i) {
+    const InstanceDesc& inst = desc.instances[i];
+    if (inst.object < 0 || size_t(inst.object) >= desc.objects.size())
+      throw SceneError(fmt::format("{}: instance {} refers to object {}, which does not exist", source_file_, i,
+                                   inst.object));
+    const Transform* end = inst.to_world_end && *inst.to_world_end != inst.to_world ? &*inst.to_world_end : nullptr;
+    if (end && end->swaps_handedness() != inst.to_world.swaps_handedness())
+      throw SceneError(fmt::format("{}: instance {}: the end transform mirrors it relative to the start transform",
+                                   source_file_, i));
+    instances_.push_back({inst.to_world, end ? std::optional<Transform>(*end) : std::nullopt});
+    embree_.add_instance(first_id + uint32_t(i), embree_objects[size_t(inst.object)], inst.to_world, end);
+    const Bounds3& ob = object_bounds[size_t(inst.object)];
+    if (ob.empty()) continue;
+    for (const Transform* T : {&inst.to_world, end})
+      if (T)
+        for (int c = 0; c < 8; ++c)
+          bounds_.extend(T->point({c & 1 ? ob.hi.x : ob.lo.x, c & 2 ? ob.hi.y : ob.lo.y, c & 4 ? ob.hi.z : ob.lo.z}));
+  }
+}
+
+void Scene::add_shape(const ShapeDesc& desc, size_t index, int object) {
   ShapeRecord rec;
   rec.name = shape_label(desc, index);
-  rec.material = uint32_t(desc.material >= 0 && desc.material < material_count ? desc.material : material_count);
+  rec.material = desc.material >= 0 && size_t(desc.material) < materials_.size() - 1 ? uint32_t(desc.material)
+                                                                                    : materials_.default_material();
   rec.flip_normal = desc.reverse_orientation;
   const Transform& T = desc.to_world;
   const Transform* T_end = moving_end_transform(desc);
@@ -106,7 +153,7 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int material_count) {
                                  source_file_, rec.name));
 
   if (const auto* s = std::get_if<SphereShape>(&desc.geometry)) {
-    add_sphere(std::move(rec), *s, T, T_end, desc.reverse_orientation, desc.emission);
+    add_sphere(std::move(rec), *s, T, T_end, desc.reverse_orientation, desc.emission, object);
     return;
   }
   if (const auto* p = std::get_if<PlaneShape>(&desc.geometry)) {
@@ -127,11 +174,11 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int material_count) {
   else if (const auto* r = std::get_if<RectangleShape>(&desc.geometry)) mesh = rectangle_mesh(*r);
   else mesh = std::get<MeshShape>(desc.geometry).mesh;
   add_triangles(std::move(rec), mesh, T, T_end, desc.reverse_orientation, desc.emission,
-                std::holds_alternative<RectangleShape>(desc.geometry));
+                std::holds_alternative<RectangleShape>(desc.geometry), object);
 }
 
 void Scene::add_sphere(ShapeRecord rec, const SphereShape& s, const Transform& T, const Transform* T_end,
-                       bool reverse, const std::optional<AreaEmission>& emission) {
+                       bool reverse, const std::optional<AreaEmission>& emission, int object) {
   rec.kind = ShapeRecord::Kind::Sphere;
   rec.sphere = SphereGeometry{T, s.center, s.radius, T_end ? std::optional<Transform>(*T_end) : std::nullopt};
   for (const Transform* X : {&T, T_end})
@@ -149,12 +196,13 @@ void Scene::add_sphere(ShapeRecord rec, const SphereShape& s, const Transform& T
     rec.two_sided_emission = emission->two_sided;
     lights_.push_back(SphereLight{T.point(s.center), s.radius * lx, rec.radiance, rec.two_sided_emission, reverse});
   }
-  embree_.add_sphere(uint32_t(shapes_.size()), rec.sphere);
+  embree_.add_sphere(uint32_t(shapes_.size()), rec.sphere, object);
   shapes_.push_back(std::move(rec));
 }
 
 void Scene::add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Transform& T, const Transform* T_end,
-                          bool reverse, const std::optional<AreaEmission>& emission, bool rectangle) {
+                          bool reverse, const std::optional<AreaEmission>& emission, bool rectangle,
+                          int object) {
   rec.kind = ShapeRecord::Kind::Triangles;
   rec.positions.reserve(mesh.positions.size());
   for (const auto& p : mesh.positions) {
@@ -217,18 +265,33 @@ void Scene::add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Trans
     if (rec.is_moving())
       embree_.add_moving_triangles(uint32_t(shapes_.size()), rec.positions, rec.positions_end, rec.indices);
     else
-      embree_.add_triangles(uint32_t(shapes_.size()), rec.positions, rec.indices);
+      embree_.add_triangles(uint32_t(shapes_.size()), rec.positions, rec.indices, object);
   }
   shapes_.push_back(std::move(rec));
 }
 
-bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {
+bool Scene::intersect(const Ray& world_ray, SurfaceHit& hit) const {
   EmbreeHit eh;
-  if (!embree_.intersect(ray, eh)) return false;
+  if (!embree_.intersect(world_ray, eh)) return false;
   const ShapeRecord& rec = shapes_[eh.geometry];
   hit.t = eh.t;
   hit.shape = eh.geometry;
   hit.primitive = eh.primitive;
+  // A hit through an instance is reconstructed in object space, then placed in the world.
+  const Transform* instance_to_world = nullptr;
+  std::optional<Transform> at_time;
+  Ray ray = world_ray;
+  if (eh.instance >= 0) {
+    const InstanceRecord& inst = instances_[size_t(eh.instance)];
+    instance_to_world = &inst.to_world;
+    if (inst.to_world_end) {
+      at_time = interpolate_transform(inst.to_world, *inst.to_world_end, embree_.normalized_time(ray.time));
+      if (at_time) instance_to_world = &*at_time;
+    }
+    const Transform& to_object = instance_to_world->inverse();
+    ray.origin = to_object.point(world_ray.origin);
+    ray.direction = to_object.vector(world_ray.direction);  // not normalised: t stays the world's
+  }
   switch (rec.kind) {
     case ShapeRecord::Kind::Triangles:
       reconstruct_triangle_hit(rec, eh, ray.time, hit);
@@ -241,8 +304,16 @@ bool Scene::intersect(const Ray& ray, SurfaceHit& hit) const {
       hit.ng = rec.flip_normal ? -rec.plane.normal : rec.plane.normal;
       hit.ns = hit.ng;
       hit.uv = {0, 0};
+      hit.dpdu = Vec3(0.0f);
       break;
     }
+  }
+  if (instance_to_world) {
+    const Transform& T = *instance_to_world;
+    hit.p = T.point(hit.p);
+    hit.ng = normalize(T.normal(hit.ng));
+    hit.ns = normalize(T.normal(hit.ns));
+    hit.dpdu = T.vector(hit.dpdu);
   }
   return true;
 }
@@ -276,7 +347,17 @@ void Scene::reconstruct_triangle_hit(const ShapeRecord& rec, const EmbreeHit& eh
   } else {
     hit.ns = hit.ng;
   }
-  hit.uv = rec.uvs.empty() ? Vec2(eh.u, eh.v) : rec.uvs[i0] * b0 + rec.uvs[i1] * eh.u + rec.uvs[i2] * eh.v;
+  if (rec.uvs.empty()) {
+    hit.uv = Vec2(eh.u, eh.v);
+    hit.dpdu = p1 - p0;
+  } else {
+    const Vec2 &uv0 = rec.uvs[i0], &uv1 = rec.uvs[i1], &uv2 = rec.uvs[i2];
+    hit.uv = uv0 * b0 + uv1 * eh.u + uv2 * eh.v;
+    // dp/du from the triangle's uv parameterisation (pbrt-v4's Triangle::InteractionFromIntersection).
+    Vec2 duv02 = uv0 - uv2, duv12 = uv1 - uv2;
+    float det = duv02.x * duv12.y - duv02.y * duv12.x;
+    hit.dpdu = std::abs(det) > 1e-12f ? ((p0 - p2) * duv12.y - (p1 - p2) * duv02.y) / det : p1 - p0;
+  }
 }
 
 void Scene::reconstruct_sphere_hit(const ShapeRecord& rec, const Ray& ray, float t, SurfaceHit& hit) const {
@@ -300,6 +381,7 @@ void Scene::reconstruct_sphere_hit(const ShapeRecord& rec, const Ray& ray, float
   float phi = std::atan2(po.y, po.x);
   if (phi < 0) phi += 2 * kPi;
   hit.uv = {phi * kInv2Pi, std::acos(std::clamp(po.z / s.radius, -1.0f, 1.0f)) * kInvPi};
+  hit.dpdu = to_world->vector(Vec3(-po.y, po.x, 0) * (2 * kPi));
 }
 
 RGB Scene::emitted(const SurfaceHit& hit, const Vec3& wo) const {

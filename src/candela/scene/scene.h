@@ -9,9 +9,10 @@
 #include "candela/geometry/embree_scene.h"
 #include "candela/geometry/surface_hit.h"
 #include "candela/lights/light.h"
-#include "candela/materials/bsdf.h"
+#include "candela/materials/material.h"
 #include "candela/sampling/distribution1d.h"
 #include "candela/scene/description.h"
+#include "candela/textures/texture.h"
 
 namespace candela {
 
@@ -49,7 +50,12 @@ class Scene {
   bool occluded(const Ray& ray) const { return embree_.occluded(ray); }
 
   const ShapeRecord& shape(const SurfaceHit& hit) const { return shapes_[hit.shape]; }
-  const Bsdf& bsdf(const SurfaceHit& hit) const { return materials_[shapes_[hit.shape].material]; }
+  // The BSDF at the hit, its textured inputs evaluated there.
+  Bsdf bsdf(const SurfaceHit& hit) const {
+    return materials_.bsdf(shapes_[hit.shape].material, TextureEvalContext{hit.p, hit.uv});
+  }
+  // Whether the surface hit is an interface without a surface of its own (rays pass through).
+  bool is_interface(const SurfaceHit& hit) const { return materials_.is_interface(shapes_[hit.shape].material); }
   // Radiance emitted from the hit point towards wo (zero for non-emitters and their back faces).
   RGB emitted(const SurfaceHit& hit, const Vec3& wo) const;
   // The light of an emissive hit, or -1.
@@ -57,28 +63,45 @@ class Scene {
 
   const std::vector<Light>& lights() const { return lights_; }
   const Distribution1D& light_distribution() const { return light_distribution_; }
-  int sky_light() const { return sky_light_; }  // index into lights(), or -1
+  // The lights at infinity (sky, environment maps) that rays escaping the scene see: indices into lights().
+  const std::vector<uint32_t>& infinite_lights() const { return infinite_lights_; }
+  // Radiance an escaping ray travelling along `dir` receives from infinite light `light`.
+  RGB escaped_radiance(uint32_t light, const Vec3& dir) const {
+    const Light& l = lights_[light];
+    if (const auto* env = std::get_if<EnvironmentLight>(&l)) return env->radiance(dir);
+    return std::get<SkyLightSource>(l).radiance(dir);
+  }
   const PerspectiveCamera& camera() const { return camera_; }
   const Bounds3& bounds() const { return bounds_; }
   size_t triangle_count() const { return triangle_count_; }
 
  private:
-  void add_shape(const ShapeDesc& desc, size_t index, int material_count);
+  // `object`: the Embree object the shape goes into (-1 = the world); object shapes keep their
+  // object-space coordinates and are placed by instances.
+  void add_shape(const ShapeDesc& desc, size_t index, int object = -1);
+  void add_objects_and_instances(const SceneDesc& desc);
   void add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Transform& to_world,
                      const Transform* to_world_end, bool reverse, const std::optional<AreaEmission>& emission,
-                     bool rectangle);  // rectangle: one RectangleLight instead of a light per triangle
+                     bool rectangle, int object);  // rectangle: one RectangleLight instead of a light per triangle
   void add_sphere(ShapeRecord rec, const SphereShape& sphere, const Transform& to_world,
-                  const Transform* to_world_end, bool reverse, const std::optional<AreaEmission>& emission);
+                  const Transform* to_world_end, bool reverse, const std::optional<AreaEmission>& emission,
+                  int object);
   void reconstruct_triangle_hit(const ShapeRecord& rec, const EmbreeHit& eh, float time, SurfaceHit& hit) const;
   void reconstruct_sphere_hit(const ShapeRecord& rec, const Ray& ray, float t, SurfaceHit& hit) const;
 
   std::string source_file_;  // for messages
   EmbreeScene embree_;
-  std::vector<ShapeRecord> shapes_;  // indexed by Embree geometry id
-  std::vector<Bsdf> materials_;
+  std::vector<ShapeRecord> shapes_;  // indexed by Embree geometry id (world and object shapes alike)
+  struct InstanceRecord {
+    Transform to_world;
+    std::optional<Transform> to_world_end;
+  };
+  std::vector<InstanceRecord> instances_;  // indexed by EmbreeHit::instance
+  TextureSet textures_;
+  MaterialTable materials_;  // refers to textures_
   std::vector<Light> lights_;
   Distribution1D light_distribution_;
-  int sky_light_ = -1;
+  std::vector<uint32_t> infinite_lights_;
   PerspectiveCamera camera_;
   Bounds3 bounds_;
   size_t triangle_count_ = 0;

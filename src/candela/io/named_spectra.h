@@ -1,0 +1,47 @@
+#pragma once
+// pbrt-v4's spectral values as candela's RGB: its built-in named spectra ("metal-Cu-eta",
+// "glass-BK7", "stdillum-D65", ...), blackbody emitters, and spectra written inline as
+// (wavelength, value) pairs. The tables and the conversions are documented in docs/pbrt-format.md
+// ("Spectra").
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "candela/math/color.h"
+
+namespace candela::pbrt_spectra {
+
+// What a spectrum describes decides how it becomes RGB.
+enum class Role {
+  Reflectance,  // an albedo in [0, 1]: weighted so that a constant spectrum keeps its value
+  Unbounded,    // an optical constant (a conductor's eta or k)
+  Illuminant    // emission: normalised to luminance 1, as pbrt-v4 normalises every light spectrum
+};
+
+// A built-in named spectrum. `kind` says which family it belongs to.
+enum class NamedKind { Metal, Glass, Illuminant };
+struct NamedSpectrum {
+  NamedKind kind;
+  RGB rgb;          // metals: eta or k per channel; illuminants: luminance 1; glasses: the IOR in all three
+  float ior_550nm;  // glasses: the refractive index at 550 nm; others: rgb.g
+};
+std::optional<NamedSpectrum> find_named(std::string_view name);
+
+// Every name find_named() knows, for messages.
+const std::vector<std::string_view>& named_spectrum_names();
+
+// A blackbody emitter at `kelvin`, as linear sRGB with luminance 1 (pbrt-v4 normalises a light's
+// spectrum to one nit before "scale" and "power" apply).
+RGB blackbody_rgb(float kelvin);
+
+// A spectrum written as (wavelength in nm, value) pairs, increasing in wavelength.
+RGB sampled_spectrum_rgb(std::span<const double> pairs, Role role);
+// Its value at `lambda` nm (linear interpolation, constant beyond the ends).
+float sampled_spectrum_at(std::span<const double> pairs, float lambda);
+
+// CIE 1931 XYZ (Y = luminance) to linear sRGB (Rec. 709 primaries, D65 white).
+RGB xyz_to_linear_srgb(float x, float y, float z);
+
+}  // namespace candela::pbrt_spectra

@@ -1,0 +1,230 @@
+#include "candela/lights/environment_light.h"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+#include <vector>
+
+#include "candela/film/image_io.h"
+#include "candela/io/error.h"
+#include "candela/sampling/distribution2d.h"
+#include "candela/sampling/warp.h"
+
+namespace candela {
+
+namespace {
+
+// The upper-left 3x3 of a 4x4 matrix, in float.
+std::array<Vec3, 3> rows_of(const Matrix4& m) {
+  std::array<Vec3, 3> r;
+  for (int i = 0; i < 3; ++i) r[size_t(i)] = Vec3(float(m.m[i][0]), float(m.m[i][1]), float(m.m[i][2]));
+  return r;
+}
+
+Vec3 apply(const std::array<Vec3, 3>& rows, const Vec3& v) {
+  return {dot(rows[0], v), dot(rows[1], v), dot(rows[2], v)};
+}
+
+float non_negative(float v) { return v > 0 && std::isfinite(v) ? v : 0.0f; }
+
+}  // namespace
+
+struct EnvironmentLight::Data {
+  int width = 0, height = 0;
+  EnvironmentMapping mapping = EnvironmentMapping::Equirectangular;
+  std::vector<RGB> texels;  // scaled, row-major, top row first
+  Distribution2D distribution;
+  std::array<Vec3, 3> world_from_light, light_from_world;
+  float scene_radius = 1;
+  float average_luminance = 0;
+
+  // The texel at integer coordinates one step outside the image at most, wrapped as the mapping
+  // continues across the image's edges.
+  const RGB& texel(int x, int y) const {
+    if (mapping == EnvironmentMapping::Equirectangular) {
+      // Periodic in phi; the top and bottom rows extend to the poles.
+      x = x < 0 ? x + width : (x >= width ? x - width : x);
+      y = std::clamp(y, 0, height - 1);
+    } else {
+      // The square's edges fold onto themselves: across the left or right edge lies the same
+      // column mirrored top to bottom, across the top or bottom edge the same row mirrored left to
+      // right (pbrt-v4's OctahedralSphere wrap, mirrored about the edge itself).
+      if (x < 0 || x >= width) {
+        x = x < 0 ? -1 - x : 2 * width - 1 - x;
+        y = height - 1 - y;
+      }
+      if (y < 0 || y >= height) {
+        y = y < 0 ? -1 - y : 2 * height - 1 - y;
+        x = width - 1 - x;
+      }
+      x = std::clamp(x, 0, width - 1);
+      y = std::clamp(y, 0, height - 1);
+    }
+    return texels[size_t(y) * size_t(width) + size_t(x)];
+  }
+
+  RGB bilinear(Vec2 uv) const {
+    // Continuous pixel coordinates with texel centres at integers.
+    float x = uv.x * float(width) - 0.5f, y = uv.y * float(height) - 0.5f;
+    float fx0 = std::floor(x), fy0 = std::floor(y);
+    float dx = x - fx0, dy = y - fy0;
+    int x0 = std::clamp(int(fx0), -1, width - 1), y0 = std::clamp(int(fy0), -1, height - 1);
+    return (texel(x0, y0) * (1 - dx) + texel(x0 + 1, y0) * dx) * (1 - dy) +
+           (texel(x0, y0 + 1) * (1 - dx) + texel(x0 + 1, y0 + 1) * dx) * dy;
+  }
+
+  Vec2 direction_to_uv(const Vec3& d) const {
+    if (mapping == EnvironmentMapping::EqualAreaOctahedral) return equal_area_sphere_to_square(d);
+    // Invert (sin(theta) sin(phi), cos(theta), -sin(theta) cos(phi)).
+    float u = std::atan2(d.x, -d.z) * kInv2Pi;
+    if (u < 0) u += 1;
+    float v = std::acos(std::clamp(d.y, -1.0f, 1.0f)) * kInvPi;
+    return {u, v};
+  }
+  Vec3 uv_to_direction(Vec2 uv) const {
+    if (mapping == EnvironmentMapping::EqualAreaOctahedral) return equal_area_square_to_sphere(uv);
+    float phi = 2 * kPi * uv.x, theta = kPi * uv.y;
+    float sin_theta = std::sin(theta);
+    return {sin_theta * std::sin(phi), std::cos(theta), -sin_theta * std::cos(phi)};
+  }
+  // Converts a density over (u, v) into one over solid angle at the local direction d.
+  float solid_angle_pdf(float pdf_uv, const Vec3& d) const {
+    if (mapping == EnvironmentMapping::EqualAreaOctahedral) return pdf_uv * kInv4Pi;
+    // d(omega) = sin(theta) dtheta dphi = 2 pi^2 sin(theta) du dv; the poles have no density.
+    float sin_theta = std::sqrt(d.x * d.x + d.z * d.z);
+    return sin_theta > 0 ? pdf_uv / (2 * kPi * kPi * sin_theta) : 0.0f;
+  }
+};
+
+EnvironmentLight::EnvironmentLight(const Image& image, EnvironmentMapping mapping, const RGB& scale,
+                                   const Transform& world_from_light, float scene_radius) {
+  if (image.width <= 0 || image.height <= 0 || image.rgb.size() < size_t(image.width) * size_t(image.height) * 3)
+    throw SceneError("environment map: the image is empty");
+  if (mapping == EnvironmentMapping::EqualAreaOctahedral && image.width != image.height)
+    throw SceneError(fmt::format("environment map: an equal-area octahedral map must be square, not {}x{}",
+                                 image.width, image.height));
+  auto d = std::make_shared<Data>();
+  const int w = image.width, h = image.height;
+  d->width = w;
+  d->height = h;
+  d->mapping = mapping;
+  d->scene_radius = scene_radius;
+  d->world_from_light = rows_of(world_from_light.matrix());
+  d->light_from_world = rows_of(world_from_light.inverse_matrix());
+  d->texels.resize(size_t(w) * size_t(h));
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      RGB c = image.at(x, y);
+      RGB s = RGB(non_negative(c.r), non_negative(c.g), non_negative(c.b)) * scale;
+      d->texels[size_t(y) * size_t(w) + size_t(x)] = RGB(non_negative(s.r), non_negative(s.g), non_negative(s.b));
+    }
+
+  // Sampling weights. Over a pixel the bilinear radiance averages to the separable [1 6 1] / 8
+  // filter of the texels (a neighbour's tent reaches halfway into the pixel with 1/8 of its area),
+  // so a pixel's weight is the luminance of that average, with the same wrapping as lookups, times
+  // the pixel's solid angle: positive wherever the radiance is, however dark the pixel's own texel.
+  std::vector<float> weights(size_t(w) * size_t(h));
+  const float k[3] = {0.125f, 0.75f, 0.125f};
+  constexpr double pi = std::numbers::pi;
+  double integral = 0;  // of the luminance over solid angle
+  for (int y = 0; y < h; ++y) {
+    // The pixel's share of the sphere's solid angle (4 pi in all).
+    double pixel_solid_angle;
+    if (mapping == EnvironmentMapping::Equirectangular)
+      pixel_solid_angle = 2 * pi / w * (std::cos(pi * y / h) - std::cos(pi * (y + 1) / h));
+    else
+      pixel_solid_angle = 4 * pi / (double(w) * h);
+    for (int x = 0; x < w; ++x) {
+      double lum = 0;
+      for (int j = -1; j <= 1; ++j)
+        for (int i = -1; i <= 1; ++i) lum += k[i + 1] * k[j + 1] * d->texel(x + i, y + j).luminance();
+      integral += lum * pixel_solid_angle;
+      // For equirectangular maps the density over (u, v) should follow L sin(theta): use the exact
+      // solid angle of the pixel's row, which stays positive in the polar rows.
+      weights[size_t(y) * size_t(w) + size_t(x)] = float(lum * pixel_solid_angle);
+    }
+  }
+  // A floor under every pixel that has any radiance, so that in a map with a very bright sun the
+  // float CDF still resolves the dim pixels (any positive floor keeps the estimator unbiased).
+  double mean_weight = 0;
+  for (float wt : weights) mean_weight += wt;
+  mean_weight /= double(weights.size());
+  for (float& wt : weights)
+    if (wt > 0) wt = std::max(wt, float(1e-3 * mean_weight));
+  d->distribution = Distribution2D(weights, w, h);
+  d->average_luminance = float(integral / (4 * pi));
+  data_ = std::move(d);
+}
+
+EnvironmentMapping EnvironmentLight::mapping() const { return data_->mapping; }
+Vec2 EnvironmentLight::direction_to_uv(const Vec3& local_dir) const { return data_->direction_to_uv(local_dir); }
+Vec3 EnvironmentLight::uv_to_direction(Vec2 uv) const { return data_->uv_to_direction(uv); }
+Vec3 EnvironmentLight::to_local(const Vec3& world_dir) const {
+  return normalize(apply(data_->light_from_world, world_dir));
+}
+Vec3 EnvironmentLight::to_world(const Vec3& local_dir) const {
+  return normalize(apply(data_->world_from_light, local_dir));
+}
+RGB EnvironmentLight::lookup(Vec2 uv) const { return data_->bilinear(uv); }
+float EnvironmentLight::average_luminance() const { return data_->average_luminance; }
+
+RGB EnvironmentLight::radiance(const Vec3& world_dir) const {
+  Vec3 local = to_local(world_dir);
+  if (!is_finite(local)) return RGB(0.0f);
+  return data_->bilinear(data_->direction_to_uv(local));
+}
+
+LightSample EnvironmentLight::sample_li(const LightSampleContext& ctx, Vec2 u) const {
+  const Data& d = *data_;
+  // Pick a pixel by the 2D distribution and a point uniformly inside it, then map it to the sphere.
+  Distribution2DSample s = d.distribution.sample(u);
+  if (!(s.pdf > 0)) return {};
+  Vec3 local = d.uv_to_direction(s.point);
+  // Convert the density over the image to one over solid angle.
+  float pdf = d.solid_angle_pdf(s.pdf, local);
+  if (!(pdf > 0) || !std::isfinite(pdf)) return {};
+  Vec3 wi = to_world(local);
+  LightSample ls;
+  ls.radiance = d.bilinear(s.point);
+  ls.wi = wi;
+  ls.distance = std::numeric_limits<float>::infinity();
+  ls.pdf = pdf;
+  ls.p_light = ctx.p + wi * (2 * d.scene_radius);  // stands in for "infinitely far", as pbrt-v4
+  ls.n_light = -wi;
+  return ls;
+}
+
+float EnvironmentLight::pdf_li(const LightSampleContext&, const Vec3& wi, const Point3&, const Normal3&) const {
+  const Data& d = *data_;
+  Vec3 local = to_local(wi);
+  if (!is_finite(local)) return 0;
+  return d.solid_angle_pdf(d.distribution.pdf(d.direction_to_uv(local)), local);
+}
+
+float EnvironmentLight::power() const {
+  const Data& d = *data_;
+  return kPi * d.scene_radius * d.scene_radius * 4 * kPi * d.average_luminance;
+}
+
+float EnvironmentLight::importance(const LightSampleContext&) const { return kPi * data_->average_luminance; }
+
+EnvironmentLight make_environment_light(const EnvironmentMap& desc, float scene_radius) {
+  Image image;
+  try {
+    image = read_image(desc.filename);
+  } catch (const std::exception& e) {
+    // read_image's message names the file already.
+    throw SceneError(fmt::format("environment map: {}", e.what()));
+  }
+  try {
+    return EnvironmentLight(image, desc.mapping, desc.scale, desc.to_world, scene_radius);
+  } catch (const SceneError& e) {
+    throw SceneError(fmt::format("{}: {}", desc.filename, e.what()));
+  }
+}
+
+}  // namespace candela

@@ -1,0 +1,206 @@
+#pragma once
+// Microfacet theory for the rough BSDFs (pbrt-v4 sec. 9.6): the anisotropic Trowbridge-Reitz (GGX)
+// distribution of microfacet normals with the height-correlated Smith masking-shadowing function and
+// Heitz's visible-normal sampling, plus the Fresnel equations of conductors and the hemispherical
+// average of dielectric Fresnel reflectance that the coated BSDFs need.
+//
+// All directions are in the local shading frame (macro-normal = +z); microfacet normals wm are in the
+// upper hemisphere. alpha_x / alpha_y are the roughness along the frame's x (surface u) and y axes.
+#include <complex>
+
+#include "candela/materials/bsdf_sample.h"
+#include "candela/math/color.h"
+#include "candela/math/vec.h"
+
+namespace candela {
+
+// Spherical-coordinate helpers of a unit direction in the local frame.
+inline float cos2_theta(const Vec3& w) { return w.z * w.z; }
+inline float sin2_theta(const Vec3& w) { return std::max(0.0f, 1 - cos2_theta(w)); }
+inline float tan2_theta(const Vec3& w) { return sin2_theta(w) / cos2_theta(w); }
+inline float cos_phi(const Vec3& w) {
+  float sin_theta = std::sqrt(sin2_theta(w));
+  return sin_theta == 0 ? 1.0f : std::clamp(w.x / sin_theta, -1.0f, 1.0f);
+}
+inline float sin_phi(const Vec3& w) {
+  float sin_theta = std::sqrt(sin2_theta(w));
+  return sin_theta == 0 ? 0.0f : std::clamp(w.y / sin_theta, -1.0f, 1.0f);
+}
+
+// Mirror reflection of w about the (unit) microfacet normal n: -w + 2 (w.n) n.
+inline Vec3 reflect_about(const Vec3& w, const Vec3& n) { return -w + n * (2 * dot(w, n)); }
+
+// Refraction of w (pointing away from the surface) through a facet with normal n, where eta is
+// n_below / n_above relative to n. Works from either side of n; returns false on total internal
+// reflection. etap receives the relative IOR actually crossed (eta, or 1/eta leaving "below").
+inline bool refract_about(const Vec3& w, Vec3 n, float eta, Vec3& wt, float& etap) {
+  float cos_i = dot(n, w);
+  if (cos_i < 0) {  // w is on the far side of n: swap the media
+    eta = 1 / eta;
+    cos_i = -cos_i;
+    n = -n;
+  }
+  float sin2_i = std::max(0.0f, 1 - cos_i * cos_i);
+  float sin2_t = sin2_i / (eta * eta);
+  if (sin2_t >= 1) return false;
+  float cos_t = safe_sqrt(1 - sin2_t);
+  wt = -w / eta + n * (cos_i / eta - cos_t);
+  etap = eta;
+  return true;
+}
+
+// The anisotropic Trowbridge-Reitz (GGX) microfacet distribution.
+struct TrowbridgeReitz {
+  float alpha_x = 0, alpha_y = 0;
+
+  TrowbridgeReitz() = default;
+  TrowbridgeReitz(float ax, float ay) : alpha_x(ax), alpha_y(ay) {}
+  explicit TrowbridgeReitz(float alpha) : alpha_x(alpha), alpha_y(alpha) {}
+
+  // pbrt-v4's mapping from the user-facing "roughness" to alpha.
+  static float roughness_to_alpha(float r) { return std::sqrt(r); }
+
+  // Below this roughness the lobes are narrower than anything float sampling resolves: treat the
+  // surface as a perfect (delta) interface, as pbrt-v4 does.
+  bool effectively_smooth() const { return std::max(alpha_x, alpha_y) < 1e-3f; }
+
+  // Distribution of microfacet normals D(wm), normalised so that the projected area is 1:
+  // integral of D(wm) cos(theta_m) dwm = 1.
+  float D(const Vec3& wm) const {
+    float tan2 = tan2_theta(wm);
+    if (std::isinf(tan2) || std::isnan(tan2)) return 0;
+    float cos4 = sqr(cos2_theta(wm));
+    if (cos4 < 1e-16f) return 0;
+    float e = tan2 * (sqr(cos_phi(wm) / alpha_x) + sqr(sin_phi(wm) / alpha_y));
+    return 1 / (kPi * alpha_x * alpha_y * cos4 * sqr(1 + e));
+  }
+
+  // Smith's auxiliary function: the masked microfacet area per visible area, for direction w.
+  float Lambda(const Vec3& w) const {
+    float tan2 = tan2_theta(w);
+    if (std::isinf(tan2) || std::isnan(tan2)) return 0;
+    // The roughness seen in w's azimuth.
+    float alpha2 = sqr(cos_phi(w) * alpha_x) + sqr(sin_phi(w) * alpha_y);
+    return (std::sqrt(1 + alpha2 * tan2) - 1) / 2;
+  }
+
+  // Masking: the fraction of microfacets visible from w.
+  float G1(const Vec3& w) const { return 1 / (1 + Lambda(w)); }
+
+  // Height-correlated masking-shadowing: microfacets visible from both wo and wi.
+  float G(const Vec3& wo, const Vec3& wi) const { return 1 / (1 + Lambda(wo) + Lambda(wi)); }
+
+  // Distribution of normals visible from w: D_w(wm) = G1(w) / |cos theta_w| D(wm) |w . wm|.
+  float D(const Vec3& w, const Vec3& wm) const {
+    float cos_w = abs_cos_theta(w);
+    if (cos_w == 0) return 0;
+    return G1(w) / cos_w * D(wm) * abs_dot(w, wm);
+  }
+
+  // Density of sample_visible_normal(w, .) at wm.
+  float pdf(const Vec3& w, const Vec3& wm) const { return D(w, wm); }
+
+  // Samples a microfacet normal from D_w (Heitz 2018, "Sampling the GGX Distribution of Visible
+  // Normals", in pbrt-v4's formulation). A w below the surface samples the normals visible from -w,
+  // so the returned normal always lies in the upper hemisphere.
+  Vec3 sample_visible_normal(const Vec3& w, Vec2 u) const {
+    // Stretch w into the configuration where the distribution is the isotropic alpha = 1 one.
+    Vec3 wh = normalize(Vec3(alpha_x * w.x, alpha_y * w.y, w.z));
+    if (wh.z < 0) wh = -wh;
+    // An orthonormal basis around wh (any one at normal incidence).
+    Vec3 t1 = wh.z < 0.99999f ? normalize(cross(Vec3(0, 0, 1), wh)) : Vec3(1, 0, 0);
+    Vec3 t2 = cross(wh, t1);
+    // A uniform point on the unit disk, warped to the projection of the visible hemisphere: its
+    // lower half is squeezed towards the projected horizon.
+    float r = std::sqrt(u.x), phi = 2 * kPi * u.y;
+    Vec2 p(r * std::cos(phi), r * std::sin(phi));
+    float h = safe_sqrt(1 - sqr(p.x));
+    p.y = lerp((1 + wh.z) / 2, h, p.y);
+    // Lift the point onto the hemisphere around wh, and unstretch the normal found there.
+    float pz = safe_sqrt(1 - sqr(p.x) - sqr(p.y));
+    Vec3 nh = t1 * p.x + t2 * p.y + wh * pz;
+    return normalize(Vec3(alpha_x * nh.x, alpha_y * nh.y, std::max(1e-6f, nh.z)));
+  }
+};
+
+namespace detail {
+// Minimal complex arithmetic for the Fresnel equations. std::complex<float>'s operators handle
+// infinities and NaNs by calling into libgcc (__mulsc3 / __divsc3), which made fresnel_complex
+// several times slower; the textbook formulas are exact enough for finite indices.
+struct Complex {
+  float re = 0, im = 0;
+};
+inline Complex operator+(Complex a, Complex b) { return {a.re + b.re, a.im + b.im}; }
+inline Complex operator-(Complex a, Complex b) { return {a.re - b.re, a.im - b.im}; }
+inline Complex operator*(Complex a, Complex b) { return {a.re * b.re - a.im * b.im, a.re * b.im + a.im * b.re}; }
+inline Complex operator/(Complex a, Complex b) {
+  float scale = 1 / (b.re * b.re + b.im * b.im);
+  return {scale * (a.re * b.re + a.im * b.im), scale * (a.im * b.re - a.re * b.im)};
+}
+inline float norm(Complex z) { return z.re * z.re + z.im * z.im; }
+// The principal square root (Re >= 0).
+inline Complex sqrt(Complex z) {
+  float n = std::sqrt(norm(z));
+  if (n == 0) return {0, 0};
+  float t1 = std::sqrt(0.5f * (n + std::abs(z.re)));
+  float t2 = 0.5f * z.im / t1;
+  if (z.re >= 0) return {t1, t2};
+  return {std::abs(t2), std::copysign(t1, z.im)};
+}
+}  // namespace detail
+
+// Fresnel reflectance of a conductor with complex relative index of refraction eta + i k, for
+// unpolarised light (pbrt-v4's FrComplex): the dielectric Fresnel equations with complex arithmetic.
+inline float fresnel_complex(float cos_i, std::complex<float> eta_c) {
+  using detail::Complex;
+  Complex eta{eta_c.real(), eta_c.imag()};
+  cos_i = std::clamp(cos_i, 0.0f, 1.0f);
+  Complex c{cos_i, 0};
+  float sin2_i = 1 - cos_i * cos_i;
+  // Snell's law with a complex index; the branch of the square root with Re >= 0 is the right one.
+  Complex sin2_t = Complex{sin2_i, 0} / (eta * eta);
+  Complex cos_t = detail::sqrt(Complex{1, 0} - sin2_t);
+  Complex r_parl = (eta * c - cos_t) / (eta * c + cos_t);
+  Complex r_perp = (c - eta * cos_t) / (c + eta * cos_t);
+  return (detail::norm(r_parl) + detail::norm(r_perp)) / 2;
+}
+
+// Per RGB channel.
+inline RGB fresnel_complex(float cos_i, const RGB& eta, const RGB& k) {
+  RGB f;
+  for (int c = 0; c < 3; ++c) f[c] = fresnel_complex(cos_i, std::complex<float>(eta[c], k[c]));
+  return f;
+}
+
+// pbrt-v4's "artist" conductor parametrisation: with eta = 1, the absorption coefficient
+// k = 2 sqrt(r) / sqrt(1 - r) gives normal-incidence reflectance exactly r. r is clamped below 1,
+// where k would be infinite.
+inline RGB conductor_k_from_reflectance(const RGB& r) {
+  RGB k;
+  for (int c = 0; c < 3; ++c) {
+    float rc = std::clamp(r[c], 0.0f, 0.9999f);
+    k[c] = 2 * std::sqrt(rc) / std::sqrt(1 - rc);
+  }
+  return k;
+}
+
+// The cosine-weighted hemispherical average of the dielectric Fresnel reflectance,
+// 2 * integral_0^1 F(mu, eta) mu dmu, for light arriving from the outside (eta = n_inside / n_outside):
+// the fraction of diffuse light the interface reflects. For eta > 1 the integral has a closed form
+// (Stern 1964; see d'Eon, "A Hitchhiker's Guide to Multiple Scattering"); for eta < 1 the
+// hemispherical transmittances on the two sides are related by T(eta) = eta^2 T(1 / eta)
+// (reciprocity with the n^2 radiance scaling). Evaluated in double: the closed form cancels badly
+// near eta = 1.
+inline float fresnel_diffuse_reflectance(float eta) {
+  if (!(eta > 0)) return 0;
+  if (std::abs(eta - 1) < 1e-3f) return 0;  // an index-matched interface barely reflects
+  if (eta < 1) return float(1 - double(eta) * eta * (1 - fresnel_diffuse_reflectance(1 / eta)));
+  double n = eta, n2 = n * n, n4 = n2 * n2;
+  double f = 0.5 + (n - 1) * (3 * n + 1) / (6 * (n + 1) * (n + 1))
+             + n2 * (n2 - 1) * (n2 - 1) / ((n2 + 1) * (n2 + 1) * (n2 + 1)) * std::log((n - 1) / (n + 1)) -
+             2 * n2 * n * (n2 + 2 * n - 1) / ((n2 + 1) * (n4 - 1)) +
+             8 * n4 * (n4 + 1) / ((n2 + 1) * (n4 - 1) * (n4 - 1)) * std::log(n);
+  return float(std::clamp(f, 0.0, 1.0));
+}
+
+}  // namespace candela

@@ -1,0 +1,170 @@
+#include "candela/textures/texture.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <exception>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <variant>
+
+#include "candela/film/image_io.h"
+#include "candela/io/error.h"
+
+namespace candela {
+namespace {
+
+Vec2 apply_mapping(const UVMapping& m, Vec2 uv) { return {m.su * uv.x + m.du, m.sv * uv.y + m.dv}; }
+
+// floor(x) as an int, kept far inside int's range (and NaN made definite) so that the index
+// arithmetic below never overflows; coordinates that large have no precision left anyway.
+int floor_index(float x) {
+  constexpr float kLimit = float(1 << 30);
+  if (!(x > -kLimit)) return -(1 << 30);
+  if (!(x < kLimit)) return 1 << 30;
+  return int(std::floor(x));
+}
+
+// Texel index i of a row or column of n texels, after wrapping; -1 for Black outside the image.
+int wrap_index(int i, int n, TextureWrap wrap) {
+  if (i >= 0 && i < n) return i;  // the common case, without the divisions below
+  switch (wrap) {
+    case TextureWrap::Repeat: {
+      int r = i % n;
+      return r < 0 ? r + n : r;
+    }
+    case TextureWrap::Clamp:
+      return i < 0 ? 0 : n - 1;
+    case TextureWrap::Black:
+      return -1;
+    case TextureWrap::Mirror: {
+      // Period 2n: n texels forward, then the same n backwards, so -1 -> 0 and n -> n - 1.
+      int period = 2 * n;
+      int r = i % period;
+      if (r < 0) r += period;
+      return r < n ? r : period - 1 - r;
+    }
+  }
+  return -1;
+}
+
+// The texel at wrapped indices; -1 (Black outside) reads zero.
+RGB texel(const Image& image, int x, int y) { return x < 0 || y < 0 ? RGB(0.0f) : image.at(x, y); }
+
+// The fractional part of a coordinate relative to its floor_index, kept in [0, 1] (NaN -> 0).
+float fraction(float x, int x0) {
+  float f = x - float(x0);
+  return f > 0 ? (f < 1 ? f : 1.0f) : 0.0f;
+}
+
+// (s, t) in texture space -> filtered texel value. Image rows run top to bottom while t runs up,
+// hence 1 - t; texel (i, j) covers [i, i + 1) x [j, j + 1) in pixel units, its centre at +0.5.
+RGB lookup(const Image& image, TextureWrap wrap, bool bilinear, Vec2 st) {
+  const int w = image.width, h = image.height;
+  float x = st.x * float(w), y = (1 - st.y) * float(h);
+  if (!bilinear) return texel(image, wrap_index(floor_index(x), w, wrap), wrap_index(floor_index(y), h, wrap));
+  x -= 0.5f;
+  y -= 0.5f;
+  int x0 = floor_index(x), y0 = floor_index(y);
+  float fx = fraction(x, x0), fy = fraction(y, y0);
+  // Wrapping each index of the 2x2 footprint separately makes Repeat blend across the seam, Clamp
+  // hold the edge texel and Black fade to zero over the outer half texel.
+  int xa = wrap_index(x0, w, wrap), xb = wrap_index(x0 + 1, w, wrap);
+  int ya = wrap_index(y0, h, wrap), yb = wrap_index(y0 + 1, h, wrap);
+  RGB top = (1 - fx) * texel(image, xa, ya) + fx * texel(image, xb, ya);
+  RGB bottom = (1 - fx) * texel(image, xa, yb) + fx * texel(image, xb, yb);
+  return (1 - fy) * top + fy * bottom;
+}
+
+RGB clamp_zero(RGB c) { return {std::max(c.r, 0.0f), std::max(c.g, 0.0f), std::max(c.b, 0.0f)}; }
+
+// Calls f with every texture index a description refers to (-1 for constants), for validation.
+template <typename F>
+void for_each_reference(const TextureDesc& desc, F&& f) {
+  if (const auto* c = std::get_if<CheckerboardTexture>(&desc)) {
+    f(c->tex1.texture);
+    f(c->tex2.texture);
+  } else if (const auto* s = std::get_if<ScaleTexture>(&desc)) {
+    f(s->tex.texture);
+    f(s->scale.texture);
+  } else if (const auto* m = std::get_if<MixTexture>(&desc)) {
+    f(m->tex1.texture);
+    f(m->tex2.texture);
+    f(m->amount.texture);
+  }
+}
+
+}  // namespace
+
+TextureSet::TextureSet(const std::vector<TextureDesc>& descs) {
+  // Keyed by the effective decoding, so Auto and SRGB on the same file share one image.
+  std::map<std::pair<std::string, IntegerEncoding>, std::shared_ptr<const Image>> images;
+  textures_.reserve(descs.size());
+  for (size_t i = 0; i < descs.size(); ++i) {
+    for_each_reference(descs[i], [&](int ref) {
+      if (ref < 0) return;
+      if (size_t(ref) >= descs.size())
+        throw SceneError(fmt::format("texture {}: refers to texture {}, but there are only {} textures", i, ref,
+                                     descs.size()));
+      if (size_t(ref) == i) throw SceneError(fmt::format("texture {}: refers to itself", i));
+      if (size_t(ref) > i)
+        throw SceneError(fmt::format(
+            "texture {}: refers to texture {}, which comes after it (a cycle, or dependencies out of order)", i,
+            ref));
+    });
+
+    if (const auto* desc = std::get_if<ImageTexture>(&descs[i])) {
+      IntegerEncoding encoding =
+          desc->encoding == ColorEncoding::Linear ? IntegerEncoding::Linear : IntegerEncoding::SRGB;
+      auto& image = images[{desc->filename, encoding}];
+      if (!image) {
+        std::error_code ec;
+        if (!std::filesystem::exists(desc->filename, ec))
+          throw SceneError(fmt::format("texture {}: image file \"{}\" not found", i, desc->filename));
+        try {
+          image = std::make_shared<const Image>(read_image(desc->filename, encoding));
+        } catch (const std::exception& e) {
+          // read_image's message already names the file.
+          throw SceneError(fmt::format("texture {}: {}", i, e.what()));
+        }
+      }
+      textures_.emplace_back(ImageLookup{image, desc->wrap, desc->bilinear, desc->scale, desc->invert, desc->mapping});
+    } else {
+      std::visit(
+          [&](const auto& d) {
+            if constexpr (!std::is_same_v<std::decay_t<decltype(d)>, ImageTexture>) textures_.emplace_back(d);
+          },
+          descs[i]);
+    }
+  }
+}
+
+RGB TextureSet::eval_texture(int index, const TextureEvalContext& ctx) const {
+  const Texture& texture = textures_[size_t(index)];
+  if (const auto* t = std::get_if<ImageLookup>(&texture)) {
+    RGB v = t->scale * lookup(*t->image, t->wrap, t->bilinear, apply_mapping(t->mapping, ctx.uv));
+    return clamp_zero(t->invert ? RGB(1.0f) - v : v);  // pbrt-v4 clamps negative results too
+  }
+  if (const auto* t = std::get_if<CheckerboardTexture>(&texture)) {
+    Vec2 st = apply_mapping(t->mapping, ctx.uv);
+    // Sum in 64 bits: floor_index's range makes the sum fit, and & 1 is the parity for negatives too.
+    bool even = ((int64_t(floor_index(st.x)) + floor_index(st.y)) & 1) == 0;
+    return eval(even ? t->tex1 : t->tex2, ctx);
+  }
+  if (const auto* t = std::get_if<ScaleTexture>(&texture)) return eval(t->tex, ctx) * eval(t->scale, ctx);
+  const auto& t = std::get<MixTexture>(texture);
+  float amount = eval(t.amount, ctx);
+  // A side with weight zero is not evaluated (as in pbrt-v4): cheaper, and an infinite value there
+  // cannot turn the result into NaN.
+  RGB result(0.0f);
+  if (amount != 1) result += (1 - amount) * eval(t.tex1, ctx);
+  if (amount != 0) result += amount * eval(t.tex2, ctx);
+  return result;
+}
+
+}  // namespace candela

@@ -1,0 +1,61 @@
+#pragma once
+// The scene's textures at render time: SceneDesc::textures with their images loaded, evaluated at
+// surface points for material parameters (ColorInput / FloatInput).
+#include <cstddef>
+#include <memory>
+#include <variant>
+#include <vector>
+
+#include "candela/film/image.h"
+#include "candela/math/color.h"
+#include "candela/math/vec.h"
+#include "candela/scene/description.h"
+
+namespace candela {
+
+// Where a texture is looked up: the hit point and the surface's (u, v).
+struct TextureEvalContext {
+  Point3 p;
+  Vec2 uv;
+};
+
+// Immutable after construction, so any number of threads may call eval at once. Copies share the
+// images.
+class TextureSet {
+ public:
+  TextureSet() = default;
+  // Loads every image once (textures naming the same file and decoding share it) and checks that
+  // each texture refers only to textures before it, which also rules out cycles. Throws SceneError
+  // for a bad reference or an unreadable image (naming the texture and the file).
+  explicit TextureSet(const std::vector<TextureDesc>& descs);
+
+  // The constant in.value, or texture in.texture; in.texture must be < size() (materials are not
+  // checked here).
+  RGB eval(const ColorInput& in, const TextureEvalContext& ctx) const {
+    return in.texture < 0 ? in.value : eval_texture(in.texture, ctx);
+  }
+  // A colour texture read as a float gives the average of its channels.
+  float eval(const FloatInput& in, const TextureEvalContext& ctx) const {
+    return in.texture < 0 ? in.value : eval_texture(in.texture, ctx).average();
+  }
+  size_t size() const { return textures_.size(); }
+
+ private:
+  // An ImageTexture with its image in memory.
+  struct ImageLookup {
+    std::shared_ptr<const Image> image;
+    TextureWrap wrap = TextureWrap::Repeat;
+    bool bilinear = true;
+    float scale = 1;
+    bool invert = false;
+    UVMapping mapping;
+  };
+  // The other kinds need nothing beyond their descriptions.
+  using Texture = std::variant<ImageLookup, CheckerboardTexture, ScaleTexture, MixTexture>;
+
+  RGB eval_texture(int index, const TextureEvalContext& ctx) const;
+
+  std::vector<Texture> textures_;
+};
+
+}  // namespace candela
