@@ -81,8 +81,9 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const
     Frame frame = Frame::from_normal_tangent(hit.ns, hit.dpdu);
     Vec3 wo_local = frame.to_local(wo);
     if (wo_local.z == 0) break;
-    // Light is gathered on the side the path arrived from.
-    Vertex vertex{hit, bsdf, frame, wo_local, {hit.p, wo_local.z > 0 ? hit.ns : -hit.ns}, ray.time};
+    // Light is gathered on the side the path arrived from, or on both for diffusely transmitting BSDFs.
+    Normal3 gather_n = bsdf_has_non_delta_transmission(bsdf) ? Normal3(0.0f) : wo_local.z > 0 ? hit.ns : -hit.ns;
+    Vertex vertex{hit, bsdf, frame, wo_local, {hit.p, gather_n}, ray.time};
 
     // Sample direct illumination with shadow rays (next-event estimation).
     float total_importance = 0;
@@ -120,27 +121,26 @@ template <typename Sampler>
 std::optional<BsdfSample> PathIntegrator::sample_direction(const Bsdf& bsdf, const Vec3& wo, Sampler& sampler) const {
   float u_lobe = sampler.get_1d();
   Vec2 u = sampler.get_2d();
-  if (direction_sampling_ == DirectionSampling::Bsdf || u_lobe >= bsdf_non_delta_probability(bsdf, wo))
-    return bsdf_sample(bsdf, wo, u_lobe, u);
+  float non_delta = bsdf_non_delta_probability(bsdf, wo);
+  if (direction_sampling_ == DirectionSampling::Bsdf || u_lobe >= non_delta) return bsdf_sample(bsdf, wo, u_lobe, u);
   // A non-delta lobe was chosen: draw the direction from the hemisphere on wo's side instead of the
-  // lobe, and weight it by the BSDF (sec. 4.7).
+  // lobe (or, for BSDFs that transmit diffusely, from either side with probability 1/2), and weight
+  // it by the BSDF (sec. 4.7).
   Vec3 wi = direction_sampling_ == DirectionSampling::Cosine ? square_to_cosine_hemisphere(u)
                                                               : square_to_uniform_hemisphere(u);
-  if (wo.z < 0) wi.z = -wi.z;
+  bool other_side = bsdf_has_non_delta_transmission(bsdf) && u_lobe < 0.5f * non_delta;
+  if ((wo.z < 0) != other_side) wi.z = -wi.z;
   float pdf = direction_pdf(bsdf, wo, wi);
   if (pdf <= 0) return std::nullopt;
   return BsdfSample{wi, bsdf_eval(bsdf, wo, wi) * (std::abs(wi.z) / pdf), pdf, false, 1};
 }
 
 float PathIntegrator::direction_pdf(const Bsdf& bsdf, const Vec3& wo, const Vec3& wi) const {
-  switch (direction_sampling_) {
-    case DirectionSampling::Bsdf: return bsdf_pdf(bsdf, wo, wi);
-    case DirectionSampling::Cosine:
-      return wo.z * wi.z > 0 ? bsdf_non_delta_probability(bsdf, wo) * std::abs(wi.z) * kInvPi : 0.0f;
-    case DirectionSampling::Uniform:
-      return wo.z * wi.z > 0 ? bsdf_non_delta_probability(bsdf, wo) * kInv2Pi : 0.0f;
-  }
-  return 0;
+  if (direction_sampling_ == DirectionSampling::Bsdf) return bsdf_pdf(bsdf, wo, wi);
+  float hemisphere = direction_sampling_ == DirectionSampling::Cosine ? std::abs(wi.z) * kInvPi : kInv2Pi;
+  float p = bsdf_non_delta_probability(bsdf, wo) * hemisphere;
+  if (bsdf_has_non_delta_transmission(bsdf)) return 0.5f * p;  // either side, half the time each
+  return wo.z * wi.z > 0 ? p : 0.0f;
 }
 
 float PathIntegrator::total_light_importance(const LightSampleContext& ctx) const {

@@ -2292,6 +2292,9 @@ void PbrtParser::shape(const Token& d) {
     // Area lights are sampled at fixed positions.
     if (state_.area_light)
       throw_scene_error(at(d), "Shape: area lights must not move (the CTM is animated inside an AreaLightSource)");
+    if (open_object_)
+      throw_scene_error(at(d), "Shape inside ObjectBegin \"{}\": shapes of an object cannot move (the CTM is "
+                        "animated); animate the ObjectInstance instead", open_object_->name);
     desc.to_world_end = state_.ctm.end;
   }
   desc.material = state_.material;

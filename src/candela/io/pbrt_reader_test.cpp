@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -882,7 +884,8 @@ TEST(PbrtReader, BadSampleCountsAndDepth) {
 
 TEST(PbrtReader, UnknownAndUnsupportedTypes) {
   expect_error({"WorldBegin", "Shape \"spere\""}, 2, "\"spere\"",
-               "unknown shape type \"spere\" (supported: \"sphere\", \"trianglemesh\", \"plymesh\")");
+               "unknown shape type \"spere\" (supported: \"sphere\", \"trianglemesh\", \"plymesh\", \"disk\", "
+               "\"bilinearmesh\")");
   for (std::string type : {"cylinder", "curve", "loopsubdiv"})
     expect_error({"WorldBegin", "Shape \"" + type + "\""}, 2, "\"" + type + "\"",
                  "shape type \"" + type + "\" is not supported: candela has no primitive or tessellation for it");
@@ -952,6 +955,876 @@ TEST(PbrtReader, ObjectInstancingErrors) {
   expect_error({"WorldBegin", "ObjectBegin \"a\"", "AreaLightSource \"diffuse\"", "Shape \"sphere\""}, 4, "Shape",
                "area lights in object instances are not supported");
   expect_error({"WorldBegin", "CoordSysTransform \"nowhere\""}, 2, "\"nowhere\"", "no coordinate system named");
+}
+
+
+TEST(PbrtReader, ShapesInsideObjectsCannotMove) {
+  expect_error({"WorldBegin", "ObjectBegin \"a\"", "ActiveTransform EndTime", "Translate 1 0 0", "Shape \"sphere\""},
+               5, "Shape", "shapes of an object cannot move");
+}
+
+TEST(PbrtReader, LightsCannotBeDefinedInsideObjects) {
+  expect_error({"WorldBegin", "ObjectBegin \"a\"", "LightSource \"point\""}, 3, "LightSource",
+               "lights cannot be part of an object definition");
+}
+
+// ---------------------------------------------------------------- the Bitterli scenes
+
+const fs::path kBitterli = fs::path(CANDELA_SHARED_DIR) / "scenes/bitterli";
+
+Warned read_bitterli(std::string_view name) {
+  Warned result;
+  result.scene = read_pbrt_scene(kBitterli / name / "scene-v4.pbrt", result.warnings);
+  return result;
+}
+
+size_t emitter_count(const SceneDesc& scene) {
+  return std::count_if(scene.shapes.begin(), scene.shapes.end(), [](const ShapeDesc& s) { return s.emission; });
+}
+
+void expect_sobol_warning(const Warned& read, int line) {
+  ASSERT_FALSE(read.warnings.empty());
+  EXPECT_NE(read.warnings[0].find(fmt::format("scene-v4.pbrt:{}:9: warning: sobol: using candela's zsobol sampler "
+                                              "(same Owen-scrambled Sobol' points, Morton-ordered)",
+                                              line)),
+            std::string::npos)
+      << read.warnings[0];
+}
+
+TEST(PbrtReaderBitterli, CornellBox) {
+  Warned read = read_bitterli("cornell-box");
+  const SceneDesc& scene = read.scene;
+  ASSERT_EQ(read.warnings.size(), 1u) << joined(read.warnings);
+  expect_sobol_warning(read, 3);
+  EXPECT_EQ(scene.shapes.size(), 8u);
+  EXPECT_EQ(emitter_count(scene), 1u);
+  EXPECT_TRUE(scene.lights.empty());
+  EXPECT_TRUE(scene.textures.empty());
+  EXPECT_EQ(scene.materials.size(), 8u);
+  EXPECT_EQ(scene.settings.integrator, "path");
+  EXPECT_EQ(scene.settings.max_depth, 65);
+  EXPECT_EQ(scene.settings.spp, 512);
+  EXPECT_EQ(scene.settings.sampler.type, SamplerType::ZSobol);
+  EXPECT_EQ(scene.settings.filter.type, FilterType::Gaussian);
+  EXPECT_EQ(scene.film.width, 1024);
+  EXPECT_FLOAT_EQ(scene.camera.fov_degrees, 19.5f);
+  expect_near(scene.camera.world_from_camera.point(Point3(0, 0, 0)), Point3(0, 1, 6.8f));
+  const ShapeDesc& light = scene.shapes.back();
+  ASSERT_TRUE(light.emission.has_value());
+  EXPECT_EQ(light.emission->radiance, RGB(17, 12, 4));
+  EXPECT_EQ(reflectance_of(scene, light), RGB(0.0f));
+  EXPECT_EQ(reflectance_of(scene, scene.shapes[3]), RGB(0.14f, 0.45f, 0.091f));  // the right wall
+}
+
+TEST(PbrtReaderBitterli, VeachMis) {
+  Warned read = read_bitterli("veach-mis");
+  const SceneDesc& scene = read.scene;
+  ASSERT_EQ(read.warnings.size(), 1u) << joined(read.warnings);
+  expect_sobol_warning(read, 4);
+  EXPECT_EQ(scene.shapes.size(), 9u);
+  EXPECT_EQ(emitter_count(scene), 3u);
+  EXPECT_TRUE(scene.lights.empty());
+  EXPECT_EQ(scene.materials.size(), 6u);
+  EXPECT_EQ(scene.settings.max_depth, 3);
+  EXPECT_EQ(scene.settings.spp, 64);
+  EXPECT_EQ(scene.settings.filter.type, FilterType::Tent);
+  EXPECT_FLOAT_EQ(scene.settings.filter.radius.x, 1);
+  const float radii[3] = {1, 0.5f, 0.05f};
+  const float radiance[3] = {7.599088f, 30.396353f, 3039.6353f};
+  int sphere = 0;
+  for (const ShapeDesc& shape : scene.shapes) {
+    if (!shape.emission) continue;
+    SCOPED_TRACE(shape.name);
+    EXPECT_FLOAT_EQ(std::get<SphereShape>(shape.geometry).radius, radii[sphere]);
+    EXPECT_FLOAT_EQ(shape.emission->radiance.g, radiance[sphere]);
+    ++sphere;
+  }
+  const auto& smooth = std::get<ConductorMaterial>(scene.materials.at(scene.shapes[0].material));
+  EXPECT_EQ(smooth.eta.value, RGB(0.200438f, 0.924033f, 1.102212f));
+  EXPECT_EQ(smooth.k.value, RGB(3.912949f, 2.452848f, 2.142188f));
+  EXPECT_FLOAT_EQ(smooth.roughness.u.value, 0.01f);
+  EXPECT_FLOAT_EQ(smooth.roughness.v.value, 0.01f);
+  EXPECT_FALSE(smooth.roughness.remap);
+  EXPECT_FALSE(smooth.reflectance.has_value());
+}
+
+TEST(PbrtReaderBitterli, VeachAjar) {
+  Warned read = read_bitterli("veach-ajar");
+  const SceneDesc& scene = read.scene;
+  ASSERT_EQ(read.warnings.size(), 4u) << joined(read.warnings);  // sobol, three "trilinear" filters
+  expect_sobol_warning(read, 4);
+  for (int i = 1; i < 4; ++i) EXPECT_NE(read.warnings[i].find("filter \"trilinear\" is read as \"bilinear\""), std::string::npos);
+  EXPECT_EQ(scene.shapes.size(), 22u);
+  EXPECT_EQ(emitter_count(scene), 1u);
+  EXPECT_EQ(scene.materials.size(), 13u);
+  ASSERT_EQ(scene.textures.size(), 3u);
+  const char* files[3] = {"landscape-with-a-lake.tga", "Good Textures_005844.tga", "cherry-wood-texture.tga"};
+  for (int i = 0; i < 3; ++i) {
+    const auto& texture = std::get<ImageTexture>(scene.textures[i]);
+    EXPECT_TRUE(fs::is_regular_file(texture.filename)) << texture.filename;
+    EXPECT_EQ(fs::path(texture.filename).filename(), files[i]);
+    EXPECT_EQ(texture.encoding, ColorEncoding::Linear);  // pbrt-v4 decodes only .png files as sRGB
+    EXPECT_TRUE(texture.bilinear);
+  }
+  // "Landscape" (the first MakeNamedMaterial) is the diffuse reflectance of texture 0.
+  const auto& landscape = std::get<DiffuseMaterial>(scene.materials[0]);
+  EXPECT_EQ(landscape.reflectance.texture, 0);
+  const auto& door = std::get<DiffuseMaterial>(scene.materials[3]);
+  EXPECT_EQ(door.reflectance.texture, 2);
+  const auto& handle = std::get<ConductorMaterial>(scene.materials[2]);
+  EXPECT_EQ(handle.eta.value, RGB(1.65746f, 0.880369f, 0.521229f));
+  EXPECT_EQ(handle.k.value, RGB(9.223869f, 6.269523f, 4.837001f));
+  EXPECT_FLOAT_EQ(handle.roughness.u.value, 0.25f);
+  const auto& glass = std::get<DielectricMaterial>(scene.materials[11]);
+  EXPECT_FLOAT_EQ(glass.ior, 1.5f);
+  EXPECT_TRUE(scene.shapes[0].emission.has_value());
+  EXPECT_EQ(scene.shapes[0].emission->radiance, RGB(1000.0f));
+  // The shapes with Transform blocks carry them.
+  expect_near(scene.shapes[3].to_world.point(Point3(0, 0, 0)), Point3(2.3f, 0, 0));
+}
+
+TEST(PbrtReaderBitterli, VeachBidir) {
+  Warned read = read_bitterli("veach-bidir");
+  const SceneDesc& scene = read.scene;
+  ASSERT_EQ(read.warnings.size(), 1u) << joined(read.warnings);
+  EXPECT_NE(read.warnings[0].find("scene-v4.pbrt:1:12: warning: Integrator \"bdpt\": using candela's path integrator "
+                                  "with maxdepth 7"),
+            std::string::npos)
+      << read.warnings[0];
+  EXPECT_EQ(scene.settings.integrator, "path");
+  EXPECT_EQ(scene.settings.max_depth, 7);
+  EXPECT_EQ(scene.settings.sampler.type, SamplerType::Independent);
+  EXPECT_EQ(scene.settings.spp, 64);
+  EXPECT_EQ(scene.shapes.size(), 14u);
+  EXPECT_EQ(emitter_count(scene), 2u);
+  EXPECT_EQ(scene.materials.size(), 4u);
+  EXPECT_EQ(scene.shapes[2].material, 0);  // the emitters keep the "Diffuse" named before their block
+  EXPECT_EQ(scene.shapes[3].emission->radiance, RGB(12048.179f, 8605.842f, 6196.206f));
+  const auto& lamp = std::get<ConductorMaterial>(scene.materials[2]);
+  EXPECT_EQ(lamp.eta.value, RGB(2.865601f, 2.119182f, 1.940077f));
+}
+
+// ---------------------------------------------------------------- samplers and integrators
+
+TEST(PbrtReader, SobolAndOtherLowDiscrepancySamplersBecomeZSobol) {
+  for (std::string type : {"sobol", "halton", "pmj02bn", "paddedsobol"}) {
+    SCOPED_TRACE(type);
+    std::vector<std::string> lines = {"Sampler \"" + type + "\" \"integer pixelsamples\" 32", "WorldBegin"};
+    expect_warning(lines, 1, "\"" + type + "\"", type + ": using candela's zsobol sampler");
+    SceneDesc scene = read_lines(lines);
+    EXPECT_EQ(scene.settings.sampler.type, SamplerType::ZSobol);
+    EXPECT_EQ(scene.settings.spp, 32);
+  }
+  expect_warning({"Sampler \"sobol\"", "WorldBegin"}, 1, "\"sobol\"",
+                 "sobol: using candela's zsobol sampler (same Owen-scrambled Sobol' points, Morton-ordered)");
+  EXPECT_EQ(read_lines({"Sampler \"halton\" \"string randomization\" \"owen\"", "WorldBegin"}).settings.spp, 16);
+}
+
+TEST(PbrtReader, EveryPbrtIntegratorIsRenderedWithThePathIntegrator) {
+  EXPECT_TRUE(read_warned({"Integrator \"path\" \"integer maxdepth\" 9", "WorldBegin"}).warnings.empty());
+  for (std::string type : {"bdpt", "mlt", "sppm", "lightpath", "randomwalk", "simplepath", "simplevolpath"}) {
+    SCOPED_TRACE(type);
+    std::vector<std::string> lines = {"Integrator \"" + type + "\" \"integer maxdepth\" 9", "WorldBegin"};
+    expect_warning(lines, 1, "\"" + type + "\"",
+                   "Integrator \"" + type + "\": using candela's path integrator with maxdepth 9");
+    SceneDesc scene = read_lines(lines);
+    EXPECT_EQ(scene.settings.integrator, "path");
+    EXPECT_EQ(scene.settings.max_depth, 9);
+  }
+  expect_warning({"Integrator \"volpath\"", "WorldBegin"}, 1, "\"volpath\"",
+                 "without participating media (which candela does not render) it is the same integrator");
+  expect_warning({"Integrator \"ambientocclusion\"", "WorldBegin"}, 1, "\"ambientocclusion\"",
+                 "not ambient occlusion");
+  Warned sppm = read_warned({"Integrator \"sppm\" \"integer photonsperiteration\" 1000 \"float radius\" 0.1",
+                             "WorldBegin"});
+  ASSERT_EQ(sppm.warnings.size(), 3u) << joined(sppm.warnings);
+  EXPECT_NE(sppm.warnings[0].find("\"photonsperiteration\" is ignored"), std::string::npos) << sppm.warnings[0];
+  Warned regularized = read_warned({"Integrator \"path\" \"bool regularize\" true", "WorldBegin"});
+  ASSERT_EQ(regularized.warnings.size(), 1u);
+  EXPECT_NE(regularized.warnings[0].find(":1:19: warning: Integrator \"path\": \"regularize\" is ignored"),
+            std::string::npos)
+      << regularized.warnings[0];
+  expect_error({"Integrator \"bdpt\" \"bool visualizestrategy\" true", "WorldBegin"}, 1, "\"bool visualizestrategy\"",
+               "unused parameter");
+}
+
+TEST(PbrtReader, ColorSpaceFilmAndAcceleratorOptions) {
+  EXPECT_TRUE(read_warned({"ColorSpace \"srgb\"", "Accelerator \"bvh\" \"integer maxnodeprims\" 4", "WorldBegin"})
+                  .warnings.empty());
+  expect_warning({"ColorSpace \"aces2065-1\"", "WorldBegin"}, 1, "\"aces2065-1\"", "reads every colour as linear sRGB");
+  expect_warning({"Film \"rgb\" \"float maxcomponentvalue\" 10", "WorldBegin"}, 1, "\"float maxcomponentvalue\"",
+                 "\"maxcomponentvalue\" is ignored");
+  expect_error({"WorldBegin", "Accelerator \"bvh\""}, 2, "Accelerator", "not allowed after WorldBegin");
+}
+
+// ---------------------------------------------------------------- materials
+
+TEST(PbrtReader, DiffuseReflectanceFromRgbSpectrumOrTexture) {
+  ScratchFile image("wood.png");
+  SceneDesc scene = read_lines({"WorldBegin",
+                                "Texture \"wood\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\"",
+                                "Material \"diffuse\" \"texture reflectance\" \"wood\"",
+                                "Material \"diffuse\" \"spectrum reflectance\" [ 300 0.5  800 0.5 ]",
+                                "Material \"diffuse\" \"rgb reflectance\" [ 0.1 0.2 0.3 ]"});
+  ASSERT_EQ(scene.materials.size(), 3u);
+  const auto& textured = std::get<DiffuseMaterial>(scene.materials[0]);
+  EXPECT_FALSE(textured.reflectance.is_constant());
+  EXPECT_EQ(textured.reflectance.texture, 0);
+  const auto& flat = std::get<DiffuseMaterial>(scene.materials[1]);
+  expect_near(Vec3(flat.reflectance.value.r, flat.reflectance.value.g, flat.reflectance.value.b), Vec3(0.5f));
+  EXPECT_EQ(std::get<DiffuseMaterial>(scene.materials[2]).reflectance.value, RGB(0.1f, 0.2f, 0.3f));
+}
+
+TEST(PbrtReader, ConductorMaterials) {
+  SceneDesc scene = read_lines(
+      {"WorldBegin",
+       "Texture \"rough\" \"float\" \"scale\" \"float tex\" 0.5 \"float scale\" 0.2",
+       "Material \"conductor\"",
+       "Material \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\" \"float roughness\" 0.2",
+       "Material \"conductor\" \"rgb eta\" [ 0.2 0.9 1.1 ] \"rgb k\" [ 3.9 2.4 2.1 ] \"float uroughness\" 0.01 "
+       "\"float vroughness\" 0.05 \"bool remaproughness\" false",
+       "Material \"conductor\" \"rgb reflectance\" [ 0.9 0.6 0.3 ] \"texture roughness\" \"rough\""});
+  ASSERT_EQ(scene.materials.size(), 4u);
+  const auto& copper = std::get<ConductorMaterial>(scene.materials[0]);
+  EXPECT_EQ(copper.eta.value, ConductorMaterial{}.eta.value);  // pbrt-v4's default "metal-Cu-eta"
+  EXPECT_EQ(copper.k.value, ConductorMaterial{}.k.value);
+  EXPECT_FALSE(copper.reflectance.has_value());
+  EXPECT_FLOAT_EQ(copper.roughness.u.value, 0);
+  EXPECT_TRUE(copper.roughness.remap);  // pbrt-v4's default
+  const auto& gold = std::get<ConductorMaterial>(scene.materials[1]);
+  EXPECT_EQ(gold.eta.value, RGB(0.143119f, 0.374957f, 1.442479f));
+  EXPECT_EQ(gold.k.value, RGB(3.983160f, 2.385721f, 1.603215f));
+  EXPECT_FLOAT_EQ(gold.roughness.u.value, 0.2f);
+  EXPECT_FLOAT_EQ(gold.roughness.v.value, 0.2f);
+  const auto& anisotropic = std::get<ConductorMaterial>(scene.materials[2]);
+  EXPECT_EQ(anisotropic.eta.value, RGB(0.2f, 0.9f, 1.1f));
+  EXPECT_FLOAT_EQ(anisotropic.roughness.u.value, 0.01f);
+  EXPECT_FLOAT_EQ(anisotropic.roughness.v.value, 0.05f);
+  EXPECT_FALSE(anisotropic.roughness.remap);
+  const auto& artist = std::get<ConductorMaterial>(scene.materials[3]);
+  ASSERT_TRUE(artist.reflectance.has_value());
+  EXPECT_EQ(artist.reflectance->value, RGB(0.9f, 0.6f, 0.3f));
+  EXPECT_EQ(artist.roughness.u.texture, 0);
+  EXPECT_EQ(artist.roughness.v.texture, 0);
+  expect_error({"WorldBegin", "Material \"conductor\" \"rgb eta\" [ 1 1 1 ] \"rgb reflectance\" [ 0.5 0.5 0.5 ]"}, 2,
+               "\"rgb reflectance\"", "cannot be given together with \"eta\"");
+  expect_error({"WorldBegin", "Material \"conductor\" \"float roughness\" -0.1"}, 2, "\"float roughness\"",
+               "must not be negative");
+}
+
+TEST(PbrtReader, DielectricMaterials) {
+  Warned read = read_warned({"WorldBegin",
+                             "Material \"dielectric\" \"float eta\" 1.33 \"float roughness\" 0.1",
+                             "Material \"dielectric\" \"spectrum eta\" \"glass-BK7\"",
+                             "Material \"dielectric\" \"spectrum eta\" [ 300 1.6  800 1.4 ]",
+                             "Material \"dielectric\" \"rgb eta\" [ 1.4 1.5 1.6 ]",
+                             "Material \"dielectric\" \"float uroughness\" 0.1 \"float vroughness\" 0.3 "
+                             "\"bool remaproughness\" false",
+                             "Material \"dielectric\""});
+  const SceneDesc& scene = read.scene;
+  ASSERT_EQ(scene.materials.size(), 6u);
+  const auto& water = std::get<DielectricMaterial>(scene.materials[0]);
+  EXPECT_FLOAT_EQ(water.ior, 1.33f);
+  EXPECT_FLOAT_EQ(water.roughness.u.value, 0.1f);
+  EXPECT_TRUE(water.roughness.remap);
+  EXPECT_NEAR(std::get<DielectricMaterial>(scene.materials[1]).ior, 1.5185f, 1e-4f);  // BK7 at 550 nm
+  EXPECT_NEAR(std::get<DielectricMaterial>(scene.materials[2]).ior, 1.5f, 1e-5f);
+  EXPECT_FLOAT_EQ(std::get<DielectricMaterial>(scene.materials[3]).ior, 1.5f);
+  const auto& rough = std::get<DielectricMaterial>(scene.materials[4]);
+  EXPECT_FLOAT_EQ(rough.roughness.v.value, 0.3f);
+  EXPECT_FALSE(rough.roughness.remap);
+  EXPECT_FLOAT_EQ(std::get<DielectricMaterial>(scene.materials[5]).ior, 1.5f);
+  ASSERT_EQ(read.warnings.size(), 1u) << joined(read.warnings);
+  EXPECT_NE(read.warnings[0].find("the green value 1.5 is the index of refraction"), std::string::npos);
+  expect_error({"WorldBegin", "Material \"dielectric\" \"float eta\" 0"}, 2, "\"float eta\"", "must be positive");
+  expect_error({"WorldBegin", "Material \"thindielectric\""}, 2, "\"thindielectric\"",
+               "material type \"thindielectric\" is not supported: candela has no thin-sheet BSDF");
+}
+
+TEST(PbrtReader, CoatedDiffuseIsTheClosedFormPlastic) {
+  Warned read = read_warned({"WorldBegin",
+                             "Material \"coateddiffuse\" \"rgb reflectance\" [ 0.2 0.4 0.6 ] \"float roughness\" 0.1 "
+                             "\"float eta\" 1.6 \"integer maxdepth\" 20 \"integer nsamples\" 4 \"rgb albedo\" [ 0 0 0 ] "
+                             "\"float g\" 0.3",
+                             "Material \"coateddiffuse\""});
+  EXPECT_TRUE(read.warnings.empty()) << joined(read.warnings);
+  const auto& coated = std::get<CoatedDiffuseMaterial>(read.scene.materials.at(0));
+  EXPECT_EQ(coated.reflectance.value, RGB(0.2f, 0.4f, 0.6f));
+  EXPECT_FLOAT_EQ(coated.ior, 1.6f);
+  EXPECT_FLOAT_EQ(coated.roughness.u.value, 0.1f);
+  EXPECT_TRUE(coated.roughness.remap);
+  EXPECT_EQ(coated.specular.value, RGB(1.0f));
+  const auto& defaults = std::get<CoatedDiffuseMaterial>(read.scene.materials.at(1));
+  EXPECT_EQ(defaults.reflectance.value, RGB(0.5f));
+  EXPECT_FLOAT_EQ(defaults.ior, 1.5f);
+  EXPECT_FLOAT_EQ(defaults.roughness.u.value, 0);
+  expect_warning({"WorldBegin", "Material \"coateddiffuse\" \"rgb albedo\" [ 0.5 0.5 0.5 ]"}, 2, "\"rgb albedo\"",
+                 "\"albedo\" is ignored: candela's coated diffuse has no scattering medium");
+  expect_warning({"WorldBegin", "Material \"coateddiffuse\" \"float thickness\" 0.1"}, 2, "\"float thickness\"",
+                 "\"thickness\" is ignored");
+}
+
+TEST(PbrtReader, DiffuseTransmissionInterfaceAndDisplacement) {
+  ScratchFile image("leaf.png");
+  SceneDesc scene = read_lines(
+      {"WorldBegin",
+       "Texture \"leaf\" \"spectrum\" \"imagemap\" \"string filename\" \"leaf.png\"",
+       "Material \"diffusetransmission\" \"rgb reflectance\" [ 0.5 0.5 0.5 ] \"rgb transmittance\" [ 0.4 0.2 0.8 ] "
+       "\"float scale\" 0.5",
+       "Material \"diffusetransmission\"",
+       "Material \"diffusetransmission\" \"texture transmittance\" \"leaf\" \"float scale\" 2",
+       "Material \"interface\"",
+       "Material \"none\""});
+  ASSERT_EQ(scene.materials.size(), 5u);
+  const auto& leaf = std::get<DiffuseTransmissionMaterial>(scene.materials[0]);
+  EXPECT_EQ(leaf.reflectance.value, RGB(0.25f));
+  EXPECT_EQ(leaf.transmittance.value, RGB(0.2f, 0.1f, 0.4f));
+  const auto& defaults = std::get<DiffuseTransmissionMaterial>(scene.materials[1]);
+  EXPECT_EQ(defaults.reflectance.value, RGB(0.25f));
+  EXPECT_EQ(defaults.transmittance.value, RGB(0.25f));
+  // A textured input with a scale becomes a ScaleTexture after the texture it scales.
+  const auto& textured = std::get<DiffuseTransmissionMaterial>(scene.materials[2]);
+  ASSERT_EQ(scene.textures.size(), 2u);
+  EXPECT_EQ(textured.transmittance.texture, 1);
+  const auto& scale = std::get<ScaleTexture>(scene.textures[1]);
+  EXPECT_EQ(scale.tex.texture, 0);
+  EXPECT_FLOAT_EQ(scale.scale.value, 2);
+  EXPECT_EQ(textured.reflectance.value, RGB(0.5f));
+  EXPECT_TRUE(std::holds_alternative<InterfaceMaterial>(scene.materials[3]));
+  EXPECT_TRUE(std::holds_alternative<InterfaceMaterial>(scene.materials[4]));
+  expect_warning({"WorldBegin", "Material \"diffuse\" \"float displacement\" 0.1"}, 2, "\"float displacement\"",
+                 "Material \"diffuse\": \"displacement\" is ignored: displacement mapping is not supported");
+  expect_warning({"WorldBegin", "Material \"conductor\" \"string normalmap\" \"n.png\""}, 2, "\"string normalmap\"",
+                 "\"normalmap\" is ignored: normal maps are not supported");
+}
+
+TEST(PbrtReader, MixMaterialSelectsWithAConstantAmountOnly) {
+  std::vector<std::string> prefix = {"WorldBegin", "MakeNamedMaterial \"a\" \"string type\" \"diffuse\"",
+                                     "MakeNamedMaterial \"b\" \"string type\" \"conductor\""};
+  auto with = [&](std::string line) {
+    std::vector<std::string> lines = prefix;
+    lines.push_back(line);
+    return lines;
+  };
+  SceneDesc first = read_lines(with("Material \"mix\" \"string materials\" [ \"a\" \"b\" ] \"float amount\" 0"));
+  EXPECT_TRUE(std::holds_alternative<DiffuseMaterial>(first.materials.back()));
+  SceneDesc second = read_lines(with("Material \"mix\" \"string materials\" [ \"a\" \"b\" ] \"float amount\" 1"));
+  EXPECT_TRUE(std::holds_alternative<ConductorMaterial>(second.materials.back()));
+  SceneDesc same = read_lines(with("Material \"mix\" \"string materials\" [ \"b\" \"b\" ]"));
+  EXPECT_TRUE(std::holds_alternative<ConductorMaterial>(same.materials.back()));
+  expect_error(with("Material \"mix\" \"string materials\" [ \"a\" \"b\" ] \"float amount\" 0.3"), 4, "\"mix\"",
+               "material type \"mix\" is not supported: candela cannot blend two materials");
+  expect_error(with("Material \"mix\" \"string materials\" [ \"a\" \"c\" ]"), 4, "\"string materials\"",
+               "names \"c\", which no MakeNamedMaterial before it defines");
+  expect_error(with("Material \"mix\" \"string materials\" \"a\""), 4, "\"string materials\"",
+               "must name exactly two materials");
+}
+
+// ---------------------------------------------------------------- textures
+
+TEST(PbrtReader, ImageTextures) {
+  ScratchFile png("wood.png"), tga("stone.tga"), exr("sky.exr");
+  Warned read = read_warned(
+      {"WorldBegin",
+       "Texture \"a\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\"",
+       "Texture \"b\" \"spectrum\" \"imagemap\" \"string filename\" \"stone.tga\" \"string filter\" \"point\" "
+       "\"string wrap\" \"clamp\" \"float scale\" 2 \"bool invert\" true \"float uscale\" 4 \"float vscale\" 3 "
+       "\"float udelta\" 0.5 \"float vdelta\" 0.25",
+       "Texture \"c\" \"float\" \"imagemap\" \"string filename\" \"stone.tga\" \"string encoding\" \"sRGB\" "
+       "\"string wrap\" \"black\"",
+       "Texture \"d\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\" \"string encoding\" \"linear\"",
+       "Texture \"e\" \"spectrum\" \"imagemap\" \"string filename\" \"sky.exr\" \"string encoding\" \"gamma 2.2\"",
+       "Texture \"f\" \"spectrum\" \"imagemap\" \"string filename\" \"sky.exr\" \"string mapping\" \"uv\"",
+       "Material \"diffuse\" \"texture reflectance\" \"b\"",
+       "Material \"conductor\" \"texture roughness\" \"c\""});
+  const SceneDesc& scene = read.scene;
+  ASSERT_EQ(scene.textures.size(), 6u);
+  const auto& a = std::get<ImageTexture>(scene.textures[0]);
+  EXPECT_EQ(fs::path(a.filename), scratch_dir() / "wood.png");  // beside the scene file
+  EXPECT_EQ(a.encoding, ColorEncoding::SRGB);                     // pbrt-v4's default for .png
+  EXPECT_TRUE(a.bilinear);
+  EXPECT_EQ(a.wrap, TextureWrap::Repeat);
+  EXPECT_FLOAT_EQ(a.scale, 1);
+  EXPECT_FALSE(a.invert);
+  EXPECT_FLOAT_EQ(a.mapping.su, 1);
+  const auto& b = std::get<ImageTexture>(scene.textures[1]);
+  EXPECT_EQ(b.encoding, ColorEncoding::Linear);  // pbrt-v4's default for everything but .png
+  EXPECT_FALSE(b.bilinear);
+  EXPECT_EQ(b.wrap, TextureWrap::Clamp);
+  EXPECT_FLOAT_EQ(b.scale, 2);
+  EXPECT_TRUE(b.invert);
+  EXPECT_FLOAT_EQ(b.mapping.su, 4);
+  EXPECT_FLOAT_EQ(b.mapping.sv, 3);
+  EXPECT_FLOAT_EQ(b.mapping.du, 0.5f);
+  EXPECT_FLOAT_EQ(b.mapping.dv, 0.25f);
+  const auto& c = std::get<ImageTexture>(scene.textures[2]);
+  EXPECT_EQ(c.encoding, ColorEncoding::SRGB);
+  EXPECT_EQ(c.wrap, TextureWrap::Black);
+  EXPECT_EQ(std::get<ImageTexture>(scene.textures[3]).encoding, ColorEncoding::Linear);
+  EXPECT_EQ(std::get<ImageTexture>(scene.textures[4]).encoding, ColorEncoding::SRGB);
+  EXPECT_EQ(std::get<ImageTexture>(scene.textures[5]).encoding, ColorEncoding::Linear);
+  EXPECT_EQ(std::get<DiffuseMaterial>(scene.materials[0]).reflectance.texture, 1);
+  EXPECT_EQ(std::get<ConductorMaterial>(scene.materials[1]).roughness.u.texture, 2);
+  ASSERT_EQ(read.warnings.size(), 1u) << joined(read.warnings);
+  EXPECT_NE(read.warnings[0].find("\"encoding\" \"gamma 2.2\" is read as sRGB"), std::string::npos);
+}
+
+TEST(PbrtReader, TrilinearAndEwaFiltersAreBilinearWithAWarning) {
+  ScratchFile png("wood.png");
+  for (std::string filter : {"trilinear", "ewa"})
+    expect_warning({"WorldBegin", "Texture \"a\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\" "
+                    "\"string filter\" \"" + filter + "\" \"float maxanisotropy\" 4"},
+                   2, "\"string filter\"", "filter \"" + filter + "\" is read as \"bilinear\": candela does not mipmap");
+}
+
+TEST(PbrtReader, BadImageTextures) {
+  ScratchFile png("wood.png");
+  const std::string texture = "Texture \"a\" \"spectrum\" \"imagemap\" ";
+  expect_error({"WorldBegin", texture + "\"string filename\" \"nope.png\""}, 2, "\"string filename\"",
+               "\"filename\": cannot find \"nope.png\"");
+  expect_error({"WorldBegin", texture}, 2, "Texture", "\"filename\" is required");
+  const std::string wood = texture + "\"string filename\" \"wood.png\" ";
+  expect_error({"WorldBegin", wood + "\"string wrap\" \"octahedralsphere\""}, 2, "\"string wrap\"",
+               "\"octahedralsphere\" is not supported for image textures");
+  expect_error({"WorldBegin", wood + "\"string filter\" \"gaussian\""}, 2, "\"string filter\"",
+               "must be \"point\", \"bilinear\", \"trilinear\" or \"ewa\"");
+  expect_error({"WorldBegin", wood + "\"string encoding\" \"gamma 1.8\""}, 2, "\"string encoding\"",
+               "\"gamma 1.8\" is not supported");
+  expect_error({"WorldBegin", wood + "\"string mapping\" \"spherical\""}, 2, "\"string mapping\"",
+               "\"spherical\" is not supported (only \"uv\")");
+  expect_error({"WorldBegin", wood, texture + "\"string filename\" \"wood.png\""}, 3, "\"a\"",
+               "spectrum texture \"a\" is already defined at");
+  expect_error({"WorldBegin", "Texture \"a\" \"color\" \"imagemap\""}, 2, "\"color\"",
+               "the value type must be \"spectrum\" or \"float\"");
+  expect_error({"WorldBegin", "Texture \"r\" \"float\" \"constant\"", "Material \"diffuse\" \"texture reflectance\" \"r\""},
+               3, "\"texture reflectance\"", "there is a \"float\" texture of that name");
+  expect_error({"WorldBegin", "Texture \"r\" \"spectrum\" \"constant\"", "Material \"conductor\" \"texture roughness\" \"r\""},
+               3, "\"texture roughness\"", "there is a \"spectrum\" texture of that name");
+}
+
+TEST(PbrtReader, ProceduralTexturesComeAfterTheTexturesTheyUse) {
+  ScratchFile png("wood.png");
+  SceneDesc scene = read_lines(
+      {"WorldBegin",
+       "Texture \"img\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\"",
+       "Texture \"checks\" \"spectrum\" \"checkerboard\" \"rgb tex1\" [ 1 0 0 ] \"texture tex2\" \"img\" "
+       "\"float uscale\" 8",
+       "Texture \"scaled\" \"spectrum\" \"scale\" \"texture tex\" \"checks\" \"float scale\" 0.5",
+       "Texture \"amount\" \"float\" \"checkerboard\" \"float tex1\" 0.25 \"float tex2\" 0.75",
+       "Texture \"mixed\" \"spectrum\" \"mix\" \"texture tex1\" \"scaled\" \"rgb tex2\" [ 0 0 1 ] "
+       "\"texture amount\" \"amount\"",
+       "Texture \"k\" \"spectrum\" \"constant\" \"rgb value\" [ 0.1 0.2 0.3 ]",
+       "Material \"diffuse\" \"texture reflectance\" \"mixed\"",
+       "Material \"diffuse\" \"texture reflectance\" \"k\""});
+  ASSERT_EQ(scene.textures.size(), 5u);  // the constant texture is no texture
+  const auto& checks = std::get<CheckerboardTexture>(scene.textures[1]);
+  EXPECT_EQ(checks.tex1.value, RGB(1, 0, 0));
+  EXPECT_EQ(checks.tex2.texture, 0);
+  EXPECT_FLOAT_EQ(checks.mapping.su, 8);
+  const auto& scaled = std::get<ScaleTexture>(scene.textures[2]);
+  EXPECT_EQ(scaled.tex.texture, 1);
+  EXPECT_FLOAT_EQ(scaled.scale.value, 0.5f);
+  const auto& amount = std::get<CheckerboardTexture>(scene.textures[3]);
+  EXPECT_EQ(amount.tex1.value, RGB(0.25f));
+  EXPECT_EQ(amount.tex2.value, RGB(0.75f));
+  const auto& mixed = std::get<MixTexture>(scene.textures[4]);
+  EXPECT_EQ(mixed.tex1.texture, 2);
+  EXPECT_EQ(mixed.tex2.value, RGB(0, 0, 1));
+  EXPECT_EQ(mixed.amount.texture, 3);
+  EXPECT_EQ(std::get<DiffuseMaterial>(scene.materials[0]).reflectance.texture, 4);
+  const auto& constant = std::get<DiffuseMaterial>(scene.materials[1]).reflectance;
+  EXPECT_TRUE(constant.is_constant());
+  EXPECT_EQ(constant.value, RGB(0.1f, 0.2f, 0.3f));
+  expect_error({"WorldBegin", "Texture \"c\" \"spectrum\" \"checkerboard\" \"integer dimension\" 3"}, 2,
+               "\"integer dimension\"", "solid (3D) checkerboards are not supported");
+  expect_error({"WorldBegin", "Texture \"c\" \"spectrum\" \"scale\" \"texture tex\" \"later\""}, 2, "\"texture tex\"",
+               "no spectrum texture named \"later\" is defined (Texture must come first)");
+}
+
+// ---------------------------------------------------------------- lights
+
+TEST(PbrtReader, SpotLights) {
+  SceneDesc scene = read_lines({"WorldBegin", "Translate 1 0 0",
+                                "LightSource \"spot\" \"rgb I\" [ 2 2 2 ] \"point3 from\" [ 0 1 0 ] "
+                                "\"point3 to\" [ 0 1 5 ] \"float coneangle\" 20 \"float conedeltaangle\" 4 "
+                                "\"float scale\" 3",
+                                "LightSource \"spot\""});
+  ASSERT_EQ(scene.lights.size(), 2u);
+  const auto& spot = std::get<SpotLight>(scene.lights[0]);
+  expect_near(spot.position, Point3(1, 1, 0));
+  expect_near(spot.direction, Vec3(0, 0, 1));
+  EXPECT_EQ(spot.intensity, RGB(6.0f));
+  EXPECT_FLOAT_EQ(spot.cone_angle, 20);
+  EXPECT_FLOAT_EQ(spot.cone_delta, 4);
+  const auto& defaults = std::get<SpotLight>(scene.lights[1]);
+  EXPECT_FLOAT_EQ(defaults.cone_angle, 30);
+  EXPECT_FLOAT_EQ(defaults.cone_delta, 5);
+  EXPECT_EQ(defaults.intensity, RGB(1.0f));
+  expect_near(defaults.position, Point3(1, 0, 0));
+  expect_error({"WorldBegin", "LightSource \"spot\" \"float coneangle\" 10 \"float conedeltaangle\" 20"}, 2,
+               "\"float conedeltaangle\"", "must be in [0, \"coneangle\" = 10] degrees");
+  expect_error({"WorldBegin", "LightSource \"spot\" \"point3 to\" [ 0 0 0 ]"}, 2, "\"point3 to\"", "must differ");
+}
+
+TEST(PbrtReader, PointAndSpotLightPower) {
+  SceneDesc scene = read_lines({"WorldBegin",
+                                "LightSource \"point\" \"rgb I\" [ 1 0.5 0.25 ] \"float power\" 100",
+                                "LightSource \"spot\" \"float power\" 10"});
+  const float pi = std::numbers::pi_v<float>;
+  RGB point = std::get<PointLight>(scene.lights[0]).intensity;
+  EXPECT_NEAR(point.r, 100 / (4 * pi), 1e-4f);
+  EXPECT_NEAR(point.b, 0.25f * 100 / (4 * pi), 1e-4f);
+  float cos_end = std::cos(30 * pi / 180), cos_start = std::cos(25 * pi / 180);
+  EXPECT_NEAR(std::get<SpotLight>(scene.lights[1]).intensity.g,
+              10 / (2 * pi * ((1 - cos_start) + (cos_start - cos_end) / 2)), 1e-3f);
+}
+
+TEST(PbrtReader, DistantLight) {
+  SceneDesc scene = read_lines({"WorldBegin", "Rotate 90 1 0 0",
+                                "LightSource \"distant\" \"rgb L\" [ 1 2 3 ] \"float scale\" 2 \"float illuminance\" 5",
+                                "LightSource \"distant\" \"point3 from\" [ 0 0 0 ] \"point3 to\" [ 1 0 0 ]"});
+  const auto& sun = std::get<DistantLight>(scene.lights[0]);
+  expect_near(sun.direction, Vec3(0, -1, 0));  // +z (from "from" to "to") turned by the CTM
+  EXPECT_EQ(sun.radiance, RGB(10, 20, 30));
+  expect_near(std::get<DistantLight>(scene.lights[1]).direction, Vec3(1, 0, 0));
+}
+
+TEST(PbrtReader, InfiniteLights) {
+  ScratchFile exr("sky.exr");
+  Warned read = read_warned({"WorldBegin",
+                             "LightSource \"infinite\" \"rgb L\" [ 1 2 3 ] \"float illuminance\" 3.14159265",
+                             "AttributeBegin",
+                             "Rotate -90 1 0 0",
+                             "LightSource \"infinite\" \"string filename\" \"sky.exr\" \"float scale\" 2",
+                             "AttributeEnd"});
+  const SceneDesc& scene = read.scene;
+  EXPECT_TRUE(read.warnings.empty());
+  ASSERT_EQ(scene.lights.size(), 2u);
+  const auto& sky = std::get<SkyLight>(scene.lights[0]);
+  EXPECT_TRUE(sky.is_constant());
+  expect_near(Vec3(sky.zenith.r, sky.zenith.g, sky.zenith.b), Vec3(1, 2, 3));  // illuminance pi: L unchanged
+  const auto& map = std::get<EnvironmentMap>(scene.lights[1]);
+  EXPECT_EQ(fs::path(map.filename), scratch_dir() / "sky.exr");
+  EXPECT_EQ(map.mapping, EnvironmentMapping::EqualAreaOctahedral);
+  EXPECT_EQ(map.scale, RGB(2.0f));
+  expect_near(map.to_world.vector(Vec3(0, 0, 1)), Vec3(0, 1, 0));  // pbrt's +z up turned to +y
+  expect_warning({"WorldBegin", "LightSource \"infinite\" \"point3 portal\" [ 0 0 0  1 0 0  1 1 0  0 1 0 ]"}, 2,
+                 "\"point3 portal\"", "\"portal\" is ignored");
+  expect_error({"WorldBegin", "LightSource \"infinite\" \"string filename\" \"sky.exr\" \"float illuminance\" 10"}, 2,
+               "\"float illuminance\"", "is not supported with an image");
+}
+
+TEST(PbrtReader, EmissionSpectra) {
+  SceneDesc scene = read_lines({"WorldBegin",
+                                "LightSource \"point\" \"spectrum I\" \"stdillum-D65\"",
+                                "LightSource \"point\" \"spectrum I\" \"stdillum-A\" \"float scale\" 2",
+                                "LightSource \"point\" \"blackbody I\" 2700",
+                                "LightSource \"point\" \"blackbody I\" 6500",
+                                "LightSource \"point\" \"spectrum I\" [ 300 5  900 5 ]"});
+  auto intensity = [&](size_t i) { return std::get<PointLight>(scene.lights.at(i)).intensity; };
+  EXPECT_EQ(intensity(0), RGB(1.0f));  // D65 is the sRGB white; pbrt-v4 normalises to luminance 1
+  RGB a = intensity(1);
+  EXPECT_NEAR(a.luminance(), 2, 2e-3f);
+  EXPECT_GT(a.r, a.g);
+  EXPECT_GT(a.g, a.b);
+  RGB warm = intensity(2);
+  EXPECT_NEAR(warm.luminance(), 1, 1e-3f);
+  EXPECT_GT(warm.r, warm.g);
+  EXPECT_GT(warm.g, warm.b);
+  RGB daylight = intensity(3);
+  EXPECT_NEAR(daylight.luminance(), 1, 1e-3f);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(daylight[c], 1, 0.15f) << c;
+  RGB equal_energy = intensity(4);  // a flat spectrum is normalised too: its scale does not matter
+  EXPECT_NEAR(equal_energy.luminance(), 1, 1e-3f);
+  EXPECT_GT(equal_energy.r, equal_energy.b);
+}
+
+// Sum of a mesh's triangle areas after `to_world`.
+double mesh_area(const TriangleMesh& mesh, const Transform& to_world = Transform()) {
+  double area = 0;
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    Point3 a = to_world.point(mesh.positions[mesh.indices[3 * t]]);
+    Point3 b = to_world.point(mesh.positions[mesh.indices[3 * t + 1]]);
+    Point3 c = to_world.point(mesh.positions[mesh.indices[3 * t + 2]]);
+    area += 0.5 * length(cross(b - a, c - a));
+  }
+  return area;
+}
+
+TEST(PbrtReader, AreaLightPowerIsPerPrimitiveAsInPbrt) {
+  const float pi = std::numbers::pi_v<float>;
+  const std::string quad = "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  2 0 0  2 1 0  0 1 0 ] "
+                           "\"integer indices\" [ 0 1 2  0 2 3 ]";
+  SceneDesc scene = read_lines(
+      {"WorldBegin",
+       "AttributeBegin",
+       "AreaLightSource \"diffuse\" \"rgb L\" [ 1 0.5 1 ] \"float power\" 10",
+       quad,  // two triangles of area 1, each emitting 10
+       "Scale 3 3 3",
+       "Shape \"sphere\" \"float radius\" 2",  // pbrt: the object-space area 16 pi, whatever the CTM's scale
+       "AttributeEnd",
+       "AttributeBegin",
+       "AreaLightSource \"diffuse\" \"float power\" 10 \"bool twosided\" true \"float scale\" 3",
+       "Shape \"disk\"",
+       "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  1 0 0  0 2 0  0 0 1  2 0 1  0 2 1 ] "
+       "\"integer indices\" [ 0 1 2  3 4 5 ]",  // areas 1 and 2
+       "AttributeEnd"});
+  ASSERT_EQ(scene.shapes.size(), 5u);
+  EXPECT_NEAR(scene.shapes[0].emission->radiance.r, 10 / pi, 1e-4f);
+  EXPECT_NEAR(scene.shapes[0].emission->radiance.g, 0.5f * 10 / pi, 1e-4f);  // the RGB is not normalised
+  EXPECT_NEAR(scene.shapes[1].emission->radiance.r, 10 / (pi * 16 * pi), 1e-5f);
+  EXPECT_NEAR(scene.shapes[2].emission->radiance.r, 3 * 10 / (pi * 2 * pi), 1e-4f);  // disk of area pi, two-sided
+  // The mesh with triangles of different areas becomes one shape per area.
+  EXPECT_EQ(mesh_of(scene.shapes[3]).triangle_count(), 1u);
+  EXPECT_EQ(mesh_of(scene.shapes[4]).triangle_count(), 1u);
+  EXPECT_NEAR(scene.shapes[3].emission->radiance.r, 3 * 10 / (pi * 2 * 1), 1e-4f);
+  EXPECT_NEAR(scene.shapes[4].emission->radiance.r, 3 * 10 / (pi * 2 * 2), 1e-4f);
+  EXPECT_NEAR(mesh_area(mesh_of(scene.shapes[4])), 2, 1e-6);
+  expect_error({"WorldBegin", "AreaLightSource \"diffuse\" \"string filename\" \"e.exr\""}, 2, "\"string filename\"",
+               "textured area lights are not supported");
+}
+
+// ---------------------------------------------------------------- shapes
+
+TEST(PbrtReader, DisksAreTriangulatedWithTheirAreaAndParameterisation) {
+  const double pi = std::numbers::pi;
+  SceneDesc scene = read_lines({"WorldBegin", "Shape \"disk\" \"float radius\" 2 \"float height\" 0.5",
+                                "Shape \"disk\" \"float radius\" 2 \"float innerradius\" 1 \"float phimax\" 90"});
+  const TriangleMesh& disk = mesh_of(scene.shapes[0]);
+  EXPECT_NEAR(mesh_area(disk), pi * 4, pi * 4 * 1e-3);
+  EXPECT_NEAR(mesh_area(disk), pi * 4, pi * 4 * 1e-5);  // the rings are stretched to keep it exact
+  ASSERT_EQ(disk.uvs.size(), disk.positions.size());
+  ASSERT_EQ(disk.normals.size(), disk.positions.size());
+  for (size_t i = 0; i < disk.positions.size(); ++i) {
+    const Point3& p = disk.positions[i];
+    EXPECT_FLOAT_EQ(p.z, 0.5f);
+    EXPECT_LE(length(Vec3(p.x, p.y, 0)), 2 * 1.0003f);
+    EXPECT_EQ(disk.normals[i], Normal3(0, 0, 1));
+    float r = length(Vec3(p.x, p.y, 0));
+    if (r > 1) {  // pbrt: u = phi / phimax, v = (radius - r) / (radius - innerradius)
+      EXPECT_FLOAT_EQ(disk.uvs[i].y, 0);
+      float phi = std::atan2(p.y, p.x);
+      if (phi < 0) phi += 2 * std::numbers::pi_v<float>;
+      if (disk.uvs[i].x < 1) {
+        EXPECT_NEAR(disk.uvs[i].x, phi / (2 * std::numbers::pi_v<float>), 1e-5f);
+      }
+    } else {
+      EXPECT_FLOAT_EQ(disk.uvs[i].y, 1);
+    }
+  }
+  for (size_t t = 0; t < disk.triangle_count(); ++t) {  // every triangle faces +z
+    const Point3 &a = disk.positions[disk.indices[3 * t]], &b = disk.positions[disk.indices[3 * t + 1]],
+                 &c = disk.positions[disk.indices[3 * t + 2]];
+    EXPECT_GT(cross(b - a, c - a).z, 0);
+  }
+  const TriangleMesh& quarter = mesh_of(scene.shapes[1]);
+  EXPECT_NEAR(mesh_area(quarter), 0.5 * (pi / 2) * (4 - 1), 3 * pi / 4 * 1e-5);
+  for (const Point3& p : quarter.positions) {
+    EXPECT_GE(p.x, -1e-5f);
+    EXPECT_GE(p.y, -1e-5f);
+    float r = length(p);
+    EXPECT_TRUE(r >= 1 && r <= 2 * 1.0003f) << r;
+  }
+  expect_error({"WorldBegin", "Shape \"disk\" \"float innerradius\" 2"}, 2, "\"float innerradius\"",
+               "must be in [0, \"radius\" = 1)");
+}
+
+TEST(PbrtReader, BilinearMeshes) {
+  SceneDesc scene = read_lines({"WorldBegin",
+                                "Shape \"bilinearmesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0  1 1 0 ]",
+                                "Shape \"bilinearmesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0  1 1 1 ]",
+                                "Shape \"bilinearmesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0  1 1 0  2 0 0  2 1 0 ] "
+                                "\"integer indices\" [ 0 1 2 3  1 4 3 5 ] \"point2 uv\" [ 0 0  1 0  0 1  1 1  2 0  2 1 ] "
+                                "\"normal N\" [ 0 0 1  0 0 1  0 0 1  0 0 1  0 0 1  0 0 1 ]"});
+  // A planar patch: two triangles facing dp/du x dp/dv (+z), with pbrt's default uvs.
+  const TriangleMesh& flat = mesh_of(scene.shapes[0]);
+  ASSERT_EQ(flat.triangle_count(), 2u);
+  EXPECT_TRUE(flat.normals.empty());
+  for (size_t t = 0; t < 2; ++t) {
+    const Point3 &a = flat.positions[flat.indices[3 * t]], &b = flat.positions[flat.indices[3 * t + 1]],
+                 &c = flat.positions[flat.indices[3 * t + 2]];
+    EXPECT_GT(cross(b - a, c - a).z, 0);
+  }
+  EXPECT_NEAR(mesh_area(flat), 1, 1e-6);
+  for (size_t i = 0; i < flat.positions.size(); ++i) {
+    EXPECT_FLOAT_EQ(flat.uvs[i].x, flat.positions[i].x);
+    EXPECT_FLOAT_EQ(flat.uvs[i].y, flat.positions[i].y);
+  }
+  // A twisted patch: 16 x 16 quads on the bilinear surface with its normals.
+  const TriangleMesh& twisted = mesh_of(scene.shapes[1]);
+  EXPECT_EQ(twisted.triangle_count(), 2u * 16 * 16);
+  ASSERT_EQ(twisted.normals.size(), twisted.positions.size());
+  bool found_centre = false;
+  for (size_t i = 0; i < twisted.positions.size(); ++i) {
+    EXPECT_NEAR(twisted.positions[i].z, twisted.positions[i].x * twisted.positions[i].y, 1e-5f);
+    if (twisted.uvs[i].x == 0.5f && twisted.uvs[i].y == 0.5f) {
+      found_centre = true;
+      expect_near(twisted.positions[i], Point3(0.5f, 0.5f, 0.25f));
+      expect_near(twisted.normals[i], normalize(Vec3(-0.5f, -0.5f, 1)));
+    }
+  }
+  EXPECT_TRUE(found_centre);
+  // Two patches with their own uvs and normals.
+  const TriangleMesh& strip = mesh_of(scene.shapes[2]);
+  EXPECT_EQ(strip.triangle_count(), 4u);
+  ASSERT_EQ(strip.normals.size(), strip.positions.size());
+  EXPECT_NEAR(mesh_area(strip), 2, 1e-6);
+  for (size_t i = 0; i < strip.positions.size(); ++i) EXPECT_FLOAT_EQ(strip.uvs[i].x, strip.positions[i].x);
+  expect_error({"WorldBegin", "Shape \"bilinearmesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0  1 1 0 ] "
+                "\"integer indices\" [ 0 1 2 ]"},
+               2, "\"integer indices\"", "not a multiple of 4");
+  expect_error({"WorldBegin", "Shape \"bilinearmesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0 ]"}, 2, "Shape",
+               "\"indices\" is required unless \"P\" has exactly 4 points");
+}
+
+TEST(PbrtReader, BilinearPatchPowerIsPerPatch) {
+  const float pi = std::numbers::pi_v<float>;
+  SceneDesc scene = read_lines({"WorldBegin", "AreaLightSource \"diffuse\" \"float power\" 1",
+                                "Shape \"bilinearmesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0  1 1 0  3 0 0  3 2 0 ] "
+                                "\"integer indices\" [ 0 1 2 3  1 4 3 5 ]"});  // areas 1 and 3
+  ASSERT_EQ(scene.shapes.size(), 2u);
+  EXPECT_NEAR(scene.shapes[0].emission->radiance.r, 1 / (pi * 1), 1e-5f);
+  EXPECT_EQ(mesh_of(scene.shapes[0]).triangle_count(), 2u);
+  EXPECT_NEAR(scene.shapes[1].emission->radiance.r, 1 / (pi * 3), 1e-5f);
+}
+
+TEST(PbrtReader, AlphaAndOtherShapeParameters) {
+  SceneDesc scene = read_lines({"WorldBegin", "Shape \"sphere\" \"float alpha\" 1"});
+  EXPECT_EQ(scene.shapes.size(), 1u);
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float alpha\" 0.5"}, 2, "\"float alpha\"",
+               "below 1 is not supported");
+  expect_error({"WorldBegin", "Texture \"a\" \"float\" \"constant\"", "Shape \"sphere\" \"texture alpha\" \"a\""}, 3,
+               "\"texture alpha\"", "textures are not supported: an alpha texture cuts the surface out");
+  expect_warning({"WorldBegin", "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0 ] "
+                  "\"vector3 S\" [ 1 0 0  1 0 0  1 0 0 ]"},
+                 2, "\"vector3 S\"", "\"S\" is ignored");
+}
+
+// ---------------------------------------------------------------- graphics state
+
+TEST(PbrtReader, ReverseOrientationToggles) {
+  SceneDesc scene = read_lines({"WorldBegin", "ReverseOrientation", "Shape \"sphere\"", "ReverseOrientation",
+                                "Shape \"sphere\""});
+  EXPECT_TRUE(scene.shapes.at(0).reverse_orientation);
+  EXPECT_FALSE(scene.shapes.at(1).reverse_orientation);
+}
+
+TEST(PbrtReader, AttributeSetsDefaultParametersForABlock) {
+  ScratchFile png("wood.png");
+  Warned read = read_warned({"WorldBegin",
+                             "AttributeBegin",
+                             "Attribute \"shape\" \"float radius\" 2",
+                             "Attribute \"light\" \"float scale\" 2",
+                             "Attribute \"material\" \"rgb reflectance\" [ 0.1 0.2 0.3 ]",
+                             "Attribute \"texture\" \"float uscale\" 4",
+                             "Shape \"sphere\"",
+                             "Shape \"sphere\" \"float radius\" 3",
+                             "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0 ]",
+                             "LightSource \"point\"",
+                             "Material \"diffuse\"",
+                             "Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\"",
+                             "AreaLightSource \"diffuse\"",
+                             "Attribute \"shape\" \"float radius\" 5",
+                             "Shape \"sphere\"",
+                             "AttributeEnd",
+                             "Shape \"sphere\"",
+                             "Material \"diffuse\""});
+  const SceneDesc& scene = read.scene;
+  EXPECT_TRUE(read.warnings.empty()) << joined(read.warnings);
+  ASSERT_EQ(scene.shapes.size(), 5u);
+  EXPECT_FLOAT_EQ(std::get<SphereShape>(scene.shapes[0].geometry).radius, 2);
+  EXPECT_FLOAT_EQ(std::get<SphereShape>(scene.shapes[1].geometry).radius, 3);  // its own parameter wins
+  EXPECT_FLOAT_EQ(std::get<SphereShape>(scene.shapes[3].geometry).radius, 5);  // a later Attribute replaces
+  EXPECT_EQ(scene.shapes[3].emission->radiance, RGB(2.0f));
+  EXPECT_FLOAT_EQ(std::get<SphereShape>(scene.shapes[4].geometry).radius, 1);  // AttributeEnd restored
+  EXPECT_EQ(std::get<PointLight>(scene.lights.at(0)).intensity, RGB(2.0f));
+  EXPECT_EQ(std::get<DiffuseMaterial>(scene.materials.at(0)).reflectance.value, RGB(0.1f, 0.2f, 0.3f));
+  EXPECT_EQ(std::get<DiffuseMaterial>(scene.materials.at(1)).reflectance.value, RGB(0.5f));
+  EXPECT_FLOAT_EQ(std::get<ImageTexture>(scene.textures.at(0)).mapping.su, 4);
+  expect_error({"WorldBegin", "Attribute \"camera\" \"float fov\" 30"}, 2, "\"camera\"",
+               "Attribute: unknown target \"camera\"");
+  expect_error({"WorldBegin", "Attribute \"shape\" \"string radius\" \"big\"", "Shape \"sphere\""}, 2,
+               "\"string radius\"", "parameter \"radius\" must be of type \"float\", not \"string\"");
+  expect_warning({"WorldBegin", "Attribute \"medium\" \"rgb sigma_a\" [ 1 1 1 ]"}, 2, "Attribute",
+                 "Attribute \"medium\" is ignored");
+}
+
+TEST(PbrtReader, MediaAreIgnoredWithWarnings) {
+  Warned read = read_warned({"MediumInterface \"\" \"fog\"",
+                             "WorldBegin",
+                             "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [ 1 1 1 ]",
+                             "MediumInterface \"\"",
+                             "MediumInterface \"fog\" \"\"",
+                             "Shape \"sphere\""});
+  EXPECT_EQ(read.scene.shapes.size(), 1u);
+  ASSERT_EQ(read.warnings.size(), 3u) << joined(read.warnings);
+  EXPECT_NE(read.warnings[0].find(":1:1: warning: MediumInterface \"\" \"fog\": participating media are not supported"),
+            std::string::npos);
+  EXPECT_NE(read.warnings[1].find(":3:1: warning: MakeNamedMedium \"fog\": participating media are not supported"),
+            std::string::npos);
+  EXPECT_NE(read.warnings[2].find(":5:1: warning: MediumInterface \"fog\" \"\""), std::string::npos);
+}
+
+TEST(PbrtReader, PrintedWarningsAreCappedPerKind) {
+  std::vector<std::string> warnings;
+  for (int line = 1; line <= 5; ++line) warnings.push_back(fmt::format("a.pbrt:{}:1: warning: same thing", line));
+  warnings.push_back("a.pbrt:9:1: warning: other thing");
+  ::testing::internal::CaptureStderr();
+  print_pbrt_warnings(warnings, 3);
+  std::string printed = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(printed,
+            "a.pbrt:1:1: warning: same thing\na.pbrt:2:1: warning: same thing\na.pbrt:3:1: warning: same thing\n"
+            "a.pbrt:9:1: warning: other thing\n(2 more warnings like \"same thing\")\n");
+}
+
+// ---------------------------------------------------------------- named spectra
+
+TEST(PbrtNamedSpectra, MetalsGlassesAndIlluminants) {
+  using namespace pbrt_spectra;
+  EXPECT_EQ(find_named("metal-Cu-eta")->rgb, ConductorMaterial{}.eta.value);
+  EXPECT_EQ(find_named("metal-Cu-k")->rgb, ConductorMaterial{}.k.value);
+  EXPECT_EQ(find_named("metal-Al-eta")->rgb, RGB(1.657460f, 0.880369f, 0.521229f));  // veach-ajar's "rgb eta"
+  for (std::string_view metal : {"Ag", "Al", "Au", "Cu", "CuZn", "MgO", "TiO2"})
+    for (std::string_view part : {"eta", "k"}) {
+      auto named = find_named(fmt::format("metal-{}-{}", metal, part));
+      ASSERT_TRUE(named.has_value()) << metal << part;
+      EXPECT_EQ(named->kind, NamedKind::Metal);
+      EXPECT_GE(named->rgb.min_component(), 0);
+    }
+  for (std::string_view glass : {"BK7", "BAF10", "FK51A", "LASF9", "F5", "F10", "F11"}) {
+    auto named = find_named(fmt::format("glass-{}", glass));
+    ASSERT_TRUE(named.has_value()) << glass;
+    EXPECT_TRUE(named->ior_550nm > 1.45f && named->ior_550nm < 1.9f) << glass;
+  }
+  EXPECT_NEAR(find_named("glass-BK7")->ior_550nm, 1.5185f, 1e-4f);
+  EXPECT_NEAR(find_named("glass-F11")->ior_550nm, 1.7911f, 1e-4f);
+  EXPECT_EQ(find_named("stdillum-D65")->rgb, RGB(1.0f));
+  for (std::string_view name : {"stdillum-A", "stdillum-D50", "stdillum-F1", "stdillum-F12", "illum-acesD60"}) {
+    auto named = find_named(name);
+    ASSERT_TRUE(named.has_value()) << name;
+    EXPECT_NEAR(named->rgb.luminance(), 1, 2e-3f) << name;
+  }
+  EXPECT_FALSE(find_named("glass-SF5").has_value());  // pbrt-v4 calls it "glass-F5"
+  EXPECT_FALSE(find_named("metal-Fe-eta").has_value());
+}
+
+TEST(PbrtNamedSpectra, SampledSpectraAndBlackbodies) {
+  using namespace pbrt_spectra;
+  const double flat[] = {300, 0.5, 900, 0.5};
+  RGB reflectance = sampled_spectrum_rgb(flat, Role::Reflectance);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(reflectance[c], 0.5f, 1e-5f);
+  EXPECT_NEAR(sampled_spectrum_rgb(flat, Role::Illuminant).luminance(), 1, 1e-3f);
+  const double ramp[] = {400, 1, 500, 2, 600, 4};
+  EXPECT_FLOAT_EQ(sampled_spectrum_at(ramp, 450), 1.5f);
+  EXPECT_FLOAT_EQ(sampled_spectrum_at(ramp, 300), 1);
+  EXPECT_FLOAT_EQ(sampled_spectrum_at(ramp, 700), 4);
+  RGB candle = blackbody_rgb(1900), sky = blackbody_rgb(12000);
+  EXPECT_NEAR(candle.luminance(), 1, 1e-3f);
+  EXPECT_GT(candle.r, candle.b);
+  EXPECT_GT(sky.b, sky.r);
+  // Tungsten's copper, reproduced from pbrt-v4's copper table by the same conversion to about 1%.
+  RGB xyz_white = xyz_to_linear_srgb(0.95047f, 1.0f, 1.08883f);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(xyz_white[c], 1, 1e-3f);
 }
 
 }  // namespace

@@ -100,7 +100,7 @@ struct CoatedDiffuseBsdf {
     return BsdfSample{wi, weight, p, false, 1};
   }
 
-  bool has_non_delta() const { return true; }
+  bool has_non_delta() const { return !distribution.effectively_smooth() || reflectance.max_component() > 0; }
   bool has_non_delta_transmission() const { return false; }
   float non_delta_probability(Vec3 wo) const {
     if (!distribution.effectively_smooth()) return 1;

@@ -16,7 +16,9 @@
 namespace candela {
 
 struct ConductorBsdf {
-  RGB eta{1.0f}, k{0.0f};  // complex index of refraction relative to the outside medium
+  // Complex index of refraction eta + i k relative to the outside medium; copper by default (as
+  // ConductorMaterial). pbrt-v4's artist mode: eta = 1, k = conductor_k_from_reflectance(r).
+  RGB eta{0.200438f, 0.924033f, 1.102212f}, k{3.912949f, 2.452848f, 2.142188f};
   RGB tint{1.0f};          // multiplies the reflection (Mitsuba's specular_reflectance); 1 = physical
   TrowbridgeReitz distribution;
 

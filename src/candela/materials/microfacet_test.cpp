@@ -4,6 +4,10 @@
 // conservation, and the smooth limits.
 #include <gtest/gtest.h>
 
+#include <complex>
+#include <functional>
+#include <tuple>
+
 #include "candela/materials/bsdf.h"
 #include "candela/math/frame.h"
 #include "candela/sampling/rng.h"
@@ -168,6 +172,9 @@ TEST(Microfacet, SmoothThresholdAndRoughnessMapping) {
   EXPECT_TRUE(TrowbridgeReitz(9e-4f, 5e-4f).effectively_smooth());
   EXPECT_FALSE(TrowbridgeReitz(9e-4f, 2e-3f).effectively_smooth());
   EXPECT_FLOAT_EQ(TrowbridgeReitz::roughness_to_alpha(0.25f), 0.5f);
+  // Rough along one axis only: the other is clamped so that D stays finite.
+  TrowbridgeReitz one_axis(0, 0.3f);
+  EXPECT_TRUE(std::isfinite(one_axis.D(normalize(Vec3(0.1f, 0.2f, 1)))));
   // Masking of the normal direction is complete visibility; G <= G1 <= 1.
   TrowbridgeReitz d(0.4f, 0.2f);
   EXPECT_FLOAT_EQ(d.G1(Vec3(0, 0, 1)), 1.0f);
@@ -175,7 +182,23 @@ TEST(Microfacet, SmoothThresholdAndRoughnessMapping) {
   EXPECT_LE(d.G(a, b), std::min(d.G1(a), d.G1(b)));
 }
 
+// pbrt-v4's FrComplex, with std::complex: the reference for the real-valued form.
+float fresnel_complex_reference(float cos_i, std::complex<double> eta) {
+  using C = std::complex<double>;
+  double c = std::clamp(double(cos_i), 0.0, 1.0);
+  C sin2_t = (1 - c * c) / (eta * eta);
+  C cos_t = std::sqrt(C(1) - sin2_t);
+  C r_parl = (eta * c - cos_t) / (eta * c + cos_t);
+  C r_perp = (c - eta * cos_t) / (c + eta * cos_t);
+  return float((std::norm(r_parl) + std::norm(r_perp)) / 2);
+}
+
 TEST(Microfacet, FresnelComplexKnownValues) {
+  // The real-valued form equals the complex Fresnel equations (metals, dielectrics both ways).
+  for (auto [n, k] : {std::pair{0.2f, 3.0f}, {1.1f, 2.1f}, {1.0f, 200.0f}, {1.5f, 0.0f}, {0.67f, 0.0f}, {2.5f, 0.5f}})
+    for (float c : {0.0f, 0.01f, 0.2f, 0.5f, 0.74f, 0.9f, 1.0f})
+      EXPECT_NEAR(fresnel_complex(c, std::complex<float>(n, k)), fresnel_complex_reference(c, {n, k}), 2e-5f)
+          << n << " + " << k << "i, cos " << c;
   // Normal incidence: ((n - 1)^2 + k^2) / ((n + 1)^2 + k^2). Gold at ~600 nm (n 0.2, k 3.0),
   // copper (pbrt's RGB defaults).
   auto normal = [](float n, float k) { return (sqr(n - 1) + k * k) / (sqr(n + 1) + k * k); };

@@ -227,7 +227,8 @@ void Scene::add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Trans
   rec.indices = mesh.indices;
   // Keep cross(p1-p0, p2-p0) equal to the object-space normal transformed as a normal: a mirroring
   // transform reverses the winding, and so does reverse orientation.
-  if (T.swaps_handedness() != reverse)
+  rec.winding_swapped = T.swaps_handedness() != reverse;
+  if (rec.winding_swapped)
     for (size_t i = 0; i < rec.indices.size(); i += 3) std::swap(rec.indices[i + 1], rec.indices[i + 2]);
   triangle_count_ += rec.indices.size() / 3;
 
@@ -348,8 +349,9 @@ void Scene::reconstruct_triangle_hit(const ShapeRecord& rec, const EmbreeHit& eh
     hit.ns = hit.ng;
   }
   if (rec.uvs.empty()) {
-    hit.uv = Vec2(eh.u, eh.v);
-    hit.dpdu = p1 - p0;
+    // Barycentric uvs in the mesh's own vertex order, whatever winding was baked for orientation.
+    hit.uv = rec.winding_swapped ? Vec2(eh.v, eh.u) : Vec2(eh.u, eh.v);
+    hit.dpdu = rec.winding_swapped ? p2 - p0 : p1 - p0;
   } else {
     const Vec2 &uv0 = rec.uvs[i0], &uv1 = rec.uvs[i1], &uv2 = rec.uvs[i2];
     hit.uv = uv0 * b0 + uv1 * eh.u + uv2 * eh.v;

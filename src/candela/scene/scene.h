@@ -25,6 +25,7 @@ struct ShapeRecord {
   RGB radiance;          // emitted radiance when emissive
   bool two_sided_emission = false;
   bool flip_normal = false;  // spheres and planes: reverse orientation
+  bool winding_swapped = false;  // triangles: indices 1 and 2 swapped to orient the normal
   // Triangles, in world space, winding baked so cross(p1-p0, p2-p0) is the oriented normal.
   std::vector<Point3> positions;
   std::vector<Normal3> normals;
