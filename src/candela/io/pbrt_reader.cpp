@@ -566,7 +566,8 @@ class PbrtParser {
 
   template <typename... Args>
   void warn(const SourceLocation& where, fmt::format_string<Args...> format, Args&&... args) {
-    warnings_.push_back(fmt::format("{}: warning: {}", where.to_string(), fmt::format(format, std::forward<Args>(args)...)));
+    warnings_.push_back(
+        fmt::format("{}: warning: {}", where.to_string(), fmt::format(format, std::forward<Args>(args)...)));
   }
   // Accepts the parameter `name` if given and warns that it is ignored (silently for one an
   // Attribute set, which applies to many directives).
@@ -1118,7 +1119,8 @@ void PbrtParser::attribute_end(const Token& d) {
 // in this attribute block (pbrt-v4).
 void PbrtParser::attribute(const Token& d) {
   require_world(d);
-  Token target = expect_string(d, "the attribute target (\"shape\", \"light\", \"material\", \"medium\" or \"texture\")");
+  Token target =
+      expect_string(d, "the attribute target (\"shape\", \"light\", \"material\", \"medium\" or \"texture\")");
   AttributeTarget index = kAttributeTargets;
   if (target.text == "shape") index = kShapeAttributes;
   if (target.text == "light") index = kLightAttributes;
@@ -1393,7 +1395,8 @@ RGB spectrum_rgb(const Param& p, const ParamList& params, Role role) {
     std::optional<pbrt_spectra::NamedSpectrum> named = pbrt_spectra::find_named(name);
     if (!named) {
       std::string names;
-      for (std::string_view n : pbrt_spectra::named_spectrum_names()) names += fmt::format("{}\"{}\"", names.empty() ? "" : ", ", n);
+      for (std::string_view n : pbrt_spectra::named_spectrum_names())
+        names += fmt::format("{}\"{}\"", names.empty() ? "" : ", ", n);
       throw_scene_error(p.where,
                         "{}: {}: unknown named spectrum \"{}\" (spectrum files are not supported; the named spectra "
                         "are {})",
@@ -1454,8 +1457,9 @@ std::optional<FloatInput> PbrtParser::read_float_texture(ParamList& params, std:
     bool is_spectrum = spectrum_textures_.contains(p->strings[0]);
     throw_scene_error(p->where, "{}: {}: no float texture named \"{}\" is defined{}", params.owner(), p->declaration(),
                       p->strings[0],
-                      is_spectrum ? " (there is a \"spectrum\" texture of that name; this parameter needs a \"float\" one)"
-                                  : " (Texture must come first)");
+                      is_spectrum
+                          ? " (there is a \"spectrum\" texture of that name; this parameter needs a \"float\" one)"
+                          : " (Texture must come first)");
   }
   return texture->second.value;
 }
@@ -1550,11 +1554,6 @@ UVMapping PbrtParser::read_uv_mapping(ParamList& params) {
   return uv;
 }
 
-std::string lowercase(std::string text) {
-  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return text;
-}
-
 ImageTexture PbrtParser::make_image_texture(ParamList& params) {
   ImageTexture texture;
   if (!params.has("filename")) params.fail("filename", "is required: name the image file");
@@ -1590,10 +1589,12 @@ ImageTexture PbrtParser::make_image_texture(ParamList& params) {
   texture.scale = params.get_float("scale", 1);
   texture.invert = params.get_bool("invert", false);
 
-  // pbrt-v4 decodes 8-bit .png files as sRGB and every other file as linear unless told otherwise;
-  // that includes 8-bit .tga and .jpg files.
-  std::string extension = lowercase(file.extension().string());
-  texture.encoding = extension == ".png" ? ColorEncoding::SRGB : ColorEncoding::Linear;
+  // pbrt-v4's "encoding" defaults to "sRGB" for .png files and to "linear" for others, but it reads
+  // every 8-bit format other than PNG (.tga, .jpg, ...) through stb_image as sRGB whatever the
+  // parameter says: 8-bit files are sRGB, float files linear, which is ColorEncoding::Auto. (Checked
+  // on veach-ajar's .tga textures against its pbrt-v4 reference render.) An explicit "encoding" is
+  // honoured for every file.
+  texture.encoding = ColorEncoding::Auto;
   if (params.has("encoding")) {
     std::string encoding = params.get_string("encoding", "");
     if (encoding == "sRGB") {
@@ -2238,7 +2239,8 @@ void PbrtParser::add_emissive_shape(ShapeDesc shape, const BuiltGeometry& built,
     if (groups.size() > 1) {
       std::sort(group.begin(), group.end());
       part.geometry = MeshShape{submesh(mesh, group)};
-      part.name = fmt::format("{} (the {} triangles of primitive area {})", shape.name, group.size(), area[group.front()]);
+      part.name =
+          fmt::format("{} (the {} triangles of primitive area {})", shape.name, group.size(), area[group.front()]);
     }
     add_shape(std::move(part), directive);
   }

@@ -1053,7 +1053,8 @@ TEST(PbrtReaderBitterli, VeachAjar) {
   const SceneDesc& scene = read.scene;
   ASSERT_EQ(read.warnings.size(), 4u) << joined(read.warnings);  // sobol, three "trilinear" filters
   expect_sobol_warning(read, 4);
-  for (int i = 1; i < 4; ++i) EXPECT_NE(read.warnings[i].find("filter \"trilinear\" is read as \"bilinear\""), std::string::npos);
+  for (int i = 1; i < 4; ++i)
+    EXPECT_NE(read.warnings[i].find("filter \"trilinear\" is read as \"bilinear\""), std::string::npos);
   EXPECT_EQ(scene.shapes.size(), 22u);
   EXPECT_EQ(emitter_count(scene), 1u);
   EXPECT_EQ(scene.materials.size(), 13u);
@@ -1063,7 +1064,8 @@ TEST(PbrtReaderBitterli, VeachAjar) {
     const auto& texture = std::get<ImageTexture>(scene.textures[i]);
     EXPECT_TRUE(fs::is_regular_file(texture.filename)) << texture.filename;
     EXPECT_EQ(fs::path(texture.filename).filename(), files[i]);
-    EXPECT_EQ(texture.encoding, ColorEncoding::Linear);  // pbrt-v4 decodes only .png files as sRGB
+    // pbrt-v4 reads 8-bit .tga files as sRGB (the reference render agrees), so: sRGB for 8-bit files.
+    EXPECT_EQ(texture.encoding, ColorEncoding::Auto);
     EXPECT_TRUE(texture.bilinear);
   }
   // "Landscape" (the first MakeNamedMaterial) is the diffuse reflectance of texture 0.
@@ -1244,7 +1246,8 @@ TEST(PbrtReader, DielectricMaterials) {
 TEST(PbrtReader, CoatedDiffuseIsTheClosedFormPlastic) {
   Warned read = read_warned({"WorldBegin",
                              "Material \"coateddiffuse\" \"rgb reflectance\" [ 0.2 0.4 0.6 ] \"float roughness\" 0.1 "
-                             "\"float eta\" 1.6 \"integer maxdepth\" 20 \"integer nsamples\" 4 \"rgb albedo\" [ 0 0 0 ] "
+                             "\"float eta\" 1.6 \"integer maxdepth\" 20 \"integer nsamples\" 4 "
+                             "\"rgb albedo\" [ 0 0 0 ] "
                              "\"float g\" 0.3",
                              "Material \"coateddiffuse\""});
   EXPECT_TRUE(read.warnings.empty()) << joined(read.warnings);
@@ -1341,14 +1344,14 @@ TEST(PbrtReader, ImageTextures) {
   ASSERT_EQ(scene.textures.size(), 6u);
   const auto& a = std::get<ImageTexture>(scene.textures[0]);
   EXPECT_EQ(fs::path(a.filename), scratch_dir() / "wood.png");  // beside the scene file
-  EXPECT_EQ(a.encoding, ColorEncoding::SRGB);                     // pbrt-v4's default for .png
+  EXPECT_EQ(a.encoding, ColorEncoding::Auto);                     // sRGB for 8-bit files, as pbrt-v4
   EXPECT_TRUE(a.bilinear);
   EXPECT_EQ(a.wrap, TextureWrap::Repeat);
   EXPECT_FLOAT_EQ(a.scale, 1);
   EXPECT_FALSE(a.invert);
   EXPECT_FLOAT_EQ(a.mapping.su, 1);
   const auto& b = std::get<ImageTexture>(scene.textures[1]);
-  EXPECT_EQ(b.encoding, ColorEncoding::Linear);  // pbrt-v4's default for everything but .png
+  EXPECT_EQ(b.encoding, ColorEncoding::Auto);
   EXPECT_FALSE(b.bilinear);
   EXPECT_EQ(b.wrap, TextureWrap::Clamp);
   EXPECT_FLOAT_EQ(b.scale, 2);
@@ -1362,7 +1365,7 @@ TEST(PbrtReader, ImageTextures) {
   EXPECT_EQ(c.wrap, TextureWrap::Black);
   EXPECT_EQ(std::get<ImageTexture>(scene.textures[3]).encoding, ColorEncoding::Linear);
   EXPECT_EQ(std::get<ImageTexture>(scene.textures[4]).encoding, ColorEncoding::SRGB);
-  EXPECT_EQ(std::get<ImageTexture>(scene.textures[5]).encoding, ColorEncoding::Linear);
+  EXPECT_EQ(std::get<ImageTexture>(scene.textures[5]).encoding, ColorEncoding::Auto);
   EXPECT_EQ(std::get<DiffuseMaterial>(scene.materials[0]).reflectance.texture, 1);
   EXPECT_EQ(std::get<ConductorMaterial>(scene.materials[1]).roughness.u.texture, 2);
   ASSERT_EQ(read.warnings.size(), 1u) << joined(read.warnings);
@@ -1374,7 +1377,8 @@ TEST(PbrtReader, TrilinearAndEwaFiltersAreBilinearWithAWarning) {
   for (std::string filter : {"trilinear", "ewa"})
     expect_warning({"WorldBegin", "Texture \"a\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\" "
                     "\"string filter\" \"" + filter + "\" \"float maxanisotropy\" 4"},
-                   2, "\"string filter\"", "filter \"" + filter + "\" is read as \"bilinear\": candela does not mipmap");
+                   2, "\"string filter\"",
+                   "filter \"" + filter + "\" is read as \"bilinear\": candela does not mipmap");
 }
 
 TEST(PbrtReader, BadImageTextures) {
@@ -1396,9 +1400,11 @@ TEST(PbrtReader, BadImageTextures) {
                "spectrum texture \"a\" is already defined at");
   expect_error({"WorldBegin", "Texture \"a\" \"color\" \"imagemap\""}, 2, "\"color\"",
                "the value type must be \"spectrum\" or \"float\"");
-  expect_error({"WorldBegin", "Texture \"r\" \"float\" \"constant\"", "Material \"diffuse\" \"texture reflectance\" \"r\""},
+  expect_error({"WorldBegin", "Texture \"r\" \"float\" \"constant\"",
+                "Material \"diffuse\" \"texture reflectance\" \"r\""},
                3, "\"texture reflectance\"", "there is a \"float\" texture of that name");
-  expect_error({"WorldBegin", "Texture \"r\" \"spectrum\" \"constant\"", "Material \"conductor\" \"texture roughness\" \"r\""},
+  expect_error({"WorldBegin", "Texture \"r\" \"spectrum\" \"constant\"",
+                "Material \"conductor\" \"texture roughness\" \"r\""},
                3, "\"texture roughness\"", "there is a \"spectrum\" texture of that name");
 }
 
@@ -1634,7 +1640,8 @@ TEST(PbrtReader, BilinearMeshes) {
                                 "Shape \"bilinearmesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0  1 1 0 ]",
                                 "Shape \"bilinearmesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0  1 1 1 ]",
                                 "Shape \"bilinearmesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0  1 1 0  2 0 0  2 1 0 ] "
-                                "\"integer indices\" [ 0 1 2 3  1 4 3 5 ] \"point2 uv\" [ 0 0  1 0  0 1  1 1  2 0  2 1 ] "
+                                "\"integer indices\" [ 0 1 2 3  1 4 3 5 ] "
+                                "\"point2 uv\" [ 0 0  1 0  0 1  1 1  2 0  2 1 ] "
                                 "\"normal N\" [ 0 0 1  0 0 1  0 0 1  0 0 1  0 0 1  0 0 1 ]"});
   // A planar patch: two triangles facing dp/du x dp/dv (+z), with pbrt's default uvs.
   const TriangleMesh& flat = mesh_of(scene.shapes[0]);
