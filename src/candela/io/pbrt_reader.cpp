@@ -1271,15 +1271,18 @@ void PbrtParser::integrator(const Token& d) {
       {"mlt", {"bootstrapsamples", "chains", "mutationsperpixel", "largestepprobability", "sigma"}},
       {"sppm", {"photonsperiteration", "radius", "seed"}},
       {"lightpath", {}},
-      {"ambientocclusion", {"cossample", "maxdistance"}},
       {"randomwalk", {}},
       {"simplepath", {"samplelights", "samplebsdf"}},
       {"simplevolpath", {}},
   };
+  // Ambient occlusion is a different image altogether, not another way to the same one.
+  if (type.text == "ambientocclusion")
+    throw_scene_error(at(type), "Integrator \"ambientocclusion\" is not supported: candela renders global "
+                      "illumination, which would be a different image (use \"path\")");
   auto known = kOwnParameters.find(type.text);
   if (known == kOwnParameters.end())
     reject_type(at(type), "integrator", type.text,
-                {"path", "volpath", "bdpt", "mlt", "sppm", "lightpath", "ambientocclusion", "randomwalk",
+                {"path", "volpath", "bdpt", "mlt", "sppm", "lightpath", "randomwalk",
                  "simplepath", "simplevolpath"},
                 {});
   ParamList params = read_params(d, fmt::format("Integrator \"{}\"", type.text));
@@ -1297,9 +1300,6 @@ void PbrtParser::integrator(const Token& d) {
   if (type.text == "volpath")
     warn(at(type), "Integrator \"volpath\": using candela's path integrator; without participating media (which "
          "candela does not render) it is the same integrator");
-  else if (type.text == "ambientocclusion")
-    warn(at(type), "Integrator \"ambientocclusion\": using candela's path integrator with maxdepth {}: the image "
-         "shows full global illumination, not ambient occlusion", max_depth);
   else if (type.text != "path")
     warn(at(type), "Integrator \"{}\": using candela's path integrator with maxdepth {} (it converges to the "
          "same image, with different noise)", type.text, max_depth);

@@ -1135,8 +1135,7 @@ TEST(PbrtReader, EveryPbrtIntegratorIsRenderedWithThePathIntegrator) {
   }
   expect_warning({"Integrator \"volpath\"", "WorldBegin"}, 1, "\"volpath\"",
                  "without participating media (which candela does not render) it is the same integrator");
-  expect_warning({"Integrator \"ambientocclusion\"", "WorldBegin"}, 1, "\"ambientocclusion\"",
-                 "not ambient occlusion");
+  EXPECT_THROW(read_lines({"Integrator \"ambientocclusion\"", "WorldBegin"}), SceneError);
   Warned sppm = read_warned({"Integrator \"sppm\" \"integer photonsperiteration\" 1000 \"float radius\" 0.1",
                              "WorldBegin"});
   ASSERT_EQ(sppm.warnings.size(), 3u) << joined(sppm.warnings);
