@@ -31,15 +31,6 @@ struct ReferenceCase {
 
 void PrintTo(const ReferenceCase& c, std::ostream* os) { *os << c.scene; }
 
-double rel_mse(const Image& test, const Image& ref) {
-  double sum = 0;
-  for (size_t i = 0; i < test.rgb.size(); ++i) {
-    double d = double(test.rgb[i]) - ref.rgb[i];
-    sum += d * d / (double(ref.rgb[i]) * ref.rgb[i] + 0.01);
-  }
-  return sum / double(test.rgb.size());
-}
-
 // mean(min(block mean, 1)) of one channel over `block` x `block` pixel blocks.
 double clamped_block_mean(const Image& img, int channel, int block) {
   double sum = 0;
@@ -75,7 +66,7 @@ TEST_P(BitterliReference, AgreesWithPbrtV4) {
     std::printf("%s channel %d: clamped mean %.5f vs pbrt-v4 %.5f (ratio %.4f)\n", c.scene, ch, ours, ref, ours / ref);
     EXPECT_NEAR(ours / ref, 1.0, c.mean_tolerance[ch]) << c.scene << " channel " << ch;
   }
-  double e = rel_mse(image, reference);
+  double e = testing::rel_mse(image, reference);
   std::printf("%s: relMSE %.5f at %d spp (bound %.4f)\n", c.scene, e, c.spp, c.relmse_bound);
   EXPECT_LT(e, c.relmse_bound) << c.scene;
 }

@@ -14,15 +14,6 @@ namespace {
 
 const std::string kSceneDir = std::string(CANDELA_SHARED_DIR) + "/scenes/cornell-box/";
 
-double rel_mse(const Image& test, const Image& ref) {
-  double sum = 0;
-  for (size_t i = 0; i < test.rgb.size(); ++i) {
-    double d = double(test.rgb[i]) - ref.rgb[i];
-    sum += d * d / (double(ref.rgb[i]) * ref.rgb[i] + 0.01);
-  }
-  return sum / double(test.rgb.size());
-}
-
 // Region label of each pixel: which shape (and for the blocks, which face) its centre ray hits;
 // -1 where the pixel straddles an edge (a neighbour differs) or sees nothing.
 std::vector<int> region_labels(const Scene& scene, int width, int height) {
@@ -66,7 +57,7 @@ TEST(CornellBoxReference, AgreesWithConvergedReference) {
   }
 
   // relMSE (eps 0.01) at 64 spp below 0.0075 (pbrt-v4 with independent samples: 0.0050).
-  double e = rel_mse(image, reference);
+  double e = testing::rel_mse(image, reference);
   std::printf("relMSE at 64 spp: %.5f\n", e);
   EXPECT_LT(e, 0.0075);
 

@@ -51,6 +51,16 @@ inline MeanEstimate region_mean(const Image& img, int channel,
   return e;
 }
 
+// relMSE = mean((x - y)^2 / (y^2 + eps)) over pixels and channels, y the reference (the project's metric).
+inline double rel_mse(const Image& test, const Image& ref, double eps = 0.01) {
+  double sum = 0;
+  for (size_t i = 0; i < test.rgb.size(); ++i) {
+    double d = double(test.rgb[i]) - ref.rgb[i];
+    sum += d * d / (double(ref.rgb[i]) * ref.rgb[i] + eps);
+  }
+  return sum / double(test.rgb.size());
+}
+
 // Camera at `eye` looking at `target` with a vertical fov, on a small square image.
 inline CameraDesc look_at_camera(const Point3& eye, const Point3& target, float fov_degrees) {
   CameraDesc c;
