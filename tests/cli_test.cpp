@@ -129,8 +129,17 @@ TEST_F(CommandLine, HelpDocumentsEveryOption) {
   EXPECT_EQ(r.exit_code, 0);
   for (const char* opt : {"--output", "--spp", "--threads", "--seed", "--max-depth", "--resolution", "--integrator",
                           "--sampler", "--filter", "--direction-sampling", "--no-mis", "--light-selection",
-                          "--shadow-rays", "--adaptive-threshold", "--adaptive-batch", "--max-spp", "--spp-map"})
+                          "--shadow-rays", "--adaptive-threshold", "--adaptive-batch", "--max-spp", "--spp-map",
+                          "--checkpoint", "--checkpoint-every", "--resume", "--time-limit", "--clamp", "--pixel"})
     EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
+}
+
+TEST_F(CommandLine, RenderControlOptionsAreChecked) {
+  std::string scene = write("good.json", kGoodJson);
+  expect_failure("render " + scene + " -o " + out() + " --checkpoint-every 1", "--checkpoint-every needs --checkpoint");
+  expect_failure("render " + scene + " -o " + out() + " --resume " + (dir_ / "none.ckpt").string(), "none\\.ckpt.*cannot open");
+  expect_failure("render " + scene + " -o " + out() + " --pixel 3", "--pixel");
+  expect_failure("render " + scene + " -o " + out() + " --pixel 99,1", "outside");
 }
 
 TEST_F(CommandLine, MissingSceneFile) { expect_failure("render " + (dir_ / "nope.json").string() + " -o " + out(), "nope\\.json"); }

@@ -3,8 +3,14 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <signal.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <optional>
 #include <regex>
@@ -14,7 +20,9 @@
 #include "candela/film/image_io.h"
 #include "candela/io/error.h"
 #include "candela/io/scene_reader.h"
+#include "candela/render/checkpoint.h"
 #include "candela/render/renderer.h"
+#include "candela/scene/resource_limits.h"
 #include "candela/scene/scene.h"
 
 namespace fs = std::filesystem;
@@ -23,6 +31,29 @@ using namespace candela;
 namespace {
 
 constexpr int kExitBadInput = 1;
+constexpr int kExitInterrupted = 3;     // SIGINT/SIGTERM: the partial image (and checkpoint) written
+constexpr int kExitSecondSignal = 130;  // a second SIGINT/SIGTERM: exit at once, nothing more written
+
+// Set by the signal handler; the render loop polls it between tiles and passes.
+std::atomic<bool> g_stop{false};
+std::atomic<int> g_signals{0};
+static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_always_lock_free);
+
+extern "C" void on_stop_signal(int) {
+  // Only atomics and _exit (async-signal-safe). Files are written atomically (temporary + rename),
+  // so leaving at any moment never leaves a half-written image or checkpoint.
+  if (g_signals.fetch_add(1) > 0) _exit(kExitSecondSignal);
+  g_stop.store(true);
+}
+
+void install_signal_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
 constexpr int kMaxResolution = 65536;
 constexpr long long kMaxPixels = 1LL << 28;
 
@@ -42,6 +73,9 @@ struct RenderCommand {
   std::optional<float> adaptive_threshold;
   bool no_mis = false;
   bool quiet = false;
+  std::string checkpoint, resume, pixel;
+  std::optional<double> checkpoint_every, time_limit;
+  std::optional<float> clamp;
 };
 
 template <typename Enum>
@@ -144,51 +178,210 @@ Image spp_heat_map(const Film& film, const fs::path& file) {
   return heat;
 }
 
+const char* sampler_name(SamplerType t) {
+  switch (t) {
+    case SamplerType::Independent: return "independent";
+    case SamplerType::Stratified: return "stratified";
+    case SamplerType::Poisson: return "poisson";
+    case SamplerType::ZSobol: return "zsobol";
+  }
+  return "?";
+}
+
+// What the image depends on besides the scene file: everything the command line can override.
+RenderFingerprint make_fingerprint(const std::string& scene_bytes, const SceneDesc& desc, float clamp) {
+  const RenderSettings& rs = desc.settings;
+  RenderFingerprint fp;
+  fp.scene_hash = fnv1a64(scene_bytes.data(), scene_bytes.size());
+  fp.settings = {
+      {"resolution", fmt::format("{}x{}", desc.film.width, desc.film.height)},
+      {"spp", std::to_string(rs.spp)},
+      {"seed", std::to_string(rs.seed)},
+      {"sampler", fmt::format("{}{}", sampler_name(rs.sampler.type), rs.sampler.jitter ? "" : " (no jitter)")},
+      {"filter", fmt::format("{} radius {},{} sigma {} b {} c {}", int(rs.filter.type), rs.filter.radius.x,
+                             rs.filter.radius.y, rs.filter.gaussian_sigma, rs.filter.mitchell_b, rs.filter.mitchell_c)},
+      {"max-depth", std::to_string(rs.max_depth)},
+      {"integrator", rs.integrator},
+      {"rr-start-depth", std::to_string(rs.rr_start_depth)},
+      {"direction-sampling", std::to_string(int(rs.direction_sampling))},
+      {"mis", rs.mis ? "on" : "off"},
+      {"light-selection", std::to_string(int(rs.light_selection))},
+      {"shadow-rays", std::to_string(rs.shadow_rays)},
+      {"adaptive-threshold", fmt::format("{}", rs.adaptive_threshold)},
+      {"clamp", clamp > 0 ? fmt::format("{}", clamp) : "off"},
+  };
+  return fp;
+}
+
+std::string read_bytes(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw UsageError(fmt::format("cannot read '{}'", file.string()));
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
 int run_render(const RenderCommand& cmd) {
   SceneDesc desc = cmd.scene_file.empty() ? read_json_scene(builtin_scene_json(), "<built-in cornell-box.json>", ".")
                                           : read_scene_file(cmd.scene_file);
   apply_overrides(cmd, desc);
+  const bool adaptive = desc.settings.adaptive_threshold > 0;
+  const bool pixel_mode = !cmd.pixel.empty();
+  if (cmd.checkpoint_every && cmd.checkpoint.empty()) throw UsageError("--checkpoint-every needs --checkpoint FILE");
+  if (adaptive && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
+    throw UsageError("--checkpoint and --resume are not supported with adaptive sampling (--adaptive-threshold)");
+  if (pixel_mode && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
+    throw UsageError("--pixel cannot be combined with --checkpoint or --resume");
+  int px = -1, py = -1;
+  if (pixel_mode) {
+    std::smatch m;
+    static const std::regex pattern(R"((\d{1,9}),(\d{1,9}))");
+    if (!std::regex_match(cmd.pixel, m, pattern))
+      throw UsageError(fmt::format("--pixel: expected X,Y such as 10,20, got '{}'", cmd.pixel));
+    px = std::stoi(m[1]);
+    py = std::stoi(m[2]);
+    if (px >= desc.film.width || py >= desc.film.height)
+      throw UsageError(fmt::format("--pixel {},{} is outside the {}x{} image", px, py, desc.film.width, desc.film.height));
+  }
   std::vector<fs::path> outputs = output_files(cmd, desc);
-  check_outputs(outputs);
+  if (!pixel_mode) check_outputs(outputs);
+  // Refuse what cannot fit in memory before allocating the scene and the film.
+  check_resources(desc);
+
+  const float clamp = cmd.clamp.value_or(0.0f);
+  RenderFingerprint fingerprint;
+  std::optional<Checkpoint> resumed;
+  if (!cmd.checkpoint.empty() || !cmd.resume.empty()) {
+    fingerprint = make_fingerprint(
+        cmd.scene_file.empty() ? std::string(builtin_scene_json()) : read_bytes(cmd.scene_file), desc, clamp);
+    if (!cmd.checkpoint.empty()) {
+      fs::path p(cmd.checkpoint);
+      fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+      if (!fs::is_directory(dir))
+        throw UsageError(fmt::format("--checkpoint '{}': directory '{}' does not exist", cmd.checkpoint, dir.string()));
+    }
+  }
+  if (!cmd.resume.empty()) {
+    resumed = read_checkpoint(cmd.resume);
+    std::string diff = resumed->fingerprint.difference(fingerprint);
+    if (!diff.empty())
+      throw UsageError(fmt::format("cannot resume from '{}': {} (checkpoint vs now)", cmd.resume, diff));
+    if (resumed->width != desc.film.width || resumed->height != desc.film.height)
+      throw UsageError(fmt::format("cannot resume from '{}': its film is {}x{}, not {}x{}", cmd.resume,
+                                   resumed->width, resumed->height, desc.film.width, desc.film.height));
+  }
 
   Scene scene(desc);
   Film film(desc.film.width, desc.film.height);
+  uint64_t earlier_non_finite = 0;
+  if (resumed) {
+    film.pixels() = std::move(resumed->pixels);
+    earlier_non_finite = resumed->non_finite_samples;
+  }
   RenderOptions options;
   options.threads = cmd.threads.value_or(0);
   options.progress = !cmd.quiet;
+  options.cancel = &g_stop;
+  options.time_limit_seconds = cmd.time_limit.value_or(0.0);
+  options.clamp = clamp;
+  if (pixel_mode) {
+    options.only_x = px;
+    options.only_y = py;
+    options.max_reported_non_finite = 1000;
+  }
+  auto save_checkpoint = [&](const Film& f, uint64_t non_finite) {
+    Checkpoint cp;
+    cp.fingerprint = fingerprint;
+    cp.width = f.width();
+    cp.height = f.height();
+    cp.non_finite_samples = non_finite;
+    cp.pixels = f.pixels();
+    write_checkpoint(cmd.checkpoint, cp);
+  };
+  auto last_checkpoint = std::chrono::steady_clock::now();
+  if (!cmd.checkpoint.empty() && cmd.checkpoint_every)
+    options.after_pass = [&](const Film& f, uint64_t non_finite_so_far) {
+      auto now = std::chrono::steady_clock::now();
+      if (std::chrono::duration<double>(now - last_checkpoint).count() < *cmd.checkpoint_every) return;
+      save_checkpoint(f, earlier_non_finite + non_finite_so_far);
+      last_checkpoint = std::chrono::steady_clock::now();
+    };
   RenderStats stats = render(scene, desc.settings, film, options);
+  const uint64_t non_finite = earlier_non_finite + stats.non_finite_samples;
+  const bool stopped = stats.cancelled || stats.time_limited;
 
+  auto nan_warning = [&] {
+    if (non_finite == 0) return;
+    std::string where;
+    for (const auto& n : stats.first_non_finite)
+      where += fmt::format("{}pixel ({}, {}) sample {}", where.empty() ? "" : ", ", n.x, n.y, n.sample);
+    std::fprintf(stderr, "candela: warning: %llu samples were NaN or infinite and counted as black%s%s\n",
+                 (unsigned long long)non_finite, where.empty() ? "" : "; first: ",
+                 (where + (where.empty() || pixel_mode ? "" : " (reproduce one with --pixel X,Y)")).c_str());
+  };
+
+  if (pixel_mode) {
+    const PixelSums& p = film.pixel(px, py);
+    RGB v = p.mean();
+    std::printf("pixel (%d, %d): %.9g %.9g %.9g (%llu samples)\n", px, py, v.r, v.g, v.b,
+                (unsigned long long)p.count);
+    std::string idx;
+    for (const auto& n : stats.first_non_finite) idx += fmt::format("{}{}", idx.empty() ? "" : " ", n.sample);
+    std::printf("non-finite samples: %s\n", idx.empty() ? "none" : idx.c_str());
+    nan_warning();
+    return stats.cancelled ? kExitInterrupted : 0;
+  }
+
+  if (stopped && !cmd.checkpoint.empty()) save_checkpoint(film, non_finite);
+
+  const double pixels = double(film.width()) * film.height();
+  const uint64_t min_spp = film.min_samples(), max_spp = film.max_samples();
+  const double mean_spp = double(film.total_samples()) / pixels;
+  std::string spp_text;
+  if (adaptive && !stopped)
+    spp_text = fmt::format("adaptive, {:.2f} on average", mean_spp);
+  else if (min_spp == max_spp)
+    spp_text = std::to_string(min_spp);
+  else
+    spp_text = fmt::format("min {}, mean {:.2f}", min_spp, mean_spp);
   std::map<std::string, std::string> metadata = {
       {"candela:scene", cmd.scene_file.empty() ? "<built-in cornell-box.json>" : cmd.scene_file},
-      {"candela:spp", desc.settings.adaptive_threshold > 0
-                          ? fmt::format("adaptive, {:.2f} on average", double(stats.samples) /
-                                                                          (double(film.width()) * film.height()))
-                          : std::to_string(desc.settings.spp)},
+      {"candela:spp", spp_text},
+      {"candela:spp_min", std::to_string(min_spp)},
+      {"candela:spp_mean", fmt::format("{:.4f}", mean_spp)},
       {"candela:render_time_seconds", fmt::format("{:.3f}", stats.seconds)},
       {"candela:integrator", desc.settings.integrator},
       {"candela:max_depth", std::to_string(desc.settings.max_depth)},
       {"candela:seed", std::to_string(desc.settings.seed)},
       {"Software", "candela " CANDELA_VERSION}};
+  if (stats.cancelled) metadata["candela:interrupted"] = "true";
+  if (stats.time_limited) metadata["candela:time-limited"] = "true";
+  if (clamp > 0) metadata["candela:clamp"] = fmt::format("{}", clamp);
+  if (non_finite > 0) metadata["candela:non_finite_samples"] = std::to_string(non_finite);
   Image image = film.mean_image();
   for (const auto& f : outputs) write_image(f, image, metadata);
   if (!cmd.spp_map.empty()) write_image(cmd.spp_map, spp_heat_map(film, fs::path(cmd.spp_map)), metadata);
-  if (stats.non_finite_samples > 0)
-    std::fprintf(stderr, "candela: warning: %llu samples were NaN or infinite and counted as black\n",
-                 (unsigned long long)stats.non_finite_samples);
+  nan_warning();
 
   double seconds = std::max(stats.seconds, 1e-9);
   std::string written;
   for (const auto& f : outputs) written += (written.empty() ? "" : ", ") + f.string();
   std::printf("%dx%d, %s spp in %.2f s: %.3f Msamples/s, %.2f Mrays/s (%.3g rays/sample) -> %s\n", desc.film.width,
-              desc.film.height, metadata["candela:spp"].c_str(), stats.seconds, double(stats.samples) / seconds * 1e-6,
-              double(stats.rays.total()) / seconds * 1e-6, double(stats.rays.total()) / double(stats.samples),
-              written.c_str());
+              desc.film.height, spp_text.c_str(), stats.seconds, double(stats.samples) / seconds * 1e-6,
+              double(stats.rays.total()) / seconds * 1e-6,
+              double(stats.rays.total()) / double(std::max<uint64_t>(stats.samples, 1)), written.c_str());
+  if (stats.time_limited)
+    std::fprintf(stderr, "candela: time limit reached: wrote the image with %s spp\n", spp_text.c_str());
+  if (stats.cancelled) {
+    std::fprintf(stderr, "candela: interrupted: wrote the image with %s spp%s\n", spp_text.c_str(),
+                 cmd.checkpoint.empty() ? "" : fmt::format(" and checkpoint {}", cmd.checkpoint).c_str());
+    return kExitInterrupted;
+  }
   return 0;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  install_signal_handlers();
   CLI::App app{"candela: a physically based Monte Carlo path tracer.\n"
                "With no arguments, renders the built-in Cornell box to cornell-box.png and cornell-box.exr."};
   app.set_version_flag("--version", "candela " CANDELA_VERSION);
@@ -233,6 +426,24 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--spp-map", cmd.spp_map,
                          "Also write the per-pixel sample counts: a heat map (.png) or raw counts (.exr, .pfm)");
   render_cmd->add_flag("-q,--quiet", cmd.quiet, "No progress bar");
+  render_cmd->add_option("--checkpoint", cmd.checkpoint,
+                         "Write the render state to FILE (atomically) every --checkpoint-every seconds "
+                         "between passes, and when interrupted or out of time");
+  render_cmd->add_option("--checkpoint-every", cmd.checkpoint_every,
+                         "Seconds between checkpoints (fractions allowed); needs --checkpoint")
+      ->check(CLI::PositiveNumber);
+  render_cmd->add_option("--resume", cmd.resume,
+                         "Continue from a checkpoint made with the same scene file and settings; the result "
+                         "equals an uninterrupted render bit for bit");
+  render_cmd->add_option("--time-limit", cmd.time_limit,
+                         "Stop after the pass during which this many seconds have passed, and write the image")
+      ->check(CLI::PositiveNumber);
+  render_cmd->add_option("--clamp", cmd.clamp,
+                         "Scale each sample so its largest RGB component is at most VALUE (biased; off by default)")
+      ->check(CLI::PositiveNumber);
+  render_cmd->add_option("--pixel", cmd.pixel,
+                         "Render only pixel X,Y (all its samples), print its value and its NaN/inf sample "
+                         "indices; writes no image");
 
   try {
     app.parse(argc, argv);

@@ -1,5 +1,6 @@
 #include "candela/film/film.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace candela {
@@ -49,6 +50,19 @@ Image Film::sample_count_image() const {
 uint64_t Film::total_samples() const {
   uint64_t n = 0;
   for (const auto& px : pixels_) n += px.count;
+  return n;
+}
+
+uint64_t Film::min_samples() const {
+  if (pixels_.empty()) return 0;
+  uint64_t n = pixels_[0].count;
+  for (const auto& px : pixels_) n = std::min(n, px.count);
+  return n;
+}
+
+uint64_t Film::max_samples() const {
+  uint64_t n = 0;
+  for (const auto& px : pixels_) n = std::max(n, px.count);
   return n;
 }
 

@@ -40,6 +40,9 @@ class Film {
     ++px.count;
   }
   const PixelSums& pixel(int x, int y) const { return pixels_[size_t(y) * width_ + x]; }
+  // All pixels, row-major: for checkpoints, which store and restore the sums bit for bit.
+  const std::vector<PixelSums>& pixels() const { return pixels_; }
+  std::vector<PixelSums>& pixels() { return pixels_; }
 
   Image mean_image() const;
   // Per-pixel variance of the mean (squared standard error), for error estimates in tests.
@@ -47,6 +50,9 @@ class Film {
   // Per-pixel sample counts, in every channel.
   Image sample_count_image() const;
   uint64_t total_samples() const;
+  // Fewest and most samples any pixel has (0, 0 for an empty film).
+  uint64_t min_samples() const;
+  uint64_t max_samples() const;
 
  private:
   int width_, height_;

@@ -347,6 +347,8 @@ PlyScalarType ply_scalar_type_or_fail(std::string_view name) {
 }
 
 void read_ply_format(const std::vector<std::string_view>& words, PlyHeader& header) {
+  // Assimp keeps the first format line and would read the data the wrong way (and leak on failing).
+  if (header.encoding) fail("malformed PLY: the header has more than one format line");
   if (words.size() == 3 && words[1] == "ascii") header.encoding = PlyEncoding::Ascii;
   else if (words.size() == 3 && words[1] == "binary_little_endian") header.encoding = PlyEncoding::BinaryLittleEndian;
   else if (words.size() == 3 && words[1] == "binary_big_endian") header.encoding = PlyEncoding::BinaryBigEndian;
@@ -355,12 +357,18 @@ void read_ply_format(const std::vector<std::string_view>& words, PlyHeader& head
 
 void read_ply_element(const std::vector<std::string_view>& words, PlyHeader& header) {
   if (words.size() != 3) fail("malformed PLY: bad element line '{}'", printable(line_of(words)));
+  // Assimp misreads a long name of digits as a count and allocates for it (tens of gigabytes).
+  if (!(std::isalpha(static_cast<unsigned char>(words[1][0])) || words[1][0] == '_'))
+    fail("malformed PLY: element name '{}' does not start with a letter", printable(words[1]));
   PlyElement element;
   element.name = printable(words[1]);  // kept for messages only
   const char* end = words[2].data() + words[2].size();
   const auto [stop, error] = std::from_chars(words[2].data(), end, element.count);
   if (error != std::errc() || stop != end)
     fail("malformed PLY: element '{}' has an invalid count '{}'", element.name, printable(words[2]));
+  // Assimp reads a second element of a name over the first (and leaks the first one's data).
+  for (const PlyElement& earlier : header.elements)
+    if (earlier.name == element.name) fail("malformed PLY: element '{}' is declared twice", element.name);
   header.elements.push_back(element);
 }
 
@@ -441,6 +449,36 @@ uint64_t read_binary_list_length(std::string_view data, uint64_t at, PlyScalarTy
     bits = bits << 8 | static_cast<uint8_t>(data[at + (big_endian ? k : type.size - 1u - k)]);
   if (type.is_signed && (bits >> (8 * type.size - 1)) != 0) fail("malformed PLY: negative list length");
   return bits;
+}
+
+// Resource limits: before Assimp (or the scans below) allocate or loop per element, every element
+// count is measured against the bytes after the header, so a corrupt header claiming billions of
+// vertices or faces is refused at once. Each element needs at least: binary, its scalar properties
+// plus the length fields of its lists (lists may be empty); ASCII, one value and a line break (2
+// bytes; the very last line may lack its line break). Sums saturate instead of overflowing.
+void check_ply_counts_fit_data(const PlyHeader& header, std::string_view data) {
+  const bool ascii = header.encoding == PlyEncoding::Ascii;
+  const uint64_t room = ascii ? uint64_t(data.size()) + 1 : uint64_t(data.size());
+  uint64_t needed = 0;
+  for (const PlyElement& element : header.elements) {
+    if (element.count == 0) continue;
+    uint64_t element_bytes = 2;
+    if (!ascii) {
+      element_bytes = 0;
+      for (const PlyProperty& property : element.properties)
+        element_bytes += property.list_length ? property.list_length->size : property.value.size;
+    }
+    uint64_t bytes = 0;
+    if (!__builtin_mul_overflow(element.count, element_bytes, &bytes) && !__builtin_add_overflow(needed, bytes, &needed) &&
+        needed <= room)
+      continue;
+    // A binary file that holds some of the elements is more likely cut short: the scan below says
+    // exactly where its data ends ("truncated PLY").
+    if (!ascii && element.count <= data.size()) return;
+    fail("corrupt PLY header: it declares {} '{}' elements (at least {} bytes each in a{} file) but only {} bytes of "
+         "data follow it",
+         element.count, element.name, element_bytes, ascii ? "n ASCII" : " binary", data.size());
+  }
 }
 
 void check_binary_ply_data(const PlyHeader& header, std::string_view data) {
@@ -569,6 +607,7 @@ void append_assimp_mesh(const aiMesh& source, bool with_normals, bool with_uvs, 
 TriangleMesh load_ply(const std::string& bytes) {
   const PlyHeader header = read_ply_header(bytes);
   const std::string_view data = std::string_view(bytes).substr(header.data_offset);
+  check_ply_counts_fit_data(header, data);
   if (header.encoding == PlyEncoding::Ascii) check_ascii_ply_data(header, data);
   else check_binary_ply_data(header, data);
 

@@ -1,6 +1,8 @@
 #include "candela/io/mesh_io.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -400,6 +402,54 @@ TEST_F(MeshIo, PlyHeaderClaimingBillionsOfElementsFailsFast) {
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
 }
 
+// Resource limits (docs/reliability.md): a header claiming 2^32 - 1 vertices in a small file is refused
+// before anything is allocated for them, with a message naming the file and the element, in ASCII
+// and binary files and when the count is only too big for the data that follows the earlier elements.
+// Run in a child process whose address space is capped at 256 MiB more than it uses: an attempt to
+// allocate for the declared counts would fail there with "out of memory" instead.
+TEST_F(MeshIo, PlyHeaderClaimingFourBillionVerticesIsRefusedWithoutAllocating) {
+  const std::string vertices = "element vertex 4294967295\nproperty float x\nproperty float y\nproperty float z\n";
+  const std::string faces = "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const fs::path ascii = write("four_billion_ascii.ply", "ply\nformat ascii 1.0\n" + vertices + faces +
+                                                             "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  const fs::path binary = write("four_billion_binary.ply", "ply\nformat binary_little_endian 1.0\n" + vertices +
+                                                               faces + std::string(36 + 13, '\0'));
+  // The 3 vertices fit, but 4 million faces do not fit in the 26 bytes of data.
+  const fs::path cumulative =
+      write("cumulative.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                              "property float z\nelement face 4000000\nproperty list uchar int vertex_indices\n"
+                              "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  const auto start = std::chrono::steady_clock::now();
+  expect_error_mentions(ascii, {"corrupt PLY header", "4294967295 'vertex'", "ASCII"});
+  expect_error_mentions(binary, {"corrupt PLY header", "4294967295 'vertex'", "49 bytes"});
+  expect_error_mentions(cumulative, {"corrupt PLY header", "4000000 'face'"});
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(1));
+
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    long vm_kb = 0;
+    std::ifstream status("/proc/self/status");
+    for (std::string line; std::getline(status, line);)
+      if (line.rfind("VmSize:", 0) == 0) vm_kb = std::stol(line.substr(7));
+    const rlimit cap{rlim_t(vm_kb) * 1024 + (rlim_t(256) << 20), rlim_t(vm_kb) * 1024 + (rlim_t(256) << 20)};
+    if (vm_kb == 0 || setrlimit(RLIMIT_AS, &cap) != 0) _exit(3);
+    for (const fs::path& file : {ascii, binary}) {
+      try {
+        load_mesh_file(file, kWhere);
+        _exit(1);
+      } catch (const SceneError& e) {
+        if (std::string(e.what()).find("corrupt PLY header") == std::string::npos) _exit(2);
+      }
+    }
+    _exit(0);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "1: loaded; 2: another error (out of memory?); 3: no rlimit";
+}
+
 TEST_F(MeshIo, PlyCutShortAnywhereIsAnErrorNotACrash) {
   // Assimp alone loops forever on a header without "end_header" and reads past the end of (or
   // asserts on) data cut short; every prefix must either load completely or fail with a SceneError.
@@ -468,6 +518,36 @@ TEST_F(MeshIo, PlyMalformedHeaderIsAnError) {
   EXPECT_EQ(load(write("empty_element.ply", with_empty_element)).triangle_count(), 12u);
   expect_error_mentions(write("bare_element.ply", "ply\nformat ascii 1.0\nelement nothing 5\nend_header\n"),
                         {"element 'nothing' has no properties"});
+}
+
+// Found by fuzz/ply_reader_fuzz.cpp (docs/reliability.md): headers that Assimp reads differently
+// from the checks here, which made it leak. The fuzzer's inputs are in fuzz/regressions/ply_reader/.
+TEST_F(MeshIo, PlyWithTwoFormatLinesIsAnError) {
+  expect_error_mentions(write("two_formats.ply", "ply\nformat ascii 1.0\nformat binary_little_endian 1.0\n" +
+                                                     kPlyTriangleHeader.substr(kPlyTriangleHeader.find("element")) +
+                                                     "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
+                        {"more than one format line"});
+  const fs::path fuzzed = fs::path(CANDELA_SOURCE_DIR) / "fuzz" / "regressions" / "ply_reader";
+  expect_error_mentions(write("fuzzed1.ply", read(fuzzed / "leak-second-format-line.ply")), {"more than one format line"});
+}
+
+TEST_F(MeshIo, PlyElementDeclaredTwiceIsAnError) {
+  expect_error_mentions(write("two_faces.ply", kPlyTriangleHeader.substr(0, kPlyTriangleHeader.find("end_header")) +
+                                                   "element face 1\nproperty list uchar int vertex_indices\n"
+                                                   "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n"),
+                        {"element 'face' is declared twice"});
+  const fs::path fuzzed = fs::path(CANDELA_SOURCE_DIR) / "fuzz" / "regressions" / "ply_reader";
+  expect_error_mentions(write("fuzzed2.ply", read(fuzzed / "leak-duplicate-elements.ply")),
+                        {"element 'vertex' is declared twice"});
+}
+
+TEST_F(MeshIo, PlyElementNameMustStartWithALetter) {
+  expect_error_mentions(write("digits.ply", "ply\nformat ascii 1.0\nelement 22222222222222222222 1\n"
+                                            "property float x\nend_header\n0\n"),
+                        {"element name '22222222222222222222' does not start with a letter"});
+  const fs::path fuzzed = fs::path(CANDELA_SOURCE_DIR) / "fuzz" / "regressions" / "ply_reader";
+  expect_error_mentions(write("fuzzed3.ply", read(fuzzed / "oom-numeric-element-name.ply")),
+                        {"does not start with a letter"});
 }
 
 // ---------------------------------------------------------------- file names and places

@@ -6,7 +6,10 @@
 
 #include <atomic>
 #include <chrono>
+#include <algorithm>
+#include <mutex>
 #include <stdexcept>
+#include <tuple>
 
 #include "candela/film/filter.h"
 #include "candela/render/progress.h"
@@ -30,6 +33,29 @@ std::vector<Tile> make_tiles(int width, int height) {
   return tiles;
 }
 
+// The non-finite samples to report: the `limit` smallest by (sample, y, x), so the list does not
+// depend on thread timing.
+class NonFiniteLog {
+ public:
+  explicit NonFiniteLog(int limit) : limit_(size_t(std::max(limit, 0))) {}
+  void add(int x, int y, uint64_t s) {
+    std::lock_guard lock(mutex_);
+    NonFiniteSample n{x, y, s};
+    auto less = [](const NonFiniteSample& a, const NonFiniteSample& b) {
+      return std::tie(a.sample, a.y, a.x) < std::tie(b.sample, b.y, b.x);
+    };
+    if (samples_.size() == limit_ && (limit_ == 0 || !less(n, samples_.back()))) return;
+    samples_.insert(std::upper_bound(samples_.begin(), samples_.end(), n, less), n);
+    if (samples_.size() > limit_) samples_.pop_back();
+  }
+  std::vector<NonFiniteSample> samples() const { return samples_; }
+
+ private:
+  size_t limit_;
+  std::mutex mutex_;
+  std::vector<NonFiniteSample> samples_;
+};
+
 // Everything one pass needs, shared by all tiles.
 struct PassContext {
   const Scene& scene;
@@ -39,7 +65,12 @@ struct PassContext {
   Film& film;
   tbb::enumerable_thread_specific<RayCounts>& ray_counts;
   std::atomic<uint64_t>& non_finite;
+  NonFiniteLog& non_finite_log;
+  float clamp;
+  const std::atomic<bool>* cancel;
 };
+
+bool cancelled(const PassContext& pc) { return pc.cancel && pc.cancel->load(std::memory_order_relaxed); }
 
 // Renders samples [first, first + count) of pixel (x, y).
 template <typename S>
@@ -56,20 +87,32 @@ void render_pixel(const PassContext& pc, S& sampler, int x, int y, uint64_t firs
     Ray ray = camera.generate_ray({float(x) + 0.5f + fs.offset.x, float(y) + 0.5f + fs.offset.y}, lens, time);
     RGB L = pc.integrator.radiance(ray, sampler, counts);
     if (!L.is_finite()) {
+      // Never reaches the film: counted, the first few logged, and the sample counts as black.
       pc.non_finite.fetch_add(1, std::memory_order_relaxed);
+      pc.non_finite_log.add(x, y, s);
       L = RGB(0.0f);
+    } else if (pc.clamp > 0) {
+      float m = L.max_component();
+      if (m > pc.clamp) L *= pc.clamp / m;
     }
     pc.film.add_sample(x, y, L, fs.weight);
   }
 }
 
-// One pass over the tiles: pixel (x, y) gets `count` samples starting at first_sample(x, y), or is
-// skipped when that returns a negative number.
-template <typename FirstSample>
-void run_pass(const PassContext& pc, const std::vector<Tile>& tiles, tbb::task_arena& arena, int count,
-              FirstSample first_sample, ProgressBar& progress) {
+// Which samples a pixel gets in a pass: [first, first + count); count <= 0 skips the pixel.
+struct SampleRange {
+  int64_t first;
+  int count;
+};
+
+// One pass over the tiles: pixel (x, y) gets the samples range(x, y) names. Tiles not yet started
+// when the cancel flag is set are skipped.
+template <typename Range>
+void run_pass(const PassContext& pc, const std::vector<Tile>& tiles, tbb::task_arena& arena, Range range,
+              ProgressBar& progress) {
   arena.execute([&] {
     tbb::parallel_for(size_t(0), tiles.size(), [&](size_t t) {
+      if (cancelled(pc)) return;
       const Tile& tile = tiles[t];
       RayCounts& counts = pc.ray_counts.local();
       uint64_t done = 0;
@@ -78,10 +121,10 @@ void run_pass(const PassContext& pc, const std::vector<Tile>& tiles, tbb::task_a
             auto sampler = prototype;
             for (int y = tile.y0; y < tile.y1; ++y)
               for (int x = tile.x0; x < tile.x1; ++x) {
-                int64_t first = first_sample(x, y);
-                if (first < 0) continue;
-                render_pixel(pc, sampler, x, y, uint64_t(first), count, counts);
-                done += uint64_t(count);
+                SampleRange r = range(x, y);
+                if (r.count <= 0) continue;
+                render_pixel(pc, sampler, x, y, uint64_t(r.first), r.count, counts);
+                done += uint64_t(r.count);
               }
           },
           pc.prototype);
@@ -104,6 +147,8 @@ float relative_error(const PixelSums& pixel) {
 RenderStats render(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options) {
   if (!is_known_integrator(settings.integrator))
     throw std::invalid_argument("unknown integrator '" + settings.integrator + "' (known: path)");
+  if (options.only_x >= film.width() || options.only_y >= film.height() || (options.only_x >= 0) != (options.only_y >= 0))
+    throw std::invalid_argument("pixel to render is outside the image");
   auto start = std::chrono::steady_clock::now();
   const bool adaptive = settings.adaptive_threshold > 0;
   const int batch = adaptive ? settings.adaptive_batch : settings.spp;
@@ -113,31 +158,72 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
   const Filter filter(settings.filter);
   const Sampler prototype = make_sampler(settings.sampler, adaptive ? batch : settings.spp, settings.seed,
                                          film.width(), film.height());
-  std::vector<Tile> tiles = make_tiles(film.width(), film.height());
+  std::vector<Tile> tiles = options.only_x >= 0 ? std::vector<Tile>{{options.only_x, options.only_y,
+                                                                     options.only_x + 1, options.only_y + 1}}
+                                                : make_tiles(film.width(), film.height());
+  const uint64_t pixel_count = options.only_x >= 0 ? 1 : uint64_t(film.width()) * film.height();
   tbb::enumerable_thread_specific<RayCounts> ray_counts;
   std::atomic<uint64_t> non_finite{0};
-  PassContext pc{scene, integrator, filter, prototype, film, ray_counts, non_finite};
-  ProgressBar progress(uint64_t(film.width()) * film.height() * uint64_t(max_spp), options.progress);
+  NonFiniteLog non_finite_log(options.max_reported_non_finite);
+  PassContext pc{scene, integrator, filter, prototype, film, ray_counts, non_finite, non_finite_log, options.clamp,
+                 options.cancel};
+  const uint64_t samples_before = film.total_samples();
+  ProgressBar progress(pixel_count * uint64_t(max_spp), options.progress);
+  progress.advance(options.only_x >= 0 ? 0 : samples_before);
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+  RenderStats stats;
+  // After a whole pass: true when the render must stop (cancelled, or out of time).
+  auto stop_after_pass = [&](bool more_to_do) {
+    if (cancelled(pc)) {
+      stats.cancelled = true;
+      return true;
+    }
+    if (more_to_do && options.time_limit_seconds > 0 &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= options.time_limit_seconds) {
+      stats.time_limited = true;
+      return true;
+    }
+    return false;
+  };
 
   if (!adaptive) {
     // A Poisson-disc set is built per pixel: render it in one pass rather than rebuilding it per pass.
+    // Every pixel continues from its own count, so a film resumed from a checkpoint (or one whose
+    // last pass was cut short) gets exactly the samples an uninterrupted render would add, in order.
     const int pass_spp = settings.sampler.type == SamplerType::Poisson ? settings.spp : kPassSpp;
-    for (int pass = 0; pass < settings.spp; pass += pass_spp)
-      run_pass(pc, tiles, arena, std::min(pass_spp, settings.spp - pass), [&](int, int) { return int64_t(pass); },
+    uint64_t least = options.only_x >= 0 ? film.pixel(options.only_x, options.only_y).count : film.min_samples();
+    const int first_pass = int(std::min<uint64_t>(least, uint64_t(settings.spp)) / uint64_t(pass_spp)) * pass_spp;
+    for (int pass = first_pass; pass < settings.spp; pass += pass_spp) {
+      const int end = std::min(pass + pass_spp, settings.spp);
+      run_pass(pc, tiles, arena,
+               [&](int x, int y) {
+                 int64_t have = int64_t(film.pixel(x, y).count);
+                 return SampleRange{have, int(std::max<int64_t>(0, end - have))};
+               },
                progress);
+      if (options.after_pass && !cancelled(pc)) options.after_pass(film, non_finite.load());
+      if (stop_after_pass(end < settings.spp)) break;
+    }
   } else {
+    if (samples_before > 0) throw std::invalid_argument("adaptive sampling cannot continue a partly rendered film");
     // Batches of F samples. Between batches, every pixel's relative error is estimated from its own
     // samples and smoothed over its 3x3 neighbourhood (one pixel's variance from a few samples is
     // itself very noisy); pixels still above the threshold get the next batch. The decision is made
     // while no pass runs, from the film alone, so it does not depend on threads.
     const int w = film.width(), h = film.height();
     std::vector<uint8_t> active(size_t(w) * h, 1);
+    if (options.only_x >= 0) {
+      std::fill(active.begin(), active.end(), 0);
+      active[size_t(options.only_y) * w + options.only_x] = 1;
+    }
     std::vector<float> error(size_t(w) * h);
     for (int rendered = 0; rendered < max_spp; rendered += batch) {
-      run_pass(pc, tiles, arena, batch,
-               [&](int x, int y) -> int64_t { return active[size_t(y) * w + x] ? int64_t(rendered) : -1; },
+      run_pass(pc, tiles, arena,
+               [&](int x, int y) {
+                 return active[size_t(y) * w + x] ? SampleRange{rendered, batch} : SampleRange{0, 0};
+               },
                progress);
+      if (stop_after_pass(rendered + batch < max_spp)) break;
       if (rendered + batch >= max_spp) break;
       arena.execute([&] {
         tbb::parallel_for(0, h, [&](int y) {
@@ -167,10 +253,11 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
   }
   progress.finish();
 
-  RenderStats stats;
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  stats.samples = film.total_samples();
+  stats.samples = film.total_samples() - samples_before;
   stats.non_finite_samples = non_finite.load();
+  stats.first_non_finite = non_finite_log.samples();
+  if (cancelled(pc)) stats.cancelled = true;
   for (const auto& c : ray_counts) stats.rays += c;
   return stats;
 }

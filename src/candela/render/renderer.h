@@ -7,8 +7,11 @@
 // Adaptive sampling (Häkkinen 2002, sec. 4.3): all pixels first get one batch of F samples (F a
 // power of two, so stratification holds within the batch); after each batch, pixels whose relative
 // standard error still exceeds the threshold get another batch, up to the maximum spp.
+#include <atomic>
 #include <cstdint>
+#include <functional>
 #include <string>
+#include <vector>
 
 #include "candela/film/film.h"
 #include "candela/integrators/path_integrator.h"
@@ -19,12 +22,35 @@ namespace candela {
 struct RenderOptions {
   int threads = 0;       // 0 = all cores
   bool progress = true;  // draw a progress bar when stderr is a terminal
+  // Set (e.g. by a signal handler) to stop: checked before every tile and between passes, so the
+  // render stops within one tile. Pixels keep the samples they have; each pixel's count says how many.
+  const std::atomic<bool>* cancel = nullptr;
+  // Stop after the first whole pass (batch) that ends at or after this many seconds; 0 = no limit.
+  double time_limit_seconds = 0;
+  // > 0: each sample's RGB is scaled so its largest component is at most this (biased).
+  float clamp = 0;
+  // Render only this pixel (all its samples); the rest of the film stays empty. -1 = every pixel.
+  int only_x = -1, only_y = -1;
+  // How many non-finite samples to report (the ones with the smallest (sample, y, x)).
+  int max_reported_non_finite = 5;
+  // Called between whole passes (never while tiles run) with the film as it stands, e.g. to write
+  // a checkpoint, and the number of non-finite samples dropped so far in this call. Not called for
+  // adaptive renders.
+  std::function<void(const Film&, uint64_t non_finite_so_far)> after_pass;
+};
+
+struct NonFiniteSample {
+  int x = 0, y = 0;
+  uint64_t sample = 0;  // sample index within the pixel
 };
 
 struct RenderStats {
   double seconds = 0;
-  uint64_t samples = 0;
+  uint64_t samples = 0;             // rendered in this call (a resumed render's earlier ones excluded)
   uint64_t non_finite_samples = 0;  // NaN/inf radiance values, dropped (counted as black)
+  std::vector<NonFiniteSample> first_non_finite;  // up to max_reported_non_finite, by (sample, y, x)
+  bool cancelled = false;                         // stopped by RenderOptions::cancel
+  bool time_limited = false;                      // stopped by the time limit before all samples
   RayCounts rays;
 };
 
@@ -36,7 +62,9 @@ bool is_known_integrator(const std::string& name);
 float relative_error(const PixelSums& pixel);
 
 // Renders into `film` (sized to the camera's resolution): settings.spp samples per pixel, or
-// adaptively when settings.adaptive_threshold > 0.
+// adaptively when settings.adaptive_threshold > 0. Without adaptive sampling the film may already
+// hold samples (a resumed checkpoint): each pixel continues from its own sample count, so the result
+// is bitwise the same as one uninterrupted render.
 RenderStats render(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options);
 
 }  // namespace candela

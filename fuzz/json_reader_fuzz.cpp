@@ -1,0 +1,18 @@
+// libFuzzer target: the JSON scene reader (read_json_scene). A SceneError is the documented answer
+// to bad input; anything else (another exception, a crash, a sanitizer report, a hang) is a bug.
+#include <cstdint>
+#include <string_view>
+
+#include "candela/io/error.h"
+#include "candela/io/scene_reader.h"
+#include "fuzz_common.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  std::string_view text(reinterpret_cast<const char*>(data), size);
+  try {
+    (void)candela::read_json_scene(text, "fuzz.json", candela_fuzz::scratch_dir());
+  } catch (const candela::SceneError& e) {
+    candela_fuzz::rejected(e);
+  }
+  return 0;
+}

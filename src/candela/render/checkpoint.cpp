@@ -1,0 +1,195 @@
+#include "candela/render/checkpoint.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <stdexcept>
+
+namespace candela {
+namespace {
+
+constexpr char kMagic[8] = {'C', 'N', 'D', 'L', 'C', 'K', 'P', 'T'};
+constexpr uint32_t kVersion = 1;
+constexpr size_t kHeaderSize = 8 + 4 + 8 + 8;
+constexpr size_t kPixelSize = 7 * 8 + 8;
+
+struct Writer {
+  std::string bytes;
+  void raw(const void* p, size_t n) { bytes.append(static_cast<const char*>(p), n); }
+  template <typename T>
+  void put(T v) {
+    raw(&v, sizeof v);
+  }
+  void str(const std::string& s) {
+    put(uint32_t(s.size()));
+    raw(s.data(), s.size());
+  }
+};
+
+struct Reader {
+  const char* p;
+  const char* end;
+  std::string file;
+  void raw(void* out, size_t n) {
+    if (size_t(end - p) < n) throw std::runtime_error("checkpoint '" + file + "': corrupt (payload too short)");
+    std::memcpy(out, p, n);
+    p += n;
+  }
+  template <typename T>
+  T get() {
+    T v;
+    raw(&v, sizeof v);
+    return v;
+  }
+  std::string str() {
+    uint32_t n = get<uint32_t>();
+    if (size_t(end - p) < n) throw std::runtime_error("checkpoint '" + file + "': corrupt (payload too short)");
+    std::string s(p, n);
+    p += n;
+    return s;
+  }
+};
+
+[[noreturn]] void fail(const std::filesystem::path& file, const std::string& what) {
+  throw std::runtime_error("checkpoint '" + file.string() + "': " + what);
+}
+
+}  // namespace
+
+uint64_t fnv1a64(const void* data, size_t size, uint64_t hash) {
+  const auto* b = static_cast<const unsigned char*>(data);
+  for (size_t i = 0; i < size; ++i) {
+    hash ^= b[i];
+    hash *= 0x100000001b3ULL;
+  }
+  return hash;
+}
+
+std::string RenderFingerprint::difference(const RenderFingerprint& now) const {
+  std::string out;
+  if (scene_hash != now.scene_hash) out = "scene file differs";
+  std::string settings_diff;
+  auto find = [](const auto& list, const std::string& key) -> const std::string* {
+    for (const auto& [k, v] : list)
+      if (k == key) return &v;
+    return nullptr;
+  };
+  for (const auto& [key, value] : settings) {
+    const std::string* other = find(now.settings, key);
+    std::string other_value = other ? *other : "(unset)";
+    if (other_value != value)
+      settings_diff += (settings_diff.empty() ? "" : ", ") + key + " " + value + " vs " + other_value;
+  }
+  for (const auto& [key, value] : now.settings)
+    if (!find(settings, key)) settings_diff += (settings_diff.empty() ? "" : ", ") + key + " (unset) vs " + value;
+  if (!settings_diff.empty()) out += (out.empty() ? "" : "; ") + std::string("settings differ: ") + settings_diff;
+  return out;
+}
+
+void write_checkpoint(const std::filesystem::path& file, const Checkpoint& cp) {
+  if (cp.pixels.size() != size_t(cp.width) * size_t(cp.height)) fail(file, "pixel count does not match the size");
+  Writer payload;
+  payload.put(cp.fingerprint.scene_hash);
+  payload.put(uint32_t(cp.fingerprint.settings.size()));
+  for (const auto& [k, v] : cp.fingerprint.settings) {
+    payload.str(k);
+    payload.str(v);
+  }
+  payload.put(int32_t(cp.width));
+  payload.put(int32_t(cp.height));
+  payload.put(cp.non_finite_samples);
+  payload.bytes.reserve(payload.bytes.size() + cp.pixels.size() * kPixelSize);
+  for (const PixelSums& px : cp.pixels) {
+    payload.raw(px.weighted, sizeof px.weighted);
+    payload.raw(px.weighted_sq, sizeof px.weighted_sq);
+    payload.put(px.weight);
+    payload.put(px.count);
+  }
+  Writer header;
+  header.raw(kMagic, sizeof kMagic);
+  header.put(kVersion);
+  header.put(uint64_t(payload.bytes.size()));
+  header.put(fnv1a64(payload.bytes.data(), payload.bytes.size()));
+
+  // Temporary file beside the target, fsynced, renamed over it, directory fsynced.
+  std::filesystem::path dir = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+  std::filesystem::path tmp = file;
+  tmp += ".tmp." + std::to_string(getpid());
+  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) fail(file, std::string("cannot create '") + tmp.string() + "': " + std::strerror(errno));
+  auto write_all = [&](const std::string& bytes) {
+    const char* p = bytes.data();
+    size_t left = bytes.size();
+    while (left > 0) {
+      ssize_t n = ::write(fd, p, left);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) return false;
+      p += n;
+      left -= size_t(n);
+    }
+    return true;
+  };
+  bool ok = write_all(header.bytes) && write_all(payload.bytes) && ::fsync(fd) == 0;
+  int err = errno;
+  if (::close(fd) != 0 && ok) {
+    ok = false;
+    err = errno;
+  }
+  if (!ok || ::rename(tmp.c_str(), file.c_str()) != 0) {
+    if (ok) err = errno;
+    ::unlink(tmp.c_str());
+    fail(file, std::string("cannot write: ") + std::strerror(err));
+  }
+  int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    ::fsync(dfd);
+    ::close(dfd);
+  }
+}
+
+Checkpoint read_checkpoint(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) fail(file, "cannot open");
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+    fail(file, "not a candela checkpoint (bad magic header)");
+  if (bytes.size() < kHeaderSize) fail(file, "truncated (header incomplete)");
+  Reader header{bytes.data() + sizeof kMagic, bytes.data() + kHeaderSize, file.string()};
+  uint32_t version = header.get<uint32_t>();
+  if (version != kVersion)
+    fail(file, "unsupported version " + std::to_string(version) + " (this candela reads version " +
+                   std::to_string(kVersion) + ")");
+  uint64_t size = header.get<uint64_t>(), hash = header.get<uint64_t>();
+  if (bytes.size() - kHeaderSize < size)
+    fail(file, "truncated (" + std::to_string(bytes.size()) + " bytes, expected " + std::to_string(kHeaderSize + size) + ")");
+  if (bytes.size() - kHeaderSize > size) fail(file, "corrupt (trailing bytes after the payload)");
+  if (fnv1a64(bytes.data() + kHeaderSize, size) != hash) fail(file, "corrupt (checksum mismatch)");
+
+  Reader r{bytes.data() + kHeaderSize, bytes.data() + bytes.size(), file.string()};
+  Checkpoint cp;
+  cp.fingerprint.scene_hash = r.get<uint64_t>();
+  uint32_t n = r.get<uint32_t>();
+  for (uint32_t i = 0; i < n; ++i) {
+    std::string k = r.str();
+    std::string v = r.str();
+    cp.fingerprint.settings.emplace_back(std::move(k), std::move(v));
+  }
+  cp.width = r.get<int32_t>();
+  cp.height = r.get<int32_t>();
+  cp.non_finite_samples = r.get<uint64_t>();
+  if (cp.width < 0 || cp.height < 0 || uint64_t(r.end - r.p) != uint64_t(cp.width) * uint64_t(cp.height) * kPixelSize)
+    fail(file, "corrupt (pixel data does not match the size)");
+  cp.pixels.resize(size_t(cp.width) * size_t(cp.height));
+  for (PixelSums& px : cp.pixels) {
+    r.raw(px.weighted, sizeof px.weighted);
+    r.raw(px.weighted_sq, sizeof px.weighted_sq);
+    px.weight = r.get<double>();
+    px.count = r.get<uint64_t>();
+  }
+  return cp;
+}
+
+}  // namespace candela

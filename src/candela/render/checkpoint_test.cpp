@@ -1,0 +1,109 @@
+// Checkpoint files: exact round trip of the film sums, fingerprints naming what differs, and
+// truncated or corrupt files refused with a clear message.
+#include "candela/render/checkpoint.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+
+namespace candela {
+namespace {
+
+namespace fs = std::filesystem;
+
+Checkpoint sample_checkpoint() {
+  Checkpoint cp;
+  cp.fingerprint.scene_hash = fnv1a64("scene", 5);
+  cp.fingerprint.settings = {{"resolution", "3x2"}, {"spp", "64"}, {"seed", "7"}};
+  cp.width = 3;
+  cp.height = 2;
+  cp.non_finite_samples = 11;
+  cp.pixels.resize(6);
+  for (size_t i = 0; i < 6; ++i) {
+    PixelSums& p = cp.pixels[i];
+    for (int c = 0; c < 3; ++c) {
+      p.weighted[c] = std::nextafter(0.1 * double(i + c), 1.0);
+      p.weighted_sq[c] = 1.0 / 3.0 + double(i);
+    }
+    p.weight = 0.7 * double(i);
+    p.count = 4 * i;
+  }
+  return cp;
+}
+
+struct CheckpointFile : ::testing::Test {
+  void SetUp() override {
+    file = fs::temp_directory_path() / ("candela_checkpoint_test_" + std::to_string(getpid()) + ".ckpt");
+  }
+  void TearDown() override { fs::remove(file); }
+  std::string bytes() const {
+    std::ifstream in(file, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  }
+  void put(const std::string& b) const { std::ofstream(file, std::ios::binary) << b; }
+  std::string error() const {
+    try {
+      read_checkpoint(file);
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "";
+  }
+  fs::path file;
+};
+
+TEST_F(CheckpointFile, RoundTripIsExact) {
+  Checkpoint cp = sample_checkpoint();
+  write_checkpoint(file, cp);
+  Checkpoint back = read_checkpoint(file);
+  EXPECT_EQ(back.width, 3);
+  EXPECT_EQ(back.height, 2);
+  EXPECT_EQ(back.non_finite_samples, 11u);
+  EXPECT_EQ(back.fingerprint.difference(cp.fingerprint), "");
+  ASSERT_EQ(back.pixels.size(), cp.pixels.size());
+  EXPECT_EQ(std::memcmp(back.pixels.data(), cp.pixels.data(), cp.pixels.size() * sizeof(PixelSums)), 0);
+  // No temporary left beside it.
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(file.parent_path()))
+    if (e.path().filename().string().rfind(file.filename().string(), 0) == 0) ++files;
+  EXPECT_EQ(files, 1);
+}
+
+TEST_F(CheckpointFile, TruncatedCorruptAndForeignFilesAreRefused) {
+  write_checkpoint(file, sample_checkpoint());
+  std::string good = bytes();
+  put(good.substr(0, good.size() - 9));
+  EXPECT_NE(error().find("truncated"), std::string::npos) << error();
+  put(good.substr(0, 12));
+  EXPECT_NE(error().find("truncated"), std::string::npos) << error();
+  std::string flipped = good;
+  flipped[flipped.size() - 20] ^= 0x10;
+  put(flipped);
+  EXPECT_NE(error().find("checksum"), std::string::npos) << error();
+  put("hello world, not a checkpoint at all");
+  EXPECT_NE(error().find("not a candela checkpoint"), std::string::npos) << error();
+  std::string other_version = good;
+  other_version[8] = 9;
+  put(other_version);
+  EXPECT_NE(error().find("version"), std::string::npos) << error();
+  fs::remove(file);
+  EXPECT_NE(error().find("cannot open"), std::string::npos) << error();
+}
+
+TEST(RenderFingerprint, NamesWhatDiffers) {
+  RenderFingerprint a = sample_checkpoint().fingerprint, b = a;
+  EXPECT_EQ(a.difference(b), "");
+  b.settings[1].second = "128";
+  EXPECT_EQ(a.difference(b), "settings differ: spp 64 vs 128");
+  b = a;
+  b.scene_hash ^= 1;
+  EXPECT_EQ(a.difference(b), "scene file differs");
+  b.settings[2].second = "8";
+  EXPECT_EQ(a.difference(b), "scene file differs; settings differ: seed 7 vs 8");
+}
+
+}  // namespace
+}  // namespace candela

@@ -1,0 +1,169 @@
+#include "candela/scene/resource_limits.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <string>
+
+#include "candela/film/image.h"
+#include "candela/film/image_io.h"
+#include "candela/io/error.h"
+
+namespace candela {
+namespace {
+
+constexpr uint64_t kGiB = uint64_t(1) << 30;
+
+// A scene of one mesh: a grid of `quads` x 1 quads (2 triangles each).
+SceneDesc scene_with(int width, int height, uint32_t quads = 0) {
+  SceneDesc desc;
+  desc.source_file = "scene.json";
+  desc.film.width = width;
+  desc.film.height = height;
+  if (quads > 0) {
+    MeshShape shape;
+    for (uint32_t i = 0; i <= quads; ++i) {
+      shape.mesh.positions.push_back({float(i), 0, 0});
+      shape.mesh.positions.push_back({float(i), 1, 0});
+    }
+    for (uint32_t i = 0; i < quads; ++i) {
+      const uint32_t a = 2 * i, b = a + 1, c = a + 2, d = a + 3;
+      shape.mesh.indices.insert(shape.mesh.indices.end(), {a, c, b, b, c, d});
+    }
+    ShapeDesc s;
+    s.geometry = std::move(shape);
+    desc.shapes.push_back(std::move(s));
+  }
+  return desc;
+}
+
+std::string error_of(const SceneDesc& desc, uint64_t available) {
+  try {
+    check_memory(desc, available);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "check_memory did not throw";
+  return "";
+}
+
+TEST(ResourceLimits, EstimateGrowsWithResolution) {
+  const MemoryEstimate small = estimate_memory(scene_with(640, 480));
+  const MemoryEstimate large = estimate_memory(scene_with(1280, 960));
+  EXPECT_GE(small.film_bytes, uint64_t(640) * 480 * 64);  // at least the Film's PixelSums
+  EXPECT_EQ(large.film_bytes, 4 * small.film_bytes);
+  EXPECT_EQ(large.scene_bytes, small.scene_bytes);
+  EXPECT_EQ(small.total, small.film_bytes + small.scene_bytes);
+  EXPECT_GT(large.total, small.total);
+
+  SceneDesc adaptive = scene_with(640, 480);
+  adaptive.settings.adaptive_threshold = 0.01f;
+  EXPECT_GT(estimate_memory(adaptive).film_bytes, small.film_bytes);
+}
+
+TEST(ResourceLimits, EstimateGrowsWithTriangleCount) {
+  const MemoryEstimate none = estimate_memory(scene_with(64, 64));
+  const MemoryEstimate few = estimate_memory(scene_with(64, 64, 1000));
+  const MemoryEstimate many = estimate_memory(scene_with(64, 64, 100000));
+  EXPECT_EQ(few.triangles, 2000u);
+  EXPECT_EQ(many.triangles, 200000u);
+  EXPECT_GT(few.scene_bytes, none.scene_bytes);
+  // At least the BVH and both index buffers per triangle.
+  EXPECT_GE(many.scene_bytes - few.scene_bytes, uint64_t(198000) * (kEmbreeBvhBytesPerTriangle + 24));
+  EXPECT_EQ(many.film_bytes, few.film_bytes);
+}
+
+TEST(ResourceLimits, InstancedObjectsCountOnceAndInstancesEach) {
+  SceneDesc desc = scene_with(64, 64, 1000);
+  ObjectDesc object;
+  object.shapes.push_back(desc.shapes[0]);
+  desc.objects.push_back(object);
+  const MemoryEstimate one = [&] {
+    desc.instances.resize(1);
+    return estimate_memory(desc);
+  }();
+  desc.instances.resize(1001);
+  const MemoryEstimate many = estimate_memory(desc);
+  EXPECT_EQ(one.triangles, 4000u);  // the world mesh and the object, once
+  EXPECT_EQ(many.triangles, 4000u);
+  EXPECT_EQ(many.scene_bytes - one.scene_bytes, 1000 * kBytesPerInstance);
+}
+
+TEST(ResourceLimits, TexturesAreCountedFromTheirHeaders) {
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / ("candela_limits_" + std::to_string(getpid()) + ".exr");
+  write_image(file, Image(256, 128), {});
+  SceneDesc desc = scene_with(64, 64);
+  const MemoryEstimate without = estimate_memory(desc);
+  ImageTexture texture;
+  texture.filename = file.string();
+  desc.textures.push_back(texture);
+  const MemoryEstimate with = estimate_memory(desc);
+  EXPECT_GE(with.texture_bytes, uint64_t(256) * 128 * 12);
+  EXPECT_GE(with.scene_bytes - without.scene_bytes, with.texture_bytes);
+
+  // A missing file is left for the texture reader to report.
+  desc.textures[0] = ImageTexture{.filename = (file.string() + ".missing")};
+  EXPECT_EQ(estimate_memory(desc).texture_bytes, 0u);
+  std::filesystem::remove(file);
+}
+
+TEST(ResourceLimits, NormalScenePasses) {
+  const SceneDesc desc = scene_with(1920, 1080, 50000);
+  EXPECT_LT(estimate_memory(desc).total, kGiB);
+  EXPECT_NO_THROW(check_memory(desc, 8 * kGiB));
+  EXPECT_NO_THROW(check_resources(desc));
+}
+
+TEST(ResourceLimits, AbsurdFilmIsRefusedNamingTheSize) {
+  // Refused whatever the memory.
+  const std::string message = error_of(scene_with(1000000, 1000000), std::numeric_limits<uint64_t>::max());
+  EXPECT_EQ(message.rfind("scene.json: ", 0), 0u) << message;
+  EXPECT_NE(message.find("1000000 x 1000000"), std::string::npos) << message;
+  EXPECT_NE(message.find("too large"), std::string::npos) << message;
+  EXPECT_THROW(check_resources(scene_with(1000000, 1000000)), SceneError);
+  EXPECT_THROW(check_resources(scene_with(2000000, 1)), SceneError);       // a side over 2^20
+  EXPECT_THROW(check_resources(scene_with(2147483647, 2147483647)), SceneError);  // no overflow
+  EXPECT_THROW(check_resources(scene_with(0, 100)), SceneError);
+  EXPECT_THROW(check_resources(scene_with(-5, 100)), SceneError);
+  // The estimate itself saturates rather than wrapping.
+  EXPECT_GT(estimate_memory(scene_with(2147483647, 2147483647)).total, uint64_t(1) << 62);
+}
+
+TEST(ResourceLimits, FilmTooBigForTheMemoryIsRefusedWithSizes) {
+  // 65536 x 65536 is a legal resolution but needs over 300 GiB.
+  const std::string message = error_of(scene_with(65536, 65536, 1000), 16 * kGiB);
+  EXPECT_EQ(message.rfind("scene.json: the render needs about ", 0), 0u) << message;
+  EXPECT_NE(message.find("film "), std::string::npos) << message;
+  EXPECT_NE(message.find("for 65536 x 65536 pixels"), std::string::npos) << message;
+  EXPECT_NE(message.find("2000 triangles"), std::string::npos) << message;
+  EXPECT_NE(message.find("but only 16.0 GiB of memory is available"), std::string::npos) << message;
+}
+
+TEST(ResourceLimits, SceneTooBigForTheMemoryIsRefused) {
+  const SceneDesc desc = scene_with(64, 64, 100000);
+  const uint64_t needed = estimate_memory(desc).total;
+  EXPECT_NO_THROW(check_memory(desc, needed));
+  const std::string message = error_of(desc, needed / 2);
+  EXPECT_NE(message.find("200000 triangles"), std::string::npos) << message;
+}
+
+TEST(ResourceLimits, FormatBytes) {
+  EXPECT_EQ(format_bytes(100), "100 bytes");
+  EXPECT_EQ(format_bytes(1536), "1.5 KiB");
+  EXPECT_EQ(format_bytes(uint64_t(23.4 * double(kGiB))), "23.4 GiB");
+  EXPECT_EQ(format_bytes(uint64_t(3.2 * 1024 * double(kGiB))), "3.2 TiB");
+  EXPECT_EQ(format_bytes(std::numeric_limits<uint64_t>::max()), "16.0 EiB");
+}
+
+TEST(ResourceLimits, AvailableMemoryIsPlausible) {
+  const uint64_t available = available_memory_bytes();
+  EXPECT_GT(available, uint64_t(64) << 20);
+  EXPECT_LT(available, uint64_t(1) << 50);  // under a PiB: something was read
+}
+
+}  // namespace
+}  // namespace candela

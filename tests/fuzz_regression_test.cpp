@@ -1,0 +1,111 @@
+// Every input that once crashed a fuzz target (fuzz/regressions/<target>/, docs/reliability.md) is
+// read again by the same reader, the way the fuzz target reads it: the reader must either succeed
+// or throw SceneError. Under the ASan+UBSan build in CI a memory error fails the test as well.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "candela/io/error.h"
+#include "candela/io/mesh_io.h"
+#include "candela/io/pbrt_reader.h"
+#include "candela/io/scene_reader.h"
+
+namespace candela {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kRegressions = fs::path(CANDELA_SOURCE_DIR) / "fuzz" / "regressions";
+
+std::string read_bytes(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+std::vector<fs::path> inputs_of(const std::string& target) {
+  std::vector<fs::path> files;
+  const fs::path dir = kRegressions / target;
+  if (fs::is_directory(dir))
+    for (const auto& entry : fs::directory_iterator(dir))
+      if (entry.is_regular_file() && entry.path().filename().string()[0] != '.') files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// A scratch directory like the fuzz targets' one (fuzz/fuzz_common.h): the input plus the two
+// meshes that fuzzed scenes may name.
+class FuzzRegression : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("candela_fuzz_regression_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+    write(dir_ / "mesh.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n");
+    write(dir_ / "mesh.ply",
+          "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+          "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  static void write(const fs::path& file, const std::string& bytes) {
+    std::ofstream out(file, std::ios::binary);
+    out << bytes;
+  }
+  fs::path copy_in(const fs::path& input, const std::string& name) {
+    write(dir_ / name, read_bytes(input));
+    return dir_ / name;
+  }
+  fs::path dir_;
+};
+
+// Runs `read` on each input; a SceneError is fine, another exception fails the test.
+template <typename Read>
+void expect_no_crash(const std::string& target, Read read) {
+  for (const fs::path& input : inputs_of(target)) {
+    SCOPED_TRACE(input.string());
+    try {
+      read(input);
+    } catch (const SceneError&) {
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "not a SceneError: " << e.what();
+    }
+  }
+}
+
+TEST_F(FuzzRegression, JsonReader) {
+  expect_no_crash("json_reader", [&](const fs::path& input) {
+    (void)read_json_scene(read_bytes(input), input.filename().string(), dir_);
+  });
+}
+
+TEST_F(FuzzRegression, PbrtReader) {
+  expect_no_crash("pbrt_reader", [&](const fs::path& input) {
+    std::vector<std::string> warnings;
+    (void)read_pbrt_scene(copy_in(input, "input.pbrt"), warnings);
+  });
+}
+
+TEST_F(FuzzRegression, ObjReader) {
+  expect_no_crash("obj_reader", [&](const fs::path& input) {
+    (void)load_mesh_file(copy_in(input, "input.obj"), SourceLocation{"fuzz", 1, 1, {}});
+  });
+}
+
+TEST_F(FuzzRegression, PlyReader) {
+  expect_no_crash("ply_reader", [&](const fs::path& input) {
+    (void)load_mesh_file(copy_in(input, "input.ply"), SourceLocation{"fuzz", 1, 1, {}});
+  });
+}
+
+}  // namespace
+}  // namespace candela

@@ -1,0 +1,265 @@
+// The command line under interruption: SIGINT writes the partial image (exit 3), a second SIGINT
+// leaves at once (exit 130), checkpoints survive kill -9 and resume to the bitwise-same image as an
+// uninterrupted render, resuming with another scene or settings (or from a damaged checkpoint) is
+// refused, --time-limit and --clamp do what they say.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "candela/film/image_io.h"
+
+namespace fs = std::filesystem;
+
+namespace candela {
+namespace {
+
+const std::string kScene = std::string(CANDELA_SOURCE_DIR) + "/scenes/cornell-box.json";
+
+class InterruptResume : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("candela_interrupt_test_" + std::to_string(getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  // Starts the CLI with `args`; its stdout and stderr go to a log file.
+  pid_t start(const std::vector<std::string>& args) {
+    std::string log = path("log" + std::to_string(runs_++) + ".txt");
+    last_log_ = log;
+    pid_t pid = fork();
+    if (pid == 0) {
+      int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      dup2(fd, 1);
+      dup2(fd, 2);
+      std::vector<char*> argv;
+      static std::string cli = CANDELA_CLI_PATH;
+      argv.push_back(cli.data());
+      for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+      argv.push_back(nullptr);
+      execv(cli.c_str(), argv.data());
+      _exit(127);
+    }
+    return pid;
+  }
+  // Exit status, or 1000 + signal number when killed.
+  static int wait_exit(pid_t pid) {
+    int status = 0;
+    waitpid(pid, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 1000 + WTERMSIG(status);
+  }
+  int run(const std::vector<std::string>& args) { return wait_exit(start(args)); }
+  std::string log() const {
+    std::ifstream in(last_log_);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }
+  // Waits (up to 60 s) until `file` exists.
+  static bool wait_for(const std::string& file) {
+    auto until = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (!fs::exists(file)) {
+      if (std::chrono::steady_clock::now() > until) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return true;
+  }
+  static bool same_pixels(const std::string& a, const std::string& b) {
+    Image ia = read_image(a), ib = read_image(b);
+    return ia.width == ib.width && ia.height == ib.height &&
+           std::memcmp(ia.rgb.data(), ib.rgb.data(), ia.rgb.size() * sizeof(float)) == 0;
+  }
+
+  fs::path dir_;
+  int runs_ = 0;
+  std::string last_log_;
+};
+
+std::vector<std::string> operator+(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+TEST_F(InterruptResume, SigintWritesThePartialImageAndExits3) {
+  std::string out = path("partial.exr"), ckpt = path("ck.bin");
+  pid_t pid = start({"render", kScene, "-o", out, "--resolution", "256x256", "--spp", "100000", "-q", "--checkpoint",
+                     ckpt, "--checkpoint-every", "0.2"});
+  ASSERT_TRUE(wait_for(ckpt));  // rendering has begun: at least one pass is done
+  kill(pid, SIGINT);
+  ASSERT_EQ(wait_exit(pid), 3) << log();
+  EXPECT_NE(log().find("interrupted"), std::string::npos) << log();
+  ASSERT_TRUE(fs::exists(out));
+  auto meta = read_image_metadata(out);
+  EXPECT_EQ(meta["candela:interrupted"], "true");
+  long long least = std::stoll(meta["candela:spp_min"]);
+  double mean = std::stod(meta["candela:spp_mean"]);
+  EXPECT_GT(least, 0);
+  EXPECT_GT(mean, 0);
+  EXPECT_LT(mean, 100000);
+  EXPECT_FALSE(meta["candela:spp"].empty());
+  for (float v : read_image(out).rgb) ASSERT_TRUE(std::isfinite(v));
+}
+
+TEST_F(InterruptResume, SigtermAlsoInterrupts) {
+  std::string out = path("partial.exr"), ckpt = path("ck.bin");
+  pid_t pid = start({"render", kScene, "-o", out, "--resolution", "64x64", "--spp", "100000", "-q", "--checkpoint",
+                     ckpt, "--checkpoint-every", "0.1"});
+  ASSERT_TRUE(wait_for(ckpt));
+  kill(pid, SIGTERM);
+  ASSERT_EQ(wait_exit(pid), 3) << log();
+  EXPECT_EQ(read_image_metadata(out)["candela:interrupted"], "true");
+}
+
+TEST_F(InterruptResume, SecondSigintExitsAtOnceWithoutWriting) {
+  std::string out = path("never.exr"), ckpt = path("ck.bin");
+  pid_t pid = start({"render", kScene, "-o", out, "--resolution", "256x256", "--spp", "100000", "-q", "--checkpoint",
+                     ckpt, "--checkpoint-every", "0.2"});
+  ASSERT_TRUE(wait_for(ckpt));
+  kill(pid, SIGINT);
+  kill(pid, SIGINT);
+  int code = wait_exit(pid);
+  // Almost always 130; 3 only if the whole partial write finished between the two signals.
+  ASSERT_TRUE(code == 130 || code == 3) << code << "\n" << log();
+  if (code == 130) {
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+TEST_F(InterruptResume, ResumeAfterKillAndAfterSigintIsBitwiseTheUninterruptedRender) {
+  const std::vector<std::string> common = {"--resolution", "128x128", "--spp", "64", "--seed", "7", "--threads", "2",
+                                           "-q"};
+  std::string ref = path("ref.exr");
+  ASSERT_EQ(run(std::vector<std::string>{"render", kScene, "-o", ref} + common), 0) << log();
+
+  // kill -9 after the first checkpoint; resume.
+  std::string ckpt = path("ck.bin"), out = path("resumed.exr");
+  pid_t pid = start(std::vector<std::string>{"render", kScene, "-o", out, "--checkpoint", ckpt, "--checkpoint-every",
+                                             "0.2"} + common);
+  ASSERT_TRUE(wait_for(ckpt));
+  kill(pid, SIGKILL);
+  ASSERT_EQ(wait_exit(pid), 1000 + SIGKILL) << "the render finished before it could be killed";
+  ASSERT_FALSE(fs::exists(out));
+  ASSERT_EQ(run(std::vector<std::string>{"render", kScene, "-o", out, "--resume", ckpt} + common), 0) << log();
+  EXPECT_TRUE(same_pixels(out, ref));
+
+  // SIGINT (mid-pass: pixels stop at different counts) writes a checkpoint too; resume from it.
+  std::string ckpt2 = path("ck2.bin"), partial = path("partial.exr"), out2 = path("resumed2.exr");
+  pid = start(std::vector<std::string>{"render", kScene, "-o", partial, "--checkpoint", ckpt2, "--checkpoint-every",
+                                       "0.2"} + common);
+  ASSERT_TRUE(wait_for(ckpt2));
+  kill(pid, SIGINT);
+  ASSERT_EQ(wait_exit(pid), 3) << log();
+  ASSERT_EQ(run(std::vector<std::string>{"render", kScene, "-o", out2, "--resume", ckpt2, "--checkpoint", ckpt2} +
+                common),
+            0)
+      << log();
+  EXPECT_TRUE(same_pixels(out2, ref));
+}
+
+TEST_F(InterruptResume, ResumeWithAnotherSceneOrSettingsOrDamagedCheckpointIsRefused) {
+  std::string ckpt = path("ck.bin"), out = path("out.exr");
+  const std::vector<std::string> common = {"--resolution", "32x32", "--seed", "3", "-q"};
+  // A time-limited render writes its checkpoint when it stops.
+  ASSERT_EQ(run(std::vector<std::string>{"render", kScene, "-o", out, "--spp", "100000", "--time-limit", "0.01",
+                                         "--checkpoint", ckpt} + common),
+            0)
+      << log();
+  ASSERT_TRUE(fs::exists(ckpt));
+
+  EXPECT_EQ(run(std::vector<std::string>{"render", kScene, "-o", out, "--spp", "128", "--resume", ckpt} + common), 1);
+  EXPECT_NE(log().find("settings differ: spp 100000 vs 128"), std::string::npos) << log();
+
+  // A copy of the scene with one number changed.
+  std::ifstream in(kScene);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  size_t at = text.find_first_of("123456789");
+  ASSERT_NE(at, std::string::npos);
+  text[at] = text[at] == '9' ? '8' : char(text[at] + 1);
+  std::string changed = path("changed.json");
+  std::ofstream(changed) << text;
+  EXPECT_EQ(run(std::vector<std::string>{"render", changed, "-o", out, "--spp", "100000", "--resume", ckpt} + common), 1);
+  EXPECT_NE(log().find("scene file differs"), std::string::npos) << log();
+
+  // Truncated and corrupted checkpoints.
+  std::ifstream cin(ckpt, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(cin)), std::istreambuf_iterator<char>());
+  std::string bad = path("bad.bin");
+  std::ofstream(bad, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  EXPECT_EQ(run(std::vector<std::string>{"render", kScene, "-o", out, "--spp", "100000", "--resume", bad} + common), 1);
+  EXPECT_NE(log().find("truncated"), std::string::npos) << log();
+  bytes[bytes.size() / 2] ^= 0x40;
+  std::ofstream(bad, std::ios::binary) << bytes;
+  EXPECT_EQ(run(std::vector<std::string>{"render", kScene, "-o", out, "--spp", "100000", "--resume", bad} + common), 1);
+  EXPECT_NE(log().find("corrupt (checksum mismatch)"), std::string::npos) << log();
+
+  // Adaptive sampling does not checkpoint.
+  EXPECT_EQ(run(std::vector<std::string>{"render", kScene, "-o", out, "--adaptive-threshold", "0.1", "--checkpoint",
+                                         ckpt} + common),
+            1);
+  EXPECT_NE(log().find("adaptive"), std::string::npos) << log();
+}
+
+TEST_F(InterruptResume, TimeLimitWritesTheImageAndExits0) {
+  std::string out = path("limited.exr");
+  ASSERT_EQ(run({"render", kScene, "-o", out, "--resolution", "64x64", "--spp", "100000", "--time-limit", "0.3", "-q"}),
+            0)
+      << log();
+  auto meta = read_image_metadata(out);
+  EXPECT_EQ(meta["candela:time-limited"], "true");
+  EXPECT_EQ(meta.count("candela:interrupted"), 0u);
+  long long spp = std::stoll(meta["candela:spp"]);
+  EXPECT_GT(spp, 0);
+  EXPECT_LT(spp, 100000);
+  EXPECT_EQ(spp % 4, 0);
+}
+
+TEST_F(InterruptResume, ClampBoundsEveryPixel) {
+  std::string plain = path("plain.exr"), clamped = path("clamped.exr");
+  const std::vector<std::string> common = {"--resolution", "48x48", "--spp", "16", "--filter", "box", "-q"};
+  ASSERT_EQ(run(std::vector<std::string>{"render", kScene, "-o", plain} + common), 0) << log();
+  ASSERT_EQ(run(std::vector<std::string>{"render", kScene, "-o", clamped, "--clamp", "0.5"} + common), 0) << log();
+  float most = 0;
+  for (float v : read_image(plain).rgb) most = std::max(most, v);
+  EXPECT_GT(most, 0.5f);  // the light and bright walls exceed it unclamped
+  for (float v : read_image(clamped).rgb) ASSERT_LE(v, 0.5f * (1 + 1e-5f));
+  EXPECT_EQ(read_image_metadata(clamped)["candela:clamp"], "0.5");
+}
+
+TEST_F(InterruptResume, PixelRendersOnePixelAsInTheFullImage) {
+  std::string full = path("full.exr");
+  const std::vector<std::string> common = {"--resolution", "32x32", "--spp", "8", "--seed", "2", "-q"};
+  ASSERT_EQ(run(std::vector<std::string>{"render", kScene, "-o", full} + common), 0) << log();
+  ASSERT_EQ(run(std::vector<std::string>{"render", kScene, "--pixel", "20,11"} + common), 0) << log();
+  std::string text = log();
+  float r, g, b;
+  unsigned long long n;
+  ASSERT_EQ(std::sscanf(text.c_str(), "pixel (20, 11): %g %g %g (%llu samples)", &r, &g, &b, &n), 4) << text;
+  EXPECT_EQ(n, 8u);
+  EXPECT_NE(text.find("non-finite samples: none"), std::string::npos) << text;
+  RGB expected = read_image(full).at(20, 11);
+  EXPECT_EQ(r, expected.r);
+  EXPECT_EQ(g, expected.g);
+  EXPECT_EQ(b, expected.b);
+  EXPECT_EQ(run(std::vector<std::string>{"render", kScene, "--pixel", "40,1"} + common), 1);
+}
+
+}  // namespace
+}  // namespace candela
