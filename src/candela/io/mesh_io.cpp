@@ -426,8 +426,14 @@ PlyHeader read_ply_header(std::string_view bytes) {
       check_ply_header_complete(header);
       header.data_offset = line_start;
       return header;
+    } else if (words[0] != "comment" && words[0] != "obj_info" && !header.elements.empty()) {
+      // Assimp ends an element's property list at the first other line and skips the property lines
+      // after it, so the two readers would disagree on the record size (the data would then be
+      // misread, in one fuzzed file into an 8.5 GB allocation). Before the first element such a line
+      // is harmless (Blender 2.4 broke its "Created by" comment over two lines) and is skipped.
+      fail("malformed PLY: unrecognised header line '{}' after element '{}'", printable(line_of(words)),
+           header.elements.back().name);
     }
-    // Anything else (comment, obj_info, a comment broken over two lines) is skipped, as Assimp does.
   }
   fail("{}", seen_magic ? "truncated PLY: the header has no 'end_header' line"
                         : "malformed PLY: the file does not start with 'ply'");
