@@ -409,7 +409,12 @@ PlyHeader read_ply_header(std::string_view bytes) {
   while (line_start < bytes.size()) {
     const size_t newline = bytes.find('\n', line_start);
     if (newline == std::string_view::npos) break;
-    const std::vector<std::string_view> words = split_words(bytes.substr(line_start, newline - line_start));
+    const std::string_view text = bytes.substr(line_start, newline - line_start);
+    // A carriage return ends a line only before the newline (CRLF files); Assimp splits header lines
+    // at a lone one while candela's words would not, and the two would then read different headers.
+    if (const size_t cr = text.find('\r'); cr != std::string_view::npos && cr + 1 != text.size())
+      fail("malformed PLY: header line {} has a carriage return inside it", header.line_count + 1);
+    const std::vector<std::string_view> words = split_words(text);
     line_start = newline + 1;
     ++header.line_count;
     if (words.empty()) continue;

@@ -550,6 +550,22 @@ TEST_F(MeshIo, PlyElementNameMustStartWithALetter) {
                         {"does not start with a letter"});
 }
 
+TEST_F(MeshIo, PlyCarriageReturnInsideAHeaderLineIsAnError) {
+  expect_error_mentions(write("cr.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+                                        "property float y\nproperty float z\n\r\r\rend_header\n0 0 0\n"),
+                        {"header line 7 has a carriage return inside it"});
+  const fs::path fuzzed = fs::path(CANDELA_SOURCE_DIR) / "fuzz" / "regressions" / "ply_reader";
+  expect_error_mentions(write("fuzzed5.ply", read(fuzzed / "segv-carriage-returns-before-end-header.ply")),
+                        {"carriage return"});
+  // CRLF line ends are fine.
+  EXPECT_EQ(load(write("crlf.ply", "ply\r\nformat ascii 1.0\r\nelement vertex 3\r\nproperty float x\r\n"
+                                   "property float y\r\nproperty float z\r\nelement face 1\r\n"
+                                   "property list uchar int vertex_indices\r\nend_header\r\n"
+                                   "0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2\r\n"))
+                .triangle_count(),
+            1u);
+}
+
 TEST_F(MeshIo, PlyUnrecognisedLineInsideAnElementIsAnError) {
   expect_error_mentions(write("garbled.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
                                              "propeofy ltrat ny\nproperty float y\nproperty float z\n"
