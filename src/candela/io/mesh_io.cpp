@@ -400,6 +400,10 @@ void check_ply_header_complete(const PlyHeader& header) {
     if (element.name == "tristrips" && element.count > 0)
       fail("unsupported PLY: triangle strips (a 'tristrips' element) are not supported; use a 'face' element");
   }
+  // Without a vertex element Assimp guesses which element holds the vertices and misreads the data.
+  if (std::none_of(header.elements.begin(), header.elements.end(),
+                   [](const PlyElement& e) { return e.name == "vertex"; }))
+    fail("malformed PLY: the header declares no 'vertex' element");
 }
 
 PlyHeader read_ply_header(std::string_view bytes) {

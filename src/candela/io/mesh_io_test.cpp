@@ -550,6 +550,15 @@ TEST_F(MeshIo, PlyElementNameMustStartWithALetter) {
                         {"does not start with a letter"});
 }
 
+TEST_F(MeshIo, PlyWithoutAVertexElementIsAnError) {
+  expect_error_mentions(write("novertex.ply", "ply\nformat ascii 1.0\nelement point 1\nproperty float x\n"
+                                              "property float y\nproperty float z\nend_header\n0 0 0\n"),
+                        {"declares no 'vertex' element"});
+  const fs::path fuzzed = fs::path(CANDELA_SOURCE_DIR) / "fuzz" / "regressions" / "ply_reader";
+  expect_error_mentions(write("fuzzed6.ply", read(fuzzed / "oom-no-vertex-element.ply")),
+                        {"declares no 'vertex' element"});
+}
+
 TEST_F(MeshIo, PlyCarriageReturnInsideAHeaderLineIsAnError) {
   expect_error_mentions(write("cr.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
                                         "property float y\nproperty float z\n\r\r\rend_header\n0 0 0\n"),
