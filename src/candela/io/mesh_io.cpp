@@ -414,10 +414,16 @@ PlyHeader read_ply_header(std::string_view bytes) {
     const size_t newline = bytes.find('\n', line_start);
     if (newline == std::string_view::npos) break;
     const std::string_view text = bytes.substr(line_start, newline - line_start);
-    // A carriage return ends a line only before the newline (CRLF files); Assimp splits header lines
-    // at a lone one while candela's words would not, and the two would then read different headers.
-    if (const size_t cr = text.find('\r'); cr != std::string_view::npos && cr + 1 != text.size())
-      fail("malformed PLY: header line {} has a carriage return inside it", header.line_count + 1);
+    // A header is text. Assimp splits lines at a lone carriage return and ends strings at a NUL, where
+    // candela's word splitting would not, so the two would read different headers: refuse control
+    // bytes (a carriage return is allowed only right before the newline, as in CRLF files).
+    for (size_t k = 0; k < text.size(); ++k) {
+      const auto c = static_cast<unsigned char>(text[k]);
+      if (c == '\r' && k + 1 != text.size())
+        fail("malformed PLY: header line {} has a carriage return inside it", header.line_count + 1);
+      if ((c < 0x20 && c != '\t' && c != '\r') || c == 0x7f)
+        fail("malformed PLY: header line {} has a control byte (0x{:02x}) in it", header.line_count + 1, c);
+    }
     const std::vector<std::string_view> words = split_words(text);
     line_start = newline + 1;
     ++header.line_count;

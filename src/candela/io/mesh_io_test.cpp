@@ -528,7 +528,7 @@ TEST_F(MeshIo, PlyWithTwoFormatLinesIsAnError) {
                                                      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
                         {"more than one format line"});
   const fs::path fuzzed = fs::path(CANDELA_SOURCE_DIR) / "fuzz" / "regressions" / "ply_reader";
-  expect_error_mentions(write("fuzzed1.ply", read(fuzzed / "leak-second-format-line.ply")), {"more than one format line"});
+  expect_error_mentions(write("fuzzed1.ply", read(fuzzed / "leak-second-format-line.ply")), {"malformed PLY"});
 }
 
 TEST_F(MeshIo, PlyElementDeclaredTwiceIsAnError) {
@@ -559,13 +559,18 @@ TEST_F(MeshIo, PlyWithoutAVertexElementIsAnError) {
                         {"declares no 'vertex' element"});
 }
 
-TEST_F(MeshIo, PlyCarriageReturnInsideAHeaderLineIsAnError) {
+TEST_F(MeshIo, PlyControlBytesInTheHeaderAreAnError) {
   expect_error_mentions(write("cr.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
                                         "property float y\nproperty float z\n\r\r\rend_header\n0 0 0\n"),
                         {"header line 7 has a carriage return inside it"});
   const fs::path fuzzed = fs::path(CANDELA_SOURCE_DIR) / "fuzz" / "regressions" / "ply_reader";
   expect_error_mentions(write("fuzzed5.ply", read(fuzzed / "segv-carriage-returns-before-end-header.ply")),
                         {"carriage return"});
+  using namespace std::string_literals;
+  expect_error_mentions(write("nul.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\0y\n"
+                                         "property float y\nproperty float z\nend_header\n0 0 0\n"s),
+                        {"header line 4 has a control byte (0x00) in it"});
+  expect_error_mentions(write("fuzzed7.ply", read(fuzzed / "oom-nul-in-header.ply")), {"control byte"});
   // CRLF line ends are fine.
   EXPECT_EQ(load(write("crlf.ply", "ply\r\nformat ascii 1.0\r\nelement vertex 3\r\nproperty float x\r\n"
                                    "property float y\r\nproperty float z\r\nelement face 1\r\n"
