@@ -76,6 +76,10 @@ struct RenderCommand {
   std::string checkpoint, resume, pixel;
   std::optional<double> checkpoint_every, time_limit;
   std::optional<float> clamp;
+  std::string bdpt_strategies;
+  bool bdpt_unweighted = false;
+  std::optional<int> mlt_bootstrap, mlt_chains;
+  std::optional<float> mlt_sigma, mlt_large_step;
 };
 
 template <typename Enum>
@@ -116,6 +120,10 @@ void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
     rs.light_selection = parse_choice<LightSelection>("--light-selection", cmd.light_selection,
                                                       {{"power", LightSelection::Power}, {"paper", LightSelection::Paper}});
   if (cmd.no_mis) rs.mis = false;
+  if (cmd.mlt_bootstrap) rs.mlt_bootstrap = *cmd.mlt_bootstrap;
+  if (cmd.mlt_chains) rs.mlt_chains = *cmd.mlt_chains;
+  if (cmd.mlt_sigma) rs.mlt_sigma = *cmd.mlt_sigma;
+  if (cmd.mlt_large_step) rs.mlt_large_step = *cmd.mlt_large_step;
   if (cmd.shadow_rays) rs.shadow_rays = *cmd.shadow_rays;
   if (cmd.adaptive_threshold) rs.adaptive_threshold = *cmd.adaptive_threshold;
   if (cmd.adaptive_batch) rs.adaptive_batch = *cmd.adaptive_batch;
@@ -138,7 +146,12 @@ void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
     throw UsageError(fmt::format("resolution {}x{} is out of range (each side 1..{}, at most {} pixels)", f.width,
                                  f.height, kMaxResolution, kMaxPixels));
   if (!is_known_integrator(scene.settings.integrator))
-    throw UsageError(fmt::format("unknown integrator '{}' (known: path)", scene.settings.integrator));
+    throw UsageError(fmt::format("unknown integrator '{}' (known: {})", scene.settings.integrator, known_integrators()));
+  if (scene.settings.integrator == "mlt" && scene.settings.adaptive_threshold > 0)
+    throw UsageError("--adaptive-threshold does not apply to the mlt integrator (its mutations go where the light is)");
+  if (!cmd.bdpt_strategies.empty() && scene.settings.integrator != "bdpt")
+    throw UsageError("--bdpt-strategies needs --integrator bdpt");
+  if (cmd.bdpt_unweighted && cmd.bdpt_strategies.empty()) throw UsageError("--bdpt-unweighted needs --bdpt-strategies DIR");
 }
 
 // The files to write: -o wins, then the scene's own film name, then <scene name>.exr. The built-in
@@ -210,6 +223,9 @@ RenderFingerprint make_fingerprint(const std::string& scene_bytes, const SceneDe
       {"adaptive-threshold", fmt::format("{}", rs.adaptive_threshold)},
       {"clamp", clamp > 0 ? fmt::format("{}", clamp) : "off"},
   };
+  if (rs.integrator == "mlt")
+    fp.settings.push_back({"mlt", fmt::format("bootstrap {} chains {} sigma {} large-step {}", rs.mlt_bootstrap,
+                                              rs.mlt_chains, rs.mlt_sigma, rs.mlt_large_step)});
   return fp;
 }
 
@@ -230,6 +246,12 @@ int run_render(const RenderCommand& cmd) {
     throw UsageError("--checkpoint and --resume are not supported with adaptive sampling (--adaptive-threshold)");
   if (pixel_mode && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
     throw UsageError("--pixel cannot be combined with --checkpoint or --resume");
+  const bool mlt = desc.settings.integrator == "mlt";
+  if (mlt && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
+    throw UsageError("--checkpoint and --resume are not supported with the mlt integrator (its chains are not saved)");
+  if (mlt && pixel_mode) throw UsageError("--pixel cannot be used with the mlt integrator (its chains roam the whole film)");
+  if (!cmd.bdpt_strategies.empty() && !fs::is_directory(cmd.bdpt_strategies))
+    throw UsageError(fmt::format("--bdpt-strategies '{}': not a directory", cmd.bdpt_strategies));
   int px = -1, py = -1;
   if (pixel_mode) {
     std::smatch m;
@@ -274,7 +296,17 @@ int run_render(const RenderCommand& cmd) {
   uint64_t earlier_non_finite = 0;
   if (resumed) {
     film.pixels() = std::move(resumed->pixels);
+    if (!resumed->splats.empty()) {
+      film.enable_splats();
+      film.splats().sums() = std::move(resumed->splats);
+    }
     earlier_non_finite = resumed->non_finite_samples;
+  }
+  // Per-strategy images of bidirectional path tracing, depth by depth up to 5 (or max-depth).
+  const int strategy_depth = std::min(desc.settings.max_depth, 5);
+  std::vector<SplatImage> strategy_images;
+  if (!cmd.bdpt_strategies.empty()) {
+    strategy_images.assign(size_t(BdptIntegrator::strategy_count(strategy_depth)), SplatImage(film.width(), film.height()));
   }
   RenderOptions options;
   options.threads = cmd.threads.value_or(0);
@@ -282,6 +314,10 @@ int run_render(const RenderCommand& cmd) {
   options.cancel = &g_stop;
   options.time_limit_seconds = cmd.time_limit.value_or(0.0);
   options.clamp = clamp;
+  if (!strategy_images.empty()) {
+    options.bdpt_strategies = &strategy_images;
+    options.bdpt_unweighted = cmd.bdpt_unweighted;
+  }
   if (pixel_mode) {
     options.only_x = px;
     options.only_y = py;
@@ -294,6 +330,7 @@ int run_render(const RenderCommand& cmd) {
     cp.height = f.height();
     cp.non_finite_samples = non_finite;
     cp.pixels = f.pixels();
+    if (f.has_splats()) cp.splats = f.splats().sums();
     write_checkpoint(cmd.checkpoint, cp);
   };
   auto last_checkpoint = std::chrono::steady_clock::now();
@@ -320,7 +357,7 @@ int run_render(const RenderCommand& cmd) {
 
   if (pixel_mode) {
     const PixelSums& p = film.pixel(px, py);
-    RGB v = p.mean();
+    RGB v = film.mean_image().at(px, py);
     std::printf("pixel (%d, %d): %.9g %.9g %.9g (%llu samples)\n", px, py, v.r, v.g, v.b,
                 (unsigned long long)p.count);
     std::string idx;
@@ -336,7 +373,9 @@ int run_render(const RenderCommand& cmd) {
   const uint64_t min_spp = film.min_samples(), max_spp = film.max_samples();
   const double mean_spp = double(film.total_samples()) / pixels;
   std::string spp_text;
-  if (adaptive && !stopped)
+  if (mlt)
+    spp_text = fmt::format("{:.2f} mutations per pixel", double(stats.samples) / pixels);
+  else if (adaptive && !stopped)
     spp_text = fmt::format("adaptive, {:.2f} on average", mean_spp);
   else if (min_spp == max_spp)
     spp_text = std::to_string(min_spp);
@@ -356,16 +395,25 @@ int run_render(const RenderCommand& cmd) {
   if (stats.time_limited) metadata["candela:time-limited"] = "true";
   if (clamp > 0) metadata["candela:clamp"] = fmt::format("{}", clamp);
   if (non_finite > 0) metadata["candela:non_finite_samples"] = std::to_string(non_finite);
+  if (mlt) metadata["candela:mlt"] = fmt::format("bootstrap {} chains {} sigma {} large-step {}", desc.settings.mlt_bootstrap,
+                                                desc.settings.mlt_chains, desc.settings.mlt_sigma, desc.settings.mlt_large_step);
   Image image = film.mean_image();
   for (const auto& f : outputs) write_image(f, image, metadata);
+  // One image per strategy: bdpt_d<depth>_s<s>_t<t>.exr, scaled like the light image.
+  for (int depth = 0; depth <= strategy_depth && !strategy_images.empty(); ++depth)
+    for (int s = 0; s <= depth + 1; ++s) {
+      int t = depth + 2 - s;
+      fs::path file = fs::path(cmd.bdpt_strategies) / fmt::format("bdpt_d{}_s{}_t{}.exr", depth, s, t);
+      write_image(file, strategy_images[size_t(BdptIntegrator::strategy_index(s, t))].image(film.splat_scale()), metadata);
+    }
   if (!cmd.spp_map.empty()) write_image(cmd.spp_map, spp_heat_map(film, fs::path(cmd.spp_map)), metadata);
   nan_warning();
 
   double seconds = std::max(stats.seconds, 1e-9);
   std::string written;
   for (const auto& f : outputs) written += (written.empty() ? "" : ", ") + f.string();
-  std::printf("%dx%d, %s spp in %.2f s: %.3f Msamples/s, %.2f Mrays/s (%.3g rays/sample) -> %s\n", desc.film.width,
-              desc.film.height, spp_text.c_str(), stats.seconds, double(stats.samples) / seconds * 1e-6,
+  std::printf("%dx%d, %s%s in %.2f s: %.3f Msamples/s, %.2f Mrays/s (%.3g rays/sample) -> %s\n", desc.film.width,
+              desc.film.height, spp_text.c_str(), mlt ? "" : " spp", stats.seconds, double(stats.samples) / seconds * 1e-6,
               double(stats.rays.total()) / seconds * 1e-6,
               double(stats.rays.total()) / double(std::max<uint64_t>(stats.samples, 1)), written.c_str());
   if (stats.time_limited)
@@ -398,7 +446,25 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--max-depth", cmd.max_depth, "Maximum number of bounces; 1 = direct light only")
       ->check(CLI::Range(1, 100000));
   render_cmd->add_option("--resolution", cmd.resolution, "Image size WIDTHxHEIGHT (overrides the scene)");
-  render_cmd->add_option("--integrator", cmd.integrator, "Integrator: path");
+  render_cmd->add_option("--integrator", cmd.integrator,
+                         "Integrator: path (path tracing), bdpt (bidirectional path tracing), mlt (Metropolis "
+                         "light transport over bidirectional paths; --spp is then mutations per pixel)");
+  render_cmd->add_option("--bdpt-strategies", cmd.bdpt_strategies,
+                         "bdpt: also write each strategy's contribution (depth <= 5) to "
+                         "DIR/bdpt_d<depth>_s<s>_t<t>.exr");
+  render_cmd->add_flag("--bdpt-unweighted", cmd.bdpt_unweighted,
+                       "bdpt: the strategy images without their MIS weights (each then estimates the whole "
+                       "image of its depth on its own)");
+  render_cmd->add_option("--mlt-bootstrap", cmd.mlt_bootstrap, "mlt: bootstrap paths per depth (default 100000)")
+      ->check(CLI::Range(1, 100000000));
+  render_cmd->add_option("--mlt-chains", cmd.mlt_chains, "mlt: independent Markov chains (default 1000)")
+      ->check(CLI::Range(1, 100000000));
+  render_cmd->add_option("--mlt-sigma", cmd.mlt_sigma,
+                         "mlt: deviation of small steps in primary sample space (default 0.01)")
+      ->check(CLI::Range(1e-6, 1.0));
+  render_cmd->add_option("--mlt-large-step", cmd.mlt_large_step,
+                         "mlt: probability of a large step (default 0.3)")
+      ->check(CLI::Range(0.0, 1.0));
   render_cmd->add_option("--sampler", cmd.sampler,
                          "Pixel sampler: random (independent), stratified (jittered, every dimension), "
                          "poisson (Poisson-disc pixel positions), zsobol (Owen-scrambled Sobol' in Morton order)");

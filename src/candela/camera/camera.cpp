@@ -6,15 +6,18 @@
 
 namespace candela {
 
-PerspectiveCamera::PerspectiveCamera(const CameraDesc& desc, int width, int height)
+PerspectiveCamera::PerspectiveCamera(const CameraDesc& desc, int width, int height, Vec2 margin)
     : world_from_camera_(desc.world_from_camera),
       lens_radius_(desc.lens_radius),
       focus_distance_(desc.focus_distance),
       shutter_open_(desc.shutter_open),
       shutter_close_(desc.shutter_close),
       width_(width),
-      height_(height) {
+      height_(height),
+      margin_(margin) {
   origin_ = world_from_camera_.point(Point3(0.0f));
+  camera_from_world_ = world_from_camera_.inverse();
+  forward_ = normalize(world_from_camera_.vector(Vec3(0, 0, 1)));
   // The screen spans [-tan_half_x, tan_half_x] x [-tan_half_y, tan_half_y] at unit distance; the fov
   // fixes one axis and the aspect ratio (square pixels) the other.
   float aspect = float(width) / float(height);
@@ -46,6 +49,54 @@ Ray PerspectiveCamera::generate_ray(Vec2 film, Vec2 lens, float time) const {
   Point3 o = world_from_camera_.point(lens_point);
   Vec3 w = normalize(world_from_camera_.vector(focus_point - lens_point));
   return Ray{o, w, std::numeric_limits<float>::infinity(), time};
+}
+
+float PerspectiveCamera::importance(const Point3& lens_point, const Vec3& w, Vec2* raster) const {
+  float cos_theta = dot(w, forward_);
+  if (!(cos_theta > 0)) return 0;
+  // Where the ray meets the plane of focus (the unit plane for a pinhole), in camera space: that
+  // point fixes the raster position, as in generate_ray.
+  Vec3 wc = camera_from_world_.vector(w);
+  Point3 oc = camera_from_world_.point(lens_point);
+  if (!(wc.z > 0)) return 0;
+  float depth = lens_radius_ > 0 ? focus_distance_ : 1.0f;
+  Point3 focus = oc + wc * ((depth - oc.z) / wc.z);
+  float sx = focus.x / depth / tan_half_x_, sy = focus.y / depth / tan_half_y_;
+  Vec2 r{(sx + 1) * 0.5f * float(width_), (1 - sy) * 0.5f * float(height_)};
+  if (!(r.x >= -margin_.x && r.x < float(width_) + margin_.x && r.y >= -margin_.y && r.y < float(height_) + margin_.y))
+    return 0;
+  if (raster) *raster = r;
+  float film_area = importance_film_area();
+  float cos2 = cos_theta * cos_theta;
+  return 1 / (film_area * lens_area() * cos2 * cos2);
+}
+
+PerspectiveCamera::ImportancePdf PerspectiveCamera::pdf_importance(const Point3& lens_point, const Vec3& w) const {
+  if (importance(lens_point, w, nullptr) == 0) return {};
+  float cos_theta = dot(w, forward_);
+  float film_area = importance_film_area();
+  return {1 / lens_area(), 1 / (film_area * cos_theta * cos_theta * cos_theta)};
+}
+
+std::optional<PerspectiveCamera::LensSample> PerspectiveCamera::sample_lens(const Point3& ref, Vec2 u) const {
+  Point3 p = origin_;
+  if (lens_radius_ > 0) {
+    Vec2 d = square_to_concentric_disk(u);
+    p = world_from_camera_.point(Point3(lens_radius_ * d.x, lens_radius_ * d.y, 0));
+  }
+  Vec3 to_lens = p - ref;
+  float dist2 = length_squared(to_lens);
+  if (!(dist2 > 0)) return std::nullopt;
+  LensSample s;
+  s.p = p;
+  s.distance = std::sqrt(dist2);
+  s.wi = to_lens / s.distance;
+  float cos_lens = std::abs(dot(forward_, s.wi));
+  if (!(cos_lens > 0)) return std::nullopt;
+  s.pdf = dist2 / (cos_lens * lens_area());
+  s.importance = importance(p, -s.wi, &s.raster);
+  if (s.importance == 0) return std::nullopt;
+  return s;
 }
 
 }  // namespace candela

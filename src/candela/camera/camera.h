@@ -3,6 +3,8 @@
 // (0,0) the top-left corner of the image; a pixel (i, j) covers [i, i+1) x [j, j+1) (the paper's eq. 9).
 // With a lens, rays start on a disk of radius lens_radius around the camera position and pass
 // through the point the pinhole ray reaches at depth focus_distance (pbrt's thin lens).
+#include <optional>
+
 #include "candela/geometry/ray.h"
 #include "candela/scene/description.h"
 
@@ -11,22 +13,63 @@ namespace candela {
 class PerspectiveCamera {
  public:
   PerspectiveCamera() = default;
-  PerspectiveCamera(const CameraDesc& desc, int width, int height);
+  // `margin`: how far (in pixels) beyond the image's edges camera rays reach, the reconstruction
+  // filter's radius; the importance function covers that larger film so that light paths reaching
+  // the margin still add to the pixels whose filter overlaps it.
+  PerspectiveCamera(const CameraDesc& desc, int width, int height, Vec2 margin = {0, 0});
 
   // `lens` in [0,1)^2 picks the point on the lens (ignored for a pinhole); `time` is the ray's time.
   Ray generate_ray(Vec2 film, Vec2 lens, float time) const;
+  // The camera as a sensor of importance (Veach's W_e, pbrt-v3 sec. 16.1.1), for paths traced from
+  // lights. W_e is normalised so that it integrates to 1 over the lens and the whole film, with the
+  // film area measured on the plane at unit distance: importance() of a ray leaving lens_point along
+  // unit w, and the raster position it reaches, or 0 when it misses the film.
+  float importance(const Point3& lens_point, const Vec3& w, Vec2* raster) const;
+  // Densities with which generate_ray (with uniform film and lens samples) produces the ray from
+  // lens_point along w: per area on the lens (1 for a pinhole) and per solid angle; 0 off the film.
+  struct ImportancePdf {
+    float pos = 0, dir = 0;
+  };
+  ImportancePdf pdf_importance(const Point3& lens_point, const Vec3& w) const;
+  // A point on the lens seen from `ref` (the t = 1 strategy of bidirectional path tracing): the
+  // direction wi from ref to it, the distance, the solid-angle pdf at ref, the importance arriving
+  // there and the raster position it lands on.
+  struct LensSample {
+    Point3 p;
+    Vec3 wi;
+    float distance = 0, pdf = 0, importance = 0;
+    Vec2 raster;
+  };
+  std::optional<LensSample> sample_lens(const Point3& ref, Vec2 u) const;
+  // The area of the importance function's film in pixels, (width + 2 margin) (height + 2 margin): a light
+  // path's splat, over the number of light paths traced, times this is its contribution to a pixel.
+  float importance_film_pixels() const {
+    return (float(width_) + 2 * margin_.x) * (float(height_) + 2 * margin_.y);
+  }
+  Vec2 margin() const { return margin_; }
+  // The viewing direction (the lens normal) in world space, and the lens area (1 for a pinhole).
+  const Vec3& forward() const { return forward_; }
+  float lens_area() const { return lens_radius_ > 0 ? kPi * lens_radius_ * lens_radius_ : 1.0f; }
+
   float shutter_open() const { return shutter_open_; }
   float shutter_close() const { return shutter_close_; }
   int width() const { return width_; }
   int height() const { return height_; }
 
  private:
-  Transform world_from_camera_;
+  // The importance function's film on the plane at unit distance (margin included).
+  float importance_film_area() const {
+    return 4 * tan_half_x_ * tan_half_y_ * importance_film_pixels() / (float(width_) * float(height_));
+  }
+
+  Transform world_from_camera_, camera_from_world_;
+  Vec3 forward_{0, 0, 1};
   Point3 origin_;
   float tan_half_x_ = 1, tan_half_y_ = 1;
   float lens_radius_ = 0, focus_distance_ = 1;
   float shutter_open_ = 0, shutter_close_ = 1;
   int width_ = 1, height_ = 1;
+  Vec2 margin_{0, 0};
 };
 
 }  // namespace candela

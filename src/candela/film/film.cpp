@@ -1,6 +1,7 @@
 #include "candela/film/film.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 namespace candela {
@@ -26,7 +27,56 @@ RGB PixelSums::standard_error() const {
 Image Film::mean_image() const {
   Image img(width_, height_);
   for (int y = 0; y < height_; ++y)
-    for (int x = 0; x < width_; ++x) img.set(x, y, pixel(x, y).mean());
+    for (int x = 0; x < width_; ++x) {
+      RGB v = pixel(x, y).mean();
+      if (has_splats()) v += splats_.at(x, y) * float(splat_scale_);
+      img.set(x, y, v);
+    }
+  return img;
+}
+
+void SplatImage::add_to_pixel(int x, int y, const RGB& v) {
+  int64_t* sums = &sums_[(size_t(y) * size_t(width_) + size_t(x)) * 3];
+  for (int c = 0; c < 3; ++c) {
+    int64_t fixed = std::llround(double(v[c]) * kUnit);
+    if (fixed != 0) std::atomic_ref<int64_t>(sums[c]).fetch_add(fixed, std::memory_order_relaxed);
+  }
+}
+
+bool SplatImage::add(Vec2 p, const RGB& v, const Filter& filter) {
+  // Larger values would overflow the fixed-point sums within a few hundred splats.
+  constexpr float kLargest = 1e9f;
+  for (int c = 0; c < 3; ++c)
+    if (!(std::abs(v[c]) < kLargest)) return false;
+  if (v.is_black()) return true;
+  Vec2 r = filter.radius();
+  if (filter.type() == FilterType::Box && r.x == 0.5f && r.y == 0.5f) {
+    // The common case: the pixel the point lies in, with weight 1.
+    add_to_pixel(std::clamp(int(p.x), 0, width_ - 1), std::clamp(int(p.y), 0, height_ - 1), v);
+    return true;
+  }
+  // Every pixel whose centre lies within the filter's radius of p.
+  int x0 = std::max(0, int(std::ceil(p.x - 0.5f - r.x))), x1 = std::min(width_ - 1, int(std::floor(p.x - 0.5f + r.x)));
+  int y0 = std::max(0, int(std::ceil(p.y - 0.5f - r.y))), y1 = std::min(height_ - 1, int(std::floor(p.y - 0.5f + r.y)));
+  float inv_integral = 1 / filter.integral();
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) {
+      float w = filter.evaluate({p.x - (float(x) + 0.5f), p.y - (float(y) + 0.5f)}) * inv_integral;
+      if (w != 0) add_to_pixel(x, y, v * w);
+    }
+  return true;
+}
+
+RGB SplatImage::at(int x, int y) const {
+  if (empty()) return RGB(0.0f);
+  const int64_t* sums = &sums_[(size_t(y) * size_t(width_) + size_t(x)) * 3];
+  return {float(double(sums[0]) / kUnit), float(double(sums[1]) / kUnit), float(double(sums[2]) / kUnit)};
+}
+
+Image SplatImage::image(double scale) const {
+  Image img(width_, height_);
+  for (int y = 0; y < height_; ++y)
+    for (int x = 0; x < width_; ++x) img.set(x, y, at(x, y) * float(scale));
   return img;
 }
 

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "candela/film/filter.h"
 #include "candela/film/image.h"
 #include "candela/math/color.h"
 
@@ -21,6 +22,34 @@ struct PixelSums {
   RGB mean() const;
   // Standard error of mean() per channel, from the spread of the samples (0 with fewer than 2).
   RGB standard_error() const;
+};
+
+// Contributions that land wherever they land on the film rather than on the pixel being sampled
+// (light paths of bidirectional path tracing, Metropolis chains). A splat is spread over the
+// pixels the filter covers with weights f / integral(f). The sums are fixed point (kUnit per unit)
+// added with atomic integer adds, so they come out the same whatever order threads add in.
+class SplatImage {
+ public:
+  static constexpr double kUnit = 16777216.0;  // 2^24: resolution 6e-8, range 5e11 per sum
+
+  SplatImage() = default;
+  SplatImage(int width, int height) : width_(width), height_(height), sums_(size_t(width) * size_t(height) * 3, 0) {}
+  bool empty() const { return sums_.empty(); }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  // Adds v at raster position p; false (and nothing added) for non-finite or absurdly large values.
+  bool add(Vec2 p, const RGB& v, const Filter& filter);
+  void add_to_pixel(int x, int y, const RGB& v);
+  RGB at(int x, int y) const;
+  // Every pixel times `scale`.
+  Image image(double scale) const;
+  // The raw sums (3 per pixel, row-major): for checkpoints.
+  const std::vector<int64_t>& sums() const { return sums_; }
+  std::vector<int64_t>& sums() { return sums_; }
+
+ private:
+  int width_ = 0, height_ = 0;
+  std::vector<int64_t> sums_;
 };
 
 class Film {
@@ -39,11 +68,21 @@ class Film {
     px.weight += weight;
     ++px.count;
   }
+  // Splats (see SplatImage), kept apart from the per-pixel sums and multiplied by splat_scale() in
+  // the image. Empty until enable_splats().
+  void enable_splats() { splats_ = SplatImage(width_, height_); }
+  bool has_splats() const { return !splats_.empty(); }
+  SplatImage& splats() { return splats_; }
+  const SplatImage& splats() const { return splats_; }
+  double splat_scale() const { return splat_scale_; }
+  void set_splat_scale(double s) { splat_scale_ = s; }
+
   const PixelSums& pixel(int x, int y) const { return pixels_[size_t(y) * width_ + x]; }
   // All pixels, row-major: for checkpoints, which store and restore the sums bit for bit.
   const std::vector<PixelSums>& pixels() const { return pixels_; }
   std::vector<PixelSums>& pixels() { return pixels_; }
 
+  // Per pixel: the mean of its samples plus its splats times splat_scale().
   Image mean_image() const;
   // Per-pixel variance of the mean (squared standard error), for error estimates in tests.
   Image variance_of_mean_image() const;
@@ -57,6 +96,8 @@ class Film {
  private:
   int width_, height_;
   std::vector<PixelSums> pixels_;
+  SplatImage splats_;
+  double splat_scale_ = 1;
 };
 
 }  // namespace candela

@@ -649,7 +649,20 @@ class JsonSceneReader {
     read_integrator_strategies(render, settings);
     if (const Json* adaptive = render.find("adaptive"))
       read_adaptive(*adaptive, render.pointer_of("adaptive"), settings);
+    if (const Json* mlt = render.find("mlt")) read_mlt(*mlt, render.pointer_of("mlt"), settings);
     render.finish();
+  }
+
+  // Metropolis light transport's parameters (integrator "mlt").
+  void read_mlt(const Json& value, const std::string& pointer, RenderSettings& settings) const {
+    CheckedObject object(report_, value, pointer);
+    constexpr int64_t kIntMax = std::numeric_limits<int>::max();
+    settings.mlt_bootstrap = object.integer_or("bootstrap", settings.mlt_bootstrap, 1, kIntMax);
+    settings.mlt_chains = object.integer_or("chains", settings.mlt_chains, 1, kIntMax);
+    settings.mlt_sigma = object.number_or("sigma", settings.mlt_sigma, Bound::Positive);
+    if (settings.mlt_sigma > 1) report_.fail(object.pointer_of("sigma"), "sigma must be at most 1, got {}", settings.mlt_sigma);
+    settings.mlt_large_step = object.number_or("large_step", settings.mlt_large_step, Bound::UnitInterval);
+    object.finish();
   }
 
   void read_transform_times(const Json& value, const std::string& pointer) {

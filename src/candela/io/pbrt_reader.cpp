@@ -1255,7 +1255,8 @@ void PbrtParser::sampler(const Token& d) {
     warn(at(type), "{}: using candela's zsobol sampler (Owen-scrambled Sobol' points, Morton-ordered; the same "
          "number of samples, a different pattern)", name);
   scene_.settings.sampler = sampler;
-  scene_.settings.spp = static_cast<int>(spp);
+  // Metropolis light transport counts mutations per pixel (its own parameter), not pixel samples.
+  if (scene_.settings.integrator != "mlt") scene_.settings.spp = static_cast<int>(spp);
   if (params.has("seed")) scene_.settings.seed = static_cast<uint64_t>(seed);
 }
 
@@ -1294,16 +1295,42 @@ void PbrtParser::integrator(const Token& d) {
       warn(params.where("regularize"), "Integrator \"{}\": \"regularize\" is ignored: candela does not roughen "
            "near-specular surfaces (the image keeps the caustics pbrt would blur)", type.text);
   }
-  for (std::string_view name : known->second)
-    ignore_param(params, name, "candela's path integrator has no such setting");
+  std::string integrator = "path";
+  if (type.text == "bdpt") {
+    integrator = "bdpt";
+    for (std::string_view name : known->second)
+      ignore_param(params, name, "use candela's --bdpt-strategies DIR (and --bdpt-unweighted) instead");
+  } else if (type.text == "mlt") {
+    integrator = "mlt";
+    RenderSettings& rs = scene_.settings;
+    int mutations = params.get_int("mutationsperpixel", 100);
+    if (mutations < 1) params.fail("mutationsperpixel", "must be positive, got {}", mutations);
+    int bootstrap = params.get_int("bootstrapsamples", 100000);
+    if (bootstrap < 1) params.fail("bootstrapsamples", "must be positive, got {}", bootstrap);
+    int chains = params.get_int("chains", 1000);
+    if (chains < 1) params.fail("chains", "must be positive, got {}", chains);
+    float large_step = params.get_float("largestepprobability", 0.3f);
+    if (!(large_step >= 0 && large_step <= 1))
+      params.fail("largestepprobability", "must be in [0, 1], got {}", large_step);
+    float sigma = params.get_float("sigma", 0.01f);
+    if (!(sigma > 0 && sigma <= 1)) params.fail("sigma", "must be in (0, 1], got {}", sigma);
+    rs.spp = mutations;
+    rs.mlt_bootstrap = bootstrap;
+    rs.mlt_chains = chains;
+    rs.mlt_large_step = large_step;
+    rs.mlt_sigma = sigma;
+  } else {
+    for (std::string_view name : known->second)
+      ignore_param(params, name, "candela's path integrator has no such setting");
+  }
   params.reject_unused();
   if (type.text == "volpath")
     warn(at(type), "Integrator \"volpath\": using candela's path integrator; without participating media (which "
          "candela does not render) it is the same integrator");
-  else if (type.text != "path")
+  else if (integrator == "path" && type.text != "path")
     warn(at(type), "Integrator \"{}\": using candela's path integrator with maxdepth {} (it converges to the "
          "same image, with different noise)", type.text, max_depth);
-  scene_.settings.integrator = "path";
+  scene_.settings.integrator = integrator;
   scene_.settings.max_depth = max_depth;
 }
 

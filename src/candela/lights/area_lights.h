@@ -54,6 +54,16 @@ struct TriangleLight {
     Vec2 b = square_to_uniform_triangle(u);
     return flat_light_sample(p0 * b.x + p1 * b.y + p2 * (1 - b.x - b.y), n, area, radiance, two_sided, ctx);
   }
+  // Emission: a uniform point, a cosine-weighted direction on the emitting side(s).
+  LightEmission sample_le(Vec2 u_pos, Vec2 u_dir, const SceneSphere&) const {
+    Vec2 b = square_to_uniform_triangle(u_pos);
+    float pdf_dir;
+    Vec3 w = sample_cosine_emission(n, two_sided, u_dir, pdf_dir);
+    return {radiance, p0 * b.x + p1 * b.y + p2 * (1 - b.x - b.y), w, n, 1 / area, pdf_dir};
+  }
+  EmissionPdf pdf_le(const Point3&, const Normal3&, const Vec3& w, const SceneSphere&) const {
+    return {1 / area, cosine_emission_pdf(n, two_sided, w)};
+  }
   float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const {
     return area_to_solid_angle_pdf(1 / area, ctx.p, p, n);
   }
@@ -76,6 +86,14 @@ struct RectangleLight {
 
   LightSample sample_li(const LightSampleContext& ctx, Vec2 u) const {
     return flat_light_sample(corner + edge_u * u.x + edge_v * u.y, n, area, radiance, two_sided, ctx);
+  }
+  LightEmission sample_le(Vec2 u_pos, Vec2 u_dir, const SceneSphere&) const {
+    float pdf_dir;
+    Vec3 w = sample_cosine_emission(n, two_sided, u_dir, pdf_dir);
+    return {radiance, corner + edge_u * u_pos.x + edge_v * u_pos.y, w, n, 1 / area, pdf_dir};
+  }
+  EmissionPdf pdf_le(const Point3&, const Normal3&, const Vec3& w, const SceneSphere&) const {
+    return {1 / area, cosine_emission_pdf(n, two_sided, w)};
   }
   float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const {
     return area_to_solid_angle_pdf(1 / area, ctx.p, p, n);
@@ -132,6 +150,18 @@ struct SphereLight {
     Vec3 wi = d / dist;
     if (!emits_from(n, -wi)) return {};
     return {radiance, wi, dist, pdf, p, n, false};
+  }
+  // Emission: a uniform point on the sphere, a cosine-weighted direction on its emitting side(s).
+  LightEmission sample_le(Vec2 u_pos, Vec2 u_dir, const SceneSphere&) const {
+    Vec3 outward = square_to_uniform_sphere(u_pos);
+    Normal3 n = emits_inward ? -outward : outward;
+    float pdf_dir;
+    Vec3 w = sample_cosine_emission(n, two_sided, u_dir, pdf_dir);
+    return {radiance, center + outward * radius, w, n, 1 / (4 * kPi * radius * radius), pdf_dir};
+  }
+  EmissionPdf pdf_le(const Point3& p, const Normal3&, const Vec3& w, const SceneSphere&) const {
+    Vec3 outward = normalize(p - center);
+    return {1 / (4 * kPi * radius * radius), cosine_emission_pdf(emits_inward ? -outward : outward, two_sided, w)};
   }
   float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const {
     if (outside(ctx.p)) return uniform_cone_pdf(cone_cos_max(ctx.p));

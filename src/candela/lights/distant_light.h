@@ -21,6 +21,14 @@ struct DistantLightSource {
     return {radiance, wi, std::numeric_limits<float>::infinity(), 1, ctx.p + wi * (2 * scene_radius), direction,
             true};
   }
+  // Emission: the single direction, from a point of the scene disk facing it.
+  LightEmission sample_le(Vec2 u_pos, Vec2, const SceneSphere& s) const {
+    return {radiance, point_on_scene_disk(s, direction, u_pos), direction, Normal3(0.0f),
+            1 / (kPi * s.radius * s.radius), 1};
+  }
+  EmissionPdf pdf_le(const Point3&, const Normal3&, const Vec3&, const SceneSphere& s) const {
+    return {1 / (kPi * s.radius * s.radius), 0};
+  }
   float pdf_li(const LightSampleContext&, const Vec3&, const Point3&, const Normal3&) const { return 0; }
   // The light crosses a disk of the scene's radius: pi r^2 E (pbrt-v4's DistantLight::Phi).
   float power() const { return kPi * scene_radius * scene_radius * radiance.luminance(); }

@@ -205,6 +205,17 @@ float EnvironmentLight::pdf_li(const LightSampleContext&, const Vec3& wi, const 
   return d.solid_angle_pdf(d.distribution.pdf(d.direction_to_uv(local)), local);
 }
 
+LightEmission EnvironmentLight::sample_le(Vec2 u_pos, Vec2 u_dir, const SceneSphere& s) const {
+  LightSample ls = sample_li({}, u_dir);
+  if (!(ls.pdf > 0)) return {};
+  Vec3 w = -ls.wi;
+  return {ls.radiance, point_on_scene_disk(s, w, u_pos), w, Normal3(0.0f), 1 / (kPi * s.radius * s.radius), ls.pdf};
+}
+
+EmissionPdf EnvironmentLight::pdf_le(const Point3&, const Normal3&, const Vec3& w, const SceneSphere& s) const {
+  return {1 / (kPi * s.radius * s.radius), pdf_li({}, -w, {}, {})};
+}
+
 float EnvironmentLight::power() const {
   const Data& d = *data_;
   return kPi * d.scene_radius * d.scene_radius * 4 * kPi * d.average_luminance;

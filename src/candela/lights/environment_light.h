@@ -38,6 +38,9 @@ class EnvironmentLight {
 
   LightSample sample_li(const LightSampleContext& ctx, Vec2 u) const;
   float pdf_li(const LightSampleContext& ctx, const Vec3& wi, const Point3& p, const Normal3& n) const;
+  // Emission: a direction drawn as sample_li draws it, through the scene disk facing it.
+  LightEmission sample_le(Vec2 u_pos, Vec2 u_dir, const SceneSphere& s) const;
+  EmissionPdf pdf_le(const Point3& p, const Normal3& n, const Vec3& w, const SceneSphere& s) const;
   // pi R^2 times the luminance integrated over the sphere (pbrt's definition for infinite lights).
   float power() const;
   // Estimated irradiance: pi times the average radiance luminance.

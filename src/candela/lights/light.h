@@ -5,6 +5,9 @@
 //   pdf_li(ctx, wi, p, n)     the solid-angle pdf sample_li would give for the direction wi reaching
 //                             the light at point p with normal n (for MIS on BSDF-sampled hits)
 //   power()                   emitted power (luminance), for choosing lights proportionally
+//   sample_le(u_pos, u_dir, S) a ray of emitted light with its position and direction densities
+//                             (lights at infinity start theirs on a disk of the scene's sphere S)
+//   pdf_le(p, n, w, S)        the densities sample_le gives the ray from p along w
 // Lights at infinity (SkyLightSource, EnvironmentLight) also offer radiance(dir) for rays that escape
 // the scene; point, spot and distant lights are delta lights, reached only by sampling them.
 // The closed list of lights is the variant `Light`; dispatch happens once, here.
@@ -33,6 +36,15 @@ inline float light_pdf_li(const Light& l, const LightSampleContext& ctx, const V
 inline float light_power(const Light& l) {
   return std::visit([](const auto& x) { return x.power(); }, l);
 }
+// A ray leaving the light (u_pos picks its origin, u_dir its direction), for paths traced from lights.
+inline LightEmission light_sample_le(const Light& l, Vec2 u_pos, Vec2 u_dir, const SceneSphere& scene) {
+  return std::visit([&](const auto& x) { return x.sample_le(u_pos, u_dir, scene); }, l);
+}
+// The densities with which light_sample_le produces the ray from p (normal n) along w.
+inline EmissionPdf light_pdf_le(const Light& l, const Point3& p, const Normal3& n, const Vec3& w,
+                                const SceneSphere& scene) {
+  return std::visit([&](const auto& x) { return x.pdf_le(p, n, w, scene); }, l);
+}
 // Estimated irradiance the light gives at ctx (radiance x projected solid angle): the paper's rule
 // for spending shadow rays (sec. 4.5). Only a heuristic: estimators stay unbiased whatever it says.
 inline float light_importance(const Light& l, const LightSampleContext& ctx) {
@@ -41,6 +53,12 @@ inline float light_importance(const Light& l, const LightSampleContext& ctx) {
 // Lights of a single point or direction: found only by sampling them, never by a ray.
 inline bool light_is_delta(const Light& l) {
   return std::holds_alternative<PointLightSource>(l) || std::holds_alternative<SpotLightSource>(l) ||
+         std::holds_alternative<DistantLightSource>(l);
+}
+
+// Lights at infinity: their light paths start on the disk of the scene's bounding sphere.
+inline bool light_is_at_infinity(const Light& l) {
+  return std::holds_alternative<SkyLightSource>(l) || std::holds_alternative<EnvironmentLight>(l) ||
          std::holds_alternative<DistantLightSource>(l);
 }
 

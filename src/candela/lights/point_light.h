@@ -15,6 +15,13 @@ struct PointLightSource {
     return {intensity / dist2, d / dist, dist, 1, position, Normal3(0.0f), true};
   }
   float pdf_li(const LightSampleContext&, const Vec3&, const Point3&, const Normal3&) const { return 0; }
+  // Emission: uniformly in all directions.
+  LightEmission sample_le(Vec2, Vec2 u_dir, const SceneSphere&) const {
+    return {intensity, position, square_to_uniform_sphere(u_dir), Normal3(0.0f), 1, uniform_sphere_pdf()};
+  }
+  EmissionPdf pdf_le(const Point3&, const Normal3&, const Vec3&, const SceneSphere&) const {
+    return {1, uniform_sphere_pdf()};
+  }
   float power() const { return 4 * kPi * intensity.luminance(); }
   // Estimated irradiance at ctx: I cos / d^2 (for spending shadow rays where lights matter).
   float importance(const LightSampleContext& ctx) const {

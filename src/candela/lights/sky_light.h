@@ -37,6 +37,15 @@ struct SkyLightSource {
     s.pdf = pdf;
     return s;
   }
+  // Emission: from a uniformly chosen direction of the sphere, through the scene disk facing it.
+  LightEmission sample_le(Vec2 u_pos, Vec2 u_dir, const SceneSphere& s) const {
+    Vec3 w = -square_to_uniform_sphere(u_dir);
+    return {radiance(-w), point_on_scene_disk(s, w, u_pos), w, Normal3(0.0f), 1 / (kPi * s.radius * s.radius),
+            uniform_sphere_pdf()};
+  }
+  EmissionPdf pdf_le(const Point3&, const Normal3&, const Vec3&, const SceneSphere& s) const {
+    return {1 / (kPi * s.radius * s.radius), uniform_sphere_pdf()};
+  }
   float pdf_li(const LightSampleContext& ctx, const Vec3& wi, const Point3&, const Normal3&) const {
     if (ctx.n == Normal3(0.0f)) return uniform_sphere_pdf();
     return std::max(0.0f, dot(ctx.n, wi)) * kInvPi;

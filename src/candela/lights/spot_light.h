@@ -37,6 +37,14 @@ struct SpotLightSource {
     if (I.is_black()) return {};
     return {I / dist2, wi, dist, 1, position, Normal3(0.0f), true};
   }
+  // Emission: uniformly within the outer cone (pbrt-v4), weighted by the falloff.
+  LightEmission sample_le(Vec2, Vec2 u_dir, const SceneSphere&) const {
+    Vec3 w = frame.to_world(square_to_uniform_cone(u_dir, cos_falloff_end));
+    return {intensity_towards(w), position, w, Normal3(0.0f), 1, uniform_cone_pdf(cos_falloff_end)};
+  }
+  EmissionPdf pdf_le(const Point3&, const Normal3&, const Vec3& w, const SceneSphere&) const {
+    return {1, dot(w, frame.n) >= cos_falloff_end ? uniform_cone_pdf(cos_falloff_end) : 0.0f};
+  }
   float pdf_li(const LightSampleContext&, const Vec3&, const Point3&, const Normal3&) const { return 0; }
   // The smoothstep integrates to half its cosine range, so the cone emits
   // I 2 pi ((1 - cos_start) + (cos_start - cos_end) / 2) (pbrt-v4's SpotLight::Phi).

@@ -48,6 +48,19 @@ inline bool bsdf_has_non_delta_transmission(const Bsdf& b) {
 inline float bsdf_non_delta_probability(const Bsdf& b, const Vec3& wo) {
   return std::visit([&](const auto& x) { return x.non_delta_probability(wo); }, b);
 }
+// Paths that carry importance (traced from the lights) need the adjoint BSDF f*(wo, wi) = f(wi, wo).
+// Every BSDF here is symmetric except in refraction, where radiance is scaled by 1 / eta'^2 and
+// importance is not (Veach 1997, sec. 5.2): the factor that turns eval() into the adjoint for a
+// transmitted pair (wo the direction the path arrived from). Sampled refractions report eta' in
+// BsdfSample::eta and are scaled by eta'^2 the same way.
+inline float bsdf_adjoint_scale(const Bsdf& b, const Vec3& wo, const Vec3& wi) {
+  if (wo.z * wi.z >= 0) return 1;
+  if (const auto* d = std::get_if<DielectricBsdf>(&b)) {
+    float etap = wo.z > 0 ? d->eta : 1 / d->eta;
+    return etap * etap;
+  }
+  return 1;
+}
 inline bool bsdf_is_black(const Bsdf& b) { return std::holds_alternative<BlackBsdf>(b); }
 
 }  // namespace candela

@@ -12,7 +12,7 @@ namespace candela {
 namespace {
 
 constexpr char kMagic[8] = {'C', 'N', 'D', 'L', 'C', 'K', 'P', 'T'};
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;
 constexpr size_t kHeaderSize = 8 + 4 + 8 + 8;
 constexpr size_t kPixelSize = 7 * 8 + 8;
 
@@ -108,6 +108,9 @@ void write_checkpoint(const std::filesystem::path& file, const Checkpoint& cp) {
     payload.put(px.weight);
     payload.put(px.count);
   }
+  if (!cp.splats.empty() && cp.splats.size() != cp.pixels.size() * 3) fail(file, "splat count does not match the size");
+  payload.put(uint64_t(cp.splats.size()));
+  for (int64_t v : cp.splats) payload.put(v);
   Writer header;
   header.raw(kMagic, sizeof kMagic);
   header.put(kVersion);
@@ -159,7 +162,7 @@ Checkpoint read_checkpoint(const std::filesystem::path& file) {
   if (bytes.size() < kHeaderSize) fail(file, "truncated (header incomplete)");
   Reader header{bytes.data() + sizeof kMagic, bytes.data() + kHeaderSize, file.string()};
   uint32_t version = header.get<uint32_t>();
-  if (version != kVersion)
+  if (version != kVersion && version != 1)
     fail(file, "unsupported version " + std::to_string(version) + " (this candela reads version " +
                    std::to_string(kVersion) + ")");
   uint64_t size = header.get<uint64_t>(), hash = header.get<uint64_t>();
@@ -180,7 +183,9 @@ Checkpoint read_checkpoint(const std::filesystem::path& file) {
   cp.width = r.get<int32_t>();
   cp.height = r.get<int32_t>();
   cp.non_finite_samples = r.get<uint64_t>();
-  if (cp.width < 0 || cp.height < 0 || uint64_t(r.end - r.p) != uint64_t(cp.width) * uint64_t(cp.height) * kPixelSize)
+  const uint64_t pixel_bytes = uint64_t(cp.width) * uint64_t(cp.height) * kPixelSize;
+  const uint64_t left = uint64_t(r.end - r.p);
+  if (cp.width < 0 || cp.height < 0 || (version == 1 ? left != pixel_bytes : left < pixel_bytes + 8))
     fail(file, "corrupt (pixel data does not match the size)");
   cp.pixels.resize(size_t(cp.width) * size_t(cp.height));
   for (PixelSums& px : cp.pixels) {
@@ -188,6 +193,13 @@ Checkpoint read_checkpoint(const std::filesystem::path& file) {
     r.raw(px.weighted_sq, sizeof px.weighted_sq);
     px.weight = r.get<double>();
     px.count = r.get<uint64_t>();
+  }
+  if (version >= 2) {
+    uint64_t splats = r.get<uint64_t>();
+    if ((splats != 0 && splats != uint64_t(cp.pixels.size()) * 3) || uint64_t(r.end - r.p) != splats * 8)
+      fail(file, "corrupt (splat data does not match the size)");
+    cp.splats.resize(size_t(splats));
+    for (int64_t& v : cp.splats) v = r.get<int64_t>();
   }
   return cp;
 }

@@ -8,10 +8,12 @@
 #include <chrono>
 #include <algorithm>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <tuple>
 
 #include "candela/film/filter.h"
+#include "candela/integrators/mlt.h"
 #include "candela/render/progress.h"
 #include "candela/sampling/samplers.h"
 
@@ -59,7 +61,9 @@ class NonFiniteLog {
 // Everything one pass needs, shared by all tiles.
 struct PassContext {
   const Scene& scene;
-  const PathIntegrator& integrator;
+  const PathIntegrator* path;  // one of the two
+  const BdptIntegrator* bdpt;
+  BdptTarget bdpt_target;
   const Filter& filter;
   const Sampler& prototype;  // copied per tile: samplers carry per-sample state
   Film& film;
@@ -85,7 +89,8 @@ void render_pixel(const PassContext& pc, S& sampler, int x, int y, uint64_t firs
     // Pick the path's time in the shutter interval (sec. 4.2); every object is seen at it.
     float time = lerp(sampler.get_1d(), camera.shutter_open(), camera.shutter_close());
     Ray ray = camera.generate_ray({float(x) + 0.5f + fs.offset.x, float(y) + 0.5f + fs.offset.y}, lens, time);
-    RGB L = pc.integrator.radiance(ray, sampler, counts);
+    RGB L = pc.bdpt ? pc.bdpt->radiance(ray, sampler, counts, pc.bdpt_target, x, y, fs.weight)
+                    : pc.path->radiance(ray, sampler, counts);
     if (!L.is_finite()) {
       // Never reaches the film: counted, the first few logged, and the sample counts as black.
       pc.non_finite.fetch_add(1, std::memory_order_relaxed);
@@ -135,7 +140,9 @@ void run_pass(const PassContext& pc, const std::vector<Tile>& tiles, tbb::task_a
 
 }  // namespace
 
-bool is_known_integrator(const std::string& name) { return name == "path"; }
+bool is_known_integrator(const std::string& name) { return name == "path" || name == "bdpt" || name == "mlt"; }
+
+std::string known_integrators() { return "path, bdpt, mlt"; }
 
 float relative_error(const PixelSums& pixel) {
   RGB mean = pixel.mean(), se = pixel.standard_error();
@@ -146,16 +153,29 @@ float relative_error(const PixelSums& pixel) {
 
 RenderStats render(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options) {
   if (!is_known_integrator(settings.integrator))
-    throw std::invalid_argument("unknown integrator '" + settings.integrator + "' (known: path)");
+    throw std::invalid_argument("unknown integrator '" + settings.integrator + "' (known: " + known_integrators() + ")");
   if (options.only_x >= film.width() || options.only_y >= film.height() || (options.only_x >= 0) != (options.only_y >= 0))
     throw std::invalid_argument("pixel to render is outside the image");
+  if (settings.integrator == "mlt") {
+    if (settings.adaptive_threshold > 0) throw std::invalid_argument("adaptive sampling does not apply to the mlt integrator");
+    if (options.only_x >= 0) throw std::invalid_argument("the mlt integrator cannot render a single pixel");
+    if (film.total_samples() > 0 || (film.has_splats() && film.splats().sums() != std::vector<int64_t>(film.splats().sums().size(), 0)))
+      throw std::invalid_argument("the mlt integrator cannot continue a partly rendered film");
+    return render_mlt(scene, settings, film, options);
+  }
+  const bool bidirectional = settings.integrator == "bdpt";
+  if (bidirectional && !film.has_splats()) film.enable_splats();
   auto start = std::chrono::steady_clock::now();
   const bool adaptive = settings.adaptive_threshold > 0;
   const int batch = adaptive ? settings.adaptive_batch : settings.spp;
   const int max_spp = adaptive ? std::max(settings.adaptive_max_spp, batch) : settings.spp;
 
-  const PathIntegrator integrator(scene, settings);
   const Filter filter(settings.filter);
+  std::optional<PathIntegrator> path;
+  std::optional<BdptIntegrator> bdpt;
+  if (bidirectional) bdpt.emplace(scene, settings);
+  else path.emplace(scene, settings);
+  BdptTarget bdpt_target{&film, &filter, options.bdpt_strategies, options.bdpt_unweighted};
   const Sampler prototype = make_sampler(settings.sampler, adaptive ? batch : settings.spp, settings.seed,
                                          film.width(), film.height());
   std::vector<Tile> tiles = options.only_x >= 0 ? std::vector<Tile>{{options.only_x, options.only_y,
@@ -165,8 +185,8 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
   tbb::enumerable_thread_specific<RayCounts> ray_counts;
   std::atomic<uint64_t> non_finite{0};
   NonFiniteLog non_finite_log(options.max_reported_non_finite);
-  PassContext pc{scene, integrator, filter, prototype, film, ray_counts, non_finite, non_finite_log, options.clamp,
-                 options.cancel};
+  PassContext pc{scene,      path ? &*path : nullptr, bdpt ? &*bdpt : nullptr, bdpt_target, filter, prototype, film,
+                 ray_counts, non_finite,            non_finite_log,          options.clamp, options.cancel};
   const uint64_t samples_before = film.total_samples();
   ProgressBar progress(pixel_count * uint64_t(max_spp), options.progress);
   progress.advance(options.only_x >= 0 ? 0 : samples_before);
@@ -253,6 +273,12 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
   }
   progress.finish();
 
+  // One light path was traced per camera sample: the light image is the splats times the
+  // importance film's area over their number.
+  if (bidirectional) {
+    uint64_t light_paths = film.total_samples();
+    film.set_splat_scale(light_paths > 0 ? double(scene.camera().importance_film_pixels()) / double(light_paths) : 0);
+  }
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   stats.samples = film.total_samples() - samples_before;
   stats.non_finite_samples = non_finite.load();

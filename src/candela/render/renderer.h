@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "candela/film/film.h"
+#include "candela/integrators/bdpt.h"
 #include "candela/integrators/path_integrator.h"
 #include "candela/scene/scene.h"
 
@@ -37,6 +38,11 @@ struct RenderOptions {
   // a checkpoint, and the number of non-finite samples dropped so far in this call. Not called for
   // adaptive renders.
   std::function<void(const Film&, uint64_t non_finite_so_far)> after_pass;
+  // Integrator "bdpt": when set, every strategy's (s, t) contribution also goes to its own image
+  // (BdptIntegrator::strategy_index; sized by the caller, images beyond its size are skipped), MIS
+  // weighted or, with bdpt_unweighted, not. Scaled like the film's splats (RenderStats::splat_scale).
+  std::vector<SplatImage>* bdpt_strategies = nullptr;
+  bool bdpt_unweighted = false;
 };
 
 struct NonFiniteSample {
@@ -54,6 +60,9 @@ struct RenderStats {
   RayCounts rays;
 };
 
+// Names of the integrators, for messages: "path, bdpt, mlt".
+std::string known_integrators();
+
 // Names accepted by RenderSettings::integrator.
 bool is_known_integrator(const std::string& name);
 
@@ -61,8 +70,10 @@ bool is_known_integrator(const std::string& name);
 // of standard error / sqrt(mean^2 + 0.01), the per-pixel form of relMSE with epsilon 0.01.
 float relative_error(const PixelSums& pixel);
 
-// Renders into `film` (sized to the camera's resolution): settings.spp samples per pixel, or
-// adaptively when settings.adaptive_threshold > 0. Without adaptive sampling the film may already
+// Renders into `film` (sized to the camera's resolution) with settings.integrator: "path" (the path
+// tracer), "bdpt" (bidirectional path tracing; light tracing lands in the film's splats) or "mlt"
+// (Metropolis light transport: settings.spp mutations per pixel, all in the splats).
+// settings.spp samples per pixel, or adaptively when settings.adaptive_threshold > 0 (path, bdpt). Without adaptive sampling the film may already
 // hold samples (a resumed checkpoint): each pixel continues from its own sample count, so the result
 // is bitwise the same as one uninterrupted render.
 RenderStats render(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options);

@@ -372,6 +372,13 @@ struct RenderSettings {
   float adaptive_threshold = 0;
   int adaptive_batch = 16;
   int adaptive_max_spp = 1024;
+  // Metropolis light transport (integrator "mlt"; spp is then the number of mutations per pixel):
+  // bootstrap states per depth, independent chains, the deviation of small steps in primary sample
+  // space and the probability of a large step (pbrt's defaults).
+  int mlt_bootstrap = 100000;
+  int mlt_chains = 1000;
+  float mlt_sigma = 0.01f;
+  float mlt_large_step = 0.3f;
 };
 
 struct SceneDesc {

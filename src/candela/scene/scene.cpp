@@ -88,7 +88,11 @@ Scene::Scene(const SceneDesc& desc)
   light_distribution_ = Distribution1D(power);
 
   int w = desc.film.width, h = desc.film.height;
-  camera_ = PerspectiveCamera(desc.camera, w, h);
+  // Camera rays reach the filter's radius beyond the outermost pixel centres.
+  Vec2 r = desc.settings.filter.radius;
+  camera_ = PerspectiveCamera(desc.camera, w, h, {std::max(0.0f, r.x - 0.5f), std::max(0.0f, r.y - 0.5f)});
+  bounding_sphere_ = {bounds_.empty() ? Point3(0.0f) : bounds_.center(), radius};
+  for (const auto& rec : shapes_) has_interfaces_ = has_interfaces_ || materials_.is_interface(rec.material);
 }
 
 void Scene::add_objects_and_instances(const SceneDesc& desc) {

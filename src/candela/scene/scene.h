@@ -74,6 +74,10 @@ class Scene {
   }
   const PerspectiveCamera& camera() const { return camera_; }
   const Bounds3& bounds() const { return bounds_; }
+  // The sphere around bounds(): light paths from lights at infinity start on a disk of its radius.
+  const SceneSphere& bounding_sphere() const { return bounding_sphere_; }
+  // Whether any surface is an interface (rays pass through it): visibility must then look past them.
+  bool has_interfaces() const { return has_interfaces_; }
   size_t triangle_count() const { return triangle_count_; }
 
  private:
@@ -105,6 +109,8 @@ class Scene {
   std::vector<uint32_t> infinite_lights_;
   PerspectiveCamera camera_;
   Bounds3 bounds_;
+  SceneSphere bounding_sphere_;
+  bool has_interfaces_ = false;
   size_t triangle_count_ = 0;
 };
 

@@ -1,0 +1,502 @@
+#include "candela/integrators/bdpt.h"
+
+#include "candela/integrators/mlt_sampler.h"
+#include "candela/sampling/samplers.h"
+
+namespace candela {
+namespace {
+
+using Kind = BdptVertex::Kind;
+
+// Veach's correction for shading normals on importance-carrying paths (sec. 5.3): the adjoint of a
+// BSDF evaluated in a shading frame picks up |wo . ns| |wi . ng| / (|wo . ng| |wi . ns|).
+float shading_normal_correction(const BdptVertex& v, const Vec3& wo, const Vec3& wi) {
+  float denom = std::abs(dot(wo, v.ng)) * std::abs(dot(wi, v.ns));
+  if (denom == 0) return 0;
+  return std::abs(dot(wo, v.ns)) * std::abs(dot(wi, v.ng)) / denom;
+}
+
+// The power heuristic's ratios do not care about a zero density of a delta vertex: it counts as 1.
+float remap0(float f) { return f != 0 ? f : 1.0f; }
+
+// Restores a value when it goes out of scope (the temporary densities of mis_weight).
+template <typename T>
+class Restore {
+ public:
+  Restore() = default;
+  Restore(T* target, T value) : target_(target), saved_(*target) { *target = value; }
+  Restore(const Restore&) = delete;
+  Restore& operator=(Restore&& o) noexcept {
+    target_ = o.target_;
+    saved_ = o.saved_;
+    o.target_ = nullptr;
+    return *this;
+  }
+  ~Restore() {
+    if (target_) *target_ = saved_;
+  }
+
+ private:
+  T* target_ = nullptr;
+  T saved_{};
+};
+
+}  // namespace
+
+BdptIntegrator::BdptIntegrator(const Scene& scene, const RenderSettings& settings)
+    : scene_(scene), max_depth_(settings.max_depth), rr_start_depth_(settings.rr_start_depth) {}
+
+// ------------------------------------------------------------------------------------------ subpaths
+
+template <typename Sampler>
+int BdptIntegrator::camera_subpath(const Ray& ray, Sampler& sampler, RayCounts& counts, int max_vertices,
+                                   BdptVertex* path) const {
+  if (max_vertices == 0) return 0;
+  BdptVertex& camera = path[0];
+  camera = BdptVertex{};
+  camera.kind = Kind::Camera;
+  camera.p = ray.origin;
+  camera.beta = RGB(1.0f);  // W_e / pdf = 1 for the camera's own rays
+  ++counts.camera;
+  Ray r = ray;
+  r.direction = normalize(r.direction);
+  float pdf_dir = scene_.camera().pdf_importance(r.origin, r.direction).dir;
+  return random_walk(r, sampler, counts, RGB(1.0f), pdf_dir, max_vertices, Transport::Radiance, path);
+}
+
+template <typename Sampler>
+int BdptIntegrator::light_subpath(Sampler& sampler, RayCounts& counts, int max_vertices, float time,
+                                  BdptVertex* path) const {
+  if (max_vertices == 0 || scene_.lights().empty()) return 0;
+  // Choose a light by power, then a ray leaving it.
+  float u_light = sampler.get_1d();
+  Vec2 u_pos = sampler.get_2d(), u_dir = sampler.get_2d();
+  const Distribution1D& choice = scene_.light_distribution();
+  size_t li = choice.sample(u_light);
+  float pmf = choice.pmf(li);
+  const Light& light = scene_.lights()[li];
+  LightEmission e = light_sample_le(light, u_pos, u_dir, scene_.bounding_sphere());
+  if (!(e.pdf_pos > 0) || !(e.pdf_dir > 0) || e.radiance.is_black() || pmf <= 0) return 0;
+
+  BdptVertex& v = path[0];
+  v = BdptVertex{};
+  v.kind = Kind::Light;
+  v.p = e.p;
+  v.ng = v.ns = e.n;
+  v.light = int(li);
+  v.at_infinity = light_is_at_infinity(light);
+  v.beta = e.radiance;
+  v.pdf_fwd = e.pdf_pos * pmf;
+  float cos_light = v.on_surface() ? std::abs(dot(e.n, e.w)) : 1.0f;
+  RGB beta = e.radiance * (cos_light / (pmf * e.pdf_pos * e.pdf_dir));
+  Point3 origin = v.on_surface() ? offset_ray_origin(e.p, e.n, e.w) : e.p;
+  int n = random_walk(Ray{origin, e.w, std::numeric_limits<float>::infinity(), time}, sampler, counts, beta,
+                      e.pdf_dir, max_vertices, Transport::Importance, path);
+
+  // Lights at infinity: the first vertex's density is the disk's per-area density projected onto
+  // it, and the light's own "position" is its direction, with the density all lights at infinity
+  // together give it (an escaping camera ray sees them all).
+  if (v.at_infinity) {
+    if (n > 1) {
+      path[1].pdf_fwd = e.pdf_pos;
+      if (path[1].on_surface()) path[1].pdf_fwd *= std::abs(dot(e.w, path[1].ng));
+    }
+    v.pdf_fwd = infinite_lights_pdf(e.w);
+  }
+  return n;
+}
+
+template <typename Sampler>
+int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RGB beta, float pdf,
+                                int max_vertices, Transport mode, BdptVertex* path) const {
+  int n = 1;
+  float pdf_fwd = pdf;
+  float eta_scale = 1;
+  // Russian roulette looks at the throughput relative to the subpath's start (light subpaths start
+  // with the light's power, not with 1).
+  const float start = std::max(beta.max_component(), 1e-30f);
+  while (n < max_vertices) {
+    SurfaceHit hit;
+    if (!scene_.intersect(ray, hit)) {
+      // A camera ray that escapes ends on the lights at infinity (a vertex even when there are none,
+      // as the s = 0 strategy's end point).
+      if (mode == Transport::Radiance) {
+        BdptVertex& v = path[n];
+        v = BdptVertex{};
+        v.kind = Kind::Light;
+        v.at_infinity = true;
+        v.p = ray.origin + normalize(ray.direction);
+        v.beta = beta;
+        v.pdf_fwd = pdf_fwd;
+        ++n;
+      }
+      break;
+    }
+    // An interface has no surface: continue beyond it.
+    if (scene_.is_interface(hit)) {
+      ray.origin = offset_ray_origin(hit.p, hit.ng, ray.direction);
+      ray.t_max = std::numeric_limits<float>::infinity();
+      continue;
+    }
+
+    BdptVertex& v = path[n];
+    BdptVertex& prev = path[n - 1];
+    v = BdptVertex{};
+    v.kind = Kind::Surface;
+    v.p = hit.p;
+    v.ng = hit.ng;
+    v.ns = hit.ns;
+    v.hit = hit;
+    v.wo = -normalize(ray.direction);
+    v.beta = beta;
+    v.light = scene_.light_index(hit);
+    v.pdf_fwd = convert_density(pdf_fwd, prev, v);
+    v.bsdf = scene_.bsdf(hit);
+    v.frame = Frame::from_normal_tangent(hit.ns, hit.dpdu);
+    ++n;
+    if (n >= max_vertices || bsdf_is_black(v.bsdf)) break;
+
+    // Sample the next direction.
+    Vec3 wo_local = v.frame.to_local(v.wo);
+    if (wo_local.z == 0) break;
+    float u_lobe = sampler.get_1d();
+    Vec2 u = sampler.get_2d();
+    auto bs = bsdf_sample(v.bsdf, wo_local, u_lobe, u);
+    if (!bs || bs->weight.is_black()) break;
+    Vec3 wi = normalize(v.frame.to_world(bs->wi));
+    RGB weight = bs->weight;
+    if (mode == Transport::Importance) {
+      // The adjoint BSDF: importance is not compressed at refractions; shading normals are corrected.
+      if (bs->eta != 1) weight *= bs->eta * bs->eta;
+      weight *= shading_normal_correction(v, v.wo, wi);
+    } else if (bs->eta != 1) {
+      eta_scale *= bs->eta * bs->eta;
+    }
+    beta *= weight;
+    pdf_fwd = bs->pdf;
+    float pdf_rev = bsdf_pdf(v.bsdf, bs->wi, wo_local);
+    if (bs->is_delta) {
+      v.delta = true;
+      pdf_fwd = pdf_rev = 0;
+    }
+    prev.pdf_rev = convert_density(pdf_rev, v, prev);
+    ray = Ray{offset_ray_origin(hit.p, hit.ng, wi), wi, std::numeric_limits<float>::infinity(), ray.time};
+    ++counts.bounce;
+
+    // Possibly terminate the subpath with Russian roulette. The MIS densities ignore it: the
+    // weights stay a partition of unity, so the estimate stays unbiased.
+    int depth = n - 1;
+    float rr = (beta * eta_scale).max_component() / start;
+    if (depth > rr_start_depth_ && rr < 1) {
+      float q = std::max(0.0f, 1 - rr);
+      if (sampler.get_1d() < q) break;
+      beta = beta / (1 - q);
+    }
+  }
+  return n;
+}
+
+// ------------------------------------------------------------------------------- densities and MIS
+
+float BdptIntegrator::convert_density(float pdf, const BdptVertex& from, const BdptVertex& next) const {
+  if (next.at_infinity) return pdf;  // directions to infinity stay per solid angle
+  Vec3 w = next.p - from.p;
+  float d2 = length_squared(w);
+  if (d2 == 0) return 0;
+  float inv_d2 = 1 / d2;
+  if (next.on_surface()) pdf *= std::abs(dot(next.ng, w * std::sqrt(inv_d2)));
+  return pdf * inv_d2;
+}
+
+float BdptIntegrator::vertex_pdf(const BdptVertex* prev, const BdptVertex& v, const BdptVertex& next) const {
+  if (v.kind == Kind::Light) return light_pdf(v, next);
+  Vec3 wn = next.p - v.p;
+  if (length_squared(wn) == 0) return 0;
+  wn = normalize(wn);
+  float pdf;
+  if (v.kind == Kind::Camera) {
+    pdf = scene_.camera().pdf_importance(v.p, wn).dir;
+  } else {
+    Vec3 wp = normalize(prev->p - v.p);
+    pdf = bsdf_pdf(v.bsdf, v.frame.to_local(wp), v.frame.to_local(wn));
+  }
+  return convert_density(pdf, v, next);
+}
+
+float BdptIntegrator::light_pdf(const BdptVertex& lv, const BdptVertex& next) const {
+  Vec3 w = next.p - lv.p;
+  float d2 = length_squared(w);
+  if (d2 == 0) return 0;
+  w = w / std::sqrt(d2);
+  float pdf;
+  const SceneSphere& sphere = scene_.bounding_sphere();
+  if (lv.at_infinity) {
+    // Light paths from infinity start on the scene disk facing their direction.
+    if (!scene_disk_covers(sphere, w, next.p)) return 0;
+    pdf = 1 / (kPi * sphere.radius * sphere.radius);
+  } else {
+    if (lv.light < 0) return 0;
+    pdf = light_pdf_le(scene_.lights()[size_t(lv.light)], lv.p, lv.ng, w, sphere).dir / d2;
+  }
+  if (next.on_surface()) pdf *= std::abs(dot(next.ng, w));
+  return pdf;
+}
+
+float BdptIntegrator::light_origin_pdf(const BdptVertex& lv, const BdptVertex& next) const {
+  Vec3 w = next.p - lv.p;
+  if (length_squared(w) == 0) return 0;
+  w = normalize(w);
+  if (lv.at_infinity) return infinite_lights_pdf(w);
+  if (lv.light < 0) return 0;
+  const Light& light = scene_.lights()[size_t(lv.light)];
+  return scene_.light_distribution().pmf(size_t(lv.light)) *
+         light_pdf_le(light, lv.p, lv.ng, w, scene_.bounding_sphere()).pos;
+}
+
+float BdptIntegrator::infinite_lights_pdf(const Vec3& emitted_dir) const {
+  float pdf = 0;
+  for (uint32_t li : scene_.infinite_lights())
+    pdf += scene_.light_distribution().pmf(li) *
+           light_pdf_le(scene_.lights()[li], {}, {}, emitted_dir, scene_.bounding_sphere()).dir;
+  return pdf;
+}
+
+float BdptIntegrator::mis_weight(BdptVertex* light, BdptVertex* camera, BdptVertex& sampled, int s, int t) const {
+  if (s + t == 2) return 1;
+  BdptVertex* qs = s > 0 ? &light[s - 1] : nullptr;
+  BdptVertex* pt = t > 0 ? &camera[t - 1] : nullptr;
+  BdptVertex* qs_minus = s > 1 ? &light[s - 2] : nullptr;
+  BdptVertex* pt_minus = t > 1 ? &camera[t - 2] : nullptr;
+
+  // The connection's end vertices as this strategy made them: a freshly sampled light or lens
+  // point replaces the subpath's own, neither end is delta, and the reverse densities across the
+  // connection are those of the joined path.
+  Restore<BdptVertex> a1;
+  if (s == 1) a1 = Restore<BdptVertex>(qs, sampled);
+  else if (t == 1) a1 = Restore<BdptVertex>(pt, sampled);
+  Restore<bool> a2, a3;
+  if (pt) a2 = Restore<bool>(&pt->delta, false);
+  if (qs) a3 = Restore<bool>(&qs->delta, false);
+  Restore<float> a4, a5, a6, a7;
+  if (pt) a4 = Restore<float>(&pt->pdf_rev, s > 0 ? vertex_pdf(qs_minus, *qs, *pt) : light_origin_pdf(*pt, *pt_minus));
+  if (pt_minus) a5 = Restore<float>(&pt_minus->pdf_rev, s > 0 ? vertex_pdf(qs, *pt, *pt_minus) : light_pdf(*pt, *pt_minus));
+  if (qs) a6 = Restore<float>(&qs->pdf_rev, vertex_pdf(pt_minus, *pt, *qs));
+  if (qs_minus) a7 = Restore<float>(&qs_minus->pdf_rev, vertex_pdf(pt, *qs, *qs_minus));
+
+  // Sum over the other strategies of (p_other / p_this)^2, the ratios built up one vertex at a time
+  // outwards from the connection on each side.
+  float sum = 0;
+  float r = 1;
+  for (int i = t - 1; i > 0; --i) {
+    r *= remap0(camera[i].pdf_rev) / remap0(camera[i].pdf_fwd);
+    if (!camera[i].delta && !camera[i - 1].delta) sum += r * r;
+  }
+  r = 1;
+  for (int i = s - 1; i >= 0; --i) {
+    r *= remap0(light[i].pdf_rev) / remap0(light[i].pdf_fwd);
+    bool delta_before = i > 0 ? light[i - 1].delta : is_delta_light(light[0]);
+    if (!light[i].delta && !delta_before) sum += r * r;
+  }
+  return 1 / (1 + sum);
+}
+
+// ------------------------------------------------------------------------------------- connections
+
+RGB BdptIntegrator::emitted(const BdptVertex& v, const BdptVertex& towards) const {
+  if (!is_light(v)) return RGB(0.0f);
+  Vec3 w = towards.p - v.p;
+  if (length_squared(w) == 0) return RGB(0.0f);
+  w = normalize(w);
+  if (v.at_infinity) {
+    RGB L(0.0f);
+    for (uint32_t li : scene_.infinite_lights()) L += scene_.escaped_radiance(li, -w);
+    return L;
+  }
+  return scene_.emitted(v.hit, w);
+}
+
+RGB BdptIntegrator::scatter(const BdptVertex& v, const BdptVertex& next, Transport mode) const {
+  Vec3 wi = next.p - v.p;
+  if (length_squared(wi) == 0) return RGB(0.0f);
+  wi = normalize(wi);
+  Vec3 wo_local = v.frame.to_local(v.wo), wi_local = v.frame.to_local(wi);
+  RGB f = bsdf_eval(v.bsdf, wo_local, wi_local);
+  if (mode == Transport::Importance)
+    f *= bsdf_adjoint_scale(v.bsdf, wo_local, wi_local) * shading_normal_correction(v, v.wo, wi);
+  return f;
+}
+
+bool BdptIntegrator::is_connectible(const BdptVertex& v) const {
+  switch (v.kind) {
+    case Kind::Camera: return true;
+    case Kind::Light:
+      return v.light >= 0 && !std::holds_alternative<DistantLightSource>(scene_.lights()[size_t(v.light)]);
+    case Kind::Surface: return bsdf_has_non_delta(v.bsdf);
+  }
+  return false;
+}
+
+bool BdptIntegrator::is_delta_light(const BdptVertex& v) const {
+  return v.kind == Kind::Light && v.light >= 0 && light_is_delta(scene_.lights()[size_t(v.light)]);
+}
+
+bool BdptIntegrator::unoccluded(const BdptVertex& a, const BdptVertex& b, float time, RayCounts& counts) const {
+  Ray ray;
+  ray.time = time;
+  if (a.at_infinity || b.at_infinity) {
+    const BdptVertex& finite = a.at_infinity ? b : a;
+    const BdptVertex& far = a.at_infinity ? a : b;
+    ray.direction = normalize(far.p - finite.p);
+    ray.origin = finite.on_surface() ? offset_ray_origin(finite.p, finite.ng, ray.direction) : finite.p;
+    ray.t_max = std::numeric_limits<float>::infinity();
+  } else {
+    Vec3 d = b.p - a.p;
+    ray.origin = a.on_surface() ? offset_ray_origin(a.p, a.ng, d) : a.p;
+    Point3 to = b.on_surface() ? offset_ray_origin(b.p, b.ng, -d) : b.p;
+    Vec3 segment = to - ray.origin;
+    float len = length(segment);
+    if (!(len > 0)) return true;
+    ray.direction = segment / len;
+    ray.t_max = len * (1 - 1e-4f);
+  }
+  ++counts.shadow;
+  if (!scene_.has_interfaces()) return !scene_.occluded(ray);
+  // Look past interfaces (surfaces without a material of their own).
+  for (int crossed = 0; crossed < 256; ++crossed) {
+    SurfaceHit hit;
+    if (!scene_.intersect(ray, hit)) return true;
+    if (!scene_.is_interface(hit)) return false;
+    Point3 next = offset_ray_origin(hit.p, hit.ng, ray.direction);
+    ray.t_max -= length(next - ray.origin);
+    ray.origin = next;
+    if (!(ray.t_max > 0)) return true;
+    ++counts.shadow;
+  }
+  return false;
+}
+
+float BdptIntegrator::geometry_term(const BdptVertex& a, const BdptVertex& b) const {
+  Vec3 d = a.p - b.p;
+  float g = 1 / length_squared(d);
+  d = d * std::sqrt(g);
+  if (a.on_surface()) g *= std::abs(dot(a.ns, d));
+  if (b.on_surface()) g *= std::abs(dot(b.ns, d));
+  return g;
+}
+
+template <typename Sampler>
+BdptIntegrator::Connection BdptIntegrator::connect(BdptVertex* light, BdptVertex* camera, int s, int t,
+                                                   Sampler& sampler, RayCounts& counts, float time) const {
+  Connection c;
+  // A camera subpath that escaped can only be completed by itself (s = 0).
+  if (t > 1 && s != 0 && camera[t - 1].kind == Kind::Light) return c;
+  RGB L(0.0f);
+  BdptVertex sampled;
+  if (s == 0) {
+    // The camera subpath hit a light.
+    const BdptVertex& pt = camera[t - 1];
+    if (is_light(pt)) L = pt.beta * emitted(pt, camera[t - 2]);
+  } else if (t == 1) {
+    // Light tracing: join the light vertex to a point on the lens.
+    const BdptVertex& qs = light[s - 1];
+    Vec2 u = sampler.get_2d();
+    if (!is_connectible(qs)) return c;
+    auto lens = scene_.camera().sample_lens(qs.p, u);
+    if (!lens) return c;
+    sampled.kind = Kind::Camera;
+    sampled.p = lens->p;
+    sampled.beta = RGB(lens->importance / lens->pdf);
+    L = qs.beta * scatter(qs, sampled, Transport::Importance) * sampled.beta;
+    if (qs.on_surface()) L *= std::abs(dot(lens->wi, qs.ns));
+    if (L.is_black() || !unoccluded(qs, sampled, time, counts)) return c;
+    c.raster = lens->raster;
+  } else if (s == 1) {
+    // Next-event estimation: a point on a light chosen by power, seen from the camera vertex.
+    const BdptVertex& pt = camera[t - 1];
+    float u_light = sampler.get_1d();
+    Vec2 u = sampler.get_2d();
+    if (!is_connectible(pt)) return c;
+    const Distribution1D& choice = scene_.light_distribution();
+    size_t li = choice.sample(u_light);
+    float pmf = choice.pmf(li);
+    const Light& lt = scene_.lights()[li];
+    Vec3 wo_local = pt.frame.to_local(pt.wo);
+    Normal3 gather = bsdf_has_non_delta_transmission(pt.bsdf) ? Normal3(0.0f) : wo_local.z > 0 ? pt.ns : -pt.ns;
+    LightSample ls = light_sample_li(lt, LightSampleContext{pt.p, gather}, u);
+    if (!(ls.pdf > 0) || ls.radiance.is_black() || pmf <= 0) return c;
+    sampled.kind = Kind::Light;
+    sampled.light = int(li);
+    sampled.at_infinity = std::isinf(ls.distance);
+    sampled.p = sampled.at_infinity ? pt.p + ls.wi * (2 * scene_.bounding_sphere().radius) : ls.p_light;
+    sampled.ng = sampled.ns = sampled.at_infinity ? Normal3(0.0f) : ls.n_light;
+    sampled.beta = ls.radiance / (ls.pdf * pmf);
+    sampled.pdf_fwd = light_origin_pdf(sampled, pt);
+    L = pt.beta * scatter(pt, sampled, Transport::Radiance) * sampled.beta * std::abs(dot(ls.wi, pt.ns));
+    if (L.is_black() || !unoccluded(pt, sampled, time, counts)) return c;
+  } else {
+    // Join the two subpaths' end vertices with a shadow ray.
+    const BdptVertex& qs = light[s - 1];
+    const BdptVertex& pt = camera[t - 1];
+    if (!is_connectible(qs) || !is_connectible(pt)) return c;
+    L = qs.beta * scatter(qs, pt, Transport::Importance) * scatter(pt, qs, Transport::Radiance) * pt.beta;
+    if (L.is_black()) return c;
+    L *= geometry_term(qs, pt);
+    if (L.is_black() || !unoccluded(qs, pt, time, counts)) return c;
+  }
+  if (L.is_black()) return c;
+  c.unweighted = L;
+  c.weight = mis_weight(light, camera, sampled, s, t);
+  c.L = L * c.weight;
+  return c;
+}
+
+// ----------------------------------------------------------------------------------- the estimator
+
+template <typename Sampler>
+RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts, const BdptTarget& target, int x,
+                             int y, float filter_weight) const {
+  thread_local std::vector<BdptVertex> camera_path, light_path;
+  camera_path.resize(size_t(max_depth_) + 2);
+  light_path.resize(size_t(max_depth_) + 1);
+  BdptVertex* cv = camera_path.data();
+  BdptVertex* lv = light_path.data();
+  int nc = camera_subpath(ray, sampler, counts, max_depth_ + 2, cv);
+  int nl = light_subpath(sampler, counts, max_depth_ + 1, ray.time, lv);
+
+  RGB L(0.0f);
+  for (int t = 1; t <= nc; ++t)
+    for (int s = 0; s <= nl; ++s) {
+      int depth = s + t - 2;
+      if ((s == 1 && t == 1) || depth < 0 || depth > max_depth_) continue;
+      Connection c = connect(lv, cv, s, t, sampler, counts, ray.time);
+      if (t == 1) {
+        if (!c.L.is_black()) target.film->splats().add(c.raster, c.L, *target.filter);
+      } else {
+        L += c.L;
+      }
+      if (target.strategies) {
+        int index = strategy_index(s, t);
+        if (index < int(target.strategies->size())) {
+          RGB v = target.unweighted ? c.unweighted : c.L;
+          SplatImage& img = (*target.strategies)[size_t(index)];
+          if (v.is_black() || !v.is_finite()) continue;
+          if (t == 1) img.add(c.raster, v, *target.filter);
+          else img.add_to_pixel(x, y, v * (filter_weight / target.filter->integral()));
+        }
+      }
+    }
+  return L;
+}
+
+// One instantiation per pixel sampler, and one for Metropolis light transport's sampler.
+#define CANDELA_INSTANTIATE(S)                                                                              \
+  template RGB BdptIntegrator::radiance<S>(const Ray&, S&, RayCounts&, const BdptTarget&, int, int, float) const; \
+  template int BdptIntegrator::camera_subpath<S>(const Ray&, S&, RayCounts&, int, BdptVertex*) const;          \
+  template int BdptIntegrator::light_subpath<S>(S&, RayCounts&, int, float, BdptVertex*) const;                \
+  template BdptIntegrator::Connection BdptIntegrator::connect<S>(BdptVertex*, BdptVertex*, int, int, S&,       \
+                                                                 RayCounts&, float) const;
+CANDELA_FOR_EACH_SAMPLER(CANDELA_INSTANTIATE)
+CANDELA_INSTANTIATE(MltSampler)
+#undef CANDELA_INSTANTIATE
+
+}  // namespace candela

@@ -1,0 +1,129 @@
+#pragma once
+// Bidirectional path tracing (Veach 1997, ch. 10; Häkkinen 2002, sec. 5.1; after pbrt-v3's BDPT).
+//
+// For every camera sample a camera subpath and a light subpath are traced, and every pair of
+// prefixes (s light vertices, t camera vertices) is joined into a complete path:
+//   s = 0   the camera subpath itself hits a light (or escapes to a light at infinity)
+//   s = 1   a point on a light is sampled from the camera vertex (next-event estimation)
+//   t = 1   the light vertex is connected to a point on the lens (light tracing): the contribution
+//           lands on whatever pixel it reaches and is splatted onto the film
+//   others  the two end vertices are joined by a shadow ray
+// Each strategy's contribution is weighted by the power heuristic over all strategies that could
+// have produced the same path, computed from the forward and reverse densities stored at the
+// vertices (the recursive scheme: ratios of neighbouring strategies, never re-walking a path).
+// Light subpaths carry importance, so they use the adjoint BSDF: no 1/eta^2 at refractions and
+// the shading-normal correction of Veach's sec. 5.3.
+//
+// The subpath and connection routines are templates over the sampler, shared with Metropolis light
+// transport (mlt.h), which drives them with its primary-sample-space sampler.
+#include <vector>
+
+#include "candela/film/film.h"
+#include "candela/film/filter.h"
+#include "candela/geometry/ray.h"
+#include "candela/integrators/path_integrator.h"
+#include "candela/materials/bsdf.h"
+#include "candela/math/frame.h"
+#include "candela/scene/scene.h"
+
+namespace candela {
+
+enum class Transport : uint8_t { Radiance, Importance };
+
+struct BdptVertex {
+  enum class Kind : uint8_t { Camera, Light, Surface };
+  Kind kind = Kind::Surface;
+  Point3 p;
+  Normal3 ng;  // geometric normal; zero where there is no surface (point lights, lights at infinity)
+  Normal3 ns;  // shading normal (surfaces)
+  Frame frame;  // shading frame (surfaces)
+  Vec3 wo;      // surfaces: unit direction towards the previous vertex of the subpath
+  SurfaceHit hit;
+  Bsdf bsdf;
+  RGB beta;           // the subpath's throughput up to here
+  float pdf_fwd = 0;  // density of this vertex when sampled from its predecessor (per area, or per solid angle
+                      // for vertices at infinity)
+  float pdf_rev = 0;  // density of this vertex when sampled from its successor (the reverse direction)
+  int light = -1;     // light vertices: the light; surfaces: the light of an emitter that was hit, or -1
+  bool delta = false;        // scattered by a delta lobe
+  bool at_infinity = false;  // a light at infinity (then p is a point along its direction), or an escaped ray
+
+  bool on_surface() const { return !(ng == Normal3(0.0f)); }
+};
+
+// Where an image-space contribution goes: t = 1 strategies splat onto the film; with `strategies`,
+// every strategy's contribution also goes to its own image (index BdptIntegrator::strategy_index).
+struct BdptTarget {
+  Film* film = nullptr;
+  const Filter* filter = nullptr;
+  std::vector<SplatImage>* strategies = nullptr;
+  bool unweighted = false;  // strategy images without the MIS weight (each then estimates the whole image)
+};
+
+class BdptIntegrator {
+ public:
+  BdptIntegrator(const Scene& scene, const RenderSettings& settings);
+
+  // The estimate of the strategies with t >= 2 for the camera ray of pixel (x, y) (added to that
+  // pixel with the filter weight by the caller); the t = 1 strategies are splatted onto target.film.
+  template <typename Sampler>
+  RGB radiance(const Ray& ray, Sampler& sampler, RayCounts& counts, const BdptTarget& target, int x, int y,
+               float filter_weight) const;
+
+  // The building blocks, shared with Metropolis light transport.
+  // A camera subpath from `ray` (vertex 0 on the lens) of at most max_vertices vertices; returns how many.
+  template <typename Sampler>
+  int camera_subpath(const Ray& ray, Sampler& sampler, RayCounts& counts, int max_vertices, BdptVertex* path) const;
+  // A light subpath of at most max_vertices vertices, starting on a light chosen by power.
+  template <typename Sampler>
+  int light_subpath(Sampler& sampler, RayCounts& counts, int max_vertices, float time, BdptVertex* path) const;
+  struct Connection {
+    RGB L;                // the MIS-weighted contribution
+    RGB unweighted;       // the same without the weight
+    float weight = 0;
+    Vec2 raster;          // t = 1: where on the film it lands
+  };
+  // Joins the first s light vertices with the first t camera vertices. The vertex arrays are
+  // modified during the call (the densities the MIS weight needs) and restored before it returns.
+  template <typename Sampler>
+  Connection connect(BdptVertex* light, BdptVertex* camera, int s, int t, Sampler& sampler, RayCounts& counts,
+                     float time) const;
+
+  int max_depth() const { return max_depth_; }
+  // Strategies (s, t) with s + t = depth + 2, numbered depth by depth: depth (depth + 5) / 2 + s.
+  static int strategy_index(int s, int t) {
+    int depth = s + t - 2;
+    return depth * (depth + 5) / 2 + s;
+  }
+  static int strategy_count(int max_depth) { return strategy_index(0, max_depth + 3); }
+
+ private:
+  template <typename Sampler>
+  int random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RGB beta, float pdf, int max_vertices,
+                  Transport mode, BdptVertex* path) const;
+
+  // The pieces of the MIS weight: densities between vertices, converted to the measure of `next`.
+  float convert_density(float pdf, const BdptVertex& from, const BdptVertex& next) const;
+  float vertex_pdf(const BdptVertex* prev, const BdptVertex& v, const BdptVertex& next) const;
+  float light_pdf(const BdptVertex& light_vertex, const BdptVertex& next) const;
+  float light_origin_pdf(const BdptVertex& light_vertex, const BdptVertex& next) const;
+  float infinite_lights_pdf(const Vec3& emitted_dir) const;
+  float mis_weight(BdptVertex* light, BdptVertex* camera, BdptVertex& sampled, int s, int t) const;
+
+  // Light emitted by a light vertex (or an emitter that was hit) towards `towards`.
+  RGB emitted(const BdptVertex& v, const BdptVertex& towards) const;
+  // The BSDF at a surface vertex towards `next`, adjoint when mode is Importance.
+  RGB scatter(const BdptVertex& v, const BdptVertex& next, Transport mode) const;
+  bool is_connectible(const BdptVertex& v) const;
+  bool is_light(const BdptVertex& v) const { return v.kind == BdptVertex::Kind::Light || v.light >= 0; }
+  bool is_delta_light(const BdptVertex& v) const;
+  // Whether nothing but interfaces lies between two vertices.
+  bool unoccluded(const BdptVertex& a, const BdptVertex& b, float time, RayCounts& counts) const;
+  float geometry_term(const BdptVertex& a, const BdptVertex& b) const;
+
+  const Scene& scene_;
+  int max_depth_;
+  int rr_start_depth_;
+};
+
+}  // namespace candela
