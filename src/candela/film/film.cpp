@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstring>
+
+#include "candela/sampling/rng.h"
 #include <cmath>
 
 namespace candela {
@@ -38,7 +41,16 @@ Image Film::mean_image() const {
 void SplatImage::add_to_pixel(int x, int y, const RGB& v) {
   int64_t* sums = &sums_[(size_t(y) * size_t(width_) + size_t(x)) * 3];
   for (int c = 0; c < 3; ++c) {
-    int64_t fixed = std::llround(double(v[c]) * kUnit);
+    if (v[c] == 0) continue;
+    // Rounded up or down with probabilities that make the expected sum exact (plain rounding would
+    // lose every value below half a unit). The "random" number is a hash of the value and the
+    // place, so the sum stays the same whatever order threads add in.
+    double scaled = double(v[c]) * kUnit;
+    float value = v[c];
+    uint32_t bits;
+    std::memcpy(&bits, &value, sizeof bits);
+    double dither = double(hash_values(bits, uint64_t(x), uint64_t(y), uint64_t(c)) >> 11) * 0x1p-53;
+    int64_t fixed = int64_t(std::floor(scaled + dither));
     if (fixed != 0) std::atomic_ref<int64_t>(sums[c]).fetch_add(fixed, std::memory_order_relaxed);
   }
 }

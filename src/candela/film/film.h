@@ -27,7 +27,8 @@ struct PixelSums {
 // Contributions that land wherever they land on the film rather than on the pixel being sampled
 // (light paths of bidirectional path tracing, Metropolis chains). A splat is spread over the
 // pixels the filter covers with weights f / integral(f). The sums are fixed point (kUnit per unit)
-// added with atomic integer adds, so they come out the same whatever order threads add in.
+// added with atomic integer adds, so they come out the same whatever order threads add in; each value
+// is rounded up or down by a deterministic dither so that the sums stay unbiased for tiny values.
 class SplatImage {
  public:
   static constexpr double kUnit = 16777216.0;  // 2^24: resolution 6e-8, range 5e11 per sum

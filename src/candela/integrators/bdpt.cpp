@@ -50,7 +50,7 @@ BdptIntegrator::BdptIntegrator(const Scene& scene, const RenderSettings& setting
 
 template <typename Sampler>
 int BdptIntegrator::camera_subpath(const Ray& ray, Sampler& sampler, RayCounts& counts, int max_vertices,
-                                   BdptVertex* path) const {
+                                   BdptVertex* path, RGB* crossed_emission) const {
   if (max_vertices == 0) return 0;
   BdptVertex& camera = path[0];
   camera = BdptVertex{};
@@ -61,7 +61,8 @@ int BdptIntegrator::camera_subpath(const Ray& ray, Sampler& sampler, RayCounts& 
   Ray r = ray;
   r.direction = normalize(r.direction);
   float pdf_dir = scene_.camera().pdf_importance(r.origin, r.direction).dir;
-  return random_walk(r, sampler, counts, RGB(1.0f), pdf_dir, max_vertices, Transport::Radiance, path);
+  return random_walk(r, sampler, counts, RGB(1.0f), pdf_dir, max_vertices, Transport::Radiance, path,
+                     crossed_emission);
 }
 
 template <typename Sampler>
@@ -91,7 +92,7 @@ int BdptIntegrator::light_subpath(Sampler& sampler, RayCounts& counts, int max_v
   RGB beta = e.radiance * (cos_light / (pmf * e.pdf_pos * e.pdf_dir));
   Point3 origin = v.on_surface() ? offset_ray_origin(e.p, e.n, e.w) : e.p;
   int n = random_walk(Ray{origin, e.w, std::numeric_limits<float>::infinity(), time}, sampler, counts, beta,
-                      e.pdf_dir, max_vertices, Transport::Importance, path);
+                      e.pdf_dir, max_vertices, Transport::Importance, path, nullptr);
 
   // Lights at infinity: the first vertex's density is the disk's per-area density projected onto
   // it, and the light's own "position" is its direction, with the density all lights at infinity
@@ -108,7 +109,7 @@ int BdptIntegrator::light_subpath(Sampler& sampler, RayCounts& counts, int max_v
 
 template <typename Sampler>
 int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RGB beta, float pdf,
-                                int max_vertices, Transport mode, BdptVertex* path) const {
+                                int max_vertices, Transport mode, BdptVertex* path, RGB* crossed_emission) const {
   int n = 1;
   float pdf_fwd = pdf;
   float eta_scale = 1;
@@ -132,8 +133,24 @@ int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RG
       }
       break;
     }
-    // An interface has no surface: continue beyond it.
+    // An interface has no surface: continue beyond it. If it emits (pbrt's area lights of material
+    // "interface"), the s = 0 strategy's path ends on it: weigh that now, as if it were the next vertex.
     if (scene_.is_interface(hit)) {
+      if (crossed_emission && scene_.light_index(hit) >= 0) {
+        BdptVertex& v = path[n];
+        v = BdptVertex{};
+        v.kind = Kind::Surface;
+        v.p = hit.p;
+        v.ng = hit.ng;
+        v.ns = hit.ns;
+        v.hit = hit;
+        v.wo = -normalize(ray.direction);
+        v.beta = beta;
+        v.light = scene_.light_index(hit);
+        v.bsdf = BlackBsdf{};
+        v.pdf_fwd = convert_density(pdf_fwd, path[n - 1], v);
+        crossed_emission[n + 1] += connect<Sampler>(nullptr, path, 0, n + 1, sampler, counts, ray.time).L;
+      }
       ray.origin = offset_ray_origin(hit.p, hit.ng, ray.direction);
       ray.t_max = std::numeric_limits<float>::infinity();
       continue;
@@ -460,10 +477,23 @@ RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts
   light_path.resize(size_t(max_depth_) + 1);
   BdptVertex* cv = camera_path.data();
   BdptVertex* lv = light_path.data();
-  int nc = camera_subpath(ray, sampler, counts, max_depth_ + 2, cv);
+  thread_local std::vector<RGB> crossed;
+  crossed.assign(size_t(max_depth_) + 3, RGB(0.0f));
+  int nc = camera_subpath(ray, sampler, counts, max_depth_ + 2, cv, crossed.data());
   int nl = light_subpath(sampler, counts, max_depth_ + 1, ray.time, lv);
 
+  // Strategy images are scaled like the light image (importance film area / light paths); camera
+  // samples of a pixel count per pixel, hence the ratio of the image's area to the importance film's.
+  const PerspectiveCamera& camera = scene_.camera();
+  const float camera_part_scale = float(camera.width()) * float(camera.height()) / camera.importance_film_pixels();
   RGB L(0.0f);
+  for (int t = 2; t <= max_depth_ + 2; ++t) {
+    if (crossed[size_t(t)].is_black()) continue;
+    L += crossed[size_t(t)];
+    if (target.strategies && strategy_index(0, t) < int(target.strategies->size()) && !target.unweighted)
+      (*target.strategies)[size_t(strategy_index(0, t))].add_to_pixel(
+          x, y, crossed[size_t(t)] * (filter_weight / target.filter->integral() * camera_part_scale));
+  }
   for (int t = 1; t <= nc; ++t)
     for (int s = 0; s <= nl; ++s) {
       int depth = s + t - 2;
@@ -481,7 +511,7 @@ RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts
           SplatImage& img = (*target.strategies)[size_t(index)];
           if (v.is_black() || !v.is_finite()) continue;
           if (t == 1) img.add(c.raster, v, *target.filter);
-          else img.add_to_pixel(x, y, v * (filter_weight / target.filter->integral()));
+          else img.add_to_pixel(x, y, v * (filter_weight / target.filter->integral() * camera_part_scale));
         }
       }
     }
@@ -491,7 +521,7 @@ RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts
 // One instantiation per pixel sampler, and one for Metropolis light transport's sampler.
 #define CANDELA_INSTANTIATE(S)                                                                              \
   template RGB BdptIntegrator::radiance<S>(const Ray&, S&, RayCounts&, const BdptTarget&, int, int, float) const; \
-  template int BdptIntegrator::camera_subpath<S>(const Ray&, S&, RayCounts&, int, BdptVertex*) const;          \
+  template int BdptIntegrator::camera_subpath<S>(const Ray&, S&, RayCounts&, int, BdptVertex*, RGB*) const;    \
   template int BdptIntegrator::light_subpath<S>(S&, RayCounts&, int, float, BdptVertex*) const;                \
   template BdptIntegrator::Connection BdptIntegrator::connect<S>(BdptVertex*, BdptVertex*, int, int, S&,       \
                                                                  RayCounts&, float) const;

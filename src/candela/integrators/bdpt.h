@@ -72,8 +72,12 @@ class BdptIntegrator {
 
   // The building blocks, shared with Metropolis light transport.
   // A camera subpath from `ray` (vertex 0 on the lens) of at most max_vertices vertices; returns how many.
+  // Emitters without a surface of their own (interface material) are passed through, not made
+  // vertices: the MIS-weighted light of the one the path would have ended on as its t-th vertex is
+  // added to crossed_emission[t] (an array of max_vertices + 1, when given).
   template <typename Sampler>
-  int camera_subpath(const Ray& ray, Sampler& sampler, RayCounts& counts, int max_vertices, BdptVertex* path) const;
+  int camera_subpath(const Ray& ray, Sampler& sampler, RayCounts& counts, int max_vertices, BdptVertex* path,
+                     RGB* crossed_emission = nullptr) const;
   // A light subpath of at most max_vertices vertices, starting on a light chosen by power.
   template <typename Sampler>
   int light_subpath(Sampler& sampler, RayCounts& counts, int max_vertices, float time, BdptVertex* path) const;
@@ -100,7 +104,7 @@ class BdptIntegrator {
  private:
   template <typename Sampler>
   int random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RGB beta, float pdf, int max_vertices,
-                  Transport mode, BdptVertex* path) const;
+                  Transport mode, BdptVertex* path, RGB* crossed_emission) const;
 
   // The pieces of the MIS weight: densities between vertices, converted to the measure of `next`.
   float convert_density(float pdf, const BdptVertex& from, const BdptVertex& next) const;

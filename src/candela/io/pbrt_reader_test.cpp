@@ -1088,12 +1088,8 @@ TEST(PbrtReaderBitterli, VeachAjar) {
 TEST(PbrtReaderBitterli, VeachBidir) {
   Warned read = read_bitterli("veach-bidir");
   const SceneDesc& scene = read.scene;
-  ASSERT_EQ(read.warnings.size(), 1u) << joined(read.warnings);
-  EXPECT_NE(read.warnings[0].find("scene-v4.pbrt:1:12: warning: Integrator \"bdpt\": using candela's path integrator "
-                                  "with maxdepth 7"),
-            std::string::npos)
-      << read.warnings[0];
-  EXPECT_EQ(scene.settings.integrator, "path");
+  EXPECT_TRUE(read.warnings.empty()) << joined(read.warnings);
+  EXPECT_EQ(scene.settings.integrator, "bdpt");
   EXPECT_EQ(scene.settings.max_depth, 7);
   EXPECT_EQ(scene.settings.sampler.type, SamplerType::Independent);
   EXPECT_EQ(scene.settings.spp, 64);
@@ -1122,9 +1118,37 @@ TEST(PbrtReader, SobolAndOtherLowDiscrepancySamplersBecomeZSobol) {
   EXPECT_EQ(read_lines({"Sampler \"halton\" \"string randomization\" \"owen\"", "WorldBegin"}).settings.spp, 16);
 }
 
-TEST(PbrtReader, EveryPbrtIntegratorIsRenderedWithThePathIntegrator) {
+TEST(PbrtReader, BdptAndMltAreCandelasOwn) {
+  SceneDesc bdpt = read_lines({"Integrator \"bdpt\" \"integer maxdepth\" 7", "WorldBegin"});
+  EXPECT_EQ(bdpt.settings.integrator, "bdpt");
+  EXPECT_EQ(bdpt.settings.max_depth, 7);
+  expect_warning({"Integrator \"bdpt\" \"bool visualizestrategies\" true", "WorldBegin"}, 1, "\"bool visualizestrategies\"",
+                 "--bdpt-strategies");
+  // MLT's mutations per pixel are its sample count, whatever the Sampler says before or after.
+  for (bool sampler_first : {false, true}) {
+    std::vector<std::string> lines = {"Integrator \"mlt\" \"integer maxdepth\" 4 \"integer mutationsperpixel\" 40 "
+                                      "\"integer bootstrapsamples\" 500 \"integer chains\" 20 "
+                                      "\"float largestepprobability\" 0.25 \"float sigma\" 0.02",
+                                      "WorldBegin"};
+    lines.insert(lines.begin() + (sampler_first ? 0 : 1), "Sampler \"independent\" \"integer pixelsamples\" 8");
+    SceneDesc mlt = read_lines(lines);
+    EXPECT_EQ(mlt.settings.integrator, "mlt");
+    EXPECT_EQ(mlt.settings.max_depth, 4);
+    EXPECT_EQ(mlt.settings.spp, 40);
+    EXPECT_EQ(mlt.settings.mlt_bootstrap, 500);
+    EXPECT_EQ(mlt.settings.mlt_chains, 20);
+    EXPECT_FLOAT_EQ(mlt.settings.mlt_large_step, 0.25f);
+    EXPECT_FLOAT_EQ(mlt.settings.mlt_sigma, 0.02f);
+  }
+  EXPECT_EQ(read_lines({"Integrator \"mlt\"", "WorldBegin"}).settings.spp, 100);  // pbrt's default
+  EXPECT_THROW(read_lines({"Integrator \"mlt\" \"float sigma\" 0", "WorldBegin"}), SceneError);
+  EXPECT_THROW(read_lines({"Integrator \"mlt\" \"float largestepprobability\" 1.5", "WorldBegin"}), SceneError);
+  EXPECT_THROW(read_lines({"Integrator \"mlt\" \"integer chains\" 0", "WorldBegin"}), SceneError);
+}
+
+TEST(PbrtReader, OtherPbrtIntegratorsAreRenderedWithThePathIntegrator) {
   EXPECT_TRUE(read_warned({"Integrator \"path\" \"integer maxdepth\" 9", "WorldBegin"}).warnings.empty());
-  for (std::string type : {"bdpt", "mlt", "sppm", "lightpath", "randomwalk", "simplepath", "simplevolpath"}) {
+  for (std::string type : {"sppm", "lightpath", "randomwalk", "simplepath", "simplevolpath"}) {
     SCOPED_TRACE(type);
     std::vector<std::string> lines = {"Integrator \"" + type + "\" \"integer maxdepth\" 9", "WorldBegin"};
     expect_warning(lines, 1, "\"" + type + "\"",

@@ -58,6 +58,9 @@ struct RenderStats {
   bool cancelled = false;                         // stopped by RenderOptions::cancel
   bool time_limited = false;                      // stopped by the time limit before all samples
   RayCounts rays;
+  // Integrator "mlt": the estimate of the image's mean luminance that scales the chains' deposits,
+  // and its standard error relative to it.
+  double mlt_normalization = 0, mlt_normalization_relative_error = 0;
 };
 
 // Names of the integrators, for messages: "path, bdpt, mlt".
