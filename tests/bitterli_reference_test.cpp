@@ -75,6 +75,9 @@ TEST_P(BitterliReference, AgreesWithPbrtV4) {
 // over seeds 1-3 at these spp: cornell-box 0.0026 (stable), veach-mis 0.023-0.17 and veach-bidir 0.50-2.9
 // (rare fireflies dominate), veach-ajar 0.73 (stable; 0.22 at 1024 spp, i.e. noise falling as 1/spp);
 // the reference's own noise adds spp/4096 of ours. Each bound is about twice the largest value seen.
+// veach-bidir names pbrt's "bdpt" integrator and is rendered with candela's: relMSE 0.013 and 0.0084
+// at 64 spp for seeds 1 and 2 (the path tracer needed 256 spp for 0.5-2.9); seed 3 has one firefly
+// that alone makes 14, as pbrt-v4's own reference has a few.
 // The blue channel of the Cornell box is 6% brighter than pbrt-v4's in every statistic and at every spp:
 // pbrt-v4 renders spectrally, and the saturated orange light (17, 12, 4) times the red and green walls
 // gives a different blue in spectra than in RGB (candela agrees with Cycles, an RGB renderer, within 1% on
@@ -84,7 +87,7 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(ReferenceCase{"cornell-box", 256, 256, 64, 0.006, {0.03, 0.03, 0.075}},
                       ReferenceCase{"veach-mis", 320, 180, 128, 0.35, {0.03, 0.03, 0.03}},
                       ReferenceCase{"veach-ajar", 320, 180, 256, 1.0, {0.03, 0.03, 0.03}},
-                      ReferenceCase{"veach-bidir", 192, 192, 256, 6.0, {0.03, 0.03, 0.03}}),
+                      ReferenceCase{"veach-bidir", 192, 192, 64, 0.05, {0.03, 0.03, 0.03}}),
     [](const ::testing::TestParamInfo<ReferenceCase>& info) {
       std::string name = info.param.scene;
       for (char& ch : name)

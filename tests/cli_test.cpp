@@ -130,7 +130,9 @@ TEST_F(CommandLine, HelpDocumentsEveryOption) {
   for (const char* opt : {"--output", "--spp", "--threads", "--seed", "--max-depth", "--resolution", "--integrator",
                           "--sampler", "--filter", "--direction-sampling", "--no-mis", "--light-selection",
                           "--shadow-rays", "--adaptive-threshold", "--adaptive-batch", "--max-spp", "--spp-map",
-                          "--checkpoint", "--checkpoint-every", "--resume", "--time-limit", "--clamp", "--pixel"})
+                          "--checkpoint", "--checkpoint-every", "--resume", "--time-limit", "--clamp", "--pixel",
+                          "--bdpt-strategies", "--bdpt-unweighted", "--mlt-bootstrap", "--mlt-chains", "--mlt-sigma",
+                          "--mlt-large-step"})
     EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
 }
 
@@ -140,6 +142,38 @@ TEST_F(CommandLine, RenderControlOptionsAreChecked) {
   expect_failure("render " + scene + " -o " + out() + " --resume " + (dir_ / "none.ckpt").string(), "none\\.ckpt.*cannot open");
   expect_failure("render " + scene + " -o " + out() + " --pixel 3", "--pixel");
   expect_failure("render " + scene + " -o " + out() + " --pixel 99,1", "outside");
+}
+
+TEST_F(CommandLine, BidirectionalAndMetropolisIntegrators) {
+  std::string scene = write("good.json", kGoodJson);
+  RunResult bdpt = run_cli("render " + scene + " -o " + out() + " --integrator bdpt --spp 4 -q --bdpt-strategies " +
+                           dir_.string());
+  ASSERT_EQ(bdpt.exit_code, 0) << bdpt.output;
+  EXPECT_EQ(read_image_metadata(out())["candela:integrator"], "bdpt");
+  EXPECT_TRUE(fs::exists(dir_ / "bdpt_d0_s0_t2.exr"));
+  EXPECT_TRUE(fs::exists(dir_ / "bdpt_d1_s2_t1.exr"));
+  RunResult mlt = run_cli("render " + scene + " -o " + out() + " --integrator mlt --spp 8 --mlt-bootstrap 500 "
+                          "--mlt-chains 16 --mlt-sigma 0.02 --mlt-large-step 0.5 -q");
+  ASSERT_EQ(mlt.exit_code, 0) << mlt.output;
+  EXPECT_THAT_MATCHES(mlt.output, "16x12, 8.00 mutations per pixel in");
+  auto meta = read_image_metadata(out());
+  EXPECT_EQ(meta["candela:integrator"], "mlt");
+  EXPECT_EQ(meta["candela:mlt"], "bootstrap 500 chains 16 sigma 0.02 large-step 0.5");
+}
+
+TEST_F(CommandLine, IntegratorOptionsAreChecked) {
+  std::string scene = write("good.json", kGoodJson);
+  expect_failure("render " + scene + " -o " + out() + " --integrator whitted", "unknown integrator 'whitted' \\(known: path, bdpt, mlt\\)");
+  expect_failure("render " + scene + " -o " + out() + " --bdpt-strategies " + dir_.string(), "--bdpt-strategies needs --integrator bdpt");
+  expect_failure("render " + scene + " -o " + out() + " --integrator bdpt --bdpt-strategies " + (dir_ / "nope").string(),
+                 "not a directory");
+  expect_failure("render " + scene + " -o " + out() + " --integrator mlt --checkpoint " + (dir_ / "c.ckpt").string(),
+                 "not supported with the mlt integrator");
+  expect_failure("render " + scene + " -o " + out() + " --integrator mlt --adaptive-threshold 0.1", "does not apply to the mlt");
+  RunResult range = run_cli("render " + scene + " -o " + out() + " --integrator mlt --mlt-large-step 2");
+  EXPECT_NE(range.exit_code, 0);
+  EXPECT_THAT_MATCHES(range.output, "--mlt-large-step");
+  EXPECT_EQ(previous_output(), "previous render");
 }
 
 TEST_F(CommandLine, MissingSceneFile) { expect_failure("render " + (dir_ / "nope.json").string() + " -o " + out(), "nope\\.json"); }

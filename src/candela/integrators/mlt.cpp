@@ -4,9 +4,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <atomic>
-#include <cstdio>
-#include <cstdlib>
 #include <chrono>
 #include <limits>
 
@@ -198,94 +197,101 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   const Distribution1D bootstrap(weights);
 
   // The chains. Their starts are chosen proportionally to the bootstrap weights, stratified over the
-  // chains. Each depth's deposits are then scaled by that depth's own mean luminance over the number
-  // of mutations its chains make, so the image does not depend on how many chains a depth happened
-  // to get (which pbrt's single scale would leave to chance).
+  // chains. Each depth's deposits are then scaled by that depth's own mean luminance over its number
+  // of chains, so the image does not depend on how many chains a depth happened to get (which a
+  // single scale, as in pbrt, would leave to chance).
   const uint64_t chains = std::max<uint64_t>(1, std::min<uint64_t>(uint64_t(settings.mlt_chains), total_mutations));
-  std::vector<size_t> start(chains);
-  std::vector<uint64_t> depth_mutations(size_t(depths), 0);
-  for (uint64_t chain = 0; chain < chains; ++chain) {
-    Rng rng(chain, hash_values(settings.seed, 0x7374617274));
-    float u = std::min((float(chain) + rng.next_float()) / float(chains), 0x1.fffffep-1f);
-    start[chain] = bootstrap.sample(u);
-    depth_mutations[start[chain] % size_t(depths)] += (chain + 1) * total_mutations / chains - chain * total_mutations / chains;
-  }
-  if (std::getenv("CANDELA_MLT_DEBUG")) {
-    std::vector<double> boot(size_t(depths), 0.0);
-    for (size_t i = 0; i < weights.size(); ++i) boot[i % size_t(depths)] += weights[i] / double(settings.mlt_bootstrap);
-    for (size_t d = 0; d < size_t(depths); ++d)
-      std::fprintf(stderr, "depth %zu: normalization %.5f bootstrap %.5f mutations %llu\n", d, normalization.per_depth[d],
-                   boot[d], (unsigned long long)depth_mutations[d]);
+  const uint64_t per_chain = (total_mutations + chains - 1) / chains;
+  struct Chain {
+    MltSampler sampler;
+    Rng rng;
+    PathState current;
+    int depth = 0;
+    float scale = 0;
+  };
+  std::vector<Chain> chain_states;
+  chain_states.reserve(chains);
+  std::vector<uint64_t> depth_chains(size_t(depths), 0);
+  for (uint64_t c = 0; c < chains; ++c) {
+    Rng pick(c, hash_values(settings.seed, 0x7374617274));
+    float u = std::min((float(c) + pick.next_float()) / float(chains), 0x1.fffffep-1f);
+    size_t index = bootstrap.sample(u);
+    chain_states.push_back(Chain{MltSampler(settings.seed, index, settings.mlt_sigma, settings.mlt_large_step),
+                                 Rng(c, hash_values(settings.seed, 0x636861696e)), PathState{}, int(index % size_t(depths)), 0});
+    ++depth_chains[index % size_t(depths)];
   }
   // Deposits are kept near 1 (relative to the largest depth scale) for the fixed-point splat sums.
-  std::vector<double> per_mutation(size_t(depths), 0.0);
+  std::vector<double> per_chain_share(size_t(depths), 0.0);
   double largest = 0;
   for (size_t d = 0; d < size_t(depths); ++d)
-    if (depth_mutations[d] > 0) {
-      per_mutation[d] = normalization.per_depth[d] / double(depth_mutations[d]);
-      largest = std::max(largest, per_mutation[d]);
+    if (depth_chains[d] > 0) {
+      per_chain_share[d] = normalization.per_depth[d] / double(depth_chains[d]);
+      largest = std::max(largest, per_chain_share[d]);
     }
-  std::vector<float> depth_scale(size_t(depths), 0.0f);
-  for (size_t d = 0; d < size_t(depths); ++d)
-    if (largest > 0) depth_scale[d] = float(per_mutation[d] / largest);
-  std::atomic<uint64_t> done{0};
+  for (Chain& c : chain_states) c.scale = largest > 0 ? float(per_chain_share[size_t(c.depth)] / largest) : 0.0f;
+
+  // The chains advance in rounds, every chain by the same number of mutations, so that a render
+  // stopped between rounds (time limit, interruption) has every depth equally far along.
+  // Rounds grow towards half a second each (how a chain's mutations are cut into rounds changes
+  // nothing in what it computes, so the image stays the same whatever the timing).
+  uint64_t round_length = 16;
   std::atomic<uint64_t> non_finite{0};
-  std::atomic<bool> out_of_time{false};
-  arena.execute([&] {
-    tbb::parallel_for(uint64_t(0), chains, [&](uint64_t chain) {
-      RayCounts& counts = ray_counts.local();
-      uint64_t first = chain * total_mutations / chains, last = (chain + 1) * total_mutations / chains;
-      Rng rng(chain, hash_values(settings.seed, 0x636861696e));
-      size_t index = start[chain];
-      int depth = int(index % size_t(depths));
-      const float scale = depth_scale[size_t(depth)];
-      MltSampler sampler(settings.seed, index, settings.mlt_sigma, settings.mlt_large_step);
-      PathState current = paths.sample(sampler, depth, counts);
-      uint64_t since_report = 0;
-      for (uint64_t m = first; m < last; ++m) {
-        if ((m - first) % 256 == 0 && (cancelled() || out_of_time.load(std::memory_order_relaxed))) break;
-        sampler.start_iteration();
-        PathState proposed = paths.sample(sampler, depth, counts);
-        float y_current = current.luminance(), y_proposed = proposed.luminance();
-        float accept = y_current > 0 ? std::min(1.0f, y_proposed / y_current) : 1.0f;
-        // Deposit both states, weighted by the probability that the chain moves or stays.
-        if (accept > 0 && !film.splats().add(proposed.raster, proposed.L * (accept * scale / y_proposed), filter))
-          non_finite.fetch_add(1, std::memory_order_relaxed);
-        if (accept < 1 && y_current > 0 &&
-            !film.splats().add(current.raster, current.L * ((1 - accept) * scale / y_current), filter))
-          non_finite.fetch_add(1, std::memory_order_relaxed);
-        if (rng.next_float() < accept) {
-          current = proposed;
-          sampler.accept();
-        } else {
-          sampler.reject();
+  uint64_t mutations_per_chain = 0;
+  bool first_round = true;
+  while (mutations_per_chain < per_chain) {
+    const uint64_t steps = std::min(round_length, per_chain - mutations_per_chain);
+    const auto round_start = std::chrono::steady_clock::now();
+    arena.execute([&] {
+      tbb::parallel_for(uint64_t(0), chains, [&](uint64_t index) {
+        Chain& c = chain_states[index];
+        RayCounts& counts = ray_counts.local();
+        if (first_round) c.current = paths.sample(c.sampler, c.depth, counts);
+        for (uint64_t m = 0; m < steps; ++m) {
+          c.sampler.start_iteration();
+          PathState proposed = paths.sample(c.sampler, c.depth, counts);
+          float y_current = c.current.luminance(), y_proposed = proposed.luminance();
+          float accept = y_current > 0 ? std::min(1.0f, y_proposed / y_current) : 1.0f;
+          // Deposit both states, weighted by the probability that the chain moves or stays.
+          if (accept > 0 && !film.splats().add(proposed.raster, proposed.L * (accept * c.scale / y_proposed), filter))
+            non_finite.fetch_add(1, std::memory_order_relaxed);
+          if (accept < 1 && y_current > 0 &&
+              !film.splats().add(c.current.raster, c.current.L * ((1 - accept) * c.scale / y_current), filter))
+            non_finite.fetch_add(1, std::memory_order_relaxed);
+          if (c.rng.next_float() < accept) {
+            c.current = proposed;
+            c.sampler.accept();
+          } else {
+            c.sampler.reject();
+          }
         }
-        done.fetch_add(1, std::memory_order_relaxed);
-        if (++since_report == 4096) {
-          progress.advance(since_report);
-          since_report = 0;
-          if (options.time_limit_seconds > 0 &&
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count() >=
-                  options.time_limit_seconds)
-            out_of_time.store(true);
-        }
-      }
-      progress.advance(since_report);
+        progress.advance(steps);
+      });
     });
-  });
+    first_round = false;
+    mutations_per_chain += steps;
+    double round_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - round_start).count();
+    double growth = round_seconds > 0 ? std::clamp(0.5 / round_seconds, 0.5, 4.0) : 4.0;
+    round_length = std::max<uint64_t>(1, uint64_t(double(round_length) * growth));
+    if (cancelled()) {
+      stats.cancelled = true;
+      break;
+    }
+    if (mutations_per_chain < per_chain && options.time_limit_seconds > 0 &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count() >= options.time_limit_seconds) {
+      stats.time_limited = true;
+      break;
+    }
+  }
   progress.finish();
 
-  // A depth's deposits carry its mean luminance per mutation; times the film area they make the image.
-  // A render stopped early scales up by the share of mutations it made.
-  const uint64_t mutations = done.load();
-  film.set_splat_scale(mutations > 0 ? largest * double(scene.camera().importance_film_pixels()) *
-                                           double(total_mutations) / double(mutations)
-                                     : 0);
+  // A chain's deposits carry its depth's mean luminance over its chains, per mutation; times the
+  // film's area they make the image.
+  film.set_splat_scale(mutations_per_chain > 0
+                           ? largest * double(scene.camera().importance_film_pixels()) / double(mutations_per_chain)
+                           : 0);
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
-  stats.samples = mutations;
+  stats.samples = mutations_per_chain * chains;
   stats.non_finite_samples = non_finite.load();
-  stats.cancelled = cancelled();
-  stats.time_limited = out_of_time.load() && mutations < total_mutations;
   for (const auto& c : ray_counts) stats.rays += c;
   return stats;
 }
