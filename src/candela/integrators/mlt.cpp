@@ -182,9 +182,13 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   for (float w : weights) sum += w;
   // The chains' deposits are scaled by b, the image's mean luminance, from its own estimator (the
   // bootstrap's mean would do in principle, but with far more noise).
+  // At least mlt_bootstrap samples, more for long renders (1 per 64 mutations: a few percent of the
+  // time), so that the image's brightness converges with the rest of it.
   const BdptIntegrator bdpt_with_roulette(scene, settings);
+  const uint64_t normalization_samples = std::max<uint64_t>(
+      uint64_t(settings.mlt_bootstrap), options.time_limit_seconds > 0 ? 0 : total_mutations / 64);
   const Normalization normalization =
-      estimate_normalization(scene, bdpt_with_roulette, settings, arena, ray_counts, uint64_t(settings.mlt_bootstrap));
+      estimate_normalization(scene, bdpt_with_roulette, settings, arena, ray_counts, normalization_samples);
   const double b = normalization.value;
   stats.mlt_normalization = b;
   stats.mlt_normalization_relative_error = normalization.relative_error;
@@ -194,13 +198,33 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
     return stats;
   }
-  const Distribution1D bootstrap(weights);
 
-  // The chains. Their starts are chosen proportionally to the bootstrap weights, stratified over the
-  // chains. Each depth's deposits are then scaled by that depth's own mean luminance over its number
-  // of chains, so the image does not depend on how many chains a depth happened to get (which a
-  // single scale, as in pbrt, would leave to chance).
-  const uint64_t chains = std::max<uint64_t>(1, std::min<uint64_t>(uint64_t(settings.mlt_chains), total_mutations));
+  // The chains: each depth gets a share of them proportional to its brightness, and at least one if
+  // it has any light (so no depth's light is lost to chance), starting from its bootstrap paths
+  // chosen proportionally to their luminance, stratified over its chains. Each depth's deposits are
+  // then scaled by its own brightness over its number of chains.
+  std::vector<uint64_t> depth_chains(size_t(depths), 0);
+  std::vector<Distribution1D> depth_bootstrap;
+  depth_bootstrap.resize(size_t(depths));
+  std::vector<bool> depth_found(size_t(depths), false);
+  for (size_t d = 0; d < size_t(depths); ++d) {
+    std::vector<float> w(size_t(settings.mlt_bootstrap));
+    for (size_t k = 0; k < w.size(); ++k) w[k] = weights[k * size_t(depths) + d];
+    depth_found[d] = std::any_of(w.begin(), w.end(), [](float x) { return x > 0; });
+    depth_bootstrap[d] = Distribution1D(w);
+  }
+  const uint64_t wanted = std::max<uint64_t>(1, std::min<uint64_t>(uint64_t(settings.mlt_chains), total_mutations));
+  for (size_t d = 0; d < size_t(depths); ++d)
+    if (depth_found[d] && normalization.per_depth[d] > 0)
+      depth_chains[d] = std::max<uint64_t>(1, uint64_t(std::llround(double(wanted) * normalization.per_depth[d] / b)));
+  uint64_t chains = 0;
+  for (uint64_t n : depth_chains) chains += n;
+  if (chains == 0) {
+    progress.finish();
+    film.set_splat_scale(0);
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+    return stats;
+  }
   const uint64_t per_chain = (total_mutations + chains - 1) / chains;
   struct Chain {
     MltSampler sampler;
@@ -211,15 +235,15 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   };
   std::vector<Chain> chain_states;
   chain_states.reserve(chains);
-  std::vector<uint64_t> depth_chains(size_t(depths), 0);
-  for (uint64_t c = 0; c < chains; ++c) {
-    Rng pick(c, hash_values(settings.seed, 0x7374617274));
-    float u = std::min((float(c) + pick.next_float()) / float(chains), 0x1.fffffep-1f);
-    size_t index = bootstrap.sample(u);
-    chain_states.push_back(Chain{MltSampler(settings.seed, index, settings.mlt_sigma, settings.mlt_large_step),
-                                 Rng(c, hash_values(settings.seed, 0x636861696e)), PathState{}, int(index % size_t(depths)), 0});
-    ++depth_chains[index % size_t(depths)];
-  }
+  for (size_t d = 0; d < size_t(depths); ++d)
+    for (uint64_t k = 0; k < depth_chains[d]; ++k) {
+      uint64_t c = chain_states.size();
+      Rng pick(c, hash_values(settings.seed, 0x7374617274));
+      float u = std::min((float(k) + pick.next_float()) / float(depth_chains[d]), 0x1.fffffep-1f);
+      size_t index = depth_bootstrap[d].sample(u) * size_t(depths) + d;
+      chain_states.push_back(Chain{MltSampler(settings.seed, index, settings.mlt_sigma, settings.mlt_large_step),
+                                   Rng(c, hash_values(settings.seed, 0x636861696e)), PathState{}, int(d), 0});
+    }
   // Deposits are kept near 1 (relative to the largest depth scale) for the fixed-point splat sums.
   std::vector<double> per_chain_share(size_t(depths), 0.0);
   double largest = 0;

@@ -6,8 +6,8 @@
 // and its contribution is multiplied by the number of strategies of that depth.
 //
 //   1. Bootstrap: n_bootstrap x (max_depth + 1) independent states with their luminance. The scale b,
-//      the image's mean luminance, is estimated separately by n_bootstrap bidirectional samples (all
-//      strategies) through a jittered grid over the film: the bootstrap's own mean estimates the
+//      the image's mean luminance, is estimated separately, per depth, by max(n_bootstrap, mutations / 64)
+//      bidirectional samples (all strategies) through a jittered grid over the film: the bootstrap's own mean estimates the
 //      share of small bright regions far too noisily.
 //   2. Chains: n_chains chains, each started from a bootstrap state chosen proportionally to its
 //      luminance (no start-up bias), run spp x pixels / n_chains mutations: a large step (all
