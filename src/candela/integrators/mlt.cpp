@@ -232,6 +232,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
     PathState current;
     int depth = 0;
     float scale = 0;
+    float brightness = 0;  // the depth's mean luminance b_d
   };
   std::vector<Chain> chain_states;
   chain_states.reserve(chains);
@@ -252,7 +253,10 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
       per_chain_share[d] = normalization.per_depth[d] / double(depth_chains[d]);
       largest = std::max(largest, per_chain_share[d]);
     }
-  for (Chain& c : chain_states) c.scale = largest > 0 ? float(per_chain_share[size_t(c.depth)] / largest) : 0.0f;
+  for (Chain& c : chain_states) {
+    c.scale = largest > 0 ? float(per_chain_share[size_t(c.depth)] / largest) : 0.0f;
+    c.brightness = float(normalization.per_depth[size_t(c.depth)]);
+  }
 
   // The chains advance in rounds, every chain by the same number of mutations, so that a render
   // stopped between rounds (time limit, interruption) has every depth equally far along.
@@ -275,11 +279,19 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
           PathState proposed = paths.sample(c.sampler, c.depth, counts);
           float y_current = c.current.luminance(), y_proposed = proposed.luminance();
           float accept = y_current > 0 ? std::min(1.0f, y_proposed / y_current) : 1.0f;
-          // Deposit both states, weighted by the probability that the chain moves or stays.
-          if (accept > 0 && !film.splats().add(proposed.raster, proposed.L * (accept * c.scale / y_proposed), filter))
+          // Deposit both states, weighted by the probability that the chain moves or stays, with
+          // Kelemen et al.'s weights: a large step is also an independent sample of the film, and
+          // the two estimators are combined by their densities (p_large against f / b), so dim
+          // regions that chains seldom visit are estimated by the large steps instead.
+          float large = c.sampler.large_step() ? 1.0f : 0.0f;
+          float floor_density = settings.mlt_large_step * c.brightness;
+          if (y_proposed > 0 && accept + large > 0 &&
+              !film.splats().add(proposed.raster,
+                                 proposed.L * ((accept + large) * c.scale / (y_proposed + floor_density)), filter))
             non_finite.fetch_add(1, std::memory_order_relaxed);
           if (accept < 1 && y_current > 0 &&
-              !film.splats().add(c.current.raster, c.current.L * ((1 - accept) * c.scale / y_current), filter))
+              !film.splats().add(c.current.raster,
+                                 c.current.L * ((1 - accept) * c.scale / (y_current + floor_density)), filter))
             non_finite.fetch_add(1, std::memory_order_relaxed);
           if (c.rng.next_float() < accept) {
             c.current = proposed;

@@ -72,6 +72,23 @@ TEST_F(CheckpointFile, RoundTripIsExact) {
   EXPECT_EQ(files, 1);
 }
 
+TEST_F(CheckpointFile, SplatSumsRoundTripAndMustMatchTheSize) {
+  // Bidirectional renders keep their light-path splats (fixed-point sums) in the checkpoint.
+  Checkpoint cp = sample_checkpoint();
+  cp.splats.resize(18);
+  for (size_t i = 0; i < cp.splats.size(); ++i) cp.splats[i] = int64_t(i * i) * (i % 2 ? -1 : 1) + (int64_t(1) << 40);
+  write_checkpoint(file, cp);
+  Checkpoint back = read_checkpoint(file);
+  EXPECT_EQ(back.splats, cp.splats);
+  EXPECT_EQ(back.pixels.size(), 6u);
+  // A checkpoint without splats reads back without them.
+  write_checkpoint(file, sample_checkpoint());
+  EXPECT_TRUE(read_checkpoint(file).splats.empty());
+  // A splat array that does not fit the film is refused before anything is written.
+  cp.splats.resize(5);
+  EXPECT_THROW(write_checkpoint(file, cp), std::runtime_error);
+}
+
 TEST_F(CheckpointFile, TruncatedCorruptAndForeignFilesAreRefused) {
   write_checkpoint(file, sample_checkpoint());
   std::string good = bytes();
