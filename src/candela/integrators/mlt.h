@@ -5,16 +5,21 @@
 // the path depth; each state's path is built with one (s, t) strategy that the state itself picks,
 // and its contribution is multiplied by the number of strategies of that depth.
 //
-//   1. Bootstrap: n_bootstrap x (max_depth + 1) independent states with their luminance. The scale b,
-//      the image's mean luminance, is estimated separately, per depth, by max(n_bootstrap, mutations / 64)
-//      bidirectional samples (all strategies) through a jittered grid over the film: the bootstrap's own mean estimates the
-//      share of small bright regions far too noisily.
-//   2. Chains: n_chains chains, each started from a bootstrap state chosen proportionally to its
-//      luminance (no start-up bias), run spp x pixels / n_chains mutations: a large step (all
-//      numbers afresh) with probability p_large, else a small Gaussian perturbation of deviation sigma.
+//   1. Bootstrap: n_bootstrap x (max_depth + 1) independent states with their luminance. The
+//      brightness of each depth (its mean luminance over the film) is estimated separately, by
+//      max(n_bootstrap, mutations / 64) bidirectional samples (all strategies) through a jittered
+//      grid over the film: the bootstrap's own mean estimates the share of small bright regions far
+//      too noisily.
+//   2. Chains: about n_chains chains, shared among the depths in proportion to their brightness (at
+//      least one for each lit depth), each started from a bootstrap state of its depth chosen
+//      proportionally to its luminance (no start-up bias), run spp x pixels / chains mutations in
+//      rounds: a large step (all numbers afresh) with probability p_large, else a small Gaussian
+//      perturbation of deviation sigma.
 //      Every proposal deposits both the proposed and the current state, weighted by the acceptance
-//      probability and its complement (Veach's expected-value splatting).
-//   3. The image is the deposits times b x film area / mutations.
+//      probability and its complement (Veach's expected-value splatting), with Kelemen's weights that
+//      count a large step also as an independent sample.
+//   3. Each depth's deposits are scaled by its brightness over its number of chains; the image is
+//      the deposits times the film's area over the mutations per chain.
 //
 // Chains are independent and their deposits are summed in fixed point, so the image is the same
 // for any number of threads.
