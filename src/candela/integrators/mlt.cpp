@@ -144,10 +144,26 @@ Normalization estimate_normalization(const Scene& scene, const BdptIntegrator& b
 
 RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options) {
   auto start_time = std::chrono::steady_clock::now();
-  RenderStats stats;
+  // Depth 0, the emission that camera rays see directly, needs no Markov chain: it is rendered as the
+  // path tracer renders it (stratified camera samples of one ray each) into the film's own pixel
+  // sums, and the chains' splats of the depths >= 1 are added to it. Left to chains, the share of
+  // the film covered by small visible lights is estimated far more noisily.
+  RenderSettings emission = settings;
+  emission.integrator = "path";
+  emission.max_depth = 0;
+  emission.spp = std::clamp(settings.spp / 16, 16, 256);
+  emission.adaptive_threshold = 0;
+  RenderOptions emission_options = options;
+  emission_options.progress = false;
+  emission_options.after_pass = nullptr;
+  emission_options.time_limit_seconds = 0;
+  emission_options.bdpt_strategies = nullptr;
+  RenderStats stats = render(scene, emission, film, emission_options);
+  stats.samples = 0;
   film.enable_splats();
-  if (scene.lights().empty()) {
-    film.set_splat_scale(0);
+  film.set_splat_scale(0);
+  if (scene.lights().empty() || settings.max_depth == 0 || stats.cancelled) {
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
     return stats;
   }
   // Russian roulette would end subpaths short of the lengths the state asks for: off.
@@ -172,8 +188,10 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
     tbb::parallel_for(tbb::blocked_range<uint64_t>(0, bootstrap_count, 1024), [&](const auto& range) {
       RayCounts& counts = ray_counts.local();
       for (uint64_t i = range.begin(); i < range.end(); ++i) {
+        int depth = int(i % uint64_t(depths));
+        if (depth == 0) continue;  // rendered directly above
         MltSampler sampler(settings.seed, i, settings.mlt_sigma, settings.mlt_large_step);
-        weights[i] = paths.sample(sampler, int(i % uint64_t(depths)), counts).luminance();
+        weights[i] = paths.sample(sampler, depth, counts).luminance();
       }
       progress.advance(range.size());
     });
@@ -214,9 +232,11 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
     depth_bootstrap[d] = Distribution1D(w);
   }
   const uint64_t wanted = std::max<uint64_t>(1, std::min<uint64_t>(uint64_t(settings.mlt_chains), total_mutations));
+  double b_chains = 0;  // the brightness the chains render: every depth but 0
+  for (size_t d = 1; d < size_t(depths); ++d) b_chains += normalization.per_depth[d];
   for (size_t d = 0; d < size_t(depths); ++d)
-    if (depth_found[d] && normalization.per_depth[d] > 0)
-      depth_chains[d] = std::max<uint64_t>(1, uint64_t(std::llround(double(wanted) * normalization.per_depth[d] / b)));
+    if (d > 0 && depth_found[d] && normalization.per_depth[d] > 0)
+      depth_chains[d] = std::max<uint64_t>(1, uint64_t(std::llround(double(wanted) * normalization.per_depth[d] / b_chains)));
   uint64_t chains = 0;
   for (uint64_t n : depth_chains) chains += n;
   if (chains == 0) {
@@ -327,8 +347,8 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
                            : 0);
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   stats.samples = mutations_per_chain * chains;
-  stats.non_finite_samples = non_finite.load();
-  for (const auto& c : ray_counts) stats.rays += c;
+  stats.non_finite_samples += non_finite.load();
+  for (const auto& c : ray_counts) stats.rays += c;  // added to the direct pass's
   return stats;
 }
 
