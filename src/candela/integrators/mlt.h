@@ -5,6 +5,8 @@
 // the path depth; each state's path is built with one (s, t) strategy that the state itself picks,
 // and its contribution is multiplied by the number of strategies of that depth.
 //
+//   0. Depth 0 (emission seen directly) is rendered as the path tracer does, into the film's pixel
+//      sums; the chains render the depths >= 1 on top of it.
 //   1. Bootstrap: n_bootstrap x (max_depth + 1) independent states with their luminance. The
 //      brightness of each depth (its mean luminance over the film) is estimated separately, by
 //      max(n_bootstrap, mutations / 64) bidirectional samples (all strategies) through a jittered
