@@ -48,6 +48,19 @@ BdptIntegrator::BdptIntegrator(const Scene& scene, const RenderSettings& setting
 
 // ------------------------------------------------------------------------------------------ subpaths
 
+BdptVertex BdptIntegrator::surface_vertex(const SurfaceHit& hit, const Ray& ray, const RGB& beta) const {
+  BdptVertex v;
+  v.kind = Kind::Surface;
+  v.p = hit.p;
+  v.ng = hit.ng;
+  v.ns = hit.ns;
+  v.hit = hit;
+  v.wo = -normalize(ray.direction);
+  v.beta = beta;
+  v.light = scene_.light_index(hit);
+  return v;
+}
+
 template <typename Sampler>
 int BdptIntegrator::camera_subpath(const Ray& ray, Sampler& sampler, RayCounts& counts, int max_vertices,
                                    BdptVertex* path, RGB* crossed_emission) const {
@@ -138,15 +151,7 @@ int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RG
     if (scene_.is_interface(hit)) {
       if (crossed_emission && scene_.light_index(hit) >= 0) {
         BdptVertex& v = path[n];
-        v = BdptVertex{};
-        v.kind = Kind::Surface;
-        v.p = hit.p;
-        v.ng = hit.ng;
-        v.ns = hit.ns;
-        v.hit = hit;
-        v.wo = -normalize(ray.direction);
-        v.beta = beta;
-        v.light = scene_.light_index(hit);
+        v = surface_vertex(hit, ray, beta);
         v.bsdf = BlackBsdf{};
         v.pdf_fwd = convert_density(pdf_fwd, path[n - 1], v);
         crossed_emission[n + 1] += connect<Sampler>(nullptr, path, 0, n + 1, sampler, counts, ray.time).L;
@@ -158,15 +163,7 @@ int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RG
 
     BdptVertex& v = path[n];
     BdptVertex& prev = path[n - 1];
-    v = BdptVertex{};
-    v.kind = Kind::Surface;
-    v.p = hit.p;
-    v.ng = hit.ng;
-    v.ns = hit.ns;
-    v.hit = hit;
-    v.wo = -normalize(ray.direction);
-    v.beta = beta;
-    v.light = scene_.light_index(hit);
+    v = surface_vertex(hit, ray, beta);
     v.pdf_fwd = convert_density(pdf_fwd, prev, v);
     v.bsdf = scene_.bsdf(hit);
     v.frame = Frame::from_normal_tangent(hit.ns, hit.dpdu);

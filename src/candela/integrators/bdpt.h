@@ -106,6 +106,9 @@ class BdptIntegrator {
   int random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RGB beta, float pdf, int max_vertices,
                   Transport mode, BdptVertex* path, RGB* crossed_emission) const;
 
+  // A surface vertex reached by `ray` (its BSDF, frame and densities are the caller's).
+  BdptVertex surface_vertex(const SurfaceHit& hit, const Ray& ray, const RGB& beta) const;
+
   // The pieces of the MIS weight: densities between vertices, converted to the measure of `next`.
   float convert_density(float pdf, const BdptVertex& from, const BdptVertex& next) const;
   float vertex_pdf(const BdptVertex* prev, const BdptVertex& v, const BdptVertex& next) const;
