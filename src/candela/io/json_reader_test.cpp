@@ -137,6 +137,24 @@ TEST(JsonReader, ReadsCameraAndRenderSettings) {
   EXPECT_EQ(scene.settings.rr_start_depth, 0);
 }
 
+TEST(JsonReader, ReadsMetropolisSettings) {
+  SceneDesc scene = read(R"({"render": {"integrator": "mlt", "spp": 64,
+    "mlt": {"bootstrap": 5000, "chains": 32, "sigma": 0.02, "large_step": 0.5}}})");
+  EXPECT_EQ(scene.settings.integrator, "mlt");
+  EXPECT_EQ(scene.settings.mlt_bootstrap, 5000);
+  EXPECT_EQ(scene.settings.mlt_chains, 32);
+  EXPECT_FLOAT_EQ(scene.settings.mlt_sigma, 0.02f);
+  EXPECT_FLOAT_EQ(scene.settings.mlt_large_step, 0.5f);
+  SceneDesc defaults = read(R"({"render": {"integrator": "bdpt"}})");
+  EXPECT_EQ(defaults.settings.integrator, "bdpt");
+  EXPECT_EQ(defaults.settings.mlt_bootstrap, 100000);
+  EXPECT_FLOAT_EQ(defaults.settings.mlt_large_step, 0.3f);
+  EXPECT_NE(error_of(R"({"render": {"mlt": {"chains": 0}}})").find("/render/mlt/chains"), std::string::npos);
+  EXPECT_NE(error_of(R"({"render": {"mlt": {"sigma": 2}}})").find("sigma must be at most 1"), std::string::npos);
+  EXPECT_NE(error_of(R"({"render": {"mlt": {"large_step": 1.5}}})").find("/render/mlt/large_step"), std::string::npos);
+  EXPECT_NE(error_of(R"({"render": {"mlt": {"mutations": 5}}})").find("mutations"), std::string::npos);
+}
+
 TEST(JsonReader, ReadsLensShutterAndMotion) {
   SceneDesc scene = read(R"({
     "camera": {"lens_radius": 0.05, "focus_distance": 4, "shutter": [0.25, 0.75]},
