@@ -160,19 +160,7 @@ SceneDesc scene_at(const std::string& file, int width, int height) {
 
 // ---------------------------------------------------------------------------------------- furnaces
 
-// A closed diffuse sphere seen from inside.
-SceneDesc closed_sphere(float albedo) {
-  SceneDesc d;
-  d.film = {16, 16, ""};
-  d.camera = look_at_camera({0.1f, -0.2f, 0.05f}, {1, 0.3f, 0.2f}, 60);
-  d.settings.max_depth = 1000;
-  d.materials = {DiffuseMaterial{RGB(albedo)}};
-  ShapeDesc s;
-  s.geometry = SphereShape{{0, 0, 0}, 2};
-  s.material = 0;
-  d.shapes = {s};
-  return d;
-}
+SceneDesc closed_sphere(float albedo) { return testing::closed_diffuse_sphere(albedo, 1000); }
 
 void expect_furnace(const Image& img, double expected, const char* what) {
   testing::MeanEstimate e = region_mean(img, -1);

@@ -115,16 +115,8 @@ TEST(Furnace, MirrorSphereReflectsItsReflectance) {
 
 // A closed diffuse sphere seen from its centre.
 SceneDesc closed_sphere(float albedo, int spp) {
-  SceneDesc d;
-  d.film = {16, 16, ""};
-  d.camera = look_at_camera({0.1f, -0.2f, 0.05f}, {1, 0.3f, 0.2f}, 60);
+  SceneDesc d = testing::closed_diffuse_sphere(albedo, 10000);
   d.settings.spp = spp;
-  d.settings.max_depth = 10000;
-  d.materials = {DiffuseMaterial{RGB(albedo)}};
-  ShapeDesc s;
-  s.geometry = SphereShape{{0, 0, 0}, 2};
-  s.material = 0;
-  d.shapes = {s};
   return d;
 }
 

@@ -70,4 +70,19 @@ inline CameraDesc look_at_camera(const Point3& eye, const Point3& target, float 
   return c;
 }
 
+// A closed diffuse sphere of radius 2 around the origin, seen from just off its centre on a 16 x 16
+// image: the furnace scenes with analytic answers (Le / (1 - rho), rho I / (pi r^2 (1 - rho))).
+inline SceneDesc closed_diffuse_sphere(float albedo, int max_depth) {
+  SceneDesc d;
+  d.film = {16, 16, ""};
+  d.camera = look_at_camera({0.1f, -0.2f, 0.05f}, {1, 0.3f, 0.2f}, 60);
+  d.settings.max_depth = max_depth;
+  d.materials = {DiffuseMaterial{RGB(albedo)}};
+  ShapeDesc s;
+  s.geometry = SphereShape{{0, 0, 0}, 2};
+  s.material = 0;
+  d.shapes = {s};
+  return d;
+}
+
 }  // namespace candela::testing
