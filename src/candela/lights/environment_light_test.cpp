@@ -16,6 +16,7 @@
 #include "candela/io/error.h"
 #include "candela/sampling/rng.h"
 #include "candela/sampling/warp.h"
+#include "candela/testing/environment_maps.h"
 #include "candela/testing/statistics.h"
 
 namespace candela {
@@ -70,29 +71,13 @@ TEST(EqualAreaMapping, IsAreaPreserving) {
 
 // ---------------------------------------------------------------- environment lights
 
-// A small map with a smooth colour gradient, a bright spot and a black patch.
-Image test_map(EnvironmentMapping mapping) {
-  const bool equirect = mapping == EnvironmentMapping::Equirectangular;
-  const int w = equirect ? 32 : 24, h = equirect ? 16 : 24;
-  Image img(w, h);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      float fx = (x + 0.5f) / w, fy = (y + 0.5f) / h;
-      RGB c = RGB(0.3f + 0.7f * fx, 0.2f + 0.8f * fy, 1.0f - 0.6f * fx) * (0.5f + fx * fy);
-      if (x >= w / 2 + 3 && x < w / 2 + 5 && y >= h / 4 && y < h / 4 + 2) c += RGB(20.0f, 15.0f, 10.0f);
-      if (x >= 4 && x < 8 && y >= h / 2 + 1 && y < h / 2 + 4) c = RGB(0.0f);
-      img.set(x, y, c);
-    }
-  return img;
-}
-
 const Transform& test_rotation() {
   static const Transform r = Transform::rotate(40, normalize(Vec3(1, 2, -0.5f)));
   return r;
 }
 
 EnvironmentLight test_light(EnvironmentMapping mapping) {
-  return EnvironmentLight(test_map(mapping), mapping, RGB(1.5f, 1.0f, 0.5f), test_rotation(), 3.0f);
+  return EnvironmentLight(testing::environment_test_map(mapping), mapping, RGB(1.5f, 1.0f, 0.5f), test_rotation(), 3.0f);
 }
 
 constexpr EnvironmentMapping kMappings[] = {EnvironmentMapping::Equirectangular,
@@ -103,7 +88,7 @@ const char* name(EnvironmentMapping m) {
 
 TEST(EnvironmentLight, EquirectangularFollowsMitsubasConvention) {
   // phi = 2 pi u, theta = pi v: (sin(theta) sin(phi), cos(theta), -sin(theta) cos(phi)).
-  EnvironmentLight light(test_map(EnvironmentMapping::Equirectangular), EnvironmentMapping::Equirectangular,
+  EnvironmentLight light(testing::environment_test_map(EnvironmentMapping::Equirectangular), EnvironmentMapping::Equirectangular,
                          RGB(1.0f), Transform(), 1);
   auto expect_dir = [&](Vec2 uv, Vec3 d) {
     Vec3 w = light.uv_to_direction(uv);
@@ -122,7 +107,7 @@ TEST(EnvironmentLight, EquirectangularFollowsMitsubasConvention) {
 
 TEST(EnvironmentLight, RadianceIsTheScaledImageAtPixelCentresUnderTheRotation) {
   for (EnvironmentMapping m : kMappings) {
-    Image img = test_map(m);
+    Image img = testing::environment_test_map(m);
     EnvironmentLight light = test_light(m);
     for (auto [x, y] : {std::pair{3, 2}, std::pair{img.width / 2 + 3, img.height / 4}, std::pair{10, 7}}) {
       Vec2 uv{(x + 0.5f) / img.width, (y + 0.5f) / img.height};
@@ -265,7 +250,7 @@ TEST(EnvironmentLight, RejectsBadImages) {
 TEST(EnvironmentLight, ReadsItsImageFromAFile) {
   auto dir = std::filesystem::temp_directory_path() / ("candela-envmap-test-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
-  Image img = test_map(EnvironmentMapping::Equirectangular);
+  Image img = testing::environment_test_map(EnvironmentMapping::Equirectangular);
   write_image(dir / "map.exr", img);
   EnvironmentMap desc;
   desc.filename = (dir / "map.exr").string();

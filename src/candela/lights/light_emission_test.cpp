@@ -11,6 +11,7 @@
 #include "candela/lights/light.h"
 #include "candela/math/transform.h"
 #include "candela/sampling/rng.h"
+#include "candela/testing/environment_maps.h"
 #include "candela/testing/statistics.h"
 
 namespace candela {
@@ -124,24 +125,8 @@ SpotLightSource test_spot() {
 
 SkyLightSource test_sky() { return {RGB(2.0f, 2.5f, 3.0f), RGB(1.0f), RGB(0.3f, 0.2f, 0.1f), {0, 1, 0}, kScene.radius}; }
 
-// A non-uniform map: a colour gradient, a bright patch and a black patch.
-Image emission_test_map(EnvironmentMapping mapping) {
-  const bool equirect = mapping == EnvironmentMapping::Equirectangular;
-  const int w = equirect ? 32 : 24, h = equirect ? 16 : 24;
-  Image img(w, h);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      float fx = (x + 0.5f) / w, fy = (y + 0.5f) / h;
-      RGB c = RGB(0.2f + 0.8f * fx, 0.1f + 0.9f * fy, 1.0f - 0.7f * fx) * (0.4f + fx * fy);
-      if (x >= w / 2 + 2 && x < w / 2 + 5 && y >= h / 4 && y < h / 4 + 2) c += RGB(30.0f, 20.0f, 10.0f);
-      if (x >= 3 && x < 7 && y >= h / 2 && y < h / 2 + 3) c = RGB(0.0f);
-      img.set(x, y, c);
-    }
-  return img;
-}
-
 EnvironmentLight test_environment(EnvironmentMapping mapping) {
-  return EnvironmentLight(emission_test_map(mapping), mapping, RGB(1.2f, 1.0f, 0.7f),
+  return EnvironmentLight(testing::environment_test_map(mapping), mapping, RGB(1.2f, 1.0f, 0.7f),
                           Transform::rotate(35, normalize(Vec3(1, -2, 0.5f))), kScene.radius);
 }
 
