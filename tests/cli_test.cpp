@@ -122,6 +122,25 @@ TEST_F(CommandLine, AdaptiveSamplingWritesTheSppMap) {
   EXPECT_EQ(read_image(heat).width, 16);
   expect_failure("render " + scene + " -o " + out() + " --adaptive-threshold 0.05 --adaptive-batch 6", "power of two");
   expect_failure("render " + scene + " -o " + out() + " --sampler sobolev", "sobolev");
+
+  // A budget: exactly 8 samples per pixel on average, the sky's pixels fewer than the sphere's.
+  ASSERT_EQ(run_cli("render " + scene + " -o " + image + " --adaptive-spp 8 --adaptive-batch 2 --spp-map " + map + " -q")
+                .exit_code,
+            0);
+  counts = read_image(map);
+  double total = 0;
+  least = 1e9f, most = 0;
+  for (size_t i = 0; i < counts.rgb.size(); i += 3) {
+    total += counts.rgb[i];
+    least = std::min(least, counts.rgb[i]);
+    most = std::max(most, counts.rgb[i]);
+  }
+  EXPECT_EQ(total, 8.0 * counts.width * counts.height);
+  EXPECT_EQ(least, 2.0f);
+  EXPECT_GT(most, 8.0f);
+  EXPECT_LE(most, 64.0f);
+  expect_failure("render " + scene + " -o " + out() + " --adaptive-spp 8 --adaptive-batch 16", "at least the batch size");
+  expect_failure("render " + scene + " -o " + out() + " --adaptive-spp 64 --max-spp 32", "must be at least --adaptive-spp");
 }
 
 TEST_F(CommandLine, HelpDocumentsEveryOption) {
@@ -129,7 +148,7 @@ TEST_F(CommandLine, HelpDocumentsEveryOption) {
   EXPECT_EQ(r.exit_code, 0);
   for (const char* opt : {"--output", "--spp", "--threads", "--seed", "--max-depth", "--resolution", "--integrator",
                           "--sampler", "--filter", "--direction-sampling", "--no-mis", "--light-selection",
-                          "--shadow-rays", "--adaptive-threshold", "--adaptive-batch", "--max-spp", "--spp-map",
+                          "--shadow-rays", "--adaptive-threshold", "--adaptive-spp", "--adaptive-batch", "--max-spp", "--spp-map",
                           "--checkpoint", "--checkpoint-every", "--resume", "--time-limit", "--clamp", "--pixel",
                           "--bdpt-strategies", "--bdpt-unweighted", "--mlt-bootstrap", "--mlt-chains", "--mlt-sigma",
                           "--mlt-large-step"})

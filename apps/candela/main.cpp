@@ -69,7 +69,7 @@ struct RenderCommand {
   std::string resolution;
   std::string integrator;
   std::string sampler, filter, direction_sampling, light_selection, spp_map;
-  std::optional<int> shadow_rays, max_spp, adaptive_batch;
+  std::optional<int> shadow_rays, max_spp, adaptive_batch, adaptive_spp;
   std::optional<float> adaptive_threshold;
   bool no_mis = false;
   bool quiet = false;
@@ -126,10 +126,17 @@ void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
   if (cmd.mlt_large_step) rs.mlt_large_step = *cmd.mlt_large_step;
   if (cmd.shadow_rays) rs.shadow_rays = *cmd.shadow_rays;
   if (cmd.adaptive_threshold) rs.adaptive_threshold = *cmd.adaptive_threshold;
+  if (cmd.adaptive_spp) rs.adaptive_spp = *cmd.adaptive_spp;
   if (cmd.adaptive_batch) rs.adaptive_batch = *cmd.adaptive_batch;
   if (cmd.max_spp) rs.adaptive_max_spp = *cmd.max_spp;
-  if (rs.adaptive_threshold > 0 && (rs.adaptive_batch & (rs.adaptive_batch - 1)) != 0)
+  if (rs.adaptive() && (rs.adaptive_batch & (rs.adaptive_batch - 1)) != 0)
     throw UsageError(fmt::format("--adaptive-batch: must be a power of two, got {}", rs.adaptive_batch));
+  if (rs.adaptive_spp > 0 && rs.adaptive_spp < rs.adaptive_batch)
+    throw UsageError(fmt::format("--adaptive-spp ({}) must be at least the batch size ({})", rs.adaptive_spp,
+                                 rs.adaptive_batch));
+  if (rs.adaptive_spp > 0 && rs.adaptive_max_spp > 0 && rs.adaptive_max_spp < rs.adaptive_spp)
+    throw UsageError(fmt::format("--max-spp ({}) must be at least --adaptive-spp ({})", rs.adaptive_max_spp,
+                                 rs.adaptive_spp));
   if (!cmd.spp_map.empty() && !is_supported_output(cmd.spp_map))
     throw UsageError(fmt::format("--spp-map '{}': unsupported image format (use .exr, .png or .pfm)", cmd.spp_map));
   if (!cmd.resolution.empty()) {
@@ -147,8 +154,8 @@ void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
                                  f.height, kMaxResolution, kMaxPixels));
   if (!is_known_integrator(scene.settings.integrator))
     throw UsageError(fmt::format("unknown integrator '{}' (known: {})", scene.settings.integrator, known_integrators()));
-  if (scene.settings.integrator == "mlt" && scene.settings.adaptive_threshold > 0)
-    throw UsageError("--adaptive-threshold does not apply to the mlt integrator (its mutations go where the light is)");
+  if (scene.settings.integrator == "mlt" && scene.settings.adaptive())
+    throw UsageError("adaptive sampling (--adaptive-threshold, --adaptive-spp) does not apply to the mlt integrator (its mutations go where the light is)");
   if (!cmd.bdpt_strategies.empty() && scene.settings.integrator != "bdpt")
     throw UsageError("--bdpt-strategies needs --integrator bdpt");
   if (cmd.bdpt_unweighted && cmd.bdpt_strategies.empty()) throw UsageError("--bdpt-unweighted needs --bdpt-strategies DIR");
@@ -221,6 +228,7 @@ RenderFingerprint make_fingerprint(const std::string& scene_bytes, const SceneDe
       {"light-selection", std::to_string(int(rs.light_selection))},
       {"shadow-rays", std::to_string(rs.shadow_rays)},
       {"adaptive-threshold", fmt::format("{}", rs.adaptive_threshold)},
+      {"adaptive-spp", std::to_string(rs.adaptive_spp)},
       {"clamp", clamp > 0 ? fmt::format("{}", clamp) : "off"},
   };
   if (rs.integrator == "mlt")
@@ -239,11 +247,11 @@ int run_render(const RenderCommand& cmd) {
   SceneDesc desc = cmd.scene_file.empty() ? read_json_scene(builtin_scene_json(), "<built-in cornell-box.json>", ".")
                                           : read_scene_file(cmd.scene_file);
   apply_overrides(cmd, desc);
-  const bool adaptive = desc.settings.adaptive_threshold > 0;
+  const bool adaptive = desc.settings.adaptive();
   const bool pixel_mode = !cmd.pixel.empty();
   if (cmd.checkpoint_every && cmd.checkpoint.empty()) throw UsageError("--checkpoint-every needs --checkpoint FILE");
   if (adaptive && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
-    throw UsageError("--checkpoint and --resume are not supported with adaptive sampling (--adaptive-threshold)");
+    throw UsageError("--checkpoint and --resume are not supported with adaptive sampling (--adaptive-threshold, --adaptive-spp)");
   if (pixel_mode && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
     throw UsageError("--pixel cannot be combined with --checkpoint or --resume");
   const bool mlt = desc.settings.integrator == "mlt";
@@ -484,10 +492,15 @@ int main(int argc, char** argv) {
                          "Adaptive sampling: keep adding batches to pixels whose relative standard error "
                          "(per channel, se / sqrt(mean^2 + 0.01)) exceeds this")
       ->check(CLI::PositiveNumber);
+  render_cmd->add_option("--adaptive-spp", cmd.adaptive_spp,
+                         "Adaptive sampling with a budget: this many samples per pixel on average, each pixel "
+                         "getting a share proportional to its estimated relative error (lowest relMSE)")
+      ->check(CLI::Range(1, 1 << 24));
   render_cmd->add_option("--adaptive-batch", cmd.adaptive_batch,
                          "Adaptive sampling: samples per batch, a power of two (default 16)")
       ->check(CLI::Range(1, 1 << 16));
-  render_cmd->add_option("--max-spp", cmd.max_spp, "Adaptive sampling: most samples a pixel gets (default 1024)")
+  render_cmd->add_option("--max-spp", cmd.max_spp,
+                         "Adaptive sampling: most samples a pixel gets (default 1024, or 8 x --adaptive-spp)")
       ->check(CLI::Range(1, 1 << 24));
   render_cmd->add_option("--spp-map", cmd.spp_map,
                          "Also write the per-pixel sample counts: a heat map (.png) or raw counts (.exr, .pfm)");

@@ -732,20 +732,28 @@ class JsonSceneReader {
     settings.shadow_rays = render.integer_or("shadow_rays", settings.shadow_rays, 1, std::numeric_limits<int>::max());
   }
 
-  // Present = on: pixels get batches of `batch` samples until their relative error is below `threshold`.
+  // Present = on (RenderSettings): a threshold on the pixels' relative error, a budget of samples
+  // per pixel on average, or both.
   void read_adaptive(const Json& value, const std::string& pointer, RenderSettings& settings) const {
     CheckedObject adaptive(report_, value, pointer);
     constexpr int64_t kIntMax = std::numeric_limits<int>::max();
-    settings.adaptive_threshold = adaptive.number("threshold", Bound::Positive);
+    settings.adaptive_threshold = adaptive.number_or("threshold", 0, Bound::Positive);
+    settings.adaptive_spp = adaptive.integer_or("spp", 0, 1, kIntMax);
+    if (!settings.adaptive()) report_.fail(pointer, "expected \"threshold\", \"spp\" or both");
     settings.adaptive_batch = adaptive.integer_or("batch", settings.adaptive_batch, 1, kIntMax);
     // Batches of a power of two keep every sampler's stratification within a batch.
     if ((settings.adaptive_batch & (settings.adaptive_batch - 1)) != 0)
       report_.fail(adaptive.pointer_of("batch"), "expected a power of two, got {}", settings.adaptive_batch);
-    settings.adaptive_max_spp = adaptive.integer_or("max_spp", settings.adaptive_max_spp, 1, kIntMax);
-    if (settings.adaptive_max_spp < settings.adaptive_batch)
-      report_.fail(adaptive.has("max_spp") ? adaptive.pointer_of("max_spp") : pointer,
-                   "max_spp ({}) must be at least the batch size ({})", settings.adaptive_max_spp,
+    if (settings.adaptive_spp > 0 && settings.adaptive_spp < settings.adaptive_batch)
+      report_.fail(adaptive.pointer_of("spp"), "spp ({}) must be at least the batch size ({})", settings.adaptive_spp,
                    settings.adaptive_batch);
+    settings.adaptive_max_spp = adaptive.integer_or("max_spp", 0, 1, kIntMax);
+    if (settings.adaptive_max_spp > 0 && settings.adaptive_max_spp < settings.adaptive_batch)
+      report_.fail(adaptive.pointer_of("max_spp"), "max_spp ({}) must be at least the batch size ({})",
+                   settings.adaptive_max_spp, settings.adaptive_batch);
+    if (settings.adaptive_max_spp > 0 && settings.adaptive_max_spp < settings.adaptive_spp)
+      report_.fail(adaptive.pointer_of("max_spp"), "max_spp ({}) must be at least spp ({})", settings.adaptive_max_spp,
+                   settings.adaptive_spp);
     adaptive.finish();
   }
 

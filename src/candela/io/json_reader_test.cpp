@@ -225,10 +225,18 @@ TEST(JsonReader, ReadsIntegratorStrategiesAndAdaptiveSampling) {
             DirectionSampling::Cosine);
   EXPECT_EQ(read(R"({"render": {"direction_sampling": "bsdf"}})").settings.direction_sampling, DirectionSampling::Bsdf);
   EXPECT_EQ(read(R"({"render": {"light_selection": "power"}})").settings.light_selection, LightSelection::Power);
-  // Only the threshold is required: batch and max_spp keep their defaults (16, 1024).
+  // A threshold alone: batch and max_spp keep their defaults (16; 0 = 1024).
   SceneDesc defaults = read(R"({"render": {"adaptive": {"threshold": 0.1}}})");
   EXPECT_EQ(defaults.settings.adaptive_batch, 16);
-  EXPECT_EQ(defaults.settings.adaptive_max_spp, 1024);
+  EXPECT_EQ(defaults.settings.adaptive_max_spp, 0);
+  EXPECT_EQ(defaults.settings.adaptive_spp_limit(), 1024);
+  EXPECT_EQ(defaults.settings.adaptive_spp, 0);
+  // A budget alone: no threshold, at most 8 x the budget per pixel.
+  SceneDesc budget = read(R"({"render": {"adaptive": {"spp": 64}}})");
+  EXPECT_TRUE(budget.settings.adaptive());
+  EXPECT_EQ(budget.settings.adaptive_threshold, 0);
+  EXPECT_EQ(budget.settings.adaptive_spp, 64);
+  EXPECT_EQ(budget.settings.adaptive_spp_limit(), 512);
 }
 
 TEST(JsonReader, AcceptsIntegralFloatsAndComments) {
@@ -649,7 +657,11 @@ TEST(JsonReader, BadStrategiesAndAdaptiveSettingsAreErrors) {
   expect_error_containing(R"({"render": {"mis": "yes"}})", "at /render/mis: expected true or false");
   expect_error_containing(R"({"render": {"shadow_rays": 0}})", "at /render/shadow_rays: expected an integer >= 1");
   expect_error_containing(R"({"render": {"adaptive": {}}})",
-                          "at /render/adaptive: missing required key \"threshold\"");
+                          "at /render/adaptive: expected \"threshold\", \"spp\" or both");
+  expect_error_containing(R"({"render": {"adaptive": {"spp": 8}}})",
+                          "at /render/adaptive/spp: spp (8) must be at least the batch size (16)");
+  expect_error_containing(R"({"render": {"adaptive": {"spp": 64, "max_spp": 32}}})",
+                          "at /render/adaptive/max_spp: max_spp (32) must be at least spp (64)");
   expect_error_containing(R"({"render": {"adaptive": {"threshold": 0}}})",
                           "at /render/adaptive/threshold: expected a positive number");
   expect_error_containing(R"({"render": {"adaptive": {"threshold": 0.1, "batch": 12}}})",
@@ -657,8 +669,6 @@ TEST(JsonReader, BadStrategiesAndAdaptiveSettingsAreErrors) {
   expect_error_containing(R"({"render": {"adaptive": {"threshold": 0.1, "batch": 0}}})", "expected an integer >= 1");
   expect_error_containing(R"({"render": {"adaptive": {"threshold": 0.1, "batch": 32, "max_spp": 16}}})",
                           "at /render/adaptive/max_spp: max_spp (16) must be at least the batch size (32)");
-  expect_error_containing(R"({"render": {"adaptive": {"threshold": 0.1, "batch": 2048}}})",
-                          "at /render/adaptive: max_spp (1024) must be at least the batch size (2048)");
   expect_error_containing(R"({"render": {"adaptive": {"threshold": 0.1, "batches": 2}}})",
                           "at /render/adaptive/batches: unknown key");
 }

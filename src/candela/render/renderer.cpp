@@ -7,6 +7,8 @@
 #include <atomic>
 #include <chrono>
 #include <algorithm>
+#include <bit>
+#include <cmath>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
@@ -138,6 +140,188 @@ void run_pass(const PassContext& pc, const std::vector<Tile>& tiles, tbb::task_a
   });
 }
 
+// ---- Adaptive sampling -------------------------------------------------------------------------
+
+// Samples per randomised set in adaptive renders. Stratified and Poisson-disc sets must be rendered
+// whole, so they are one batch. A ZSobol set spans the most a pixel can get: a pixel's samples are
+// then the first n points of one net, as in a plain render of n samples.
+int adaptive_set_size(const RenderSettings& settings) {
+  if (settings.sampler.type == SamplerType::ZSobol)
+    return int(std::bit_ceil(unsigned(std::max(settings.adaptive_spp_limit(), settings.adaptive_batch))));
+  return settings.adaptive_batch;
+}
+
+// The smallest number of samples a pixel is given at a time.
+int adaptive_granule(const RenderSettings& settings) {
+  bool whole_sets = settings.sampler.type == SamplerType::Stratified || settings.sampler.type == SamplerType::Poisson;
+  return whole_sets ? settings.adaptive_batch : 1;
+}
+
+// A pixel's relative deviation squared: n times its squared standard error over (mean^2 + 0.01),
+// averaged over the channels. Its error after n samples is this over n, and its share of the
+// image's relMSE (epsilon 0.01) falls the most per sample where this is largest.
+double relative_deviation_sq(const PixelSums& pixel) {
+  RGB mean = pixel.mean(), se = pixel.standard_error();
+  double sum = 0;
+  for (int c = 0; c < 3; ++c) sum += double(se[c]) * se[c] / (double(mean[c]) * mean[c] + 0.01);
+  return double(pixel.count) * sum / 3;
+}
+
+// The mean of `v` over the (2r+1)^2 pixels around each pixel (fewer at the borders): one pixel's
+// variance estimated from a few samples is itself very noisy, and neighbours' variances are alike.
+std::vector<double> box_mean(const std::vector<double>& v, int w, int h, int r) {
+  std::vector<double> rows(v.size()), out(v.size());
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      double sum = 0;
+      int n = 0;
+      for (int dx = std::max(0, x - r); dx <= std::min(w - 1, x + r); ++dx, ++n) sum += v[size_t(y) * w + dx];
+      rows[size_t(y) * w + x] = sum / n;
+    }
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      double sum = 0;
+      int n = 0;
+      for (int dy = std::max(0, y - r); dy <= std::min(h - 1, y + r); ++dy, ++n) sum += rows[size_t(dy) * w + x];
+      out[size_t(y) * w + x] = sum / n;
+    }
+  return out;
+}
+
+// How many samples each open pixel gets so that `total` are added and the counts come as close as
+// the caps allow to lambda x deviation (the relMSE-optimal allocation: minimising sum r_i^2 / n_i
+// at a fixed sum n_i gives n_i proportional to r_i): n_i' = clamp(lambda r_i, n_i, cap), lambda
+// found by bisection. Whole granules only; fractions carry over to the next pixel in raster order,
+// so the total comes out exact and the result does not depend on threads.
+std::vector<int> allocate_samples(const std::vector<double>& deviation, const std::vector<uint64_t>& count,
+                                  const std::vector<uint8_t>& open, int cap, double total, int granule) {
+  const size_t n = deviation.size();
+  auto added = [&](double lambda) {
+    double sum = 0;
+    for (size_t i = 0; i < n; ++i)
+      if (open[i]) sum += std::clamp(lambda * deviation[i], double(count[i]), double(cap)) - double(count[i]);
+    return sum;
+  };
+  double hi = 1;
+  for (int i = 0; i < 200 && added(hi) < total; ++i) hi *= 2;
+  double lo = 0;
+  for (int i = 0; i < 60; ++i) {
+    double mid = 0.5 * (lo + hi);
+    (added(mid) < total ? lo : hi) = mid;
+  }
+  std::vector<int> give(n, 0);
+  double carry = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (!open[i]) continue;
+    double want = std::clamp(hi * deviation[i], double(count[i]), double(cap)) - double(count[i]) + carry;
+    int granules = int(std::floor(want / granule + 0.5));
+    granules = std::clamp(granules, 0, int((uint64_t(cap) - count[i]) / uint64_t(granule)));
+    give[i] = granules * granule;
+    carry = want - give[i];
+  }
+  // The bisection's tolerance and the caps can leave the sum a granule or so off: settle the
+  // difference on the last pixels that can take or give one.
+  int64_t surplus = -int64_t(total / granule) * granule;
+  for (int g : give) surplus += g;
+  for (size_t i = n; i-- > 0 && surplus != 0;) {
+    if (!open[i]) continue;
+    if (surplus > 0 && give[i] > 0) {
+      give[i] -= granule;
+      surplus -= granule;
+    } else if (surplus < 0 && count[i] + uint64_t(give[i] + granule) <= uint64_t(cap)) {
+      give[i] += granule;
+      surplus += granule;
+    }
+  }
+  return give;
+}
+
+// Adaptive sampling (sec. 4.3; see RenderSettings): rounds of passes, each pixel's share of the
+// next round decided from the film alone between rounds, so the result does not depend on threads.
+template <typename StopAfterPass>
+void render_adaptive(const PassContext& pc, const std::vector<Tile>& tiles, tbb::task_arena& arena,
+                     ProgressBar& progress, const RenderSettings& settings, const RenderOptions& options,
+                     StopAfterPass stop_after_pass) {
+  Film& film = pc.film;
+  const int w = film.width(), h = film.height();
+  const size_t pixels = size_t(w) * h;
+  const int batch = settings.adaptive_batch, cap = std::max(settings.adaptive_spp_limit(), batch);
+  const int granule = adaptive_granule(settings);
+  std::vector<uint8_t> in_image(pixels, 1);  // the pixels this render may sample
+  if (options.only_x >= 0) {
+    std::fill(in_image.begin(), in_image.end(), 0);
+    in_image[size_t(options.only_y) * w + options.only_x] = 1;
+  }
+  const uint64_t sampled_pixels = options.only_x >= 0 ? 1 : pixels;
+  const uint64_t budget = settings.adaptive_spp > 0 ? uint64_t(settings.adaptive_spp) * sampled_pixels : 0;
+
+  // Every pixel starts with one batch.
+  std::vector<int> give(pixels, 0);
+  for (size_t i = 0; i < pixels; ++i) give[i] = in_image[i] ? std::min(batch, cap) : 0;
+  uint64_t spent = 0;
+  std::vector<uint64_t> count(pixels);
+  std::vector<double> error(pixels), deviation_sq(pixels);
+  std::vector<uint8_t> open(pixels);
+  for (;;) {
+    run_pass(pc, tiles, arena,
+             [&](int x, int y) {
+               size_t i = size_t(y) * w + x;
+               return SampleRange{int64_t(film.pixel(x, y).count), give[i]};
+             },
+             progress);
+    for (int g : give) spent += uint64_t(g);
+    bool more = budget > 0 ? spent < budget : true;
+    if (stop_after_pass(more) || !more) break;
+
+    // Each pixel's errors, from its own samples.
+    arena.execute([&] {
+      tbb::parallel_for(0, h, [&](int y) {
+        for (int x = 0; x < w; ++x) {
+          size_t i = size_t(y) * w + x;
+          const PixelSums& p = film.pixel(x, y);
+          count[i] = p.count;
+          error[i] = relative_error(p);
+          deviation_sq[i] = relative_deviation_sq(p);
+        }
+      });
+    });
+    // Pixels whose relative error (RMS over the 3x3 neighbourhood) is below the threshold, and
+    // pixels at the cap, are done.
+    bool any_open = false;
+    if (settings.adaptive_threshold > 0) {
+      std::vector<double> error_sq(pixels);
+      for (size_t i = 0; i < pixels; ++i) error_sq[i] = error[i] * error[i];
+      error_sq = box_mean(error_sq, w, h, 1);
+      for (size_t i = 0; i < pixels; ++i) error[i] = std::sqrt(error_sq[i]);
+    }
+    for (size_t i = 0; i < pixels; ++i) {
+      open[i] = in_image[i] && count[i] < uint64_t(cap) &&
+                (settings.adaptive_threshold <= 0 || error[i] > settings.adaptive_threshold);
+      any_open = any_open || open[i];
+    }
+    if (!any_open) break;
+
+    if (budget == 0) {
+      // No budget: another batch for every open pixel.
+      for (size_t i = 0; i < pixels; ++i) give[i] = open[i] ? int(std::min<uint64_t>(batch, cap - count[i])) : 0;
+      continue;
+    }
+    // A budget: each round adds as many samples as the film holds (or what is left), so the
+    // estimates the allocation rests on get better as it spends more. Deviations are smoothed over
+    // 3x3 pixels (5x5 and 9x9 were no better on the Cornell box) and kept above a small floor, so
+    // no pixel is starved on the word of a few samples.
+    std::vector<double> deviation = box_mean(deviation_sq, w, h, 1);
+    double mean_deviation = 0;
+    for (size_t i = 0; i < pixels; ++i) {
+      deviation[i] = std::sqrt(deviation[i]);
+      if (in_image[i]) mean_deviation += deviation[i] / double(sampled_pixels);
+    }
+    for (double& d : deviation) d = std::max(d, 0.05 * mean_deviation);
+    give = allocate_samples(deviation, count, open, cap, double(std::min(budget - spent, spent)), granule);
+    if (std::all_of(give.begin(), give.end(), [](int g) { return g == 0; })) break;
+  }
+}
+
 }  // namespace
 
 bool is_known_integrator(const std::string& name) { return name == "path" || name == "bdpt" || name == "mlt"; }
@@ -157,7 +341,7 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
   if (options.only_x >= film.width() || options.only_y >= film.height() || (options.only_x >= 0) != (options.only_y >= 0))
     throw std::invalid_argument("pixel to render is outside the image");
   if (settings.integrator == "mlt") {
-    if (settings.adaptive_threshold > 0) throw std::invalid_argument("adaptive sampling does not apply to the mlt integrator");
+    if (settings.adaptive()) throw std::invalid_argument("adaptive sampling does not apply to the mlt integrator");
     if (options.only_x >= 0) throw std::invalid_argument("the mlt integrator cannot render a single pixel");
     if (film.total_samples() > 0 || (film.has_splats() && film.splats().sums() != std::vector<int64_t>(film.splats().sums().size(), 0)))
       throw std::invalid_argument("the mlt integrator cannot continue a partly rendered film");
@@ -166,9 +350,8 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
   const bool bidirectional = settings.integrator == "bdpt";
   if (bidirectional && !film.has_splats()) film.enable_splats();
   auto start = std::chrono::steady_clock::now();
-  const bool adaptive = settings.adaptive_threshold > 0;
-  const int batch = adaptive ? settings.adaptive_batch : settings.spp;
-  const int max_spp = adaptive ? std::max(settings.adaptive_max_spp, batch) : settings.spp;
+  const bool adaptive = settings.adaptive();
+  const int max_spp = adaptive ? std::max(settings.adaptive_spp_limit(), settings.adaptive_batch) : settings.spp;
 
   const Filter filter(settings.filter);
   std::optional<PathIntegrator> path;
@@ -176,8 +359,8 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
   if (bidirectional) bdpt.emplace(scene, settings);
   else path.emplace(scene, settings);
   BdptTarget bdpt_target{&film, &filter, options.bdpt_strategies, options.bdpt_unweighted};
-  const Sampler prototype = make_sampler(settings.sampler, adaptive ? batch : settings.spp, settings.seed,
-                                         film.width(), film.height());
+  const Sampler prototype = make_sampler(settings.sampler, adaptive ? adaptive_set_size(settings) : settings.spp,
+                                         settings.seed, film.width(), film.height());
   std::vector<Tile> tiles = options.only_x >= 0 ? std::vector<Tile>{{options.only_x, options.only_y,
                                                                      options.only_x + 1, options.only_y + 1}}
                                                 : make_tiles(film.width(), film.height());
@@ -188,7 +371,8 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
   PassContext pc{scene,      path ? &*path : nullptr, bdpt ? &*bdpt : nullptr, bdpt_target, filter, prototype, film,
                  ray_counts, non_finite,            non_finite_log,          options.clamp, options.cancel};
   const uint64_t samples_before = film.total_samples();
-  ProgressBar progress(pixel_count * uint64_t(max_spp), options.progress);
+  const uint64_t expected_spp = adaptive && settings.adaptive_spp > 0 ? uint64_t(settings.adaptive_spp) : uint64_t(max_spp);
+  ProgressBar progress(pixel_count * expected_spp, options.progress);
   progress.advance(options.only_x >= 0 ? 0 : samples_before);
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   RenderStats stats;
@@ -226,50 +410,7 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
     }
   } else {
     if (samples_before > 0) throw std::invalid_argument("adaptive sampling cannot continue a partly rendered film");
-    // Batches of F samples. Between batches, every pixel's relative error is estimated from its own
-    // samples and smoothed over its 3x3 neighbourhood (one pixel's variance from a few samples is
-    // itself very noisy); pixels still above the threshold get the next batch. The decision is made
-    // while no pass runs, from the film alone, so it does not depend on threads.
-    const int w = film.width(), h = film.height();
-    std::vector<uint8_t> active(size_t(w) * h, 1);
-    if (options.only_x >= 0) {
-      std::fill(active.begin(), active.end(), 0);
-      active[size_t(options.only_y) * w + options.only_x] = 1;
-    }
-    std::vector<float> error(size_t(w) * h);
-    for (int rendered = 0; rendered < max_spp; rendered += batch) {
-      run_pass(pc, tiles, arena,
-               [&](int x, int y) {
-                 return active[size_t(y) * w + x] ? SampleRange{rendered, batch} : SampleRange{0, 0};
-               },
-               progress);
-      if (stop_after_pass(rendered + batch < max_spp)) break;
-      if (rendered + batch >= max_spp) break;
-      arena.execute([&] {
-        tbb::parallel_for(0, h, [&](int y) {
-          for (int x = 0; x < w; ++x) error[size_t(y) * w + x] = relative_error(film.pixel(x, y));
-        });
-      });
-      bool any = false;
-      for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-          uint8_t& a = active[size_t(y) * w + x];
-          if (!a) continue;
-          double sum_sq = 0;
-          int n = 0;
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) {
-              int nx = x + dx, ny = y + dy;
-              if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
-              float e = error[size_t(ny) * w + nx];
-              sum_sq += double(e) * e;
-              ++n;
-            }
-          a = std::sqrt(sum_sq / n) > settings.adaptive_threshold;
-          any = any || a;
-        }
-      if (!any) break;
-    }
+    render_adaptive(pc, tiles, arena, progress, settings, options, stop_after_pass);
   }
   progress.finish();
 

@@ -5,8 +5,10 @@
 // is bitwise identical for any thread count.
 //
 // Adaptive sampling (Häkkinen 2002, sec. 4.3): all pixels first get one batch of F samples (F a
-// power of two, so stratification holds within the batch); after each batch, pixels whose relative
-// standard error still exceeds the threshold get another batch, up to the maximum spp.
+// power of two, so stratification holds within the batch); then, round by round, pixels whose
+// relative standard error still exceeds the threshold get another batch, up to the maximum spp, or,
+// with a budget of samples, each pixel gets a share proportional to its estimated relative
+// deviation (RenderSettings::adaptive_spp).
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -76,7 +78,7 @@ float relative_error(const PixelSums& pixel);
 // Renders into `film` (sized to the camera's resolution) with settings.integrator: "path" (the path
 // tracer), "bdpt" (bidirectional path tracing; light tracing lands in the film's splats) or "mlt"
 // (Metropolis light transport: settings.spp mutations per pixel, all in the splats).
-// settings.spp samples per pixel, or adaptively when settings.adaptive_threshold > 0 (path, bdpt). Without adaptive sampling the film may already
+// settings.spp samples per pixel, or adaptively when settings.adaptive() (path, bdpt). Without adaptive sampling the film may already
 // hold samples (a resumed checkpoint): each pixel continues from its own sample count, so the result
 // is bitwise the same as one uninterrupted render.
 RenderStats render(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options);

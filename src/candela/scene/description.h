@@ -366,12 +366,21 @@ struct RenderSettings {
   bool mis = true;  // false: light sampling for direct light, emission found by bounces ignored
   LightSelection light_selection = LightSelection::Power;
   int shadow_rays = 1;
-  // Adaptive sampling (sec. 4.3): after every batch of `adaptive_batch` samples (a power of two),
-  // pixels whose relative standard error exceeds the threshold get another batch, up to
-  // `adaptive_max_spp`. 0 = off: every pixel gets `spp`.
+  // Adaptive sampling (sec. 4.3), on when a threshold or a budget is set (then `spp` is unused).
+  // Every pixel first gets `adaptive_batch` samples (a power of two). With a threshold, pixels
+  // whose relative standard error falls below it get no more. With a budget of `adaptive_spp`
+  // samples per pixel on average, the rest of the budget goes, in rounds, to each pixel in
+  // proportion to its estimated relative deviation (the allocation that minimises the image's
+  // relMSE); without a budget every pixel above the threshold gets another batch per round. No
+  // pixel gets more than `adaptive_max_spp` (0: 1024, or 8 x adaptive_spp with a budget).
   float adaptive_threshold = 0;
+  int adaptive_spp = 0;
   int adaptive_batch = 16;
-  int adaptive_max_spp = 1024;
+  int adaptive_max_spp = 0;
+  bool adaptive() const { return adaptive_threshold > 0 || adaptive_spp > 0; }
+  int adaptive_spp_limit() const {
+    return adaptive_max_spp > 0 ? adaptive_max_spp : adaptive_spp > 0 ? 8 * adaptive_spp : 1024;
+  }
   // Metropolis light transport (integrator "mlt"; spp is then the number of mutations per pixel):
   // bootstrap states per depth, independent chains, the deviation of small steps in primary sample
   // space and the probability of a large step (pbrt's defaults).

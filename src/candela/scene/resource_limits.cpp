@@ -36,13 +36,14 @@ uint64_t non_negative(int64_t v) { return v < 0 ? 0 : uint64_t(v); }
 // ---------------------------------------------------------------- film
 
 constexpr uint64_t kOutputBytesPerPixel = 3 * sizeof(float) + 3;  // the mean Image and an 8-bit copy for PNG
-constexpr uint64_t kAdaptiveBytesPerPixel = sizeof(uint8_t) + sizeof(float);  // renderer's active + error
+// The renderer's per-pixel masks, counts, errors and smoothing buffers.
+constexpr uint64_t kAdaptiveBytesPerPixel = 2 * sizeof(uint8_t) + sizeof(int) + sizeof(uint64_t) + 6 * sizeof(double);
 
 uint64_t film_pixels(const FilmDesc& film) { return mul(non_negative(film.width), non_negative(film.height)); }
 
 uint64_t film_bytes(const SceneDesc& desc) {
   uint64_t per_pixel = sizeof(PixelSums) + kOutputBytesPerPixel;
-  if (desc.settings.adaptive_threshold > 0) per_pixel += kAdaptiveBytesPerPixel;
+  if (desc.settings.adaptive()) per_pixel += kAdaptiveBytesPerPixel;
   return mul(film_pixels(desc.film), per_pixel);
 }
 
