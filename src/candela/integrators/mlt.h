@@ -9,7 +9,7 @@
 //      sums; the chains render the depths >= 1 on top of it.
 //   1. Bootstrap: n_bootstrap x (max_depth + 1) independent states with their luminance. The
 //      brightness of each depth (its mean luminance over the film) is estimated separately, by
-//      max(n_bootstrap, mutations / 64) bidirectional samples (all strategies) through a jittered
+//      max(n_bootstrap, mutations / 8) bidirectional samples (all strategies) through a jittered
 //      grid over the film: the bootstrap's own mean estimates the share of small bright regions far
 //      too noisily.
 //   2. Chains: about n_chains chains, shared among the depths in proportion to their brightness (at
