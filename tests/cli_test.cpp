@@ -151,7 +151,7 @@ TEST_F(CommandLine, HelpDocumentsEveryOption) {
                           "--shadow-rays", "--adaptive-threshold", "--adaptive-spp", "--adaptive-batch", "--max-spp", "--spp-map",
                           "--checkpoint", "--checkpoint-every", "--resume", "--time-limit", "--clamp", "--pixel",
                           "--bdpt-strategies", "--bdpt-unweighted", "--mlt-bootstrap", "--mlt-chains", "--mlt-sigma",
-                          "--mlt-large-step"})
+                          "--mlt-large-step", "--mlt-lens", "--mlt-caustic"})
     EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
 }
 
@@ -172,12 +172,12 @@ TEST_F(CommandLine, BidirectionalAndMetropolisIntegrators) {
   EXPECT_TRUE(fs::exists(dir_ / "bdpt_d0_s0_t2.exr"));
   EXPECT_TRUE(fs::exists(dir_ / "bdpt_d1_s2_t1.exr"));
   RunResult mlt = run_cli("render " + scene + " -o " + out() + " --integrator mlt --spp 8 --mlt-bootstrap 500 "
-                          "--mlt-chains 16 --mlt-sigma 0.02 --mlt-large-step 0.5 -q");
+                          "--mlt-chains 16 --mlt-sigma 0.02 --mlt-large-step 0.5 --mlt-lens 0.2 --mlt-caustic 0.1 -q");
   ASSERT_EQ(mlt.exit_code, 0) << mlt.output;
   EXPECT_THAT_MATCHES(mlt.output, "16x12, 8.00 mutations per pixel in");
   auto meta = read_image_metadata(out());
   EXPECT_EQ(meta["candela:integrator"], "mlt");
-  EXPECT_EQ(meta["candela:mlt"], "bootstrap 500 chains 16 sigma 0.02 large-step 0.5");
+  EXPECT_EQ(meta["candela:mlt"], "bootstrap 500 chains 16 sigma 0.02 large-step 0.5 lens 0.2 caustic 0.1");
 }
 
 TEST_F(CommandLine, IntegratorOptionsAreChecked) {
@@ -192,6 +192,8 @@ TEST_F(CommandLine, IntegratorOptionsAreChecked) {
   RunResult range = run_cli("render " + scene + " -o " + out() + " --integrator mlt --mlt-large-step 2");
   EXPECT_NE(range.exit_code, 0);
   EXPECT_THAT_MATCHES(range.output, "--mlt-large-step");
+  expect_failure("render " + scene + " -o " + out() + " --integrator mlt --mlt-large-step 0.5 --mlt-lens 0.4 --mlt-caustic 0.2",
+                 "must be at most 1, got 1.1");
   EXPECT_EQ(previous_output(), "previous render");
 }
 

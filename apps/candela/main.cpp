@@ -79,7 +79,7 @@ struct RenderCommand {
   std::string bdpt_strategies;
   bool bdpt_unweighted = false;
   std::optional<int> mlt_bootstrap, mlt_chains;
-  std::optional<float> mlt_sigma, mlt_large_step;
+  std::optional<float> mlt_sigma, mlt_large_step, mlt_lens, mlt_caustic;
 };
 
 template <typename Enum>
@@ -124,6 +124,11 @@ void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
   if (cmd.mlt_chains) rs.mlt_chains = *cmd.mlt_chains;
   if (cmd.mlt_sigma) rs.mlt_sigma = *cmd.mlt_sigma;
   if (cmd.mlt_large_step) rs.mlt_large_step = *cmd.mlt_large_step;
+  if (cmd.mlt_lens) rs.mlt_lens = *cmd.mlt_lens;
+  if (cmd.mlt_caustic) rs.mlt_caustic = *cmd.mlt_caustic;
+  if (rs.mlt_large_step + rs.mlt_lens + rs.mlt_caustic > 1)
+    throw UsageError(fmt::format("--mlt-large-step + --mlt-lens + --mlt-caustic must be at most 1, got {}",
+                                 rs.mlt_large_step + rs.mlt_lens + rs.mlt_caustic));
   if (cmd.shadow_rays) rs.shadow_rays = *cmd.shadow_rays;
   if (cmd.adaptive_threshold) rs.adaptive_threshold = *cmd.adaptive_threshold;
   if (cmd.adaptive_spp) rs.adaptive_spp = *cmd.adaptive_spp;
@@ -232,8 +237,9 @@ RenderFingerprint make_fingerprint(const std::string& scene_bytes, const SceneDe
       {"clamp", clamp > 0 ? fmt::format("{}", clamp) : "off"},
   };
   if (rs.integrator == "mlt")
-    fp.settings.push_back({"mlt", fmt::format("bootstrap {} chains {} sigma {} large-step {}", rs.mlt_bootstrap,
-                                              rs.mlt_chains, rs.mlt_sigma, rs.mlt_large_step)});
+    fp.settings.push_back({"mlt", fmt::format("bootstrap {} chains {} sigma {} large-step {} lens {} caustic {}",
+                                              rs.mlt_bootstrap, rs.mlt_chains, rs.mlt_sigma, rs.mlt_large_step,
+                                              rs.mlt_lens, rs.mlt_caustic)});
   return fp;
 }
 
@@ -403,8 +409,10 @@ int run_render(const RenderCommand& cmd) {
   if (stats.time_limited) metadata["candela:time-limited"] = "true";
   if (clamp > 0) metadata["candela:clamp"] = fmt::format("{}", clamp);
   if (non_finite > 0) metadata["candela:non_finite_samples"] = std::to_string(non_finite);
-  if (mlt) metadata["candela:mlt"] = fmt::format("bootstrap {} chains {} sigma {} large-step {}", desc.settings.mlt_bootstrap,
-                                                desc.settings.mlt_chains, desc.settings.mlt_sigma, desc.settings.mlt_large_step);
+  if (mlt) metadata["candela:mlt"] = fmt::format(
+      "bootstrap {} chains {} sigma {} large-step {} lens {} caustic {}", desc.settings.mlt_bootstrap,
+      desc.settings.mlt_chains, desc.settings.mlt_sigma, desc.settings.mlt_large_step, desc.settings.mlt_lens,
+      desc.settings.mlt_caustic);
   Image image = film.mean_image();
   for (const auto& f : outputs) write_image(f, image, metadata);
   // One image per strategy: bdpt_d<depth>_s<s>_t<t>.exr, scaled like the light image.
@@ -472,6 +480,13 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1e-6, 1.0));
   render_cmd->add_option("--mlt-large-step", cmd.mlt_large_step,
                          "mlt: probability of a large step (default 0.3)")
+      ->check(CLI::Range(0.0, 1.0));
+  render_cmd->add_option("--mlt-lens", cmd.mlt_lens,
+                         "mlt: probability of a lens perturbation (only the film position moves; default 0)")
+      ->check(CLI::Range(0.0, 1.0));
+  render_cmd->add_option("--mlt-caustic", cmd.mlt_caustic,
+                         "mlt: probability of a caustic perturbation (only the direction leaving the light moves; "
+                         "default 0)")
       ->check(CLI::Range(0.0, 1.0));
   render_cmd->add_option("--sampler", cmd.sampler,
                          "Pixel sampler: random (independent), stratified (jittered, every dimension), "

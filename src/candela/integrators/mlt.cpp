@@ -190,7 +190,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
       for (uint64_t i = range.begin(); i < range.end(); ++i) {
         int depth = int(i % uint64_t(depths));
         if (depth == 0) continue;  // rendered directly above
-        MltSampler sampler(settings.seed, i, settings.mlt_sigma, settings.mlt_large_step);
+        MltSampler sampler(settings.seed, i, settings.mlt_sigma);
         weights[i] = paths.sample(sampler, depth, counts).luminance();
       }
       progress.advance(range.size());
@@ -258,6 +258,12 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
     float scale = 0;
     float brightness = 0;  // the depth's mean luminance b_d
   };
+  // The perturbations move the film position (camera stream number 1, after the strategy) and the
+  // direction leaving the light (light stream numbers 3-4, after the light's choice and the point on it).
+  const MltMutationProbabilities mutations{settings.mlt_large_step, settings.mlt_lens, settings.mlt_caustic};
+  const PerspectiveCamera& camera = scene.camera();
+  const MltPerturbedNumbers perturbed{1, 3, {float(camera.width()) + 2 * camera.margin().x,
+                                             float(camera.height()) + 2 * camera.margin().y}};
   std::vector<Chain> chain_states;
   chain_states.reserve(chains);
   for (size_t d = 0; d < size_t(depths); ++d)
@@ -266,7 +272,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
       Rng pick(c, hash_values(settings.seed, 0x7374617274));
       float u = std::min((float(k) + pick.next_float()) / float(depth_chains[d]), 0x1.fffffep-1f);
       size_t index = depth_bootstrap[d].sample(u) * size_t(depths) + d;
-      chain_states.push_back(Chain{MltSampler(settings.seed, index, settings.mlt_sigma, settings.mlt_large_step),
+      chain_states.push_back(Chain{MltSampler(settings.seed, index, settings.mlt_sigma, mutations, perturbed),
                                    Rng(c, hash_values(settings.seed, 0x636861696e)), PathState{}, int(d), 0});
     }
   // Deposits are kept near 1 (relative to the largest depth scale) for the fixed-point splat sums.

@@ -662,6 +662,11 @@ class JsonSceneReader {
     settings.mlt_sigma = object.number_or("sigma", settings.mlt_sigma, Bound::Positive);
     if (settings.mlt_sigma > 1) report_.fail(object.pointer_of("sigma"), "sigma must be at most 1, got {}", settings.mlt_sigma);
     settings.mlt_large_step = object.number_or("large_step", settings.mlt_large_step, Bound::UnitInterval);
+    settings.mlt_lens = object.number_or("lens", settings.mlt_lens, Bound::UnitInterval);
+    settings.mlt_caustic = object.number_or("caustic", settings.mlt_caustic, Bound::UnitInterval);
+    if (settings.mlt_large_step + settings.mlt_lens + settings.mlt_caustic > 1)
+      report_.fail(pointer, "large_step + lens + caustic must be at most 1, got {}",
+                   settings.mlt_large_step + settings.mlt_lens + settings.mlt_caustic);
     object.finish();
   }
 

@@ -139,12 +139,14 @@ TEST(JsonReader, ReadsCameraAndRenderSettings) {
 
 TEST(JsonReader, ReadsMetropolisSettings) {
   SceneDesc scene = read(R"({"render": {"integrator": "mlt", "spp": 64,
-    "mlt": {"bootstrap": 5000, "chains": 32, "sigma": 0.02, "large_step": 0.5}}})");
+    "mlt": {"bootstrap": 5000, "chains": 32, "sigma": 0.02, "large_step": 0.5, "lens": 0.25, "caustic": 0.125}}})");
   EXPECT_EQ(scene.settings.integrator, "mlt");
   EXPECT_EQ(scene.settings.mlt_bootstrap, 5000);
   EXPECT_EQ(scene.settings.mlt_chains, 32);
   EXPECT_FLOAT_EQ(scene.settings.mlt_sigma, 0.02f);
   EXPECT_FLOAT_EQ(scene.settings.mlt_large_step, 0.5f);
+  EXPECT_FLOAT_EQ(scene.settings.mlt_lens, 0.25f);
+  EXPECT_FLOAT_EQ(scene.settings.mlt_caustic, 0.125f);
   SceneDesc defaults = read(R"({"render": {"integrator": "bdpt"}})");
   EXPECT_EQ(defaults.settings.integrator, "bdpt");
   EXPECT_EQ(defaults.settings.mlt_bootstrap, 100000);
@@ -153,6 +155,9 @@ TEST(JsonReader, ReadsMetropolisSettings) {
   EXPECT_NE(error_of(R"({"render": {"mlt": {"sigma": 2}}})").find("sigma must be at most 1"), std::string::npos);
   EXPECT_NE(error_of(R"({"render": {"mlt": {"large_step": 1.5}}})").find("/render/mlt/large_step"), std::string::npos);
   EXPECT_NE(error_of(R"({"render": {"mlt": {"mutations": 5}}})").find("mutations"), std::string::npos);
+  EXPECT_NE(error_of(R"({"render": {"mlt": {"large_step": 0.5, "lens": 0.5, "caustic": 0.25}}})")
+                .find("at /render/mlt: large_step + lens + caustic must be at most 1, got 1.25"),
+            std::string::npos);
 }
 
 TEST(JsonReader, ReadsLensShutterAndMotion) {

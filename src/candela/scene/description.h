@@ -383,11 +383,14 @@ struct RenderSettings {
   }
   // Metropolis light transport (integrator "mlt"; spp is then the number of mutations per pixel):
   // bootstrap states per depth, independent chains, the deviation of small steps in primary sample
-  // space and the probability of a large step (pbrt's defaults).
+  // space and the probability of a large step (pbrt's defaults), and the probabilities of a lens
+  // and of a caustic perturbation (mlt_sampler.h); the rest are small steps.
   int mlt_bootstrap = 100000;
   int mlt_chains = 1000;
   float mlt_sigma = 0.01f;
   float mlt_large_step = 0.3f;
+  float mlt_lens = 0;
+  float mlt_caustic = 0;
 };
 
 struct SceneDesc {
