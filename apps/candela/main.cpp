@@ -433,9 +433,9 @@ int run_render(const RenderCommand& cmd) {
               double(stats.rays.total()) / seconds * 1e-6,
               double(stats.rays.total()) / double(std::max<uint64_t>(stats.samples, 1)), written.c_str());
   if (stats.time_limited)
-    std::fprintf(stderr, "candela: time limit reached: wrote the image with %s spp\n", spp_text.c_str());
+    std::fprintf(stderr, "candela: time limit reached: wrote the image with %s%s\n", spp_text.c_str(), mlt ? "" : " spp");
   if (stats.cancelled) {
-    std::fprintf(stderr, "candela: interrupted: wrote the image with %s spp%s\n", spp_text.c_str(),
+    std::fprintf(stderr, "candela: interrupted: wrote the image with %s%s%s\n", spp_text.c_str(), mlt ? "" : " spp",
                  cmd.checkpoint.empty() ? "" : fmt::format(" and checkpoint {}", cmd.checkpoint).c_str());
     return kExitInterrupted;
   }

@@ -80,7 +80,7 @@ struct Normalization {
 
 Normalization estimate_normalization(const Scene& scene, const BdptIntegrator& bdpt, const RenderSettings& settings,
                                      tbb::task_arena& arena, tbb::enumerable_thread_specific<RayCounts>& ray_counts,
-                                     uint64_t samples) {
+                                     uint64_t samples, uint64_t batch = 0) {
   const PerspectiveCamera& camera = scene.camera();
   const Vec2 margin = camera.margin();
   const float width = float(camera.width()) + 2 * margin.x, height = float(camera.height()) + 2 * margin.y;
@@ -97,7 +97,8 @@ Normalization estimate_normalization(const Scene& scene, const BdptIntegrator& b
       camera_path.resize(size_t(max_depth) + 2);
       light_path.resize(size_t(max_depth) + 1);
       RayCounts& counts = ray_counts.local();
-      IndependentSampler sampler(hash_values(settings.seed, 0x6e6f726d));
+      IndependentSampler sampler(batch == 0 ? hash_values(settings.seed, 0x6e6f726d)
+                                            : hash_values(settings.seed, 0x6e6f726d, batch));
       for (uint64_t i = range.begin(); i < range.end(); ++i) {
         int cx = int(i % uint64_t(gx)), cy = int(i / uint64_t(gx));
         sampler.start_pixel_sample(cx, cy, 0);
@@ -209,8 +210,28 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   const BdptIntegrator bdpt_with_roulette(scene, settings);
   const uint64_t normalization_samples = std::max<uint64_t>(
       uint64_t(settings.mlt_bootstrap), options.time_limit_seconds > 0 ? 0 : total_mutations / 8);
-  const Normalization normalization =
+  Normalization normalization =
       estimate_normalization(scene, bdpt_with_roulette, settings, arena, ray_counts, normalization_samples);
+  // Under a time limit the number of mutations is not known: further independent batches of
+  // mlt_bootstrap samples, averaged, until about a ninth of the time is spent (1 sample per 8
+  // mutations costs about that much).
+  if (options.time_limit_seconds > 0) {
+    double sum_sq_error = std::pow(normalization.relative_error * normalization.value, 2);
+    uint64_t batches = 1;
+    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count(); };
+    while (elapsed() < options.time_limit_seconds / 9 && !cancelled()) {
+      Normalization more = estimate_normalization(scene, bdpt_with_roulette, settings, arena, ray_counts,
+                                                  normalization_samples, batches);
+      double k = double(batches);
+      for (size_t d = 0; d < normalization.per_depth.size(); ++d)
+        normalization.per_depth[d] = (normalization.per_depth[d] * k + more.per_depth[d]) / (k + 1);
+      normalization.value = (normalization.value * k + more.value) / (k + 1);
+      sum_sq_error += std::pow(more.relative_error * more.value, 2);
+      ++batches;
+    }
+    normalization.relative_error =
+        normalization.value > 0 ? std::sqrt(sum_sq_error) / double(batches) / normalization.value : 0;
+  }
   const double b = normalization.value;
   stats.mlt_normalization = b;
   stats.mlt_normalization_relative_error = normalization.relative_error;
