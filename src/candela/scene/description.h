@@ -2,6 +2,7 @@
 // The format-neutral scene description: plain structs with defaults that every reader (JSON, pbrt-v4,
 // later Mitsuba and glTF) fills in and that scene/build turns into a render scene. Nothing after this
 // point knows which file format a scene came from. Units are whatever the scene uses; colours are linear RGB.
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -379,7 +380,8 @@ struct RenderSettings {
   int adaptive_max_spp = 0;
   bool adaptive() const { return adaptive_threshold > 0 || adaptive_spp > 0; }
   int adaptive_spp_limit() const {
-    return adaptive_max_spp > 0 ? adaptive_max_spp : adaptive_spp > 0 ? 8 * adaptive_spp : 1024;
+    if (adaptive_max_spp > 0) return adaptive_max_spp;
+    return adaptive_spp > 0 ? int(std::min<int64_t>(8 * int64_t(adaptive_spp), 0x7fffffff)) : 1024;
   }
   // Metropolis light transport (integrator "mlt"; spp is then the number of mutations per pixel):
   // bootstrap states per depth, independent chains, the deviation of small steps in primary sample
