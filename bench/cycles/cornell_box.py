@@ -1,0 +1,148 @@
+"""Builds the Cornell box of ../shared/scenes/cornell-box/SPEC.md in Blender and renders it with
+Cycles on the CPU, with the settings of a fair comparison: no adaptive sampling, no denoising, no
+clamping, box pixel filter of width 1, 16 bounces of every kind, a fixed thread count, linear
+float EXR output. Prints "cycles render seconds: S" (the render alone, scene set-up excluded).
+
+Usage: blender -b --factory-startup --python bench/cycles/cornell_box.py -- \
+           --spp 256 --threads 2 --seed 1 --resolution 512 --out cornell-cycles.exr
+"""
+import argparse
+import sys
+import time
+
+import bpy
+
+# SPEC.md: millimetres, y up, right-handed, camera looking along +z. Blender is z up: rotate by +90
+# degrees about x, (x, y, z) -> (x, -z, y), which keeps the handedness.
+def to_blender(p):
+    x, y, z = p
+    return (x, -z, y)
+
+
+QUADS = {
+    "floor": ("white", [(552.8, 0, 0), (0, 0, 0), (0, 0, 559.2), (549.6, 0, 559.2)]),
+    "ceiling": ("white", [(556, 548.8, 0), (556, 548.8, 559.2), (0, 548.8, 559.2), (0, 548.8, 0)]),
+    "back wall": ("white", [(549.6, 0, 559.2), (0, 0, 559.2), (0, 548.8, 559.2), (556, 548.8, 559.2)]),
+    "right wall": ("green", [(0, 0, 559.2), (0, 0, 0), (0, 548.8, 0), (0, 548.8, 559.2)]),
+    "left wall": ("red", [(552.8, 0, 0), (549.6, 0, 559.2), (556, 548.8, 559.2), (556, 548.8, 0)]),
+    "short top": ("white", [(130, 165, 65), (82, 165, 225), (240, 165, 272), (290, 165, 114)]),
+    "short 1": ("white", [(290, 0, 114), (290, 165, 114), (240, 165, 272), (240, 0, 272)]),
+    "short 2": ("white", [(130, 0, 65), (130, 165, 65), (290, 165, 114), (290, 0, 114)]),
+    "short 3": ("white", [(82, 0, 225), (82, 165, 225), (130, 165, 65), (130, 0, 65)]),
+    "short 4": ("white", [(240, 0, 272), (240, 165, 272), (82, 165, 225), (82, 0, 225)]),
+    "tall top": ("white", [(423, 330, 247), (265, 330, 296), (314, 330, 456), (472, 330, 406)]),
+    "tall 1": ("white", [(423, 0, 247), (423, 330, 247), (472, 330, 406), (472, 0, 406)]),
+    "tall 2": ("white", [(472, 0, 406), (472, 330, 406), (314, 330, 456), (314, 0, 456)]),
+    "tall 3": ("white", [(314, 0, 456), (314, 330, 456), (265, 330, 296), (265, 0, 296)]),
+    "tall 4": ("white", [(265, 0, 296), (265, 330, 296), (423, 330, 247), (423, 0, 247)]),
+    "light": ("light", [(343, 548.7, 227), (343, 548.7, 332), (213, 548.7, 332), (213, 548.7, 227)]),
+}
+ALBEDO = {"white": (0.725, 0.71, 0.68), "red": (0.63, 0.065, 0.05), "green": (0.14, 0.45, 0.091)}
+LIGHT_RADIANCE = (17.0, 12.0, 4.0)
+
+
+def diffuse_material(name, rgb):
+    m = bpy.data.materials.new(name)
+    m.use_nodes = True
+    nodes = m.node_tree.nodes
+    nodes.clear()
+    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
+    bsdf.inputs["Color"].default_value = (*rgb, 1.0)
+    bsdf.inputs["Roughness"].default_value = 0.0  # Lambertian (not Oren-Nayar)
+    out = nodes.new("ShaderNodeOutputMaterial")
+    m.node_tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
+    return m
+
+
+def emission_material(name, radiance):
+    m = bpy.data.materials.new(name)
+    m.use_nodes = True
+    nodes = m.node_tree.nodes
+    nodes.clear()
+    emission = nodes.new("ShaderNodeEmission")
+    peak = max(radiance)
+    emission.inputs["Color"].default_value = (*[c / peak for c in radiance], 1.0)
+    emission.inputs["Strength"].default_value = peak  # radiance = colour x strength
+    out = nodes.new("ShaderNodeOutputMaterial")
+    m.node_tree.links.new(emission.outputs["Emission"], out.inputs["Surface"])
+    return m
+
+
+def build_scene(resolution):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    materials = {name: diffuse_material(name, rgb) for name, rgb in ALBEDO.items()}
+    materials["light"] = emission_material("light", LIGHT_RADIANCE)
+    for name, (material, quad) in QUADS.items():
+        mesh = bpy.data.meshes.new(name)
+        mesh.from_pydata([to_blender(p) for p in quad], [], [(0, 1, 2, 3)])
+        mesh.materials.append(materials[material])
+        obj = bpy.data.objects.new(name, mesh)
+        scene.collection.objects.link(obj)
+    # Camera at (278, 273, -800) looking along +z with y up; 35 mm lens on a 25 mm square film.
+    cam_data = bpy.data.cameras.new("camera")
+    cam_data.lens = 35.0
+    cam_data.sensor_fit = "HORIZONTAL"
+    cam_data.sensor_width = 25.0
+    cam_data.clip_start = 1.0
+    cam_data.clip_end = 1e5
+    cam = bpy.data.objects.new("camera", cam_data)
+    cam.location = to_blender((278, 273, -800))
+    # A Blender camera looks along its local -z with +y up: 90 degrees about x makes it look along
+    # world +y with +z (SPEC's +y) up, then 180 degrees about z along world -y (SPEC's +z), with
+    # image right along world -x (SPEC: +x is the image's left).
+    cam.rotation_euler = (1.5707963267948966, 0.0, 3.141592653589793)
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    world = bpy.data.worlds.new("black")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    scene.world = world
+
+    r = scene.render
+    r.engine = "CYCLES"
+    r.resolution_x = r.resolution_y = resolution
+    r.resolution_percentage = 100
+    r.image_settings.file_format = "OPEN_EXR"
+    r.image_settings.color_depth = "32"
+    r.image_settings.color_mode = "RGB"
+    r.use_compositing = False
+    r.use_sequencer = False
+    scene.view_settings.view_transform = "Standard"
+    c = scene.cycles
+    c.device = "CPU"
+    c.use_adaptive_sampling = False
+    c.use_denoising = False
+    c.sample_clamp_direct = 0.0
+    c.sample_clamp_indirect = 0.0
+    c.pixel_filter_type = "BOX"
+    c.filter_width = 1.0
+    c.max_bounces = 16
+    c.diffuse_bounces = c.glossy_bounces = c.transmission_bounces = 16
+    c.volume_bounces = c.transparent_max_bounces = 16
+    c.caustics_reflective = c.caustics_refractive = True
+    c.blur_glossy = 0.0
+    return scene
+
+
+def main():
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    p = argparse.ArgumentParser()
+    p.add_argument("--spp", type=int, default=256)
+    p.add_argument("--threads", type=int, default=2)
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--resolution", type=int, default=512)
+    p.add_argument("--out", required=True)
+    a = p.parse_args(argv)
+    scene = build_scene(a.resolution)
+    scene.cycles.samples = a.spp
+    scene.cycles.seed = a.seed
+    scene.render.threads_mode = "FIXED"
+    scene.render.threads = a.threads
+    scene.render.filepath = a.out
+    start = time.perf_counter()
+    bpy.ops.render.render(write_still=True)
+    print(f"cycles render seconds: {time.perf_counter() - start:.3f}", flush=True)
+
+
+main()
