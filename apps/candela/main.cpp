@@ -390,11 +390,13 @@ int run_render(const RenderCommand& cmd) {
   if (mlt)
     spp_text = fmt::format("{:.2f} mutations per pixel", double(stats.samples) / pixels);
   else if (adaptive && !stopped)
-    spp_text = fmt::format("adaptive, {:.2f} on average", mean_spp);
+    spp_text = fmt::format("adaptive, {:.2f} spp on average", mean_spp);
   else if (min_spp == max_spp)
     spp_text = std::to_string(min_spp);
   else
     spp_text = fmt::format("min {}, mean {:.2f}", min_spp, mean_spp);
+  // Appended where the text is a bare count.
+  const char* spp_unit = mlt || spp_text.find("spp") != std::string::npos ? "" : " spp";
   std::map<std::string, std::string> metadata = {
       {"candela:scene", cmd.scene_file.empty() ? "<built-in cornell-box.json>" : cmd.scene_file},
       {"candela:spp", spp_text},
@@ -429,13 +431,13 @@ int run_render(const RenderCommand& cmd) {
   std::string written;
   for (const auto& f : outputs) written += (written.empty() ? "" : ", ") + f.string();
   std::printf("%dx%d, %s%s in %.2f s: %.3f Msamples/s, %.2f Mrays/s (%.3g rays/sample) -> %s\n", desc.film.width,
-              desc.film.height, spp_text.c_str(), mlt ? "" : " spp", stats.seconds, double(stats.samples) / seconds * 1e-6,
+              desc.film.height, spp_text.c_str(), spp_unit, stats.seconds, double(stats.samples) / seconds * 1e-6,
               double(stats.rays.total()) / seconds * 1e-6,
               double(stats.rays.total()) / double(std::max<uint64_t>(stats.samples, 1)), written.c_str());
   if (stats.time_limited)
-    std::fprintf(stderr, "candela: time limit reached: wrote the image with %s%s\n", spp_text.c_str(), mlt ? "" : " spp");
+    std::fprintf(stderr, "candela: time limit reached: wrote the image with %s%s\n", spp_text.c_str(), spp_unit);
   if (stats.cancelled) {
-    std::fprintf(stderr, "candela: interrupted: wrote the image with %s%s%s\n", spp_text.c_str(), mlt ? "" : " spp",
+    std::fprintf(stderr, "candela: interrupted: wrote the image with %s%s%s\n", spp_text.c_str(), spp_unit,
                  cmd.checkpoint.empty() ? "" : fmt::format(" and checkpoint {}", cmd.checkpoint).c_str());
     return kExitInterrupted;
   }
