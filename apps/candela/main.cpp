@@ -387,16 +387,17 @@ int run_render(const RenderCommand& cmd) {
   const uint64_t min_spp = film.min_samples(), max_spp = film.max_samples();
   const double mean_spp = double(film.total_samples()) / pixels;
   std::string spp_text;
-  if (mlt)
+  const char* spp_unit = " spp";  // appended in messages where spp_text is a bare count
+  if (mlt) {
     spp_text = fmt::format("{:.2f} mutations per pixel", double(stats.samples) / pixels);
-  else if (adaptive && !stopped)
+    spp_unit = "";
+  } else if (adaptive && !stopped) {
     spp_text = fmt::format("adaptive, {:.2f} spp on average", mean_spp);
-  else if (min_spp == max_spp)
+    spp_unit = "";
+  } else if (min_spp == max_spp)
     spp_text = std::to_string(min_spp);
   else
     spp_text = fmt::format("min {}, mean {:.2f}", min_spp, mean_spp);
-  // Appended where the text is a bare count.
-  const char* spp_unit = mlt || spp_text.find("spp") != std::string::npos ? "" : " spp";
   std::map<std::string, std::string> metadata = {
       {"candela:scene", cmd.scene_file.empty() ? "<built-in cornell-box.json>" : cmd.scene_file},
       {"candela:spp", spp_text},

@@ -41,31 +41,28 @@ ALBEDO = {"white": (0.725, 0.71, 0.68), "red": (0.63, 0.065, 0.05), "green": (0.
 LIGHT_RADIANCE = (17.0, 12.0, 4.0)
 
 
-def diffuse_material(name, rgb):
+def shader_material(name, node_type, inputs, output):
+    """A material whose surface is one shader node with the given input values."""
     m = bpy.data.materials.new(name)
     m.use_nodes = True
-    nodes = m.node_tree.nodes
-    nodes.clear()
-    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
-    bsdf.inputs["Color"].default_value = (*rgb, 1.0)
-    bsdf.inputs["Roughness"].default_value = 0.0  # Lambertian (not Oren-Nayar)
-    out = nodes.new("ShaderNodeOutputMaterial")
-    m.node_tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
+    m.node_tree.nodes.clear()
+    shader = m.node_tree.nodes.new(node_type)
+    for key, value in inputs.items():
+        shader.inputs[key].default_value = value
+    out = m.node_tree.nodes.new("ShaderNodeOutputMaterial")
+    m.node_tree.links.new(shader.outputs[output], out.inputs["Surface"])
     return m
+
+
+def diffuse_material(name, rgb):
+    # Roughness 0: Lambertian, not Oren-Nayar.
+    return shader_material(name, "ShaderNodeBsdfDiffuse", {"Color": (*rgb, 1.0), "Roughness": 0.0}, "BSDF")
 
 
 def emission_material(name, radiance):
-    m = bpy.data.materials.new(name)
-    m.use_nodes = True
-    nodes = m.node_tree.nodes
-    nodes.clear()
-    emission = nodes.new("ShaderNodeEmission")
-    peak = max(radiance)
-    emission.inputs["Color"].default_value = (*[c / peak for c in radiance], 1.0)
-    emission.inputs["Strength"].default_value = peak  # radiance = colour x strength
-    out = nodes.new("ShaderNodeOutputMaterial")
-    m.node_tree.links.new(emission.outputs["Emission"], out.inputs["Surface"])
-    return m
+    peak = max(radiance)  # radiance = colour x strength
+    return shader_material(name, "ShaderNodeEmission",
+                           {"Color": (*[c / peak for c in radiance], 1.0), "Strength": peak}, "Emission")
 
 
 def build_scene(resolution):

@@ -32,6 +32,12 @@ class MltPathSampler {
  public:
   MltPathSampler(const Scene& scene, const BdptIntegrator& bdpt) : scene_(scene), bdpt_(bdpt) {}
 
+  // The numbers the perturbations move: the film position is the camera stream's numbers 1-2 (after
+  // the strategy, drawn at every depth >= 1, the only depths chains run), the direction leaving the
+  // light the light stream's numbers 3-4 (BdptIntegrator::light_subpath draws the light, the point
+  // on it, then the direction).
+  static constexpr int kFilmNumber = 1, kLightDirectionNumber = 3;
+
   PathState sample(MltSampler& sampler, int depth, RayCounts& counts) const {
     thread_local std::vector<BdptVertex> camera_path, light_path;
     camera_path.resize(size_t(depth) + 2);
@@ -279,12 +285,11 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
     float scale = 0;
     float brightness = 0;  // the depth's mean luminance b_d
   };
-  // The perturbations move the film position (camera stream number 1, after the strategy) and the
-  // direction leaving the light (light stream numbers 3-4, after the light's choice and the point on it).
   const MltMutationProbabilities mutations{settings.mlt_large_step, settings.mlt_lens, settings.mlt_caustic};
   const PerspectiveCamera& camera = scene.camera();
-  const MltPerturbedNumbers perturbed{1, 3, {float(camera.width()) + 2 * camera.margin().x,
-                                             float(camera.height()) + 2 * camera.margin().y}};
+  const MltPerturbedNumbers perturbed{MltPathSampler::kFilmNumber, MltPathSampler::kLightDirectionNumber,
+                                      {float(camera.width()) + 2 * camera.margin().x,
+                                       float(camera.height()) + 2 * camera.margin().y}};
   std::vector<Chain> chain_states;
   chain_states.reserve(chains);
   for (size_t d = 0; d < size_t(depths); ++d)

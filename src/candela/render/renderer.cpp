@@ -280,8 +280,8 @@ void render_adaptive(const PassContext& pc, const std::vector<Tile>& tiles, tbb:
           size_t i = size_t(y) * w + x;
           const PixelSums& p = film.pixel(x, y);
           count[i] = p.count;
-          error[i] = relative_error(p);
-          deviation_sq[i] = relative_deviation_sq(p);
+          if (settings.adaptive_threshold > 0) error[i] = relative_error(p);
+          if (budget > 0) deviation_sq[i] = relative_deviation_sq(p);
         }
       });
     });

@@ -4,6 +4,7 @@
 // point knows which file format a scene came from. Units are whatever the scene uses; colours are linear RGB.
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <variant>
@@ -381,7 +382,7 @@ struct RenderSettings {
   bool adaptive() const { return adaptive_threshold > 0 || adaptive_spp > 0; }
   int adaptive_spp_limit() const {
     if (adaptive_max_spp > 0) return adaptive_max_spp;
-    return adaptive_spp > 0 ? int(std::min<int64_t>(8 * int64_t(adaptive_spp), 0x7fffffff)) : 1024;
+    return adaptive_spp > 0 ? int(std::min<int64_t>(8 * int64_t(adaptive_spp), std::numeric_limits<int>::max())) : 1024;
   }
   // Metropolis light transport (integrator "mlt"; spp is then the number of mutations per pixel):
   // bootstrap states per depth, independent chains, the deviation of small steps in primary sample
