@@ -216,15 +216,18 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   const BdptIntegrator bdpt_with_roulette(scene, settings);
   const uint64_t normalization_samples = std::max<uint64_t>(
       uint64_t(settings.mlt_bootstrap), options.time_limit_seconds > 0 ? 0 : total_mutations / 8);
+  const auto normalization_start = std::chrono::steady_clock::now();
   Normalization normalization =
       estimate_normalization(scene, bdpt_with_roulette, settings, arena, ray_counts, normalization_samples);
   // Under a time limit the number of mutations is not known: further independent batches of
-  // mlt_bootstrap samples, averaged, until about a ninth of the time is spent (1 sample per 8
-  // mutations costs about that much).
+  // mlt_bootstrap samples, averaged, until the normalisation has taken about a ninth of the time
+  // (1 sample per 8 mutations costs about that much).
   if (options.time_limit_seconds > 0) {
     double sum_sq_error = std::pow(normalization.relative_error * normalization.value, 2);
     uint64_t batches = 1;
-    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count(); };
+    auto elapsed = [&] {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - normalization_start).count();
+    };
     while (elapsed() < options.time_limit_seconds / 9 && !cancelled()) {
       Normalization more = estimate_normalization(scene, bdpt_with_roulette, settings, arena, ray_counts,
                                                   normalization_samples, batches);
