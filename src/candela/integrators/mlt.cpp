@@ -222,9 +222,9 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   // Under a time limit the number of mutations is not known: further independent batches of
   // mlt_bootstrap samples, averaged, until the normalisation has taken about a ninth of the time
   // (1 sample per 8 mutations costs about that much).
+  uint64_t batches = 1;
   if (options.time_limit_seconds > 0) {
     double sum_sq_error = std::pow(normalization.relative_error * normalization.value, 2);
-    uint64_t batches = 1;
     auto elapsed = [&] {
       return std::chrono::duration<double>(std::chrono::steady_clock::now() - normalization_start).count();
     };
@@ -244,6 +244,9 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   const double b = normalization.value;
   stats.mlt_normalization = b;
   stats.mlt_normalization_relative_error = normalization.relative_error;
+  stats.mlt_normalization_samples = normalization_samples * batches;
+  stats.mlt_normalization_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - normalization_start).count();
   if (!(b > 0) || !(sum > 0)) {
     progress.finish();
     film.set_splat_scale(0);

@@ -61,8 +61,10 @@ struct RenderStats {
   bool time_limited = false;                      // stopped by the time limit before all samples
   RayCounts rays;
   // Integrator "mlt": the estimate of the image's mean luminance that scales the chains' deposits,
-  // and its standard error relative to it.
+  // its standard error relative to it, the samples it took and the seconds they took.
   double mlt_normalization = 0, mlt_normalization_relative_error = 0;
+  uint64_t mlt_normalization_samples = 0;
+  double mlt_normalization_seconds = 0;
 };
 
 // Names of the integrators, for messages: "path, bdpt, mlt".
