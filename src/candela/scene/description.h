@@ -72,7 +72,13 @@ struct MixTexture {
   FloatInput amount{0.5f};
 };
 
-using TextureDesc = std::variant<ImageTexture, CheckerboardTexture, ScaleTexture, MixTexture>;
+// A value stored on the mesh itself (Mitsuba's mesh_attribute): TriangleMesh::attributes[name],
+// per vertex (interpolated with the hit's barycentrics) or per face. Zero on other shapes.
+struct MeshAttributeTexture {
+  std::string name;  // without the "vertex_" / "face_" prefix
+};
+
+using TextureDesc = std::variant<ImageTexture, CheckerboardTexture, ScaleTexture, MixTexture, MeshAttributeTexture>;
 
 // ---------------------------------------------------------------- materials
 
@@ -98,6 +104,10 @@ struct MirrorMaterial {
   ColorInput reflectance{RGB(1.0f)};
 };
 
+// The microfacet normal distribution: Trowbridge-Reitz (GGX, the default) or Beckmann (Mitsuba's
+// "beckmann"); alpha has the usual meaning for each (Beckmann: the RMS slope).
+enum class MicrofacetDistribution { GGX, Beckmann };
+
 // Microfacet roughness: the Trowbridge-Reitz (GGX) alpha along the shading frame's u and v axes.
 // alpha < 1e-3 on both axes is treated as perfectly smooth (a delta BSDF), as pbrt-v4 does.
 // remap = true reads u, v as pbrt's "roughness" and uses alpha = sqrt(roughness) (pbrt-v4's
@@ -105,6 +115,7 @@ struct MirrorMaterial {
 struct Roughness {
   FloatInput u{0.0f}, v{0.0f};
   bool remap = false;
+  MicrofacetDistribution distribution = MicrofacetDistribution::GGX;
 };
 
 // Metal: Fresnel reflection of a conductor with complex index of refraction eta + i k (per RGB
@@ -154,9 +165,72 @@ struct BlackMaterial {};
 // while keeping it as an emitter.
 struct InterfaceMaterial {};
 
+// Mitsuba 3's principled BSDF (after the Disney BSDF, Burley 2015), with Mitsuba's exact definitions
+// of every lobe and of how the parameters combine; `thin` selects Mitsuba's principledthin (a thin
+// sheet: diffuse and specular transmission without refraction). glTF's metallic-roughness model is
+// this with specular 0.5 and the other lobes off.
+struct PrincipledMaterial {
+  ColorInput base_color{RGB(0.5f)};
+  FloatInput roughness{0.5f};
+  FloatInput metallic{0.0f};
+  FloatInput specular{0.5f};       // ignored where eta is given (eta_given)
+  FloatInput specular_tint{0.0f};
+  FloatInput anisotropic{0.0f};
+  FloatInput sheen{0.0f};
+  FloatInput sheen_tint{0.0f};
+  FloatInput clearcoat{0.0f};
+  FloatInput clearcoat_gloss{0.0f};
+  FloatInput spec_trans{0.0f};
+  float eta = 1.5f;
+  bool eta_given = false;
+  // principledthin only:
+  bool thin = false;
+  FloatInput diff_trans{0.0f};
+  FloatInput flatness{0.0f};
+};
+
+// Wrappers around another material (indices into SceneDesc::materials, always smaller than the
+// wrapper's own index). Mitsuba's BSDFs are one-sided unless wrapped in "twosided"; candela's are
+// two-sided, so a reader of Mitsuba scenes wraps its opaque BSDFs in OneSidedMaterial.
+
+// The material seen from the front (the side the shading normal points to); black from the back.
+struct OneSidedMaterial {
+  int material = -1;
+};
+
+// Alpha masking (Mitsuba's "mask"): with probability 1 - opacity the surface is not there and the
+// ray passes straight through; otherwise `material` scatters.
+struct MaskMaterial {
+  FloatInput opacity{1.0f};
+  int material = -1;
+};
+
+// f = (1 - weight) f_material0 + weight f_material1 (Mitsuba's "blendbsdf").
+struct BlendMaterial {
+  FloatInput weight{0.5f};
+  int material0 = -1, material1 = -1;
+};
+
+// Shading normals from a tangent-space normal map (Mitsuba's "normalmap"): the texture's RGB in
+// [0, 1], read without any colour decoding, is n = 2 rgb - 1 in the frame (dp/du, dp/dv, n).
+struct NormalMapMaterial {
+  int normal_map = -1;  // index into SceneDesc::textures
+  int material = -1;
+};
+
+// Shading normals from a height field (Mitsuba's "bumpmap"): the surface displaced by
+// scale * height(u, v) along its normal; the height texture's finite differences in u and v tilt
+// the normal.
+struct BumpMapMaterial {
+  int height = -1;  // index into SceneDesc::textures (its channel average is the height)
+  float scale = 1;
+  int material = -1;
+};
+
 using MaterialDesc = std::variant<DiffuseMaterial, PhongMaterial, MirrorMaterial, DielectricMaterial, BlackMaterial,
                                   ConductorMaterial, CoatedDiffuseMaterial, DiffuseTransmissionMaterial,
-                                  InterfaceMaterial>;
+                                  InterfaceMaterial, PrincipledMaterial, OneSidedMaterial, MaskMaterial,
+                                  BlendMaterial, NormalMapMaterial, BumpMapMaterial>;
 
 // ---------------------------------------------------------------- shapes
 
@@ -165,6 +239,15 @@ struct TriangleMesh {
   std::vector<Normal3> normals;  // empty or one per position (shading normals)
   std::vector<Vec2> uvs;         // empty or one per position
   std::vector<uint32_t> indices;  // three per triangle
+  // Named per-vertex or per-face values (PLY's extra properties; Mitsuba's mesh_attribute), each
+  // with 1 or 3 channels: values.size() == channels * (vertex count or triangle count).
+  struct Attribute {
+    std::string name;  // without the "vertex_" / "face_" prefix
+    bool per_face = false;
+    int channels = 1;
+    std::vector<float> values;
+  };
+  std::vector<Attribute> attributes;
   size_t triangle_count() const { return indices.size() / 3; }
 };
 
@@ -195,7 +278,18 @@ struct MeshShape {
   TriangleMesh mesh;
 };
 
-using ShapeGeometry = std::variant<SphereShape, PlaneShape, BoxShape, RectangleShape, MeshShape>;
+// Disk of radius 1 around the origin in the z = 0 plane, normal +z (Mitsuba's "disk"); to_world
+// scales it. (u, v) = (r, phi / 2 pi), as Mitsuba parameterises it.
+struct DiskShape {};
+
+// Open tube (no caps) of `radius` around the segment p0-p1 (Mitsuba's "cylinder"), normals pointing
+// outwards; (u, v) = (phi / 2 pi, distance along the axis / its length).
+struct CylinderShape {
+  Point3 p0{0.0f}, p1{0, 0, 1};
+  float radius = 1;
+};
+
+using ShapeGeometry = std::variant<SphereShape, PlaneShape, BoxShape, RectangleShape, MeshShape, DiskShape, CylinderShape>;
 
 // Diffuse emission attached to a shape (an area light). One-sided: emits on the side the surface
 // normal points to, unless two_sided.
@@ -241,13 +335,29 @@ struct PointLight {
 };
 
 // Point light emitting into a cone around `direction`: full intensity inside cone_angle - cone_delta,
-// falling off to zero at cone_angle with pbrt-v4's smoothstep in cos(angle).
+// falling off to zero at cone_angle with pbrt-v4's smoothstep in cos(angle), or (mitsuba_falloff)
+// with Mitsuba 3's spot: linearly in the angle from beam width = cone_angle - cone_delta to cone_angle,
+// times the image `texture` projected over the cone (-1 = none), as Mitsuba defines both.
 struct SpotLight {
   Point3 position{0.0f};
   Vec3 direction{0, 0, 1};
   RGB intensity{1.0f};  // W/sr on the axis
   float cone_angle = 30;  // degrees from the axis where the light reaches zero
   float cone_delta = 5;   // degrees over which it falls off
+  bool mitsuba_falloff = false;
+  int texture = -1;      // index into SceneDesc::textures
+  Vec3 up{0, 1, 0};      // with a texture: the image's up direction (the light frame's +y)
+};
+
+// A point light that projects an image (Mitsuba's "projector"): at the origin of to_world looking
+// along its +z with the field of view `fov_degrees` on the image's wider axis; `irradiance` is the
+// image (index into SceneDesc::textures), scaled by `scale`, as Mitsuba defines it (irradiance on a
+// surface one unit away facing the projector).
+struct ProjectorLight {
+  Transform to_world;
+  float fov_degrees = 90;
+  int irradiance = -1;
+  RGB scale{1.0f};
 };
 
 // Parallel light from infinitely far away, travelling along `direction`; `radiance` is the
@@ -285,15 +395,26 @@ struct EnvironmentMap {
   Transform to_world;  // from the map's local frame to the world (rotations only are meaningful)
 };
 
-using LightDesc = std::variant<PointLight, SkyLight, SpotLight, DistantLight, EnvironmentMap>;
+using LightDesc = std::variant<PointLight, SkyLight, SpotLight, DistantLight, EnvironmentMap, ProjectorLight>;
 
 // ---------------------------------------------------------------- camera, film, settings
 
 enum class FovAxis { X, Y, Smaller, Larger, Diagonal };
+enum class Projection {
+  Perspective,
+  // Parallel rays along +z; the film covers camera-space x in [-1, 1] and y in [-1 / aspect,
+  // 1 / aspect] (aspect = width / height), as Mitsuba's orthographic sensor; world_from_camera
+  // scales it.
+  Orthographic
+};
 
 struct CameraDesc {
-  // Maps camera space (+x image right, +y image up, +z forward) to world space.
+  // Maps camera space (+x image right, +y image up, +z forward) to world space. It may scale
+  // (orthographic cameras); directions are normalised after it.
   Transform world_from_camera;
+  Projection projection = Projection::Perspective;
+  // Nothing nearer than this (along +z, in camera space) is seen by camera rays (Mitsuba's near_clip).
+  float near_clip = 0;
   float fov_degrees = 40;
   FovAxis fov_axis = FovAxis::Y;  // JSON gives a vertical fov; pbrt-v4 gives it on the smaller axis
   // Thin lens (depth of field): 0 = pinhole. Points at focus_distance along +z are sharp.

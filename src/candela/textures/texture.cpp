@@ -157,6 +157,7 @@ RGB TextureSet::eval_texture(int index, const TextureEvalContext& ctx) const {
     return eval(even ? t->tex1 : t->tex2, ctx);
   }
   if (const auto* t = std::get_if<ScaleTexture>(&texture)) return eval(t->tex, ctx) * eval(t->scale, ctx);
+  if (std::holds_alternative<MeshAttributeTexture>(texture)) return RGB(0.0f);  // TODO(mesh attributes helper)
   const auto& t = std::get<MixTexture>(texture);
   float amount = eval(t.amount, ctx);
   // A side with weight zero is not evaluated (as in pbrt-v4): cheaper, and an infinite value there

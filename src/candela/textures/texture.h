@@ -51,7 +51,7 @@ class TextureSet {
     UVMapping mapping;
   };
   // The other kinds need nothing beyond their descriptions.
-  using Texture = std::variant<ImageLookup, CheckerboardTexture, ScaleTexture, MixTexture>;
+  using Texture = std::variant<ImageLookup, CheckerboardTexture, ScaleTexture, MixTexture, MeshAttributeTexture>;
 
   RGB eval_texture(int index, const TextureEvalContext& ctx) const;
 
