@@ -274,7 +274,9 @@ TEST(BidirectionalFurnace, MetropolisClosedSphereUnderATimeLimit) {
     EXPECT_NEAR(limited.mlt_normalization_relative_error * std::sqrt(batches),
                 single.mlt_normalization_relative_error, 0.35 * single.mlt_normalization_relative_error)
         << batches << " batches";
-    if (batches >= 4) EXPECT_LT(limited.mlt_normalization_relative_error, 0.7 * single.mlt_normalization_relative_error);
+    if (batches >= 4) {
+      EXPECT_LT(limited.mlt_normalization_relative_error, 0.7 * single.mlt_normalization_relative_error);
+    }
     means.push_back(image_mean(film.mean_image()));
   }
   double m = 0, v = 0;
