@@ -1,0 +1,134 @@
+// Mitsuba 3's own render-regression scenes (../shared/scenes/mitsuba-tests/), read by candela's Mitsuba
+// reader and rendered by candela, judged by Mitsuba's protocol (candela/testing/mitsuba_z_test.h)
+// against Mitsuba's references (mean of 32,000 spp) and their per-sample variance. docs/conformance.md
+// lists every scene with its passing fraction, and the reason for each that does not pass.
+//
+// Set CANDELA_CONFORMANCE_OUT to a directory to also write each render there (NAME.exr).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "candela/film/image_io.h"
+#include "candela/io/error.h"
+#include "candela/io/scene_reader.h"
+#include "candela/testing/mitsuba_z_test.h"
+#include "candela/testing/render_helpers.h"
+
+namespace candela {
+namespace {
+
+enum class Expect {
+  Pass,
+  MissingFile,  // names a file that is not in ../shared: reading must fail, naming it
+  Fail          // renders, but does not pass yet: the reason is in docs/conformance.md
+};
+
+struct ConformanceCase {
+  const char* folder;
+  const char* scene;  // file name without .xml; the reference drops the last "_integrator" part
+  Expect expect;
+  const char* missing = "";  // for MissingFile: a part of the missing file's name
+};
+
+void PrintTo(const ConformanceCase& c, std::ostream* os) { *os << c.scene; }
+
+std::string reference_name(const std::string& scene) { return scene.substr(0, scene.rfind('_')); }
+
+class MitsubaConformance : public ::testing::TestWithParam<ConformanceCase> {};
+
+TEST_P(MitsubaConformance, PassesMitsubasRenderTest) {
+  const ConformanceCase& c = GetParam();
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(CANDELA_SHARED_DIR) / "scenes/mitsuba-tests/tests/scenes" / c.folder;
+  const fs::path file = dir / (std::string(c.scene) + ".xml");
+  if (c.expect == Expect::MissingFile) {
+    try {
+      read_scene_file(file);
+      ADD_FAILURE() << c.scene << ": read without error, but it names a file that is missing";
+    } catch (const SceneError& e) {
+      std::printf("%s: refused: %s\n", c.scene, e.what());
+      EXPECT_NE(std::string(e.what()).find(c.missing), std::string::npos) << e.what();
+    }
+    return;
+  }
+  SceneDesc desc = read_scene_file(file);
+  const std::string ref = (dir / "refs" / reference_name(c.scene)).string();
+  Image reference = read_image(ref + "_ref_rgb.exr");
+  Image variance = read_image(ref + "_ref_rgb_var.exr");
+  ASSERT_EQ(desc.film.width, reference.width);
+  ASSERT_EQ(desc.film.height, reference.height);
+  desc.settings.spp = testing::mitsuba_test_spp(desc.film.width, desc.film.height);
+  desc.settings.seed = 1;
+  Image image = testing::render_description(desc).mean_image();
+  if (const char* out = std::getenv("CANDELA_CONFORMANCE_OUT"))
+    write_image(fs::path(out) / (std::string(c.scene) + ".exr"), image);
+
+  testing::MitsubaZTestResult r = testing::mitsuba_z_test(image, reference, variance, desc.settings.spp);
+  std::printf("CONFORMANCE %s %s %.5f (%d pixel-channels, %d spp, alpha %.3g)\n", c.scene,
+              r.passed() ? "pass" : "FAIL", r.passing_fraction, r.pixel_channels, desc.settings.spp, r.alpha);
+  if (c.expect == Expect::Pass) EXPECT_TRUE(r.passed()) << c.scene << ": " << r.passing_fraction << " pass";
+}
+
+// The 26 scenes. Expectations are what this checkout achieves; docs/conformance.md explains each Fail.
+const ConformanceCase kCases[] = {
+    {"bsdf_spheres", "test_arealight_path", Expect::Fail},
+    {"bsdf_spheres", "test_bumpmap_path", Expect::Fail},
+    {"bsdf_spheres", "test_constant_path", Expect::Fail},
+    {"bsdf_spheres", "test_envmap_path", Expect::MissingFile, "museum.exr"},
+    {"bsdf_spheres", "test_normalmap_identity_roughconductor_path", Expect::Fail},
+    {"bsdf_spheres", "test_normalmap_path", Expect::Fail},
+    {"bsdf_spheres", "test_normalmap_roughconductor_path", Expect::Fail},
+    {"bsdf_spheres", "test_pointlight_path", Expect::Fail},
+    {"bsdf_spheres", "test_roughdielectric_path", Expect::Fail},
+    {"bsdf_spheres", "test_roughplastic_linear_path", Expect::Fail},
+    {"bsdf_spheres", "test_roughplastic_nonlinear_path", Expect::Fail},
+    {"bsdf_spheres", "test_textured_diffuse_path", Expect::Fail},
+    {"bsdf_spheres", "test_textured_roughconductor_path", Expect::Fail},
+    {"bsdf_spheres", "test_texturedprincipled1_path", Expect::Fail},
+    {"bsdf_spheres", "test_texturedprincipled2_path", Expect::Fail},
+    {"bsdf_spheres", "test_texturedprincipledthin_path", Expect::Fail},
+    {"instancing", "test_instancing_path", Expect::Fail},
+    {"mesh_attributes", "test_mesh_attributes_1_face_direct", Expect::Fail},
+    {"mesh_attributes", "test_mesh_attributes_3_face_direct", Expect::Fail},
+    {"mesh_attributes", "test_mesh_attributes_3_vertex_direct", Expect::Fail},
+    {"orthographic_sensor", "test_orthographic_path", Expect::Fail},
+    {"projector", "test_projector_constant_direct", Expect::Fail},
+    {"projector", "test_projector_textured_direct", Expect::Fail},
+    {"spot_light", "test_spot_direct", Expect::Fail},
+    {"various_emitters", "test_various_emitters_ptracer", Expect::Fail},
+    {"various_shapes", "test_various_shapes_path", Expect::MissingFile, "rectangle_normals_uv"},
+};
+
+INSTANTIATE_TEST_SUITE_P(Scenes, MitsubaConformance, ::testing::ValuesIn(kCases),
+                         [](const ::testing::TestParamInfo<ConformanceCase>& info) {
+                           return std::string(info.param.scene);
+                         });
+
+// The protocol itself: unbiased noise of the reference's variance passes, a 20% bias does not.
+TEST(MitsubaZTest, PassesUnbiasedNoiseAndFailsABias) {
+  const int w = 48, h = 48, spp = testing::mitsuba_test_spp(w, h);
+  Image reference(w, h), variance(w, h), noisy(w, h), biased(w, h);
+  uint64_t state = 12345;
+  auto gaussian = [&] {  // Box-Muller on a 64-bit LCG: deterministic
+    auto uniform = [&] {
+      state = state * 6364136223846793005ull + 1442695040888963407ull;
+      return (double(state >> 11) + 0.5) / double(1ull << 53);
+    };
+    return std::sqrt(-2 * std::log(uniform())) * std::cos(2 * 3.14159265358979 * uniform());
+  };
+  for (size_t i = 0; i < reference.rgb.size(); ++i) {
+    reference.rgb[i] = 0.5f;
+    variance.rgb[i] = 0.25f;
+    noisy.rgb[i] = float(0.5 + gaussian() * std::sqrt(0.25 / spp));
+    biased.rgb[i] = float(0.6 + gaussian() * std::sqrt(0.25 / spp));
+  }
+  EXPECT_TRUE(testing::mitsuba_z_test(noisy, reference, variance, spp).passed());
+  testing::MitsubaZTestResult b = testing::mitsuba_z_test(biased, reference, variance, spp);
+  EXPECT_FALSE(b.passed()) << b.passing_fraction;
+}
+
+}  // namespace
+}  // namespace candela
