@@ -137,6 +137,10 @@ struct DielectricMaterial {
   ColorInput reflectance{RGB(1.0f)};    // tints (Mitsuba's specular_reflectance / _transmittance); 1 = physical
   ColorInput transmittance{RGB(1.0f)};
   Roughness roughness;
+  // A thin sheet (Mitsuba's "thindielectric"): light passes straight through without refraction,
+  // with the Fresnel reflectance of the two interfaces and their internal reflections summed
+  // (R' = R + T^2 R / (1 - R^2)); smooth only.
+  bool thin = false;
 };
 
 // Plastic / coated diffuse: a dielectric coat (smooth or GGX-rough) of index `ior` over a Lambertian
@@ -296,6 +300,9 @@ using ShapeGeometry = std::variant<SphereShape, PlaneShape, BoxShape, RectangleS
 struct AreaEmission {
   RGB radiance{1.0f};
   bool two_sided = false;
+  // A textured emitter (Mitsuba's area light with a texture as "radiance"): radiance *
+  // SceneDesc::textures[texture] evaluated at the hit's uv (-1 = none).
+  int texture = -1;
 };
 
 struct ShapeDesc {
