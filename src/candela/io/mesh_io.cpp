@@ -245,36 +245,44 @@ class ObjMeshBuilder {
   std::unordered_map<ObjCorner, uint32_t, ObjCornerHash> vertex_of_corner_;
 };
 
-TriangleMesh load_obj(const std::string& text) {
+// Parses OBJ text (and the MTL library text, which may be empty) with every check above.
+tinyobj::ObjReader parse_obj(const std::string& text, const std::string& mtl_text) {
   tinyobj::ObjReaderConfig config;
   config.triangulate = true;
   config.vertex_color = false;
   tinyobj::ObjReader reader;
   check_obj_vertex_lines(text);
-  // Parsing from a string makes tinyobjloader ignore `mtllib`: materials are not used yet, and a
-  // missing or misplaced .mtl file must not fail the load.
-  if (!reader.ParseFromString(text, "", config)) fail("malformed OBJ: {}", printable(first_line(reader.Error()), 200));
-
-  const tinyobj::attrib_t& attrib = reader.GetAttrib();
-  const std::vector<tinyobj::shape_t>& shapes = reader.GetShapes();
-  check_obj_corners(attrib, shapes);
+  // Parsing from strings makes tinyobjloader ignore `mtllib`: the caller reads the library (or not),
+  // so a missing or misplaced .mtl file cannot fail the load of the geometry.
+  if (!reader.ParseFromString(text, mtl_text, config))
+    fail("malformed OBJ: {}", printable(first_line(reader.Error()), 200));
+  check_obj_corners(reader.GetAttrib(), reader.GetShapes());
   fail_on_dropped_obj_faces(reader.Warning());
-
   size_t corner_count = 0;
-  for (const tinyobj::shape_t& shape : shapes) corner_count += shape.mesh.indices.size();
+  for (const tinyobj::shape_t& shape : reader.GetShapes()) corner_count += shape.mesh.indices.size();
   if (corner_count == 0) fail("the OBJ file contains no triangles (no 'f' faces)");
+  return reader;
+}
 
-  ObjMeshBuilder builder(attrib, every_corner_has(shapes, &tinyobj::index_t::normal_index),
+// The faces of the OBJ whose material is `material` (every face when material is std::nullopt).
+TriangleMesh obj_faces(const tinyobj::ObjReader& reader, std::optional<int> material) {
+  const std::vector<tinyobj::shape_t>& shapes = reader.GetShapes();
+  ObjMeshBuilder builder(reader.GetAttrib(), every_corner_has(shapes, &tinyobj::index_t::normal_index),
                          every_corner_has(shapes, &tinyobj::index_t::texcoord_index));
   for (const tinyobj::shape_t& shape : shapes) {
     size_t corner = 0;
-    for (const unsigned char face_size : shape.mesh.num_face_vertices) {
-      builder.add_face(&shape.mesh.indices[corner], face_size);
+    for (size_t face = 0; face < shape.mesh.num_face_vertices.size(); ++face) {
+      const unsigned char face_size = shape.mesh.num_face_vertices[face];
+      if (!material || shape.mesh.material_ids[face] == *material) builder.add_face(&shape.mesh.indices[corner], face_size);
       corner += face_size;
     }
   }
   return builder.take();
 }
+
+TriangleMesh load_obj(const std::string& text) { return obj_faces(parse_obj(text, ""), std::nullopt); }
+
+RGB rgb_of(const float c[3]) { return {c[0], c[1], c[2]}; }
 
 // ---------------------------------------------------------------- PLY
 // Assimp's PLY reader trusts the file: it loops forever on a header cut short, allocates whatever
@@ -681,7 +689,73 @@ void validate_mesh(const TriangleMesh& mesh) {
   }
 }
 
+// The `mtllib` file names of an OBJ text (the rest of each mtllib line, as tinyobjloader takes it).
+std::vector<std::string> mtl_libraries(std::string_view text) {
+  std::vector<std::string> names;
+  size_t at = 0;
+  while (at < text.size()) {
+    const size_t end = std::min(text.find('\n', at), text.size());
+    std::string_view line = text.substr(at, end - at);
+    at = end + 1;
+    const std::vector<std::string_view> words = split_words(line.substr(0, line.find('#')));
+    if (words.size() >= 2 && words[0] == "mtllib")
+      for (size_t k = 1; k < words.size(); ++k) names.emplace_back(words[k]);
+  }
+  return names;
+}
+
 }  // namespace
+
+ObjModel load_obj_model(const std::filesystem::path& file, const SourceLocation& referenced_from) {
+  try {
+    const std::string text = read_whole_file(file);
+    ObjModel model;
+    std::string mtl_text;
+    for (const std::string& name : mtl_libraries(text)) {
+      const std::filesystem::path library = file.parent_path() / name;
+      try {
+        mtl_text += read_whole_file(library) + "\n";
+      } catch (const MeshFileProblem& problem) {
+        model.warnings.push_back(fmt::format("material library '{}': {}; its materials are diffuse grey",
+                                             library.string(), problem.what()));
+      }
+    }
+    const tinyobj::ObjReader reader = parse_obj(text, mtl_text);
+    for (const tinyobj::material_t& m : reader.GetMaterials()) {
+      ObjMaterial om;
+      om.name = m.name;
+      om.diffuse = rgb_of(m.diffuse);
+      om.specular = rgb_of(m.specular);
+      om.emission = rgb_of(m.emission);
+      om.transmission_filter = rgb_of(m.transmittance);
+      om.shininess = m.shininess;
+      om.ior = m.ior;
+      om.dissolve = m.dissolve;
+      om.illum = m.illum;
+      if (!m.diffuse_texname.empty()) om.diffuse_map = (file.parent_path() / m.diffuse_texname).string();
+      model.materials.push_back(std::move(om));
+    }
+    // One mesh per material that faces use (-1: faces without a material).
+    std::vector<int> used;
+    for (const tinyobj::shape_t& shape : reader.GetShapes())
+      for (int id : shape.mesh.material_ids)
+        if (std::find(used.begin(), used.end(), id) == used.end()) used.push_back(id);
+    std::sort(used.begin(), used.end());
+    for (int id : used) {
+      if (id >= int(model.materials.size())) fail("internal error: material {} of {}", id, model.materials.size());
+      TriangleMesh mesh = obj_faces(reader, id);
+      if (mesh.indices.empty()) continue;
+      validate_mesh(mesh);
+      model.parts.push_back({id, std::move(mesh)});
+    }
+    if (model.parts.empty()) fail("the OBJ file contains no triangles");
+    return model;
+  } catch (const MeshFileProblem& problem) {
+    throw_scene_error(referenced_from, "cannot read mesh '{}': {}", file.string(), problem.what());
+  } catch (const std::bad_alloc&) {
+    throw_scene_error(referenced_from, "cannot read mesh '{}': out of memory", file.string());
+  }
+}
 
 TriangleMesh load_mesh_file(const std::filesystem::path& file, const SourceLocation& referenced_from) {
   try {

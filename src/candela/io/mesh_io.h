@@ -1,6 +1,8 @@
 #pragma once
 // Triangle meshes from files: .obj through tinyobjloader, .ply through Assimp.
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "candela/io/error.h"
 #include "candela/scene/description.h"
@@ -11,5 +13,29 @@ namespace candela {
 // uvs kept when present). `referenced_from` is where the scene named the file, for messages.
 // Throws SceneError naming both places for a missing, unreadable, malformed or empty file.
 TriangleMesh load_mesh_file(const std::filesystem::path& file, const SourceLocation& referenced_from);
+
+// A material of an OBJ file's MTL library, as written there (the meaning of each is in
+// io/obj_scene_reader.cpp, which turns them into candela materials).
+struct ObjMaterial {
+  std::string name;
+  RGB diffuse{0.0f}, specular{0.0f}, emission{0.0f}, transmission_filter{1.0f};  // Kd, Ks, Ke, Tf
+  float shininess = 1, ior = 1, dissolve = 1;                                  // Ns, Ni, d (1 - Tr)
+  int illum = 0;
+  std::string diffuse_map;  // map_Kd, relative to the working directory; empty = none
+};
+
+// An OBJ file with the materials of its `mtllib` libraries (looked up beside the OBJ file): one mesh
+// per material that faces use; `material` indexes `materials`, -1 for faces without one. A missing
+// or unreadable library is a warning (its materials become the default), a malformed OBJ an error.
+struct ObjModel {
+  struct Part {
+    int material = -1;
+    TriangleMesh mesh;
+  };
+  std::vector<Part> parts;
+  std::vector<ObjMaterial> materials;
+  std::vector<std::string> warnings;
+};
+ObjModel load_obj_model(const std::filesystem::path& file, const SourceLocation& referenced_from);
 
 }  // namespace candela

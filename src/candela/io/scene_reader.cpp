@@ -11,6 +11,7 @@
 #include <system_error>
 
 #include "candela/io/error.h"
+#include "candela/io/obj_scene_reader.h"
 
 namespace candela {
 namespace {
@@ -53,8 +54,10 @@ SceneDesc read_scene_file(const std::filesystem::path& file) {
     scene = read_json_scene(read_text_file(file), file.string(), file.parent_path());
   else if (extension == ".pbrt")
     scene = read_pbrt_scene(file);
+  else if (extension == ".obj")
+    scene = read_obj_scene(file);
   else
-    throw_scene_error(location_of_file(file), "unsupported scene file extension {}; supported: .json, .pbrt",
+    throw_scene_error(location_of_file(file), "unsupported scene file extension {}; supported: .json, .pbrt, .obj",
                       extension.empty() ? std::string("(none)") : "\"" + extension + "\"");
   scene.source_file = file.string();
   return scene;

@@ -1,0 +1,146 @@
+// OBJ + MTL as a scene. The MTL model is loose (every exporter reads it a little differently), so
+// each material becomes the closest candela material by these rules (docs/obj-format.md):
+//   Ke > 0                          an area light of radiance Ke on the material below
+//   illum 4, 6, 7, or d < 1         glass: a smooth dielectric of index Ni (1.5 when Ni <= 1)
+//   illum 3 or 5 with Ks > 0        an ideal mirror of reflectance Ks
+//   Ks > 0                          the paper's Phong material: diffuse Kd (x map_Kd), Phong lobe Ks with
+//                                   exponent Ns, chosen with probabilities max(Kd) and max(Ks) (scaled
+//                                   down together when they sum to more than 1, which would create energy)
+//   otherwise                       Lambertian Kd (x map_Kd)
+#include "candela/io/obj_scene_reader.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "candela/io/error.h"
+#include "candela/io/mesh_io.h"
+
+namespace candela {
+namespace {
+
+float max_channel(const RGB& c) { return std::max({c.r, c.g, c.b}); }
+
+// Kd as a material input: the map multiplied by Kd when there is one (Kd 1 1 1 leaves it alone).
+ColorInput diffuse_input(const ObjMaterial& m, const RGB& kd, SceneDesc& scene) {
+  if (m.diffuse_map.empty()) return kd;
+  ImageTexture image;
+  image.filename = m.diffuse_map;
+  scene.textures.push_back(image);
+  ColorInput map;
+  map.texture = int(scene.textures.size() - 1);
+  if (kd == RGB(1.0f)) return map;
+  // ScaleTexture's factor is a float: a coloured Kd scales the map by its average (material_of warns).
+  scene.textures.push_back(ScaleTexture{map, FloatInput(kd.average())});
+  ColorInput scaled;
+  scaled.texture = int(scene.textures.size() - 1);
+  return scaled;
+}
+
+MaterialDesc material_of(const ObjMaterial& m, SceneDesc& scene, std::vector<std::string>& warnings,
+                         const std::string& where) {
+  auto warn = [&](const std::string& what) {
+    warnings.push_back(fmt::format("{}: warning: material \"{}\": {}", where, m.name, what));
+  };
+  if (!m.diffuse_map.empty() && !(m.diffuse.r == m.diffuse.g && m.diffuse.g == m.diffuse.b))
+    warn("a coloured Kd with map_Kd: the map is scaled by Kd's average, Kd's hue is dropped");
+  const bool glass = m.illum == 4 || m.illum == 6 || m.illum == 7 || m.dissolve < 1;
+  if (glass) {
+    DielectricMaterial d;
+    d.ior = m.ior > 1 ? m.ior : 1.5f;
+    if (!(m.ior > 1)) warn(fmt::format("transparent with Ni {}: rendered as glass of index 1.5", m.ior));
+    return d;
+  }
+  const float s = max_channel(m.specular);
+  if ((m.illum == 3 || m.illum == 5) && s > 0) {
+    if (max_channel(m.diffuse) > 0.05f) warn("a mirror (illum 3 or 5) with a diffuse Kd: Kd is dropped");
+    return MirrorMaterial{RGB(std::min(m.specular.r, 1.0f), std::min(m.specular.g, 1.0f), std::min(m.specular.b, 1.0f))};
+  }
+  float d = max_channel(m.diffuse);
+  if (s <= 0) {
+    RGB kd = m.diffuse;
+    if (d > 1) {
+      warn(fmt::format("Kd above 1 (max {}): scaled to 1", d));
+      kd = kd * (1 / d);
+    }
+    return DiffuseMaterial{diffuse_input(m, kd, scene)};
+  }
+  float scale = 1;
+  if (d + s > 1) {
+    scale = 1 / (d + s);
+    warn(fmt::format("Kd + Ks = {} reflects more than arrives: both scaled by {:.3f}", d + s, scale));
+  }
+  PhongMaterial p;
+  p.d = d * scale;
+  p.s = s * scale;
+  p.t = 0;
+  p.diffuse = diffuse_input(m, d > 0 ? m.diffuse * (1 / d) : RGB(0.0f), scene);
+  p.specular = m.specular * (1 / s);
+  p.exponent = std::max(m.shininess, 0.0f);
+  return p;
+}
+
+}  // namespace
+
+CameraDesc camera_framing(const Point3& lo, const Point3& hi, float fov_degrees, int width, int height) {
+  const Point3 center = (lo + hi) * 0.5f;
+  const float radius = std::max(1e-3f, 0.5f * length(hi - lo));
+  // The bounding sphere fits the smaller field of view.
+  const float vertical = fov_degrees * 3.14159265f / 180;
+  const float aspect = float(width) / float(height);
+  const float smaller = aspect >= 1 ? vertical : 2 * std::atan(std::tan(vertical / 2) * aspect);
+  const float distance = radius / std::sin(smaller / 2);
+  CameraDesc camera;
+  camera.fov_degrees = fov_degrees;
+  camera.fov_axis = FovAxis::Y;
+  camera.world_from_camera =
+      Transform::look_at_right_handed(center + Vec3(0, 0, distance), center, Vec3(0, 1, 0));
+  return camera;
+}
+
+SceneDesc read_obj_scene(const std::filesystem::path& file) {
+  const SourceLocation where{file.string(), 0, 0, {}};
+  ObjModel model = load_obj_model(file, where);
+  std::vector<std::string> warnings = std::move(model.warnings);
+
+  SceneDesc scene;
+  scene.settings.sampler.type = SamplerType::ZSobol;  // the most efficient measured (docs/performance.md)
+  std::vector<int> material_index(model.materials.size(), -1);
+  for (size_t i = 0; i < model.materials.size(); ++i) {
+    scene.materials.push_back(material_of(model.materials[i], scene, warnings, file.string()));
+    material_index[i] = int(scene.materials.size() - 1);
+  }
+  Point3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  bool any_emitter = false;
+  for (ObjModel::Part& part : model.parts) {
+    for (const Point3& p : part.mesh.positions) {
+      lo = min(lo, p);
+      hi = max(hi, p);
+    }
+    ShapeDesc shape;
+    shape.material = part.material >= 0 ? material_index[size_t(part.material)] : -1;
+    shape.name = part.material >= 0 ? model.materials[size_t(part.material)].name : file.filename().string();
+    if (part.material >= 0) {
+      const RGB& ke = model.materials[size_t(part.material)].emission;
+      if (max_channel(ke) > 0) {
+        shape.emission = AreaEmission{ke, false};
+        any_emitter = true;
+      }
+    }
+    shape.geometry = MeshShape{std::move(part.mesh)};
+    scene.shapes.push_back(std::move(shape));
+  }
+  scene.camera = camera_framing(lo, hi, scene.camera.fov_degrees, scene.film.width, scene.film.height);
+  // Without emitters the model would be black: a white sky lights it (and is what the user sees
+  // around it).
+  if (!any_emitter) scene.lights.push_back(SkyLight{});
+  for (const std::string& w : warnings) std::fprintf(stderr, "%s\n", w.c_str());
+  return scene;
+}
+
+}  // namespace candela

@@ -1,0 +1,18 @@
+#pragma once
+// An OBJ file as a whole scene: its geometry with the materials of its MTL library, emitters from
+// Ke, and (OBJ has no cameras) a camera that frames the model. docs/obj-format.md has the mapping.
+#include <filesystem>
+
+#include "candela/scene/description.h"
+
+namespace candela {
+
+// Throws SceneError naming the file for a missing or malformed OBJ. Warnings (a missing MTL file,
+// material parameters that cannot be represented) are printed to stderr, as the other readers do.
+SceneDesc read_obj_scene(const std::filesystem::path& file);
+
+// A perspective camera looking at the box from its +z side (up +y, vertical field of view
+// `fov_degrees`), far enough back that the box's bounding sphere fits the smaller image axis.
+CameraDesc camera_framing(const Point3& lo, const Point3& hi, float fov_degrees, int width, int height);
+
+}  // namespace candela

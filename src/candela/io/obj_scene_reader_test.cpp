@@ -1,0 +1,110 @@
+#include "candela/io/obj_scene_reader.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "candela/io/error.h"
+#include "candela/io/scene_reader.h"
+#include "candela/testing/render_helpers.h"
+
+namespace candela {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kCornell = fs::path(CANDELA_SHARED_DIR) / "meshes/cornell-box";
+
+const ShapeDesc& shape_named(const SceneDesc& scene, const std::string& name) {
+  for (const ShapeDesc& s : scene.shapes)
+    if (s.name == name) return s;
+  ADD_FAILURE() << "no shape " << name;
+  return scene.shapes.front();
+}
+
+TEST(ObjScene, McGuiresCornellBoxGetsItsMaterialsLightAndAFramingCamera) {
+  SceneDesc scene = read_scene_file(kCornell / "CornellBox-Original.obj");
+  ASSERT_EQ(scene.shapes.size(), 8u);  // one mesh per material
+  const ShapeDesc& light = shape_named(scene, "light");
+  ASSERT_TRUE(light.emission);
+  EXPECT_EQ(light.emission->radiance, RGB(17, 12, 4));
+  const auto& left = std::get<DiffuseMaterial>(scene.materials[size_t(shape_named(scene, "leftWall").material)]);
+  EXPECT_EQ(left.reflectance.value, RGB(0.63f, 0.065f, 0.05f));
+  EXPECT_FALSE(shape_named(scene, "floor").emission);
+  EXPECT_TRUE(scene.lights.empty()) << "a scene with emitters gets no sky";
+  // The camera looks at the box's centre (0, ~1, 0) along -z from in front of its open side.
+  const Point3 eye = scene.camera.world_from_camera.point(Point3(0.0f));
+  const Vec3 forward = normalize(scene.camera.world_from_camera.vector(Vec3(0, 0, 1)));
+  EXPECT_NEAR(eye.x, 0, 0.05);
+  EXPECT_GT(eye.z, 2);
+  EXPECT_NEAR(forward.z, -1, 1e-4);
+}
+
+TEST(ObjScene, VisibleLightPixelsHoldKeAndTheBoxFillsTheFrame) {
+  SceneDesc scene = read_scene_file(kCornell / "CornellBox-Original.obj");
+  scene.film.width = scene.film.height = 48;
+  scene.settings.spp = 16;
+  scene.settings.max_depth = 4;
+  Image image = testing::render_description(scene).mean_image();
+  // The brightest pixel sees the light (radiance Ke, reflected light adds a little: Kd 0.78 of the
+  // irradiance under the light is far below 17).
+  RGB brightest(0.0f);
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x)
+      if (image.at(x, y).r > brightest.r) brightest = image.at(x, y);
+  EXPECT_NEAR(brightest.r, 17, 0.5);
+  EXPECT_NEAR(brightest.g, 12, 0.4);
+  EXPECT_NEAR(brightest.b, 4, 0.2);
+  // The centre pixel sees the lit back wall (or a box), not the black outside.
+  EXPECT_GT(image.at(24, 24).average(), 0.05f);
+}
+
+TEST(ObjScene, GlossyMirrorAndWaterMaterials) {
+  SceneDesc glossy = read_scene_file(kCornell / "CornellBox-Glossy.obj");
+  const auto& sphere = std::get<PhongMaterial>(glossy.materials[size_t(shape_named(glossy, "sphere").material)]);
+  EXPECT_LE(sphere.d + sphere.s, 1.0f + 1e-6f) << "Kd + Ks > 1 is scaled down";
+  EXPECT_NEAR(sphere.d / sphere.s, 0.663f / 0.7f, 1e-4);
+  EXPECT_EQ(sphere.exponent, 32);
+
+  SceneDesc mirror = read_scene_file(kCornell / "CornellBox-Mirror.obj");
+  const auto& tall = std::get<MirrorMaterial>(mirror.materials[size_t(shape_named(mirror, "tallBox").material)]);
+  EXPECT_EQ(tall.reflectance.value, RGB(0.95f));
+
+  SceneDesc water = read_scene_file(kCornell / "CornellBox-Water.obj");
+  const auto& w = std::get<DielectricMaterial>(water.materials[size_t(shape_named(water, "water").material)]);
+  EXPECT_FLOAT_EQ(w.ior, 1.33f);
+}
+
+TEST(ObjScene, MissingMaterialLibraryIsAWarningAndALitModel) {
+  const fs::path dir = fs::temp_directory_path() / "candela_obj_scene_test";
+  fs::create_directories(dir);
+  const fs::path file = dir / "quad.obj";
+  std::ofstream(file) << "mtllib nowhere.mtl\nusemtl red\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
+  testing::internal::CaptureStderr();
+  SceneDesc scene = read_scene_file(file);
+  std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("nowhere.mtl"), std::string::npos) << err;
+  ASSERT_EQ(scene.shapes.size(), 1u);
+  EXPECT_EQ(scene.shapes[0].material, -1);  // the default diffuse
+  ASSERT_EQ(scene.lights.size(), 1u);       // no emitters: a sky lights it
+  EXPECT_TRUE(std::holds_alternative<SkyLight>(scene.lights[0]));
+}
+
+TEST(ObjScene, MalformedObjNamesTheFile) {
+  const fs::path dir = fs::temp_directory_path() / "candela_obj_scene_test";
+  fs::create_directories(dir);
+  const fs::path file = dir / "broken.obj";
+  std::ofstream(file) << "v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n";
+  try {
+    read_scene_file(file);
+    FAIL() << "read a broken OBJ";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("broken.obj"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("line 2"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace candela
