@@ -45,3 +45,28 @@ float sampled_spectrum_at(std::span<const double> pairs, float lambda);
 RGB xyz_to_linear_srgb(float x, float y, float z);
 
 }  // namespace candela::pbrt_spectra
+
+// Mitsuba 3's spectral values as its RGB variants (scalar_rgb) see them (docs/mitsuba-format.md).
+namespace candela::mitsuba_spectra {
+
+// Mitsuba's spectrum_list_to_srgb: the piecewise-linear spectrum (zero outside its first and last
+// wavelength) integrated against the CIE 1931 curves at 1000 points over 360..830 nm, turned into
+// linear sRGB, and clamped to [0, 1] (bounded) or at 0. The values are used as given: Mitsuba's XML
+// parser first multiplies inline spectra by kCieYNormalization.
+RGB spectrum_list_to_srgb(std::span<const double> wavelengths, std::span<const double> values, bool bounded);
+inline constexpr double kCieYNormalization = 1.0 / 106.7502593994140625;
+
+// Mitsuba's named indices of refraction (src/render/ior.h: "bk7", "air", "diamond", ...), by
+// lower-case name.
+std::optional<float> named_ior(std::string_view name);
+const std::vector<std::string_view>& named_ior_names();
+
+// A conductor preset ("material" of conductor / roughconductor): eta and k as Mitsuba's RGB mode
+// converts the measured spectra (resources/data/ior/NAME.{eta,k}.spd through spectrum_list_to_srgb).
+struct Conductor {
+  RGB eta, k;
+};
+std::optional<Conductor> named_conductor(std::string_view name);
+const std::vector<std::string_view>& named_conductor_names();
+
+}  // namespace candela::mitsuba_spectra

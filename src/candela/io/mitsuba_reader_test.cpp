@@ -1,0 +1,229 @@
+// Tests of the Mitsuba 3 XML reader: each parses small scenes and checks the SceneDesc.
+#include "candela/io/mitsuba_reader.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <variant>
+
+#include "candela/io/error.h"
+#include "candela/io/named_spectra.h"
+
+namespace candela {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path temp_dir() {
+  fs::path dir = fs::temp_directory_path() / "candela_mitsuba_test";
+  fs::create_directories(dir);
+  return dir;
+}
+
+SceneDesc read_text(const std::string& body, const MitsubaReadOptions& options = {}) {
+  std::vector<std::string> warnings;
+  return read_mitsuba_scene_text("<scene version=\"3.0.0\">\n" + body + "\n</scene>", "test.xml", temp_dir(),
+                                 warnings, options);
+}
+
+std::string error_of(const std::string& body) {
+  try {
+    read_text(body);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(MitsubaReader, CameraLooksAtTargetWithImageRightToTheRight) {
+  SceneDesc s = read_text(R"(<sensor type="perspective"><float name="fov" value="45"/>
+      <transform name="to_world"><lookat origin="0,0,-5" target="0,0,0" up="0,1,0"/></transform>
+      <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="16"/></film></sensor>)");
+  const Transform& cam = s.camera.world_from_camera;
+  Vec3 eye = cam.point({0, 0, 0}), forward = normalize(cam.vector({0, 0, 1}));
+  EXPECT_NEAR(eye.z, -5, 1e-5);
+  EXPECT_NEAR(forward.z, 1, 1e-5);
+  // Looking along +z with +y up, the image's right is world -x (Mitsuba's camera +x is the left).
+  Vec3 right = cam.vector({1, 0, 0}), up = cam.vector({0, 1, 0});
+  EXPECT_NEAR(right.x, -1, 1e-5);
+  EXPECT_NEAR(up.y, 1, 1e-5);
+  EXPECT_EQ(s.camera.fov_axis, FovAxis::X);
+  EXPECT_FLOAT_EQ(s.camera.fov_degrees, 45);
+  EXPECT_EQ(s.film.width, 32);
+  EXPECT_EQ(s.film.height, 16);
+  EXPECT_FLOAT_EQ(s.camera.near_clip, 0.01f);
+}
+
+TEST(MitsubaReader, TransformsComposeInOrder) {
+  SceneDesc s = read_text(R"(<shape type="sphere"><transform name="to_world">
+      <scale value="2"/><translate x="1"/><rotate y="1" angle="90"/></transform></shape>)");
+  ASSERT_EQ(s.shapes.size(), 1u);
+  Vec3 p = s.shapes[0].to_world.point({1, 0, 0});  // scale -> (2,0,0), translate -> (3,0,0), rotate -> (0,0,-3)
+  EXPECT_NEAR(p.x, 0, 1e-5);
+  EXPECT_NEAR(p.z, -3, 1e-5);
+}
+
+TEST(MitsubaReader, DefaultsParametersAndOverrides) {
+  std::string body = R"(<default name="spp" value="7"/>
+      <integrator type="moment"><integrator type="path"><integer name="max_depth" value="2"/></integrator></integrator>
+      <sensor type="perspective"><sampler type="independent"><integer name="sample_count" value="$spp"/></sampler></sensor>)";
+  SceneDesc s = read_text(body);
+  EXPECT_EQ(s.settings.spp, 7);
+  EXPECT_EQ(s.settings.max_depth, 1);  // Mitsuba's depth 2 = direct lighting
+  EXPECT_EQ(s.settings.sampler.type, SamplerType::Independent);
+  MitsubaReadOptions o;
+  o.parameters["spp"] = "64";
+  EXPECT_EQ(read_text(body, o).settings.spp, 64);
+  EXPECT_NE(error_of("<integer name=\"x\" value=\"$nope\"/>").find("undefined parameter"), std::string::npos);
+}
+
+TEST(MitsubaReader, MaxDepthMapping) {
+  EXPECT_EQ(read_text(R"(<integrator type="path"/>)").settings.max_depth, 1024);
+  EXPECT_EQ(read_text(R"(<integrator type="path"><integer name="max_depth" value="5"/></integrator>)")
+                .settings.max_depth, 4);
+  EXPECT_EQ(read_text(R"(<integrator type="direct"/>)").settings.max_depth, 1);
+}
+
+TEST(MitsubaReader, RefsIncludeAndOneSidedWrapping) {
+  {
+    std::ofstream f(temp_dir() / "inc.xml");
+    f << R"(<scene version="3.0.0"><bsdf type="diffuse" id="white"><rgb name="reflectance" value="0.8"/></bsdf></scene>)";
+  }
+  SceneDesc s = read_text(R"(<include filename="inc.xml"/>
+      <shape type="rectangle"><ref id="white"/></shape>
+      <shape type="rectangle"><bsdf type="twosided"><ref id="white"/></bsdf></shape>
+      <shape type="disk"/>)");
+  ASSERT_EQ(s.shapes.size(), 3u);
+  const auto* one = std::get_if<OneSidedMaterial>(&s.materials[s.shapes[0].material]);
+  ASSERT_NE(one, nullptr);
+  EXPECT_LT(one->material, s.shapes[0].material);
+  const auto* d = std::get_if<DiffuseMaterial>(&s.materials[one->material]);
+  ASSERT_NE(d, nullptr);
+  EXPECT_FLOAT_EQ(d->reflectance.value.g, 0.8f);
+  EXPECT_TRUE(std::holds_alternative<DiffuseMaterial>(s.materials[s.shapes[1].material]));  // twosided
+  const auto* def = std::get_if<OneSidedMaterial>(&s.materials[s.shapes[2].material]);  // Mitsuba's default bsdf
+  ASSERT_NE(def, nullptr);
+  EXPECT_FLOAT_EQ(std::get<DiffuseMaterial>(s.materials[def->material]).reflectance.value.r, 0.5f);
+  EXPECT_TRUE(std::holds_alternative<DiskShape>(s.shapes[2].geometry));
+}
+
+TEST(MitsubaReader, Bsdfs) {
+  SceneDesc s = read_text(R"(
+    <shape type="sphere"><bsdf type="dielectric"><string name="int_ior" value="diamond"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="roughconductor"><string name="material" value="Al"/>
+      <string name="distribution" value="ggx"/><float name="alpha_u" value="0.25"/><float name="alpha_v" value="0.05"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="roughplastic"><float name="alpha" value="0.1"/><boolean name="nonlinear" value="true"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="thindielectric"/></shape>
+    <shape type="sphere"><bsdf type="null"/></shape>)");
+  const auto& d = std::get<DielectricMaterial>(s.materials[s.shapes[0].material]);
+  EXPECT_NEAR(d.ior, 2.419f / 1.000277f, 1e-5);
+  const auto& c = std::get<ConductorMaterial>(
+      s.materials[std::get<OneSidedMaterial>(s.materials[s.shapes[1].material]).material]);
+  EXPECT_EQ(c.roughness.distribution, MicrofacetDistribution::GGX);
+  EXPECT_FLOAT_EQ(c.roughness.u.value, 0.25f);
+  EXPECT_FLOAT_EQ(c.roughness.v.value, 0.05f);
+  EXPECT_NEAR(c.eta.value.r, 1.6575f, 1e-3);
+  const auto& p = std::get<CoatedDiffuseMaterial>(
+      s.materials[std::get<OneSidedMaterial>(s.materials[s.shapes[2].material]).material]);
+  EXPECT_EQ(p.roughness.distribution, MicrofacetDistribution::Beckmann);  // Mitsuba's default
+  EXPECT_TRUE(p.nonlinear);
+  EXPECT_NEAR(p.ior, 1.49f / 1.000277f, 1e-5);
+  EXPECT_TRUE(std::get<DielectricMaterial>(s.materials[s.shapes[3].material]).thin);
+  EXPECT_TRUE(std::holds_alternative<InterfaceMaterial>(s.materials[s.shapes[4].material]));
+}
+
+TEST(MitsubaReader, CheckerboardMapsToCandelasSquares) {
+  SceneDesc s = read_text(R"(<bsdf type="diffuse" id="b"><texture name="reflectance" type="checkerboard">
+      <transform name="to_uv"><scale x="5" y="3"/></transform><rgb name="color0" value="0.8"/><float name="color1" value="0.1"/>
+      </texture></bsdf><shape type="rectangle"><ref id="b"/></shape>)");
+  ASSERT_EQ(s.textures.size(), 1u);
+  const auto& c = std::get<CheckerboardTexture>(s.textures[0]);
+  EXPECT_FLOAT_EQ(c.tex1.value.r, 0.8f);
+  EXPECT_FLOAT_EQ(c.tex2.value.r, 0.1f);
+  EXPECT_FLOAT_EQ(c.mapping.su, 10);
+  EXPECT_FLOAT_EQ(c.mapping.sv, 6);
+}
+
+TEST(MitsubaReader, SpectraAsMitsubasRgbVariant) {
+  // A flat reflectance of 0.78 given on 400..700 nm only (zero outside, as Mitsuba integrates it).
+  SceneDesc s = read_text(R"(<shape type="rectangle"><bsdf type="diffuse">
+      <spectrum name="reflectance" value="400:0.78, 500:0.78, 600:0.78, 700:0.78"/></bsdf>
+      <emitter type="area"><spectrum name="radiance" value="400:0, 500:8, 600:15.6, 700:18.4"/></emitter></shape>)");
+  const auto& one = std::get<OneSidedMaterial>(s.materials[s.shapes[0].material]);
+  RGB r = std::get<DiffuseMaterial>(s.materials[one.material]).reflectance.value;
+  EXPECT_NEAR(r.r, 0.935761f, 1e-4);
+  EXPECT_NEAR(r.g, 0.740626f, 1e-4);
+  EXPECT_NEAR(r.b, 0.704686f, 1e-4);
+  ASSERT_TRUE(s.shapes[0].emission);
+  EXPECT_NEAR(s.shapes[0].emission->radiance.r, 20.7108f, 2e-3);
+  EXPECT_NEAR(s.shapes[0].emission->radiance.g, 10.8546f, 2e-3);
+  EXPECT_NEAR(s.shapes[0].emission->radiance.b, 2.77115f, 2e-3);
+  // Mitsuba 3's own silver: eta = (0.155276, 0.116728, 0.138388).
+  auto ag = mitsuba_spectra::named_conductor("Ag");
+  ASSERT_TRUE(ag);
+  EXPECT_NEAR(ag->eta.g, 0.116728f, 1e-5);
+}
+
+TEST(MitsubaReader, Emitters) {
+  SceneDesc s = read_text(R"(
+    <emitter type="point"><point name="position" x="1" y="2" z="3"/><rgb name="intensity" value="300"/></emitter>
+    <emitter type="constant"><rgb name="radiance" value="0.1"/></emitter>
+    <emitter type="directional"><vector name="direction" value="0,0,1"/><rgb name="irradiance" value="2"/></emitter>
+    <emitter type="spot"><float name="cutoff_angle" value="30"/>
+      <transform name="to_world"><lookat origin="0,3,0" target="0,0,0" up="0,0,1"/></transform></emitter>)");
+  ASSERT_EQ(s.lights.size(), 4u);
+  EXPECT_FLOAT_EQ(std::get<PointLight>(s.lights[0]).position.z, 3);
+  EXPECT_TRUE(std::get<SkyLight>(s.lights[1]).is_constant());
+  EXPECT_FLOAT_EQ(std::get<DistantLight>(s.lights[2]).radiance.g, 2);
+  const auto& spot = std::get<SpotLight>(s.lights[3]);
+  EXPECT_TRUE(spot.mitsuba_falloff);
+  EXPECT_FLOAT_EQ(spot.cone_angle, 30);
+  EXPECT_FLOAT_EQ(spot.cone_delta, 30 - 22.5f);  // beam_width defaults to 3/4 of the cutoff
+  EXPECT_NEAR(spot.direction.y, -1, 1e-5);
+  EXPECT_NEAR(spot.up.z, 1, 1e-5);
+}
+
+TEST(MitsubaReader, ErrorsNameFileAndLine) {
+  EXPECT_NE(error_of("<shape type=\"sphere\">\n<float name=\"radiuss\" value=\"1\"/></shape>").find("test.xml:3"),
+            std::string::npos);
+  EXPECT_NE(error_of("<shape type=\"sphere\"><float name=\"radiuss\" value=\"1\"/></shape>").find("unknown parameter"),
+            std::string::npos);
+  EXPECT_NE(error_of("<shape type=\"teapot\"/>").find("unknown shape type"), std::string::npos);
+  EXPECT_NE(error_of("<shape type=\"sphere\"><ref id=\"nothing\"/></shape>").find("undefined id \"nothing\""),
+            std::string::npos);
+  EXPECT_NE(error_of("<shape type=\"obj\"><string name=\"filename\" value=\"missing.obj\"/></shape>")
+                .find("\"missing.obj\" not found"),
+            std::string::npos);
+  EXPECT_NE(error_of("<shape type=\"sphere\">").find("malformed XML"), std::string::npos);
+}
+
+// Every scene of Mitsuba's render tests either reads or fails naming a file missing from the
+// shared data.
+TEST(MitsubaReader, RenderTestScenes) {
+  fs::path root = fs::path(CANDELA_SHARED_DIR) / "scenes/mitsuba-tests/tests/scenes";
+  if (!fs::exists(root)) GTEST_SKIP() << "no shared Mitsuba test scenes";
+  int read = 0, missing = 0;
+  for (const auto& dir : fs::directory_iterator(root))
+    for (const auto& entry : fs::directory_iterator(dir.path())) {
+      if (entry.path().extension() != ".xml") continue;
+      std::vector<std::string> warnings;
+      try {
+        SceneDesc s = read_mitsuba_scene(entry.path(), warnings);
+        EXPECT_FALSE(s.shapes.empty() && s.instances.empty()) << entry.path();
+        ++read;
+      } catch (const SceneError& e) {
+        std::string what = e.what();
+        bool names_missing = what.find("museum.exr\" not found") != std::string::npos ||
+                             what.find("rectangle_normals_uv.serialized\" not found") != std::string::npos;
+        EXPECT_TRUE(names_missing) << entry.path() << ": " << what;
+        ++missing;
+      }
+    }
+  EXPECT_EQ(read + missing, 26);
+  EXPECT_EQ(read, 12);
+}
+
+}  // namespace
+}  // namespace candela
