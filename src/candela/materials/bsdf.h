@@ -23,12 +23,13 @@
 #include "candela/materials/diffuse.h"
 #include "candela/materials/diffuse_transmission.h"
 #include "candela/materials/phong.h"
+#include "candela/materials/principled.h"
 #include "candela/materials/specular.h"
 
 namespace candela {
 
 using Bsdf = std::variant<DiffuseBsdf, PhongBsdf, MirrorBsdf, DielectricBsdf, BlackBsdf, ConductorBsdf,
-                          CoatedDiffuseBsdf, DiffuseTransmissionBsdf>;
+                          CoatedDiffuseBsdf, DiffuseTransmissionBsdf, PrincipledBsdf, PrincipledThinBsdf>;
 
 inline RGB bsdf_eval(const Bsdf& b, const Vec3& wo, const Vec3& wi) {
   return std::visit([&](const auto& x) { return x.eval(wo, wi); }, b);
@@ -57,6 +58,10 @@ inline float bsdf_adjoint_scale(const Bsdf& b, const Vec3& wo, const Vec3& wi) {
   if (wo.z * wi.z >= 0) return 1;
   if (const auto* d = std::get_if<DielectricBsdf>(&b)) {
     float etap = wo.z > 0 ? d->eta : 1 / d->eta;
+    return etap * etap;
+  }
+  if (const auto* p = std::get_if<PrincipledBsdf>(&b)) {  // its specular transmission (the thin one does not bend)
+    float etap = wo.z > 0 ? p->eta : 1 / p->eta;
     return etap * etap;
   }
   return 1;

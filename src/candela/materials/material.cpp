@@ -23,6 +23,12 @@ bool has_constant_inputs(const MaterialDesc& desc) {
                  is_constant(m.specular_tint) && is_constant(m.roughness);
         else if constexpr (std::is_same_v<T, CoatedDiffuseMaterial>)
           return is_constant(m.reflectance) && is_constant(m.specular) && is_constant(m.roughness);
+        else if constexpr (std::is_same_v<T, PrincipledMaterial>)
+          return is_constant(m.base_color) && is_constant(m.roughness) && is_constant(m.metallic) &&
+                 is_constant(m.specular) && is_constant(m.specular_tint) && is_constant(m.anisotropic) &&
+                 is_constant(m.sheen) && is_constant(m.sheen_tint) && is_constant(m.clearcoat) &&
+                 is_constant(m.clearcoat_gloss) && is_constant(m.spec_trans) && is_constant(m.diff_trans) &&
+                 is_constant(m.flatness);
         else if constexpr (std::is_same_v<T, DiffuseTransmissionMaterial>)
           return is_constant(m.reflectance) && is_constant(m.transmittance);
         else return true;
@@ -81,6 +87,36 @@ Bsdf MaterialTable::build(const MaterialDesc& desc, const TextureEvalContext& ct
                                    m.nonlinear};
         } else if constexpr (std::is_same_v<T, DiffuseTransmissionMaterial>) {
           return DiffuseTransmissionBsdf{albedo(m.reflectance), albedo(m.transmittance)};
+        } else if constexpr (std::is_same_v<T, PrincipledMaterial>) {
+          // Mitsuba's principled / principledthin; the inputs clamped to their documented ranges.
+          auto unit = [&](const FloatInput& f) { return std::clamp(tex.eval(f, ctx), 0.0f, 1.0f); };
+          PrincipledParams p;
+          p.base_color = albedo(m.base_color);
+          p.roughness = unit(m.roughness);
+          p.anisotropic = unit(m.anisotropic);
+          p.metallic = unit(m.metallic);
+          p.spec_tint = unit(m.specular_tint);
+          p.spec_trans = unit(m.spec_trans);
+          p.sheen = unit(m.sheen);
+          p.sheen_tint = unit(m.sheen_tint);
+          p.clearcoat = unit(m.clearcoat);
+          p.clearcoat_gloss = unit(m.clearcoat_gloss);
+          p.flatness = unit(m.flatness);
+          p.diff_trans = std::clamp(tex.eval(m.diff_trans, ctx), 0.0f, 2.0f);
+          if (m.thin) {
+            p.eta = m.eta;
+            return PrincipledThinBsdf(p);
+          }
+          // As Mitsuba: where spec_trans is given (a texture or non-zero), eta 1 becomes 1.001 and
+          // specular 0 becomes 1e-3, so that the transmission has an interface.
+          bool has_trans = !m.spec_trans.is_constant() || m.spec_trans.value != 0;
+          if (m.eta_given) {
+            p.eta = has_trans && m.eta == 1 ? 1.001f : m.eta;
+          } else {
+            float specular = unit(m.specular);
+            p.eta = principled_eta_from_specular(has_trans && specular == 0 ? 1e-3f : specular);
+          }
+          return PrincipledBsdf(p);
         } else {
           return BlackBsdf{};  // black, and interfaces (never shaded: the integrator passes through)
         }
