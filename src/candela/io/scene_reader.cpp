@@ -11,6 +11,7 @@
 #include <system_error>
 
 #include "candela/io/error.h"
+#include "candela/io/gltf_reader.h"
 #include "candela/io/mitsuba_reader.h"
 #include "candela/io/obj_scene_reader.h"
 
@@ -57,10 +58,12 @@ SceneDesc read_scene_file(const std::filesystem::path& file) {
     scene = read_pbrt_scene(file);
   else if (extension == ".obj")
     scene = read_obj_scene(file);
+  else if (extension == ".gltf" || extension == ".glb")
+    scene = read_gltf_scene(file);
   else if (extension == ".xml")
     scene = read_mitsuba_scene(file);
   else
-    throw_scene_error(location_of_file(file), "unsupported scene file extension {}; supported: .json, .pbrt, .obj, .xml (Mitsuba 3)",
+    throw_scene_error(location_of_file(file), "unsupported scene file extension {}; supported: .json, .pbrt, .obj, .gltf, .glb, .xml (Mitsuba 3)",
                       extension.empty() ? std::string("(none)") : "\"" + extension + "\"");
   scene.source_file = file.string();
   return scene;
