@@ -19,6 +19,7 @@
 
 #include "candela/film/image_io.h"
 #include "candela/io/error.h"
+#include "candela/io/json_writer.h"
 #include "candela/io/scene_reader.h"
 #include "candela/render/checkpoint.h"
 #include "candela/render/renderer.h"
@@ -445,6 +446,19 @@ int run_render(const RenderCommand& cmd) {
   return 0;
 }
 
+// `candela convert IN OUT.json`: any scene candela reads, in its JSON format.
+int run_convert(const std::string& in, const std::string& out) {
+  const std::filesystem::path output(out);
+  if (output.extension() != ".json")
+    throw UsageError(fmt::format("convert writes candela's JSON format: the output must end in .json, got \"{}\"", out));
+  SceneDesc scene = read_scene_file(in);
+  write_json_scene(scene, output);
+  std::fprintf(stderr, "%s -> %s: %zu shapes, %zu instances, %zu materials, %zu textures, %zu lights\n", in.c_str(),
+               out.c_str(), scene.shapes.size(), scene.instances.size(), scene.materials.size(), scene.textures.size(),
+               scene.lights.size());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -542,12 +556,19 @@ int main(int argc, char** argv) {
                          "Render only pixel X,Y (all its samples), print its value and its NaN/inf sample "
                          "indices; writes no image");
 
+  std::string convert_in, convert_out;
+  CLI::App* convert_cmd = app.add_subcommand(
+      "convert", "Write a scene (.json, .pbrt, .xml, .obj, .gltf, .glb) in candela's JSON format");
+  convert_cmd->add_option("scene", convert_in, "The scene file to read")->required();
+  convert_cmd->add_option("output", convert_out, "The JSON file to write (replaced atomically)")->required();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
   try {
+    if (convert_cmd->parsed()) return run_convert(convert_in, convert_out);
     return run_render(cmd);
   } catch (const std::exception& e) {  // SceneError, UsageError, image I/O: one message, no output written
     std::fprintf(stderr, "candela: error: %s\n", e.what());

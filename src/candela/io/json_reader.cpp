@@ -588,22 +588,44 @@ class JsonSceneReader {
 
   void read_camera(const Json& value, const std::string& pointer) {
     CheckedObject camera(report_, value, pointer);
+    const Json* transform = camera.find("transform");
+    if (transform && (camera.has("position") || camera.has("look_at") || camera.has("up")))
+      report_.fail(camera.pointer_of("transform"),
+                   "a camera takes either \"transform\" or \"position\"/\"look_at\"/\"up\", not both");
     Point3 position = camera.vec3_or("position", {0, 0, 0});
     Point3 look_at = camera.vec3_or("look_at", {0, 0, 1});
     Vec3 up = camera.direction_or("up", {0, 1, 0});
     float fov = camera.number_or("fov", 40);
     if (!(fov > 0 && fov < 180))
-      report_.fail(camera.pointer_of("fov"), "the vertical field of view must be in (0, 180) degrees, got {}", fov);
+      report_.fail(camera.pointer_of("fov"), "the field of view must be in (0, 180) degrees, got {}", fov);
+    if (const Json* axis = camera.find("fov_axis"))
+      scene_.camera.fov_axis = read_name<FovAxis>(report_, *axis, camera.pointer_of("fov_axis"), "field of view axis",
+                                                  {{"x", FovAxis::X},
+                                                   {"y", FovAxis::Y},
+                                                   {"smaller", FovAxis::Smaller},
+                                                   {"larger", FovAxis::Larger},
+                                                   {"diagonal", FovAxis::Diagonal}});
+    else
+      scene_.camera.fov_axis = FovAxis::Y;
+    if (const Json* projection = camera.find("projection"))
+      scene_.camera.projection =
+          read_name<Projection>(report_, *projection, camera.pointer_of("projection"), "projection",
+                                {{"perspective", Projection::Perspective}, {"orthographic", Projection::Orthographic}});
+    scene_.camera.near_clip = camera.number_or("near_clip", scene_.camera.near_clip, Bound::NonNegative);
     scene_.film.width = camera.integer_or("width", scene_.film.width, 1, kMaxResolution);
     scene_.film.height = camera.integer_or("height", scene_.film.height, 1, kMaxResolution);
     read_lens_and_shutter(camera);
     camera.finish();
     if (int64_t(scene_.film.width) * scene_.film.height > kMaxPixels)
       report_.fail(pointer, "{} x {} pixels exceeds the limit of 2^28 pixels", scene_.film.width, scene_.film.height);
-    check_view_direction(camera, position, look_at, up);
-    scene_.camera.world_from_camera = Transform::look_at_right_handed(position, look_at, up);
+    if (transform) {
+      // Camera space: +x image right, +y image up, +z the view direction.
+      scene_.camera.world_from_camera = read_transform(*transform, camera.pointer_of("transform"));
+    } else {
+      check_view_direction(camera, position, look_at, up);
+      scene_.camera.world_from_camera = Transform::look_at_right_handed(position, look_at, up);
+    }
     scene_.camera.fov_degrees = fov;
-    scene_.camera.fov_axis = FovAxis::Y;
   }
 
   void read_lens_and_shutter(CheckedObject& camera) {
@@ -852,9 +874,12 @@ class JsonSceneReader {
       mix.tex2 = color_input_or(t, "tex2", kAny, mix.tex2);
       mix.amount = float_input_or(t, "amount", Bound::UnitInterval, mix.amount);
       texture = mix;
+    } else if (type == "mesh_attribute") {
+      texture = MeshAttributeTexture{t.string("name")};
     } else {
       report_.fail(t.pointer_of("type"),
-                   "unknown texture type \"{}\"; expected one of: image, checkerboard, scale, mix", type);
+                   "unknown texture type \"{}\"; expected one of: image, checkerboard, scale, mix, mesh_attribute",
+                   type);
     }
     t.finish();
     return texture;
@@ -960,14 +985,26 @@ class JsonSceneReader {
 
   // ---- materials
 
+  // Named materials may wrap (one_sided, mask, blend, normal_map, bump_map) materials named anywhere
+  // in the file: each is read when first needed, after what it wraps, as named textures are.
   void read_materials(const Json& value, const std::string& pointer) {
     if (!value.is_object())
       report_.fail(pointer, "expected an object mapping material names to materials, got {}", describe(value));
+    std::vector<std::string> names;  // in the file's order
     for (auto it = value.begin(); it != value.end(); ++it) {
       if (it.key() == "_comment") continue;
-      material_index_[it.key()] = add_material(read_material(it.value(), child_pointer(pointer, it.key())));
+      names.push_back(it.key());
+      named_materials_[it.key()] = NamedMaterial{&it.value(), child_pointer(pointer, it.key())};
     }
+    for (const std::string& name : names) material_by_name(name, named_materials_[name].pointer);
   }
+
+  struct NamedMaterial {
+    const Json* value = nullptr;
+    std::string pointer;
+    bool reading = false;
+    int index = -1;
+  };
 
   int add_material(MaterialDesc material) {
     scene_.materials.push_back(std::move(material));
@@ -996,10 +1033,33 @@ class JsonSceneReader {
       material = InterfaceMaterial{};
     else if (type == "black")
       material = BlackMaterial{};
-    else
+    else if (type == "principled")
+      material = read_principled(m);
+    else if (type == "one_sided")
+      material = OneSidedMaterial{wrapped_material(m, "material")};
+    else if (type == "mask") {
+      MaskMaterial mask;
+      mask.opacity = float_input_or(m, "opacity", Bound::UnitInterval, mask.opacity);
+      mask.material = wrapped_material(m, "material");
+      material = mask;
+    } else if (type == "blend")
+      material = read_blend(m);
+    else if (type == "normal_map") {
+      NormalMapMaterial map;
+      map.normal_map = texture_reference(m, "normal_map");
+      map.material = wrapped_material(m, "material");
+      material = map;
+    } else if (type == "bump_map") {
+      BumpMapMaterial map;
+      map.height = texture_reference(m, "height");
+      map.scale = m.number_or("scale", map.scale);
+      map.material = wrapped_material(m, "material");
+      material = map;
+    } else
       report_.fail(m.pointer_of("type"),
                    "unknown material type \"{}\"; expected one of: diffuse, phong, mirror, conductor, dielectric, "
-                   "glass, coated_diffuse, plastic, diffuse_transmission, interface, null, black",
+                   "glass, coated_diffuse, plastic, diffuse_transmission, interface, null, black, principled, "
+                   "one_sided, mask, blend, normal_map, bump_map",
                    type);
     m.finish();
     return material;
@@ -1042,6 +1102,12 @@ class JsonSceneReader {
       roughness.u = read_float_input(*alpha_u, m.pointer_of("alpha_u"), Bound::NonNegative);
       roughness.v = read_float_input(*alpha_v, m.pointer_of("alpha_v"), Bound::NonNegative);
     }
+    // pbrt-v4's remaproughness: the values are pbrt's "roughness", alpha = sqrt(roughness).
+    roughness.remap = m.boolean_or("remap_roughness", false);
+    if (const Json* distribution = m.find("distribution"))
+      roughness.distribution = read_name<MicrofacetDistribution>(
+          report_, *distribution, m.pointer_of("distribution"), "microfacet distribution",
+          {{"ggx", MicrofacetDistribution::GGX}, {"beckmann", MicrofacetDistribution::Beckmann}});
     return roughness;
   }
 
@@ -1074,13 +1140,14 @@ class JsonSceneReader {
     report_.fail(pointer, "unknown metal \"{}\"; expected one of: {}", name, fmt::join(metal_names(), ", "));
   }
 
-  // An index of refraction must be > 0 in each channel (constants; textures are not checked).
+  // A conductor's eta must be >= 0 in each channel (0 with k > 0 is a perfect mirror, Mitsuba's
+  // "none"); constants only, textures are not checked.
   void check_positive_color(const ColorInput& input, const Json& value, const std::string& pointer) const {
     if (!input.is_constant()) return;
     for (int i = 0; i < 3; ++i)
-      if (!(input.value[i] > 0))
+      if (!(input.value[i] >= 0))
         report_.fail(value.is_array() ? child_pointer(pointer, size_t(i)) : pointer,
-                     "an index of refraction must be > 0 in each channel, got {}", input.value[i]);
+                     "an index of refraction must be >= 0 in each channel, got {}", input.value[i]);
   }
 
   DielectricMaterial read_dielectric(CheckedObject& m) {
@@ -1089,6 +1156,7 @@ class JsonSceneReader {
     d.reflectance = color_input_or(m, "reflectance", ColorKind::Albedo, d.reflectance);
     d.transmittance = color_input_or(m, "transmittance", ColorKind::Albedo, d.transmittance);
     d.roughness = read_roughness(m);
+    d.thin = m.boolean_or("thin", d.thin);
     return d;
   }
 
@@ -1118,13 +1186,83 @@ class JsonSceneReader {
     return d;
   }
 
-  int material_by_name(const std::string& name, const std::string& pointer) const {
-    auto it = material_index_.find(name);
-    if (it != material_index_.end()) return it->second;
-    std::vector<std::string> names;
-    for (const auto& entry : material_index_) names.push_back(entry.first);
-    if (names.empty()) report_.fail(pointer, "unknown material \"{}\" (\"materials\" defines none)", name);
-    report_.fail(pointer, "unknown material \"{}\"; defined: {}", name, fmt::join(names, ", "));
+  int material_by_name(const std::string& name, const std::string& pointer) {
+    auto it = named_materials_.find(name);
+    if (it == named_materials_.end()) {
+      std::vector<std::string> names;
+      for (const auto& entry : named_materials_) names.push_back(entry.first);
+      if (names.empty()) report_.fail(pointer, "unknown material \"{}\" (\"materials\" defines none)", name);
+      report_.fail(pointer, "unknown material \"{}\"; defined: {}", name, fmt::join(names, ", "));
+    }
+    NamedMaterial& material = it->second;
+    if (material.index >= 0) return material.index;
+    if (material.reading) report_.fail(pointer, "material \"{}\" wraps itself (a cycle of wrapping materials)", name);
+    material.reading = true;
+    MaterialDesc desc = read_material(*material.value, material.pointer);
+    material.reading = false;
+    material.index = add_material(std::move(desc));
+    return material.index;
+  }
+
+  // The material a wrapper wraps: a name or an inline material object, read (and added) before it.
+  int wrapped_material(CheckedObject& m, std::string_view key) {
+    const Json& value = m.require(key);
+    std::string pointer = m.pointer_of(key);
+    if (value.is_string()) return material_by_name(value.get<std::string>(), pointer);
+    if (value.is_object()) return add_material(read_material(value, pointer));
+    report_.fail(pointer, "expected a material name or a material object, got {}", describe(value));
+  }
+
+  // A texture given by name or inline object (not a constant): normal and bump maps.
+  int texture_reference(CheckedObject& m, std::string_view key) {
+    const Json& value = m.require(key);
+    std::string pointer = m.pointer_of(key);
+    if (value.is_string()) return named_texture(value.get<std::string>(), pointer);
+    if (value.is_object()) return add_texture(read_texture(value, pointer));
+    report_.fail(pointer, "expected a texture (a name or an object), got {}", describe(value));
+  }
+
+  PrincipledMaterial read_principled(CheckedObject& m) {
+    PrincipledMaterial p;
+    p.base_color = color_input_or(m, "base_color", ColorKind::Albedo, p.base_color);
+    auto unit = [&](std::string_view key, FloatInput& input) { input = float_input_or(m, key, Bound::UnitInterval, input); };
+    unit("roughness", p.roughness);
+    unit("metallic", p.metallic);
+    unit("specular", p.specular);
+    unit("specular_tint", p.specular_tint);
+    unit("anisotropic", p.anisotropic);
+    unit("sheen", p.sheen);
+    unit("sheen_tint", p.sheen_tint);
+    unit("clearcoat", p.clearcoat);
+    unit("clearcoat_gloss", p.clearcoat_gloss);
+    unit("spec_trans", p.spec_trans);
+    if (m.has("eta")) {
+      p.eta = m.number("eta", Bound::Positive);
+      p.eta_given = true;
+    }
+    p.thin = m.boolean_or("thin", p.thin);
+    unit("diff_trans", p.diff_trans);
+    unit("flatness", p.flatness);
+    return p;
+  }
+
+  BlendMaterial read_blend(CheckedObject& m) {
+    BlendMaterial b;
+    b.weight = float_input_or(m, "weight", Bound::UnitInterval, b.weight);
+    const Json& list = m.require("materials");
+    std::string pointer = m.pointer_of("materials");
+    if (!list.is_array() || list.size() != 2)
+      report_.fail(pointer, "expected two materials [weight 0, weight 1], got {}", describe(list));
+    int index[2];
+    for (size_t i = 0; i < 2; ++i) {
+      std::string item = child_pointer(pointer, i);
+      if (list[i].is_string()) index[i] = material_by_name(list[i].get<std::string>(), item);
+      else if (list[i].is_object()) index[i] = add_material(read_material(list[i], item));
+      else report_.fail(item, "expected a material name or a material object, got {}", describe(list[i]));
+    }
+    b.material0 = index[0];
+    b.material1 = index[1];
+    return b;
   }
 
   int black_material() {
@@ -1165,8 +1303,16 @@ class JsonSceneReader {
     if (type == "box") return read_box(s);
     if (type == "rectangle") return read_rectangle(s);
     if (type == "mesh") return read_mesh(s);
+    if (type == "disk") return DiskShape{};
+    if (type == "cylinder") {
+      CylinderShape c{s.vec3_or("p0", {0, 0, 0}), s.vec3_or("p1", {0, 0, 1}), s.number_or("radius", 1, Bound::Positive)};
+      if (length_squared(c.p1 - c.p0) == 0) report_.fail(s.pointer_of("p1"), "p1 must differ from p0 (the axis)");
+      return c;
+    }
     report_.fail(s.pointer_of("type"),
-                 "unknown shape type \"{}\"; expected one of: sphere, plane, box, rectangle, mesh, instance", type);
+                 "unknown shape type \"{}\"; expected one of: sphere, plane, box, rectangle, mesh, disk, cylinder, "
+                 "instance",
+                 type);
   }
 
   static SphereShape read_sphere(CheckedObject& s) { return {s.vec3("center"), s.number("radius", Bound::Positive)}; }
@@ -1196,9 +1342,10 @@ class JsonSceneReader {
     report_.fail(pointer, "expected a material name or a material object, got {}", describe(*material));
   }
 
-  AreaEmission read_emission(const Json& value, const std::string& pointer) const {
+  AreaEmission read_emission(const Json& value, const std::string& pointer) {
     CheckedObject e(report_, value, pointer);
     AreaEmission emission{e.rgb("radiance", ColorKind::Emission), e.boolean_or("two_sided", false)};
+    if (e.has("texture")) emission.texture = texture_reference(e, "texture");
     e.finish();
     return emission;
   }
@@ -1290,7 +1437,7 @@ class JsonSceneReader {
   }
 
   TriangleMesh read_mesh_file(CheckedObject& s) const {
-    for (std::string_view key : {"indices", "normals", "uvs"})
+    for (std::string_view key : {"indices", "normals", "uvs", "attributes"})
       if (s.has(key)) report_.fail(s.pointer_of(key), "inline mesh data cannot be combined with \"file\"");
     std::string file = s.string("file");
     if (file.empty()) report_.fail(s.pointer_of("file"), "the mesh file name is empty");
@@ -1318,7 +1465,32 @@ class JsonSceneReader {
       mesh.uvs = read_vec2_list(*uvs, s.pointer_of("uvs"));
       check_per_vertex_count(mesh.uvs.size(), mesh.positions.size(), s.pointer_of("uvs"));
     }
+    if (const Json* attributes = s.find("attributes")) read_mesh_attributes(*attributes, s.pointer_of("attributes"), mesh);
     return mesh;
+  }
+
+  // [{"name": ..., "per_face": bool, "channels": 1 or 3, "values": [...]}, ...]
+  void read_mesh_attributes(const Json& value, const std::string& pointer, TriangleMesh& mesh) const {
+    check_is_array(report_, value, pointer, "mesh attributes");
+    for (size_t i = 0; i < value.size(); ++i) {
+      CheckedObject a(report_, value[i], child_pointer(pointer, i));
+      TriangleMesh::Attribute attribute;
+      attribute.name = a.string("name");
+      attribute.per_face = a.boolean_or("per_face", false);
+      attribute.channels = a.integer_or("channels", 1, 1, 3);
+      if (attribute.channels == 2) report_.fail(a.pointer_of("channels"), "an attribute has 1 or 3 channels, got 2");
+      const Json& values = a.require("values");
+      check_is_array(report_, values, a.pointer_of("values"), "attribute values");
+      size_t count = attribute.per_face ? mesh.triangle_count() : mesh.positions.size();
+      if (values.size() != count * size_t(attribute.channels))
+        report_.fail(a.pointer_of("values"), "expected {} values ({} per {}), got {}", count * attribute.channels,
+                     attribute.channels, attribute.per_face ? "triangle" : "position", values.size());
+      attribute.values.reserve(values.size());
+      for (size_t k = 0; k < values.size(); ++k)
+        attribute.values.push_back(read_float(report_, values[k], child_pointer(a.pointer_of("values"), k)));
+      a.finish();
+      mesh.attributes.push_back(std::move(attribute));
+    }
   }
 
   std::vector<Vec3> read_vec3_list(const Json& value, const std::string& pointer, std::string_view of_what) const {
@@ -1466,10 +1638,12 @@ class JsonSceneReader {
       scene_.shapes.push_back(read_shape_light(light, read_sphere(light)));
     else if (type == "rectangle")
       scene_.shapes.push_back(read_shape_light(light, read_rectangle(light)));
+    else if (type == "projector")
+      scene_.lights.push_back(read_projector(light));
     else
       report_.fail(light.pointer_of("type"),
                    "unknown light type \"{}\"; expected one of: point, spot, distant, sky, environment, sphere, "
-                   "rectangle",
+                   "rectangle, projector",
                    type);
     light.finish();
   }
@@ -1507,7 +1681,20 @@ class JsonSceneReader {
     return sky;
   }
 
-  SpotLight read_spot(CheckedObject& light) const {
+  // Mitsuba's projector: an image projected from the origin of "transform" along its +z.
+  ProjectorLight read_projector(CheckedObject& light) {
+    ProjectorLight projector;
+    projector.to_world = read_transform_key(light);
+    projector.fov_degrees = light.number_or("fov", projector.fov_degrees);
+    if (!(projector.fov_degrees > 0 && projector.fov_degrees < 180))
+      report_.fail(light.pointer_of("fov"), "the field of view must be in (0, 180) degrees, got {}",
+                   projector.fov_degrees);
+    projector.irradiance = texture_reference(light, "irradiance");
+    projector.scale = light.rgb_or("scale", ColorKind::Emission, projector.scale);
+    return projector;
+  }
+
+  SpotLight read_spot(CheckedObject& light) {
     SpotLight spot;
     spot.position = light.vec3("position");
     bool has_direction = light.has("direction"), has_look_at = light.has("look_at");
@@ -1532,6 +1719,11 @@ class JsonSceneReader {
     if (!(spot.cone_delta >= 0 && spot.cone_delta <= spot.cone_angle))
       report_.fail(light.pointer_of("cone_delta"), "cone_delta must be in [0, cone_angle] = [0, {}] degrees, got {}",
                    spot.cone_angle, spot.cone_delta);
+    if (const Json* falloff = light.find("falloff"))
+      spot.mitsuba_falloff = read_name<bool>(report_, *falloff, light.pointer_of("falloff"), "spot falloff",
+                                             {{"smoothstep", false}, {"linear", true}});
+    if (light.has("texture")) spot.texture = texture_reference(light, "texture");
+    spot.up = normalize(light.direction_or("up", spot.up));
     return spot;
   }
 
@@ -1596,7 +1788,7 @@ class JsonSceneReader {
   std::map<std::string, NamedTexture> named_textures_;
   std::vector<std::string> texture_stack_;  // the named textures being read, outermost first
   int texture_depth_ = 0;                   // textures being read, named or inline
-  std::map<std::string, int> material_index_;
+  std::map<std::string, NamedMaterial> named_materials_;
   std::map<std::string, int> object_index_;
   std::optional<int> black_material_;
 };

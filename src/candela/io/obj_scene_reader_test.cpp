@@ -82,9 +82,9 @@ TEST(ObjScene, MissingMaterialLibraryIsAWarningAndALitModel) {
   fs::create_directories(dir);
   const fs::path file = dir / "quad.obj";
   std::ofstream(file) << "mtllib nowhere.mtl\nusemtl red\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
-  testing::internal::CaptureStderr();
+  ::testing::internal::CaptureStderr();
   SceneDesc scene = read_scene_file(file);
-  std::string err = testing::internal::GetCapturedStderr();
+  std::string err = ::testing::internal::GetCapturedStderr();
   EXPECT_NE(err.find("nowhere.mtl"), std::string::npos) << err;
   ASSERT_EQ(scene.shapes.size(), 1u);
   EXPECT_EQ(scene.shapes[0].material, -1);  // the default diffuse

@@ -63,7 +63,8 @@ SceneDesc read_scene_file(const std::filesystem::path& file) {
   else if (extension == ".xml")
     scene = read_mitsuba_scene(file);
   else
-    throw_scene_error(location_of_file(file), "unsupported scene file extension {}; supported: .json, .pbrt, .obj, .gltf, .glb, .xml (Mitsuba 3)",
+    throw_scene_error(location_of_file(file),
+                      "unsupported scene file extension {}; supported: .json, .pbrt, .xml (Mitsuba 3), .gltf, .glb, .obj",
                       extension.empty() ? std::string("(none)") : "\"" + extension + "\"");
   scene.source_file = file.string();
   return scene;

@@ -1,0 +1,396 @@
+// SceneDesc -> candela JSON. Each section mirrors what json_reader.cpp reads (docs/scene-format.md);
+// a key is written only where the value differs from the reader's default, except where the reader
+// requires it.
+#include "candela/io/json_writer.h"
+
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <system_error>
+
+#include "candela/io/error.h"
+
+namespace candela {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+
+template <class... Ts>
+struct Overloaded : Ts... {
+  using Ts::operator()...;
+};
+template <class... Ts>
+Overloaded(Ts...) -> Overloaded<Ts...>;
+
+[[noreturn]] void cannot_express(const std::string& what) {
+  throw SceneError(fmt::format("convert: the JSON format cannot express {}", what));
+}
+
+Json vec3(const Vec3& v) { return Json::array({v.x, v.y, v.z}); }
+Json rgb(const RGB& c) { return Json::array({c.r, c.g, c.b}); }
+
+Json matrix(const Transform& t) {
+  Json values = Json::array();
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) values.push_back(t.matrix().m[r][c]);
+  return Json::array({Json{{"matrix", values}}});
+}
+
+std::string texture_name(int index) { return fmt::format("texture{:05}", index); }
+std::string material_name(int index) { return fmt::format("material{:05}", index); }
+std::string object_name(int index) { return fmt::format("object{:05}", index); }
+
+Json color(const ColorInput& in) { return in.is_constant() ? rgb(in.value) : Json(texture_name(in.texture)); }
+Json number(const FloatInput& in) { return in.is_constant() ? Json(in.value) : Json(texture_name(in.texture)); }
+std::string absolute(const std::string& file) { return fs::absolute(file).lexically_normal().string(); }
+
+void write_mapping(const UVMapping& m, Json& j) {
+  if (m.su != 1 || m.sv != 1) j["uv_scale"] = Json::array({m.su, m.sv});
+  if (m.du != 0 || m.dv != 0) j["uv_offset"] = Json::array({m.du, m.dv});
+}
+
+Json texture_json(const TextureDesc& desc) {
+  return std::visit(
+      Overloaded{
+          [](const ImageTexture& t) {
+            Json j{{"type", "image"}, {"filename", absolute(t.filename)}};
+            static const char* kWrap[] = {"repeat", "clamp", "black", "mirror"};
+            static const char* kEncoding[] = {"auto", "linear", "srgb"};
+            j["wrap"] = kWrap[int(t.wrap)];
+            j["encoding"] = kEncoding[int(t.encoding)];
+            j["filter"] = t.bilinear ? "bilinear" : "nearest";
+            if (t.scale != 1) j["scale"] = t.scale;
+            if (t.invert) j["invert"] = true;
+            write_mapping(t.mapping, j);
+            return j;
+          },
+          [](const CheckerboardTexture& t) {
+            Json j{{"type", "checkerboard"}, {"tex1", color(t.tex1)}, {"tex2", color(t.tex2)}};
+            write_mapping(t.mapping, j);
+            return j;
+          },
+          [](const ScaleTexture& t) { return Json{{"type", "scale"}, {"tex", color(t.tex)}, {"scale", number(t.scale)}}; },
+          [](const MixTexture& t) {
+            return Json{{"type", "mix"}, {"tex1", color(t.tex1)}, {"tex2", color(t.tex2)}, {"amount", number(t.amount)}};
+          },
+          [](const MeshAttributeTexture& t) { return Json{{"type", "mesh_attribute"}, {"name", t.name}}; },
+      },
+      desc);
+}
+
+void write_roughness(const Roughness& r, Json& j) {
+  if (r.remap) j["remap_roughness"] = true;
+  if (r.u.is_constant() && r.v.is_constant() && r.u.value == r.v.value) {
+    if (r.u.value != 0) j["roughness"] = r.u.value;
+  } else if (r.u.texture == r.v.texture && !r.u.is_constant()) {
+    j["roughness"] = number(r.u);
+  } else {
+    j["alpha_u"] = number(r.u);
+    j["alpha_v"] = number(r.v);
+  }
+  if (r.distribution == MicrofacetDistribution::Beckmann) j["distribution"] = "beckmann";
+}
+
+Json material_json(const MaterialDesc& desc) {
+  return std::visit(
+      Overloaded{
+          [](const DiffuseMaterial& m) { return Json{{"type", "diffuse"}, {"reflectance", color(m.reflectance)}}; },
+          [](const PhongMaterial& m) {
+            return Json{{"type", "phong"},           {"diffuse", color(m.diffuse)},
+                        {"specular", color(m.specular)}, {"exponent", m.exponent},
+                        {"transmission", color(m.transmission)}, {"ior", m.ior},
+                        {"d", m.d},                      {"s", m.s},
+                        {"t", m.t}};
+          },
+          [](const MirrorMaterial& m) { return Json{{"type", "mirror"}, {"reflectance", color(m.reflectance)}}; },
+          [](const DielectricMaterial& m) {
+            Json j{{"type", "dielectric"}, {"ior", m.ior}, {"reflectance", color(m.reflectance)},
+                   {"transmittance", color(m.transmittance)}};
+            write_roughness(m.roughness, j);
+            if (m.thin) j["thin"] = true;
+            return j;
+          },
+          [](const BlackMaterial&) { return Json{{"type", "black"}}; },
+          [](const ConductorMaterial& m) {
+            Json j{{"type", "conductor"}};
+            if (m.reflectance) {
+              j["reflectance"] = color(*m.reflectance);
+            } else {
+              j["eta"] = color(m.eta);
+              j["k"] = color(m.k);
+            }
+            j["specular_tint"] = color(m.specular_tint);
+            write_roughness(m.roughness, j);
+            return j;
+          },
+          [](const CoatedDiffuseMaterial& m) {
+            Json j{{"type", "coated_diffuse"}, {"reflectance", color(m.reflectance)}, {"specular", color(m.specular)},
+                   {"ior", m.ior}};
+            write_roughness(m.roughness, j);
+            if (m.nonlinear) j["nonlinear"] = true;
+            return j;
+          },
+          [](const DiffuseTransmissionMaterial& m) {
+            return Json{{"type", "diffuse_transmission"},
+                        {"reflectance", color(m.reflectance)},
+                        {"transmittance", color(m.transmittance)}};
+          },
+          [](const InterfaceMaterial&) { return Json{{"type", "interface"}}; },
+          [](const PrincipledMaterial& m) {
+            Json j{{"type", "principled"},
+                   {"base_color", color(m.base_color)},
+                   {"roughness", number(m.roughness)},
+                   {"metallic", number(m.metallic)},
+                   {"specular", number(m.specular)},
+                   {"specular_tint", number(m.specular_tint)},
+                   {"anisotropic", number(m.anisotropic)},
+                   {"sheen", number(m.sheen)},
+                   {"sheen_tint", number(m.sheen_tint)},
+                   {"clearcoat", number(m.clearcoat)},
+                   {"clearcoat_gloss", number(m.clearcoat_gloss)},
+                   {"spec_trans", number(m.spec_trans)}};
+            if (m.eta_given) j["eta"] = m.eta;
+            if (m.thin) {
+              j["thin"] = true;
+              j["diff_trans"] = number(m.diff_trans);
+              j["flatness"] = number(m.flatness);
+            } else if (!(m.flatness.is_constant() && m.flatness.value == 0)) {
+              j["flatness"] = number(m.flatness);
+            }
+            return j;
+          },
+          [](const OneSidedMaterial& m) { return Json{{"type", "one_sided"}, {"material", material_name(m.material)}}; },
+          [](const MaskMaterial& m) {
+            return Json{{"type", "mask"}, {"opacity", number(m.opacity)}, {"material", material_name(m.material)}};
+          },
+          [](const BlendMaterial& m) {
+            return Json{{"type", "blend"},
+                        {"weight", number(m.weight)},
+                        {"materials", Json::array({material_name(m.material0), material_name(m.material1)})}};
+          },
+          [](const NormalMapMaterial& m) {
+            return Json{{"type", "normal_map"},
+                        {"normal_map", texture_name(m.normal_map)},
+                        {"material", material_name(m.material)}};
+          },
+          [](const BumpMapMaterial& m) {
+            return Json{{"type", "bump_map"},
+                        {"height", texture_name(m.height)},
+                        {"scale", m.scale},
+                        {"material", material_name(m.material)}};
+          },
+      },
+      desc);
+}
+
+Json mesh_json(const TriangleMesh& mesh) {
+  Json j{{"type", "mesh"}};
+  Json positions = Json::array();
+  for (const Point3& p : mesh.positions) positions.push_back(vec3(p));
+  j["positions"] = std::move(positions);
+  j["indices"] = mesh.indices;
+  if (!mesh.normals.empty()) {
+    Json normals = Json::array();
+    for (const Normal3& n : mesh.normals) normals.push_back(vec3(n));
+    j["normals"] = std::move(normals);
+  }
+  if (!mesh.uvs.empty()) {
+    Json uvs = Json::array();
+    for (const Vec2& uv : mesh.uvs) uvs.push_back(Json::array({uv.x, uv.y}));
+    j["uvs"] = std::move(uvs);
+  }
+  if (!mesh.attributes.empty()) {
+    Json attributes = Json::array();
+    for (const TriangleMesh::Attribute& a : mesh.attributes)
+      attributes.push_back(
+          Json{{"name", a.name}, {"per_face", a.per_face}, {"channels", a.channels}, {"values", a.values}});
+    j["attributes"] = std::move(attributes);
+  }
+  return j;
+}
+
+Json geometry_json(const ShapeGeometry& geometry) {
+  return std::visit(
+      Overloaded{
+          [](const SphereShape& s) { return Json{{"type", "sphere"}, {"center", vec3(s.center)}, {"radius", s.radius}}; },
+          [](const PlaneShape& p) { return Json{{"type", "plane"}, {"point", vec3(p.point)}, {"normal", vec3(p.normal)}}; },
+          [](const BoxShape& b) { return Json{{"type", "box"}, {"min", vec3(b.lo)}, {"max", vec3(b.hi)}}; },
+          [](const RectangleShape& r) {
+            return Json{{"type", "rectangle"}, {"corner", vec3(r.corner)}, {"edge_u", vec3(r.edge_u)},
+                        {"edge_v", vec3(r.edge_v)}};
+          },
+          [](const MeshShape& m) { return mesh_json(m.mesh); },
+          [](const DiskShape&) { return Json{{"type", "disk"}}; },
+          [](const CylinderShape& c) {
+            return Json{{"type", "cylinder"}, {"p0", vec3(c.p0)}, {"p1", vec3(c.p1)}, {"radius", c.radius}};
+          },
+      },
+      geometry);
+}
+
+Json shape_json(const ShapeDesc& shape) {
+  Json j = geometry_json(shape.geometry);
+  if (shape.material >= 0) j["material"] = material_name(shape.material);
+  if (shape.emission) {
+    Json e{{"radiance", rgb(shape.emission->radiance)}, {"two_sided", shape.emission->two_sided}};
+    if (shape.emission->texture >= 0) e["texture"] = texture_name(shape.emission->texture);
+    j["emission"] = std::move(e);
+  }
+  if (!shape.to_world.is_identity()) j["transform"] = matrix(shape.to_world);
+  if (shape.to_world_end) j["transform_end"] = matrix(*shape.to_world_end);
+  if (!shape.name.empty()) j["name"] = shape.name;
+  if (shape.reverse_orientation) j["reverse_orientation"] = true;
+  return j;
+}
+
+Json light_json(const LightDesc& light) {
+  return std::visit(
+      Overloaded{
+          [](const PointLight& l) { return Json{{"type", "point"}, {"position", vec3(l.position)}, {"intensity", rgb(l.intensity)}}; },
+          [](const SkyLight& l) {
+            return Json{{"type", "sky"},      {"zenith", rgb(l.zenith)}, {"horizon", rgb(l.horizon)},
+                        {"ground", rgb(l.ground)}, {"up", vec3(l.up)}};
+          },
+          [](const SpotLight& l) {
+            Json j{{"type", "spot"},         {"position", vec3(l.position)}, {"direction", vec3(l.direction)},
+                   {"intensity", rgb(l.intensity)}, {"cone_angle", l.cone_angle},  {"cone_delta", l.cone_delta}};
+            if (l.mitsuba_falloff) j["falloff"] = "linear";
+            if (l.texture >= 0) j["texture"] = texture_name(l.texture);
+            j["up"] = vec3(l.up);
+            return j;
+          },
+          [](const DistantLight& l) {
+            return Json{{"type", "distant"}, {"direction", vec3(l.direction)}, {"radiance", rgb(l.radiance)}};
+          },
+          [](const EnvironmentMap& l) {
+            Json j{{"type", "environment"},
+                   {"filename", absolute(l.filename)},
+                   {"mapping", l.mapping == EnvironmentMapping::Equirectangular ? "equirectangular" : "equal_area"},
+                   {"scale", rgb(l.scale)}};
+            if (!l.to_world.is_identity()) j["transform"] = matrix(l.to_world);
+            return j;
+          },
+          [](const ProjectorLight& l) {
+            return Json{{"type", "projector"},
+                        {"transform", matrix(l.to_world)},
+                        {"fov", l.fov_degrees},
+                        {"irradiance", texture_name(l.irradiance)},
+                        {"scale", rgb(l.scale)}};
+          },
+      },
+      light);
+}
+
+Json camera_json(const SceneDesc& scene) {
+  const CameraDesc& c = scene.camera;
+  static const char* kAxis[] = {"x", "y", "smaller", "larger", "diagonal"};
+  Json j{{"transform", matrix(c.world_from_camera)}, {"fov", c.fov_degrees}, {"fov_axis", kAxis[int(c.fov_axis)]}};
+  if (c.projection == Projection::Orthographic) j["projection"] = "orthographic";
+  if (c.near_clip != 0) j["near_clip"] = c.near_clip;
+  j["width"] = scene.film.width;
+  j["height"] = scene.film.height;
+  if (c.lens_radius != 0) {
+    j["lens_radius"] = c.lens_radius;
+    j["focus_distance"] = c.focus_distance;
+  }
+  j["shutter"] = Json::array({c.shutter_open, c.shutter_close});
+  return j;
+}
+
+Json render_json(const SceneDesc& scene) {
+  const RenderSettings& s = scene.settings;
+  Json j{{"spp", s.spp}, {"max_depth", s.max_depth}, {"seed", s.seed}, {"integrator", s.integrator}};
+  if (!scene.film.filename.empty()) j["output"] = scene.film.filename;
+  j["rr_start_depth"] = s.rr_start_depth;
+  j["transform_times"] = Json::array({scene.transform_start_time, scene.transform_end_time});
+  static const char* kSampler[] = {"independent", "stratified", "poisson", "zsobol"};
+  Json sampler{{"type", kSampler[int(s.sampler.type)]}};
+  if (s.sampler.type == SamplerType::Stratified) sampler["jitter"] = s.sampler.jitter;
+  j["sampler"] = std::move(sampler);
+  static const char* kFilter[] = {"box", "tent", "gaussian", "mitchell"};
+  Json filter{{"type", kFilter[int(s.filter.type)]}, {"radius", Json::array({s.filter.radius.x, s.filter.radius.y})}};
+  if (s.filter.type == FilterType::Gaussian) filter["sigma"] = s.filter.gaussian_sigma;
+  if (s.filter.type == FilterType::Mitchell) {
+    filter["b"] = s.filter.mitchell_b;
+    filter["c"] = s.filter.mitchell_c;
+  }
+  j["filter"] = std::move(filter);
+  static const char* kDirections[] = {"bsdf", "cosine", "uniform"};
+  j["direction_sampling"] = kDirections[int(s.direction_sampling)];
+  j["mis"] = s.mis;
+  j["light_selection"] = s.light_selection == LightSelection::Power ? "power" : "paper";
+  j["shadow_rays"] = s.shadow_rays;
+  if (s.adaptive()) {
+    Json adaptive;
+    if (s.adaptive_threshold > 0) adaptive["threshold"] = s.adaptive_threshold;
+    if (s.adaptive_spp > 0) adaptive["spp"] = s.adaptive_spp;
+    adaptive["batch"] = s.adaptive_batch;
+    if (s.adaptive_max_spp > 0) adaptive["max_spp"] = s.adaptive_max_spp;
+    j["adaptive"] = std::move(adaptive);
+  }
+  j["mlt"] = Json{{"bootstrap", s.mlt_bootstrap}, {"chains", s.mlt_chains},   {"sigma", s.mlt_sigma},
+                  {"large_step", s.mlt_large_step}, {"lens", s.mlt_lens}, {"caustic", s.mlt_caustic}};
+  return j;
+}
+
+}  // namespace
+
+std::string scene_to_json(const SceneDesc& scene) {
+  Json root;
+  if (!scene.source_file.empty()) root["_comment"] = fmt::format("converted by candela from {}", scene.source_file);
+  root["camera"] = camera_json(scene);
+  root["render"] = render_json(scene);
+  Json textures = Json::object();
+  for (size_t i = 0; i < scene.textures.size(); ++i) textures[texture_name(int(i))] = texture_json(scene.textures[i]);
+  root["textures"] = std::move(textures);
+  Json materials = Json::object();
+  for (size_t i = 0; i < scene.materials.size(); ++i)
+    materials[material_name(int(i))] = material_json(scene.materials[i]);
+  root["materials"] = std::move(materials);
+  Json objects = Json::object();
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    Json shapes = Json::array();
+    for (const ShapeDesc& shape : scene.objects[i].shapes) shapes.push_back(shape_json(shape));
+    objects[object_name(int(i))] = Json{{"shapes", std::move(shapes)}};
+  }
+  if (!scene.objects.empty()) root["objects"] = std::move(objects);
+  Json shapes = Json::array();
+  for (const ShapeDesc& shape : scene.shapes) shapes.push_back(shape_json(shape));
+  for (const InstanceDesc& instance : scene.instances) {
+    Json j{{"type", "instance"}, {"object", object_name(instance.object)}};
+    if (!instance.to_world.is_identity()) j["transform"] = matrix(instance.to_world);
+    if (instance.to_world_end) j["transform_end"] = matrix(*instance.to_world_end);
+    shapes.push_back(std::move(j));
+  }
+  root["shapes"] = std::move(shapes);
+  Json lights = Json::array();
+  for (const LightDesc& light : scene.lights) lights.push_back(light_json(light));
+  root["lights"] = std::move(lights);
+  // Shortest round-tripping numbers (nlohmann writes doubles so that they read back exactly).
+  return root.dump(1) + "\n";
+}
+
+void write_json_scene(const SceneDesc& scene, const fs::path& file) {
+  const std::string text = scene_to_json(scene);
+  fs::path temporary = file;
+  temporary += ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error(fmt::format("{}: cannot write: {}", file.string(), std::strerror(errno)));
+    out << text;
+    out.close();
+    if (!out) throw std::runtime_error(fmt::format("{}: write failed", file.string()));
+  }
+  std::error_code ec;
+  fs::rename(temporary, file, ec);
+  if (ec) {
+    fs::remove(temporary, ec);
+    throw std::runtime_error(fmt::format("{}: cannot write: {}", file.string(), ec.message()));
+  }
+}
+
+}  // namespace candela
