@@ -6,9 +6,11 @@
 
 namespace candela {
 
-PerspectiveCamera::PerspectiveCamera(const CameraDesc& desc, int width, int height, Vec2 margin)
+Camera::Camera(const CameraDesc& desc, int width, int height, Vec2 margin)
     : world_from_camera_(desc.world_from_camera),
-      lens_radius_(desc.lens_radius),
+      orthographic_(desc.projection == Projection::Orthographic),
+      near_clip_(std::max(0.0f, desc.near_clip)),
+      lens_radius_(desc.projection == Projection::Orthographic ? 0.0f : desc.lens_radius),
       focus_distance_(desc.focus_distance),
       shutter_open_(desc.shutter_open),
       shutter_close_(desc.shutter_close),
@@ -21,6 +23,7 @@ PerspectiveCamera::PerspectiveCamera(const CameraDesc& desc, int width, int heig
   // The screen spans [-tan_half_x, tan_half_x] x [-tan_half_y, tan_half_y] at unit distance; the fov
   // fixes one axis and the aspect ratio (square pixels) the other.
   float aspect = float(width) / float(height);
+  ortho_half_y_ = 1 / aspect;
   float t = std::tan(radians(desc.fov_degrees) / 2);
   FovAxis axis = desc.fov_axis;
   if (axis == FovAxis::Smaller) axis = width < height ? FovAxis::X : FovAxis::Y;
@@ -36,22 +39,42 @@ PerspectiveCamera::PerspectiveCamera(const CameraDesc& desc, int width, int heig
   }
 }
 
-Ray PerspectiveCamera::generate_ray(Vec2 film, Vec2 lens, float time) const {
+float Camera::near_t(const Point3& o, const Vec3& d) const {
+  if (!(near_clip_ > o.z) || !(d.z > 0)) return 0;
+  Point3 on_plane = o + d * ((near_clip_ - o.z) / d.z);
+  return length(world_from_camera_.point(on_plane) - world_from_camera_.point(o));
+}
+
+Ray Camera::generate_ray(Vec2 film, Vec2 lens, float time) const {
+  const float inf = std::numeric_limits<float>::infinity();
+  if (orthographic_) {
+    Point3 o(2 * film.x / float(width_) - 1, (1 - 2 * film.y / float(height_)) * ortho_half_y_, 0);
+    Vec3 d(0, 0, 1);
+    Ray ray{world_from_camera_.point(o), normalize(world_from_camera_.vector(d)), inf, time};
+    ray.t_min = near_t(o, d);
+    return ray;
+  }
   float sx = (2 * film.x / float(width_) - 1) * tan_half_x_;
   float sy = (1 - 2 * film.y / float(height_)) * tan_half_y_;
   Vec3 dir(sx, sy, 1);  // camera space, z = 1
-  if (lens_radius_ <= 0)
-    return Ray{origin_, normalize(world_from_camera_.vector(dir)), std::numeric_limits<float>::infinity(), time};
+  if (lens_radius_ <= 0) {
+    Ray ray{origin_, normalize(world_from_camera_.vector(dir)), inf, time};
+    ray.t_min = near_t(Point3(0.0f), dir);
+    return ray;
+  }
   // Thin lens: start on the lens disk and aim at the point of the pinhole ray on the plane of focus.
   Vec2 d = square_to_concentric_disk(lens);
   Point3 lens_point(lens_radius_ * d.x, lens_radius_ * d.y, 0);
   Point3 focus_point = dir * focus_distance_;
   Point3 o = world_from_camera_.point(lens_point);
   Vec3 w = normalize(world_from_camera_.vector(focus_point - lens_point));
-  return Ray{o, w, std::numeric_limits<float>::infinity(), time};
+  Ray ray{o, w, inf, time};
+  ray.t_min = near_t(lens_point, focus_point - lens_point);
+  return ray;
 }
 
-float PerspectiveCamera::importance(const Point3& lens_point, const Vec3& w, Vec2* raster) const {
+float Camera::importance(const Point3& lens_point, const Vec3& w, Vec2* raster) const {
+  if (orthographic_) return 0;  // a delta in direction: no ray found by chance carries any
   float cos_theta = dot(w, forward_);
   if (!(cos_theta > 0)) return 0;
   // Where the ray meets the plane of focus (the unit plane for a pinhole), in camera space: that
@@ -71,14 +94,16 @@ float PerspectiveCamera::importance(const Point3& lens_point, const Vec3& w, Vec
   return 1 / (film_area * lens_area() * cos2 * cos2);
 }
 
-PerspectiveCamera::ImportancePdf PerspectiveCamera::pdf_importance(const Point3& lens_point, const Vec3& w) const {
+Camera::ImportancePdf Camera::pdf_importance(const Point3& lens_point, const Vec3& w) const {
+  if (orthographic_) return {};  // delta in direction (see is_delta_direction)
   if (importance(lens_point, w, nullptr) == 0) return {};
   float cos_theta = dot(w, forward_);
   float film_area = importance_film_area();
   return {1 / lens_area(), 1 / (film_area * cos_theta * cos_theta * cos_theta)};
 }
 
-std::optional<PerspectiveCamera::LensSample> PerspectiveCamera::sample_lens(const Point3& ref, Vec2 u) const {
+std::optional<Camera::LensSample> Camera::sample_lens(const Point3& ref, Vec2 u) const {
+  if (orthographic_) return std::nullopt;  // no point is connected to an orthographic camera
   Point3 p = origin_;
   if (lens_radius_ > 0) {
     Vec2 d = square_to_concentric_disk(u);
@@ -96,6 +121,14 @@ std::optional<PerspectiveCamera::LensSample> PerspectiveCamera::sample_lens(cons
   s.pdf = dist2 / (cos_lens * lens_area());
   s.importance = importance(p, -s.wi, &s.raster);
   if (s.importance == 0) return std::nullopt;
+  s.p_visible = p;
+  if (near_clip_ > 0) {
+    // Nothing in front of the near plane is seen: ref must lie beyond it, and visibility is
+    // tested from where the segment crosses it.
+    Point3 rc = camera_from_world_.point(ref), lc = camera_from_world_.point(p);
+    if (!(rc.z > near_clip_)) return std::nullopt;
+    s.p_visible = world_from_camera_.point(lc + (rc - lc) * ((near_clip_ - lc.z) / (rc.z - lc.z)));
+  }
   return s;
 }
 

@@ -1,8 +1,16 @@
 #pragma once
-// Perspective camera, pinhole or thin lens. Film coordinates are in pixels: x to the right, y down,
-// (0,0) the top-left corner of the image; a pixel (i, j) covers [i, i+1) x [j, j+1) (the paper's eq. 9).
-// With a lens, rays start on a disk of radius lens_radius around the camera position and pass
-// through the point the pinhole ray reaches at depth focus_distance (pbrt's thin lens).
+// The camera: perspective (pinhole or thin lens) or orthographic. Film coordinates are in pixels: x
+// to the right, y down, (0,0) the top-left corner of the image; a pixel (i, j) covers [i, i+1) x
+// [j, j+1) (the paper's eq. 9). With a lens, rays start on a disk of radius lens_radius around the
+// camera position and pass through the point the pinhole ray reaches at depth focus_distance
+// (pbrt's thin lens). Orthographic rays are parallel to camera +z and start on the film rectangle
+// [-1, 1] x [-1/aspect, 1/aspect] of the camera's z = 0 plane (Mitsuba's orthographic sensor), mapped
+// by world_from_camera (which may scale it). With near_clip, camera rays start where they cross
+// the camera-space plane z = near_clip (Ray::t_min), and t = 1 connections ignore everything nearer.
+//
+// An orthographic camera's importance is a delta in direction: no connection can reach it, so it
+// has no importance() or sample_lens() (they return 0 and nothing), and bidirectional methods treat
+// its vertex as delta (is_delta_direction()).
 #include <optional>
 
 #include "candela/geometry/ray.h"
@@ -10,13 +18,19 @@
 
 namespace candela {
 
-class PerspectiveCamera {
+class Camera {
  public:
-  PerspectiveCamera() = default;
+  Camera() = default;
   // `margin`: how far (in pixels) beyond the image's edges camera rays reach, the reconstruction
   // filter's radius; the importance function covers that larger film so that light paths reaching
   // the margin still add to the pixels whose filter overlaps it.
-  PerspectiveCamera(const CameraDesc& desc, int width, int height, Vec2 margin = {0, 0});
+  Camera(const CameraDesc& desc, int width, int height, Vec2 margin = {0, 0});
+
+  bool is_orthographic() const { return orthographic_; }
+  // Whether the camera's rays come from a delta distribution in direction (orthographic): light
+  // paths cannot be connected to it (no t = 1 strategy).
+  bool is_delta_direction() const { return orthographic_; }
+  float near_clip() const { return near_clip_; }
 
   // `lens` in [0,1)^2 picks the point on the lens (ignored for a pinhole); `time` is the ray's time.
   Ray generate_ray(Vec2 film, Vec2 lens, float time) const;
@@ -36,6 +50,8 @@ class PerspectiveCamera {
   // there and the raster position it lands on.
   struct LensSample {
     Point3 p;
+    Point3 p_visible;  // where the segment from ref meets the near clipping plane (p without one):
+                       // visibility is tested from ref to here
     Vec3 wi;
     float distance = 0, pdf = 0, importance = 0;
     Vec2 raster;
@@ -62,7 +78,14 @@ class PerspectiveCamera {
     return 4 * tan_half_x_ * tan_half_y_ * importance_film_pixels() / (float(width_) * float(height_));
   }
 
+  // Ray::t_min for a ray from the camera-space point o along the camera-space direction d (d.z > 0)
+  // whose world direction has length world_len: the near plane's distance along the world ray.
+  float near_t(const Point3& o, const Vec3& d) const;
+
   Transform world_from_camera_, camera_from_world_;
+  bool orthographic_ = false;
+  float near_clip_ = 0;
+  float ortho_half_y_ = 1;  // orthographic: the film spans [-1, 1] x [-ortho_half_y, ortho_half_y]
   Vec3 forward_{0, 0, 1};
   Point3 origin_;
   float tan_half_x_ = 1, tan_half_y_ = 1;
@@ -71,5 +94,8 @@ class PerspectiveCamera {
   int width_ = 1, height_ = 1;
   Vec2 margin_{0, 0};
 };
+
+// The name from before orthographic cameras.
+using PerspectiveCamera = Camera;
 
 }  // namespace candela

@@ -69,6 +69,61 @@ bool intersect_moving_sphere(const SphereGeometry& s, const UserRay& ray, double
   return to_world && intersect_sphere_in_object_space(s, to_world->inverse_matrix(), ray, t_hit);
 }
 
+// The unit disk (z = 0, x^2 + y^2 <= 1) or open unit cylinder (x^2 + y^2 = 1, 0 <= z <= 1), in
+// object space, in double precision.
+bool intersect_unit_quadric_d(QuadricGeometry::Kind kind, const Vec3d& o, const Vec3d& d, double t_near, double t_far,
+                              double& t_hit) {
+  if (kind == QuadricGeometry::Kind::Disk) {
+    if (d.z == 0) return false;
+    double t = -o.z / d.z;
+    if (!(t > t_near && t < t_far)) return false;
+    double x = o.x + t * d.x, y = o.y + t * d.y;
+    if (x * x + y * y > 1) return false;
+    t_hit = t;
+    return true;
+  }
+  // The tube: the 2D ray (o.xy + t d.xy) against the unit circle, roots in increasing order, the
+  // first in (t_near, t_far) whose height is within [0, 1]. The discriminant comes from the
+  // perpendicular distance to the axis, which stays accurate for distant rays (as for spheres).
+  double a = d.x * d.x + d.y * d.y;
+  if (!(a > 0)) return false;
+  double b_half = o.x * d.x + o.y * d.y;
+  double inv_len = 1.0 / std::sqrt(a);
+  double dnx = d.x * inv_len, dny = d.y * inv_len;
+  double fd = o.x * dnx + o.y * dny;
+  double px = o.x - fd * dnx, py = o.y - fd * dny;
+  double perp = std::sqrt(px * px + py * py);
+  double disc = (1 - perp) * (1 + perp);
+  if (disc < 0) return false;
+  double c = o.x * o.x + o.y * o.y - 1;
+  double q = -(b_half + std::copysign(std::sqrt(a * disc), b_half));
+  double t0 = q / a, t1 = q != 0 ? c / q : t0;
+  if (t0 > t1) std::swap(t0, t1);
+  for (double t : {t0, t1}) {
+    if (!(t > t_near && t < t_far)) continue;
+    double z = o.z + t * d.z;
+    if (z >= 0 && z <= 1) {
+      t_hit = t;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool intersect_quadric(const QuadricGeometry& q, const UserRay& ray, double& t_hit) {
+  const Matrix4* inv = &q.to_world.inverse_matrix();
+  std::optional<Transform> at_time;
+  if (q.to_world_end) {
+    // A moving shape is intersected under its transform at the ray's time.
+    at_time = interpolate_transform(q.to_world, *q.to_world_end, ray.time);
+    if (!at_time) return false;
+    inv = &at_time->inverse_matrix();
+  }
+  Vec3d o = apply(*inv, ray.o.x, ray.o.y, ray.o.z, 1);
+  Vec3d d = apply(*inv, ray.d.x, ray.d.y, ray.d.z, 0);
+  return intersect_unit_quadric_d(q.kind, o, d, ray.t_near, ray.t_far, t_hit);
+}
+
 bool intersect_plane(const PlaneGeometry& pl, float extent, const UserRay& ray, double& t_hit) {
   const Vec3d &o = ray.o, &d = ray.d;
   const double t_near = ray.t_near, t_far = ray.t_far;
@@ -138,7 +193,7 @@ RTCRay make_rtc_ray(const Ray& r, float embree_time) {
   ray.org_x = r.origin.x;
   ray.org_y = r.origin.y;
   ray.org_z = r.origin.z;
-  ray.tnear = 0;
+  ray.tnear = r.t_min;
   ray.dir_x = r.direction.x;
   ray.dir_y = r.direction.y;
   ray.dir_z = r.direction.z;
@@ -160,6 +215,21 @@ Bounds3 sphere_world_bounds(const SphereGeometry& s, const Transform& to_world) 
     b.extend(to_world.point(s.center + corner));
   }
   return b;
+}
+
+Bounds3 quadric_world_bounds(const QuadricGeometry& q, const Transform& to_world) {
+  Bounds3 b;
+  const bool disk = q.kind == QuadricGeometry::Kind::Disk;
+  for (int i = 0; i < 8; ++i) {
+    Point3 corner(i & 1 ? 1.0f : -1.0f, i & 2 ? 1.0f : -1.0f, disk ? 0.0f : (i & 4 ? 1.0f : 0.0f));
+    b.extend(to_world.point(corner));
+  }
+  return b;
+}
+
+bool intersect_unit_quadric(QuadricGeometry::Kind kind, const Point3& o, const Vec3& d, double t_near, double t_far,
+                            double& t_hit) {
+  return intersect_unit_quadric_d(kind, {o.x, o.y, o.z}, {d.x, d.y, d.z}, t_near, t_far, t_hit);
 }
 
 std::optional<Transform> interpolate_transform(const Transform& start, const Transform& end, float t) {
@@ -274,6 +344,19 @@ void EmbreeScene::add_sphere(uint32_t id, const SphereGeometry& sphere, int obje
   attach(geom, id, object);
 }
 
+void EmbreeScene::add_quadric(uint32_t id, const QuadricGeometry& q, int object) {
+  quadrics_.push_back(std::make_unique<QuadricGeometry>(q));
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(geom, 1);
+  rtcSetGeometryUserData(geom, quadrics_.back().get());
+  rtcSetGeometryBoundsFunction(geom, quadric_bounds, nullptr);
+  // Moving: two time steps whose boxes Embree interpolates (every point moves linearly).
+  if (q.to_world_end) rtcSetGeometryTimeStepCount(geom, 2);
+  rtcSetGeometryIntersectFunction(geom, quadric_intersect);
+  rtcSetGeometryOccludedFunction(geom, quadric_occluded);
+  attach(geom, id, object);
+}
+
 void EmbreeScene::add_plane(uint32_t id, const PlaneGeometry& plane, float extent) {
   planes_.push_back(std::make_unique<PlaneRecord>(PlaneRecord{plane, extent}));
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
@@ -344,6 +427,26 @@ void EmbreeScene::moving_sphere_intersect(const RTCIntersectFunctionNArguments* 
 
 void EmbreeScene::moving_sphere_occluded(const RTCOccludedFunctionNArguments* args) {
   user_occluded(args, *static_cast<const SphereGeometry*>(args->geometryUserPtr), intersect_moving_sphere);
+}
+
+void EmbreeScene::quadric_bounds(const RTCBoundsFunctionArguments* args) {
+  const auto& q = *static_cast<const QuadricGeometry*>(args->geometryUserPtr);
+  Bounds3 b = quadric_world_bounds(q, args->timeStep == 0 ? q.to_world : *q.to_world_end);
+  Vec3 pad = Vec3(1e-5f) * (1.0f + max_component(max(b.hi, -b.lo)));
+  args->bounds_o->lower_x = b.lo.x - pad.x;
+  args->bounds_o->lower_y = b.lo.y - pad.y;
+  args->bounds_o->lower_z = b.lo.z - pad.z;
+  args->bounds_o->upper_x = b.hi.x + pad.x;
+  args->bounds_o->upper_y = b.hi.y + pad.y;
+  args->bounds_o->upper_z = b.hi.z + pad.z;
+}
+
+void EmbreeScene::quadric_intersect(const RTCIntersectFunctionNArguments* args) {
+  user_intersect(args, *static_cast<const QuadricGeometry*>(args->geometryUserPtr), intersect_quadric);
+}
+
+void EmbreeScene::quadric_occluded(const RTCOccludedFunctionNArguments* args) {
+  user_occluded(args, *static_cast<const QuadricGeometry*>(args->geometryUserPtr), intersect_quadric);
 }
 
 void EmbreeScene::plane_bounds(const RTCBoundsFunctionArguments* args) {

@@ -1,7 +1,7 @@
 #pragma once
 // The acceleration structure: every intersection and occlusion query goes through Embree.
-// Triangle meshes are Embree triangle geometry; spheres and infinite planes are Embree user
-// geometry intersected analytically in double precision (exact, not tessellated).
+// Triangle meshes are Embree triangle geometry; spheres, disks, open cylinders and infinite planes
+// are Embree user geometry intersected analytically in double precision (exact, not tessellated).
 // Moving shapes (motion blur, the paper's sec. 4.2) have two Embree time steps: their transform is
 // interpolated linearly between the start and end transforms, as Embree interpolates vertices.
 #include <embree3/rtcore.h>
@@ -36,6 +36,15 @@ struct SphereGeometry {
   // A moving sphere: its transform at Embree time 1 (to_world is the one at time 0).
   std::optional<Transform> to_world_end;
 };
+// A disk or an open cylinder: the unit shape in its own space (disk: x^2 + y^2 <= 1 in the plane
+// z = 0; cylinder: x^2 + y^2 = 1, 0 <= z <= 1) placed by any invertible affine `to_world`
+// (non-uniform scales and shears make ellipses and elliptic tubes, intersected exactly).
+struct QuadricGeometry {
+  enum class Kind : uint8_t { Disk, Cylinder };
+  Kind kind = Kind::Disk;
+  Transform to_world;
+  std::optional<Transform> to_world_end;  // moving: the transform at Embree time 1
+};
 struct PlaneGeometry {
   Point3 point;
   Normal3 normal;  // unit length, world space
@@ -43,6 +52,12 @@ struct PlaneGeometry {
 
 // Bounds of a sphere under `to_world`: the transformed corners of its object-space box.
 Bounds3 sphere_world_bounds(const SphereGeometry& sphere, const Transform& to_world);
+// Bounds of a disk or cylinder under `to_world`: the transformed corners of its object-space box.
+Bounds3 quadric_world_bounds(const QuadricGeometry& q, const Transform& to_world);
+// The nearest intersection of (o + t d) with the unit disk or cylinder in its own space, t in
+// (t_near, t_far); exposed for tests.
+bool intersect_unit_quadric(QuadricGeometry::Kind kind, const Point3& o, const Vec3& d, double t_near, double t_far,
+                            double& t_hit);
 
 class EmbreeScene {
  public:
@@ -62,6 +77,7 @@ class EmbreeScene {
   void add_moving_triangles(uint32_t id, const std::vector<Point3>& positions, const std::vector<Point3>& positions_end,
                             const std::vector<uint32_t>& indices);
   void add_sphere(uint32_t id, const SphereGeometry& sphere, int object = -1);  // moving when sphere.to_world_end is set
+  void add_quadric(uint32_t id, const QuadricGeometry& q, int object = -1);  // moving when q.to_world_end is set
   void add_plane(uint32_t id, const PlaneGeometry& plane, float extent);
   // Objects for instancing: a separate acceleration structure, built once, placed by instances.
   int add_object();
@@ -82,6 +98,9 @@ class EmbreeScene {
   static void sphere_occluded(const RTCOccludedFunctionNArguments* args);
   static void moving_sphere_intersect(const RTCIntersectFunctionNArguments* args);
   static void moving_sphere_occluded(const RTCOccludedFunctionNArguments* args);
+  static void quadric_bounds(const RTCBoundsFunctionArguments* args);
+  static void quadric_intersect(const RTCIntersectFunctionNArguments* args);
+  static void quadric_occluded(const RTCOccludedFunctionNArguments* args);
   static void plane_bounds(const RTCBoundsFunctionArguments* args);
   static void plane_intersect(const RTCIntersectFunctionNArguments* args);
   static void plane_occluded(const RTCOccludedFunctionNArguments* args);
@@ -101,6 +120,7 @@ class EmbreeScene {
   std::vector<uint32_t> instance_ids_;  // Embree geometry id of each instance, in add_instance order
   // Stable storage for user-geometry data (Embree keeps raw pointers to it).
   std::vector<std::unique_ptr<SphereGeometry>> spheres_;
+  std::vector<std::unique_ptr<QuadricGeometry>> quadrics_;
   std::vector<std::unique_ptr<PlaneRecord>> planes_;
 };
 

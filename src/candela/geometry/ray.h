@@ -10,6 +10,7 @@ struct Ray {
   Vec3 direction;  // not necessarily normalised; t is measured in its units
   float t_max = std::numeric_limits<float>::infinity();
   float time = 0;  // absolute, in [shutter open, shutter close]; moving shapes are seen at this time
+  float t_min = 0;  // nothing nearer is hit (camera rays: the near clipping plane)
   Point3 at(float t) const { return origin + direction * t; }
 };
 

@@ -16,6 +16,7 @@ struct SurfaceHit {
               // shading frame's first axis, which anisotropic roughness is measured along
   uint32_t shape = 0;      // index into Scene::shapes
   uint32_t primitive = 0;  // triangle index within a mesh
+  Vec2 bary;               // triangles: the weights of the triangle's vertices 1 and 2 (vertex 0 has 1 - x - y)
 };
 
 }  // namespace candela

@@ -70,6 +70,9 @@ int BdptIntegrator::camera_subpath(const Ray& ray, Sampler& sampler, RayCounts& 
   camera.kind = Kind::Camera;
   camera.p = ray.origin;
   camera.beta = RGB(1.0f);  // W_e / pdf = 1 for the camera's own rays
+  // An orthographic camera's directions are a delta: no strategy connects to it (t = 1), and MIS
+  // leaves that strategy out as it leaves out connections to delta lights.
+  camera.delta = scene_.camera().is_delta_direction();
   ++counts.camera;
   Ray r = ray;
   r.direction = normalize(r.direction);
@@ -422,7 +425,10 @@ BdptIntegrator::Connection BdptIntegrator::connect(BdptVertex* light, BdptVertex
     sampled.beta = RGB(lens->importance / lens->pdf);
     L = qs.beta * scatter(qs, sampled, Transport::Importance) * sampled.beta;
     if (qs.on_surface()) L *= std::abs(dot(lens->wi, qs.ns));
-    if (L.is_black() || !unoccluded(qs, sampled, time, counts)) return c;
+    // Visibility up to the near clipping plane only (the lens point itself without one).
+    BdptVertex visible = sampled;
+    visible.p = lens->p_visible;
+    if (L.is_black() || !unoccluded(qs, visible, time, counts)) return c;
     c.raster = lens->raster;
   } else if (s == 1) {
     // Next-event estimation: a point on a light chosen by power, seen from the camera vertex.

@@ -1,6 +1,6 @@
 #pragma once
-// Diffuse area lights on shapes: one TriangleLight per emissive triangle (meshes, boxes and
-// rectangles become triangles) and SphereLight for emissive spheres. Radiance is constant over the
+// Diffuse area lights on shapes: one TriangleLight per emissive triangle (meshes and boxes become
+// triangles), RectangleLight, SphereLight, DiskLight and CylinderLight for those shapes. Radiance is constant over the
 // surface and emitted on the side of `n` (both sides if two_sided).
 #include "candela/lights/light_sample.h"
 #include "candela/math/frame.h"
@@ -175,6 +175,100 @@ struct SphereLight {
     float cos_max = cone_cos_max(ctx.p);
     float cos_p = ctx.n == Normal3(0.0f) ? 1.0f : std::max(0.0f, dot(ctx.n, w));
     return radiance.luminance() * kPi * (1 - cos_max * cos_max) * cos_p;
+  }
+};
+
+// A disk (an ellipse under a non-uniform to_world): center + axis_u x + axis_v y over the unit disk,
+// sampled uniformly by area (the concentric map is area-preserving up to the constant Jacobian).
+struct DiskLight {
+  Point3 center;
+  Vec3 axis_u, axis_v;  // the images of the unit disk's x and y axes
+  Normal3 n;            // unit, the emitting side
+  float area;
+  RGB radiance;
+  bool two_sided;
+
+  Point3 point(Vec2 u) const {
+    Vec2 d = square_to_concentric_disk(u);
+    return center + axis_u * d.x + axis_v * d.y;
+  }
+  LightSample sample_li(const LightSampleContext& ctx, Vec2 u) const {
+    return flat_light_sample(point(u), n, area, radiance, two_sided, ctx);
+  }
+  LightEmission sample_le(Vec2 u_pos, Vec2 u_dir, const SceneSphere&) const {
+    float pdf_dir;
+    Vec3 w = sample_cosine_emission(n, two_sided, u_dir, pdf_dir);
+    return {radiance, point(u_pos), w, n, 1 / area, pdf_dir};
+  }
+  EmissionPdf pdf_le(const Point3&, const Normal3&, const Vec3& w, const SceneSphere&) const {
+    return {1 / area, cosine_emission_pdf(n, two_sided, w)};
+  }
+  float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const {
+    return area_to_solid_angle_pdf(1 / area, ctx.p, p, n);
+  }
+  float power() const { return radiance.luminance() * area * kPi * (two_sided ? 2 : 1); }
+  float importance(const LightSampleContext& ctx) const {
+    return flat_light_importance(center, n, area, radiance, two_sided, ctx);
+  }
+};
+
+// An open circular tube: base + radius (cos(phi) axis_u + sin(phi) axis_v) + z axis, phi in
+// [0, 2 pi), z in [0, 1], with axis_u, axis_v orthonormal and axis perpendicular to both (a
+// cylinder, not an elliptic or oblique tube: only then is (phi, z) proportional to area).
+// Sampled uniformly by area as Mitsuba does (z from u.x, phi from u.y).
+struct CylinderLight {
+  Point3 base;
+  Vec3 axis_u, axis_v;  // unit, perpendicular to each other and to axis
+  Vec3 axis;            // from the base circle's centre to the top circle's
+  float radius;
+  float area;
+  RGB radiance;
+  bool two_sided;
+  bool emits_inward;  // flipped normals: the emitting side faces the axis
+
+  Normal3 emitting_normal(const Point3& p) const {
+    Vec3 d = p - base;
+    Vec3 radial = axis_u * dot(d, axis_u) + axis_v * dot(d, axis_v);
+    float len = length(radial);
+    Normal3 out = len > 0 ? radial / len : axis_u;
+    return emits_inward ? -out : out;
+  }
+  Point3 point(Vec2 u, Normal3& n) const {
+    float phi = 2 * kPi * u.y;
+    Vec3 radial = axis_u * std::cos(phi) + axis_v * std::sin(phi);
+    n = emits_inward ? -radial : radial;
+    return base + radial * radius + axis * u.x;
+  }
+  LightSample sample_li(const LightSampleContext& ctx, Vec2 u) const {
+    Normal3 n;
+    Point3 p = point(u, n);
+    return flat_light_sample(p, n, area, radiance, two_sided, ctx);
+  }
+  LightEmission sample_le(Vec2 u_pos, Vec2 u_dir, const SceneSphere&) const {
+    Normal3 n;
+    Point3 p = point(u_pos, n);
+    float pdf_dir;
+    Vec3 w = sample_cosine_emission(n, two_sided, u_dir, pdf_dir);
+    return {radiance, p, w, n, 1 / area, pdf_dir};
+  }
+  EmissionPdf pdf_le(const Point3& p, const Normal3&, const Vec3& w, const SceneSphere&) const {
+    return {1 / area, cosine_emission_pdf(emitting_normal(p), two_sided, w)};
+  }
+  float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const {
+    return area_to_solid_angle_pdf(1 / area, ctx.p, p, emitting_normal(p));
+  }
+  float power() const { return radiance.luminance() * area * kPi * (two_sided ? 2 : 1); }
+  // Estimated irradiance at ctx: L times the tube's projected area seen from its centre over d^2.
+  float importance(const LightSampleContext& ctx) const {
+    Point3 c = base + axis * 0.5f;
+    Vec3 d = c - ctx.p;
+    float d2 = std::max(length_squared(d), 1e-12f);
+    Vec3 w = d / std::sqrt(d2);
+    float h = length(axis);
+    float along = h > 0 ? std::abs(dot(w, axis)) / h : 0.0f;
+    float projected = 2 * radius * h * safe_sqrt(1 - along * along) + kPi * radius * radius * along;
+    float cos_p = ctx.n == Normal3(0.0f) ? 1.0f : std::max(0.0f, dot(ctx.n, w));
+    return radiance.luminance() * std::min(kPi, projected * cos_p / d2);
   }
 };
 

@@ -9,7 +9,7 @@
 //                             (lights at infinity start theirs on a disk of the scene's sphere S)
 //   pdf_le(p, n, w, S)        the densities sample_le gives the ray from p along w
 // Lights at infinity (SkyLightSource, EnvironmentLight) also offer radiance(dir) for rays that escape
-// the scene; point, spot and distant lights are delta lights, reached only by sampling them.
+// the scene; point, spot, projector and distant lights are delta lights, reached only by sampling them.
 // The closed list of lights is the variant `Light`; dispatch happens once, here.
 #include <limits>
 #include <variant>
@@ -18,13 +18,15 @@
 #include "candela/lights/distant_light.h"
 #include "candela/lights/environment_light.h"
 #include "candela/lights/point_light.h"
+#include "candela/lights/projector_light.h"
 #include "candela/lights/sky_light.h"
 #include "candela/lights/spot_light.h"
 
 namespace candela {
 
 using Light = std::variant<PointLightSource, TriangleLight, RectangleLight, SphereLight, SkyLightSource,
-                           SpotLightSource, DistantLightSource, EnvironmentLight>;
+                           SpotLightSource, DistantLightSource, EnvironmentLight, DiskLight, CylinderLight,
+                           ProjectorLightSource>;
 
 inline LightSample light_sample_li(const Light& l, const LightSampleContext& ctx, Vec2 u) {
   return std::visit([&](const auto& x) { return x.sample_li(ctx, u); }, l);
@@ -53,7 +55,7 @@ inline float light_importance(const Light& l, const LightSampleContext& ctx) {
 // Lights of a single point or direction: found only by sampling them, never by a ray.
 inline bool light_is_delta(const Light& l) {
   return std::holds_alternative<PointLightSource>(l) || std::holds_alternative<SpotLightSource>(l) ||
-         std::holds_alternative<DistantLightSource>(l);
+         std::holds_alternative<DistantLightSource>(l) || std::holds_alternative<ProjectorLightSource>(l);
 }
 
 // Lights at infinity: their light paths start on the disk of the scene's bounding sphere.

@@ -68,7 +68,9 @@ Scene::Scene(const SceneDesc& desc)
       infinite_lights_.push_back(uint32_t(lights_.size()));
       lights_.push_back(SkyLightSource{s->zenith, s->horizon, s->ground, normalize(s->up), radius});
     } else if (const auto* spot = std::get_if<SpotLight>(&l)) {
-      lights_.push_back(make_spot_light(*spot));
+      lights_.push_back(make_spot_light(*spot, &textures_));
+    } else if (const auto* projector = std::get_if<ProjectorLight>(&l)) {
+      lights_.push_back(make_projector_light(*projector, &textures_));
     } else if (const auto* distant = std::get_if<DistantLight>(&l)) {
       lights_.push_back(make_distant_light(*distant, radius));
     } else if (const auto* env = std::get_if<EnvironmentMap>(&l)) {
@@ -173,6 +175,34 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int object) {
     shapes_.push_back(std::move(rec));
     return;
   }
+  if (std::holds_alternative<DiskShape>(desc.geometry)) {
+    add_quadric(std::move(rec), QuadricGeometry::Kind::Disk, T, T_end, desc.emission, object);
+    return;
+  }
+  if (const auto* c = std::get_if<CylinderShape>(&desc.geometry)) {
+    // The unit tube placed on the segment p0-p1 with the radius (Mitsuba's to_frame of the axis,
+    // so phi = 0 lies along the axis frame's first vector), then to_world.
+    Vec3 d = c->p1 - c->p0;
+    float len = length(d);
+    if (!(len > 0) || !(c->radius > 0) || !std::isfinite(len) || !std::isfinite(c->radius))
+      throw SceneError(fmt::format("{}: {}: a cylinder needs a positive radius and two distinct end points",
+                                   source_file_, rec.name));
+    Frame f(d / len);
+    Matrix4 m = Matrix4::identity();
+    for (int r = 0; r < 3; ++r) {
+      m.m[r][0] = double(f.s[r]) * c->radius;
+      m.m[r][1] = double(f.t[r]) * c->radius;
+      m.m[r][2] = double(d[r]);
+      m.m[r][3] = double(c->p0[r]);
+    }
+    Transform place = *Transform::from_matrix(m);
+    Transform unit = T * place;
+    std::optional<Transform> unit_end;
+    if (T_end) unit_end = *T_end * place;
+    add_quadric(std::move(rec), QuadricGeometry::Kind::Cylinder, unit, unit_end ? &*unit_end : nullptr, desc.emission,
+                object);
+    return;
+  }
   TriangleMesh mesh;
   if (const auto* b = std::get_if<BoxShape>(&desc.geometry)) mesh = box_mesh(*b);
   else if (const auto* r = std::get_if<RectangleShape>(&desc.geometry)) mesh = rectangle_mesh(*r);
@@ -204,6 +234,41 @@ void Scene::add_sphere(ShapeRecord rec, const SphereShape& s, const Transform& T
   shapes_.push_back(std::move(rec));
 }
 
+void Scene::add_quadric(ShapeRecord rec, QuadricGeometry::Kind kind, const Transform& M, const Transform* M_end,
+                        const std::optional<AreaEmission>& emission, int object) {
+  const bool disk = kind == QuadricGeometry::Kind::Disk;
+  rec.kind = disk ? ShapeRecord::Kind::Disk : ShapeRecord::Kind::Cylinder;
+  if (!Transform::from_matrix(M.matrix()) || (M_end && !Transform::from_matrix(M_end->matrix())))
+    throw SceneError(fmt::format("{}: {}: the transform is singular", source_file_, rec.name));
+  rec.quadric = QuadricGeometry{kind, M, M_end ? std::optional<Transform>(*M_end) : std::nullopt};
+  for (const Transform* X : {&M, M_end})
+    if (X) bounds_.extend(quadric_world_bounds(rec.quadric, *X));
+  if (emission) {
+    rec.first_light = int(lights_.size());
+    rec.radiance = emission->radiance;
+    rec.two_sided_emission = emission->two_sided;
+    Vec3 eu = M.vector({1, 0, 0}), ev = M.vector({0, 1, 0}), ez = M.vector({0, 0, 1});
+    if (disk) {
+      Normal3 n = normalize(M.normal({0, 0, 1}));
+      if (rec.flip_normal) n = -n;
+      lights_.push_back(DiskLight{M.point(Point3(0.0f)), eu, ev, n, kPi * length(cross(eu, ev)), rec.radiance,
+                                  rec.two_sided_emission});
+    } else {
+      // Uniform sampling by area needs a circular, right cylinder in world space.
+      float lu = length(eu), lv = length(ev), lz = length(ez);
+      if (std::abs(lu - lv) > 1e-4f * lu || std::abs(dot(eu, ev)) > 1e-4f * lu * lv ||
+          std::abs(dot(eu, ez)) > 1e-4f * lu * lz || std::abs(dot(ev, ez)) > 1e-4f * lv * lz)
+        throw SceneError(fmt::format(
+            "{}: {}: an emissive cylinder must stay circular (no non-uniform scale across its axis, no shear)",
+            source_file_, rec.name));
+      lights_.push_back(CylinderLight{M.point(Point3(0.0f)), eu / lu, ev / lv, ez, lu, 2 * kPi * lu * lz,
+                                      rec.radiance, rec.two_sided_emission, rec.flip_normal});
+    }
+  }
+  embree_.add_quadric(uint32_t(shapes_.size()), rec.quadric, object);
+  shapes_.push_back(std::move(rec));
+}
+
 void Scene::add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Transform& T, const Transform* T_end,
                           bool reverse, const std::optional<AreaEmission>& emission, bool rectangle,
                           int object) {
@@ -229,6 +294,8 @@ void Scene::add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Trans
   }
   rec.uvs = mesh.uvs;
   rec.indices = mesh.indices;
+  if (!mesh.attributes.empty())
+    rec.attributes = std::make_shared<const std::vector<TriangleMesh::Attribute>>(mesh.attributes);
   // Keep cross(p1-p0, p2-p0) equal to the object-space normal transformed as a normal: a mirroring
   // transform reverses the winding, and so does reverse orientation.
   rec.winding_swapped = T.swaps_handedness() != reverse;
@@ -304,6 +371,10 @@ bool Scene::intersect(const Ray& world_ray, SurfaceHit& hit) const {
     case ShapeRecord::Kind::Sphere:
       reconstruct_sphere_hit(rec, ray, eh.t, hit);
       break;
+    case ShapeRecord::Kind::Disk:
+    case ShapeRecord::Kind::Cylinder:
+      reconstruct_quadric_hit(rec, ray, eh.t, hit);
+      break;
     case ShapeRecord::Kind::Plane: {
       hit.p = ray.at(eh.t);
       hit.ng = rec.flip_normal ? -rec.plane.normal : rec.plane.normal;
@@ -327,6 +398,7 @@ void Scene::reconstruct_triangle_hit(const ShapeRecord& rec, const EmbreeHit& eh
   uint32_t i0 = rec.indices[3 * eh.primitive], i1 = rec.indices[3 * eh.primitive + 1],
            i2 = rec.indices[3 * eh.primitive + 2];
   float b0 = 1 - eh.u - eh.v;
+  hit.bary = {eh.u, eh.v};
   Point3 p0 = rec.positions[i0], p1 = rec.positions[i1], p2 = rec.positions[i2];
   const bool moving = rec.is_moving();
   // A moving triangle is where Embree found it: its vertices interpolated at the ray's time.
@@ -388,6 +460,55 @@ void Scene::reconstruct_sphere_hit(const ShapeRecord& rec, const Ray& ray, float
   if (phi < 0) phi += 2 * kPi;
   hit.uv = {phi * kInv2Pi, std::acos(std::clamp(po.z / s.radius, -1.0f, 1.0f)) * kInvPi};
   hit.dpdu = to_world->vector(Vec3(-po.y, po.x, 0) * (2 * kPi));
+}
+
+void Scene::reconstruct_quadric_hit(const ShapeRecord& rec, const Ray& ray, float t, SurfaceHit& hit) const {
+  const QuadricGeometry& q = rec.quadric;
+  const Transform* M = &q.to_world;
+  std::optional<Transform> at_time;
+  if (q.to_world_end) {
+    at_time = interpolate_transform(q.to_world, *q.to_world_end, embree_.normalized_time(ray.time));
+    if (at_time) M = &*at_time;
+  }
+  // Back to the unit shape, projected onto it (removing the error of o + t d), and out again.
+  Point3 local = M->inverse().point(ray.at(t));
+  if (q.kind == QuadricGeometry::Kind::Disk) {
+    // Mitsuba's disk: (u, v) = (r, phi / 2 pi), dp/du the radial direction.
+    local.z = 0;
+    float r = std::sqrt(local.x * local.x + local.y * local.y);
+    float phi = std::atan2(local.y, local.x);
+    if (phi < 0) phi += 2 * kPi;
+    hit.uv = {r, phi * kInv2Pi};
+    hit.dpdu = M->vector(r > 0 ? Vec3(local.x / r, local.y / r, 0) : Vec3(1, 0, 0));
+    hit.ng = normalize(M->normal({0, 0, 1}));
+  } else {
+    // Mitsuba's cylinder: (u, v) = (phi / 2 pi, height along the axis / its length),
+    // dp/du = 2 pi (-y, x, 0) in the tube's space; the normal points away from the axis.
+    float rho = std::sqrt(local.x * local.x + local.y * local.y);
+    float x = rho > 0 ? local.x / rho : 1.0f, y = rho > 0 ? local.y / rho : 0.0f;
+    local = {x, y, std::clamp(local.z, 0.0f, 1.0f)};
+    float phi = std::atan2(y, x);
+    if (phi < 0) phi += 2 * kPi;
+    hit.uv = {phi * kInv2Pi, local.z};
+    hit.dpdu = M->vector(Vec3(-y, x, 0) * (2 * kPi));
+    hit.ng = normalize(M->normal({x, y, 0}));
+  }
+  hit.p = M->point(local);
+  if (rec.flip_normal) hit.ng = -hit.ng;
+  hit.ns = hit.ng;
+}
+
+TextureEvalContext Scene::texture_context(const SurfaceHit& hit) const {
+  TextureEvalContext ctx{hit.p, hit.uv, {}};
+  const ShapeRecord& rec = shapes_[hit.shape];
+  if (rec.attributes && rec.kind == ShapeRecord::Kind::Triangles && 3 * size_t(hit.primitive) + 2 < rec.indices.size()) {
+    ctx.mesh.attributes = rec.attributes.get();
+    ctx.mesh.face = hit.primitive;
+    for (int k = 0; k < 3; ++k) ctx.mesh.vertex[k] = rec.indices[3 * size_t(hit.primitive) + size_t(k)];
+    ctx.mesh.b1 = hit.bary.x;
+    ctx.mesh.b2 = hit.bary.y;
+  }
+  return ctx;
 }
 
 RGB Scene::emitted(const SurfaceHit& hit, const Vec3& wo) const {

@@ -17,14 +17,14 @@
 namespace candela {
 
 struct ShapeRecord {
-  enum class Kind : uint8_t { Triangles, Sphere, Plane };
+  enum class Kind : uint8_t { Triangles, Sphere, Plane, Disk, Cylinder };
   Kind kind = Kind::Triangles;
   uint32_t material = 0;
   int first_light = -1;  // index of the light of primitive 0 when emissive
   bool light_per_triangle = true;  // meshes: one light per triangle; rectangles: one light
   RGB radiance;          // emitted radiance when emissive
   bool two_sided_emission = false;
-  bool flip_normal = false;  // spheres and planes: reverse orientation
+  bool flip_normal = false;  // spheres, planes, disks and cylinders: reverse orientation
   bool winding_swapped = false;  // triangles: indices 1 and 2 swapped to orient the normal
   // Triangles, in world space, winding baked so cross(p1-p0, p2-p0) is the oriented normal.
   std::vector<Point3> positions;
@@ -37,9 +37,14 @@ struct ShapeRecord {
   std::vector<uint32_t> indices;
   SphereGeometry sphere;
   PlaneGeometry plane;
+  QuadricGeometry quadric;  // disks and cylinders
+  // Triangles: the mesh's named attributes (mesh_attribute textures), shared; null when none.
+  std::shared_ptr<const std::vector<TriangleMesh::Attribute>> attributes;
   std::string name;
   bool is_emissive() const { return first_light >= 0; }
-  bool is_moving() const { return !positions_end.empty() || sphere.to_world_end.has_value(); }
+  bool is_moving() const {
+    return !positions_end.empty() || sphere.to_world_end.has_value() || quadric.to_world_end.has_value();
+  }
 };
 
 class Scene {
@@ -53,8 +58,11 @@ class Scene {
   const ShapeRecord& shape(const SurfaceHit& hit) const { return shapes_[hit.shape]; }
   // The BSDF at the hit, its textured inputs evaluated there.
   Bsdf bsdf(const SurfaceHit& hit) const {
-    return materials_.bsdf(shapes_[hit.shape].material, TextureEvalContext{hit.p, hit.uv});
+    return materials_.bsdf(shapes_[hit.shape].material, texture_context(hit));
   }
+  // Where textures are looked up at the hit: its point, uv and (on meshes) the triangle for
+  // mesh-attribute textures.
+  TextureEvalContext texture_context(const SurfaceHit& hit) const;
   // Whether the surface hit is an interface without a surface of its own (rays pass through).
   bool is_interface(const SurfaceHit& hit) const { return materials_.is_interface(shapes_[hit.shape].material); }
   // Radiance emitted from the hit point towards wo (zero for non-emitters and their back faces).
@@ -91,6 +99,9 @@ class Scene {
   void add_sphere(ShapeRecord rec, const SphereShape& sphere, const Transform& to_world,
                   const Transform* to_world_end, bool reverse, const std::optional<AreaEmission>& emission,
                   int object);
+  void add_quadric(ShapeRecord rec, QuadricGeometry::Kind kind, const Transform& unit_to_world,
+                   const Transform* unit_to_world_end, const std::optional<AreaEmission>& emission, int object);
+  void reconstruct_quadric_hit(const ShapeRecord& rec, const Ray& ray, float t, SurfaceHit& hit) const;
   void reconstruct_triangle_hit(const ShapeRecord& rec, const EmbreeHit& eh, float time, SurfaceHit& hit) const;
   void reconstruct_sphere_hit(const ShapeRecord& rec, const Ray& ray, float t, SurfaceHit& hit) const;
 

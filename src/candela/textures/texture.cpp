@@ -99,7 +99,33 @@ void for_each_reference(const TextureDesc& desc, F&& f) {
   }
 }
 
+// A mesh attribute at the hit (Mitsuba's mesh_attribute): per vertex, interpolated with the
+// barycentrics; per face, the triangle's value. One channel reads as grey. Zero off meshes and
+// where the mesh has no attribute of that name.
+RGB eval_mesh_attribute(const std::string& name, const MeshAttributeContext& m) {
+  if (!m.attributes) return RGB(0.0f);
+  for (const TriangleMesh::Attribute& a : *m.attributes) {
+    if (a.name != name) continue;
+    const size_t c = size_t(a.channels == 3 ? 3 : 1);
+    auto value = [&](size_t element) {
+      size_t i = element * c;
+      if (i + c > a.values.size()) return RGB(0.0f);
+      return c == 3 ? RGB(a.values[i], a.values[i + 1], a.values[i + 2]) : RGB(a.values[i]);
+    };
+    if (a.per_face) return value(m.face);
+    return value(m.vertex[0]) * (1 - m.b1 - m.b2) + value(m.vertex[1]) * m.b1 + value(m.vertex[2]) * m.b2;
+  }
+  return RGB(0.0f);
+}
+
 }  // namespace
+
+std::pair<int, int> TextureSet::resolution(int index) const {
+  if (index < 0 || size_t(index) >= textures_.size()) return {1, 1};
+  if (const auto* t = std::get_if<ImageLookup>(&textures_[size_t(index)]))
+    return {std::max(1, t->image->width), std::max(1, t->image->height)};
+  return {1, 1};
+}
 
 TextureSet::TextureSet(const std::vector<TextureDesc>& descs) {
   // Keyed by the effective decoding, so Auto and SRGB on the same file share one image.
@@ -157,7 +183,7 @@ RGB TextureSet::eval_texture(int index, const TextureEvalContext& ctx) const {
     return eval(even ? t->tex1 : t->tex2, ctx);
   }
   if (const auto* t = std::get_if<ScaleTexture>(&texture)) return eval(t->tex, ctx) * eval(t->scale, ctx);
-  if (std::holds_alternative<MeshAttributeTexture>(texture)) return RGB(0.0f);  // TODO(mesh attributes helper)
+  if (const auto* t = std::get_if<MeshAttributeTexture>(&texture)) return eval_mesh_attribute(t->name, ctx.mesh);
   const auto& t = std::get<MixTexture>(texture);
   float amount = eval(t.amount, ctx);
   // A side with weight zero is not evaluated (as in pbrt-v4): cheaper, and an infinite value there

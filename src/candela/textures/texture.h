@@ -2,6 +2,8 @@
 // The scene's textures at render time: SceneDesc::textures with their images loaded, evaluated at
 // surface points for material parameters (ColorInput / FloatInput).
 #include <cstddef>
+#include <cstdint>
+#include <utility>
 #include <memory>
 #include <variant>
 #include <vector>
@@ -13,10 +15,21 @@
 
 namespace candela {
 
-// Where a texture is looked up: the hit point and the surface's (u, v).
+// The triangle a texture is looked up on, for mesh-attribute textures: the mesh's attributes
+// (null off meshes), the triangle's index and vertex indices, and the barycentric weights of its
+// vertices 1 and 2 (vertex 0 has 1 - b1 - b2).
+struct MeshAttributeContext {
+  const std::vector<TriangleMesh::Attribute>* attributes = nullptr;
+  uint32_t face = 0;
+  uint32_t vertex[3] = {0, 0, 0};
+  float b1 = 0, b2 = 0;
+};
+
+// Where a texture is looked up: the hit point, the surface's (u, v) and, on meshes, the triangle.
 struct TextureEvalContext {
   Point3 p;
   Vec2 uv;
+  MeshAttributeContext mesh;
 };
 
 // Immutable after construction, so any number of threads may call eval at once. Copies share the
@@ -39,6 +52,9 @@ class TextureSet {
     return in.texture < 0 ? in.value : eval_texture(in.texture, ctx).average();
   }
   size_t size() const { return textures_.size(); }
+  // The image's size in texels when texture `index` is an image; (1, 1) for the other kinds (as
+  // Mitsuba's Texture::resolution).
+  std::pair<int, int> resolution(int index) const;
 
  private:
   // An ImageTexture with its image in memory.
