@@ -197,6 +197,34 @@ TEST_F(CommandLine, IntegratorOptionsAreChecked) {
   EXPECT_EQ(previous_output(), "previous render");
 }
 
+TEST_F(CommandLine, ConvertWritesJsonThatRendersTheSameImage) {
+  const std::string pbrt = std::string(CANDELA_SHARED_DIR) + "/scenes/cornell-box/cornell-box.pbrt";
+  const std::string json = (dir_ / "box.json").string();
+  RunResult convert = run_cli("convert " + pbrt + " " + json);
+  ASSERT_EQ(convert.exit_code, 0) << convert.output;
+  const std::string a = (dir_ / "a.exr").string(), b = (dir_ / "b.exr").string();
+  ASSERT_EQ(run_cli("render " + pbrt + " -o " + a + " --resolution 24x24 --spp 2 -q").exit_code, 0);
+  ASSERT_EQ(run_cli("render " + json + " -o " + b + " --resolution 24x24 --spp 2 -q").exit_code, 0);
+  Image ia = read_image(a), ib = read_image(b);
+  EXPECT_EQ(ia.rgb, ib.rgb);
+}
+
+TEST_F(CommandLine, ConvertRefusesOtherOutputsAndBadScenes) {
+  std::string scene = write("good.json", kGoodJson);
+  RunResult r = run_cli("convert " + scene + " " + out());
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT_MATCHES(r.output, "must end in \\.json");
+  EXPECT_EQ(previous_output(), "previous render");
+  std::string bad = write("bad.json", "{ \"shapes\": [ { \"type\": \"torus\" } ] }");
+  std::string target = write("target.json", "previous");
+  RunResult refused = run_cli("convert " + bad + " " + target);
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_THAT_MATCHES(refused.output, "bad\\.json.*torus");
+  std::ifstream in(target);
+  std::string kept((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(kept, "previous");
+}
+
 TEST_F(CommandLine, MissingSceneFile) { expect_failure("render " + (dir_ / "nope.json").string() + " -o " + out(), "nope\\.json"); }
 
 TEST_F(CommandLine, MalformedJsonNamesLine) {
