@@ -14,6 +14,7 @@ struct SurfaceHit {
   Vec2 uv;
   Vec3 dpdu;  // surface tangent along u (world space, not normalised; zero when unknown): the
               // shading frame's first axis, which anisotropic roughness is measured along
+  Vec3 dpdv;  // surface tangent along v (world space, not normalised; zero when unknown): bump mapping
   uint32_t shape = 0;      // index into Scene::shapes
   uint32_t primitive = 0;  // triangle index within a mesh
   Vec2 bary;               // triangles: the weights of the triangle's vertices 1 and 2 (vertex 0 has 1 - x - y)

@@ -155,7 +155,7 @@ int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RG
       if (crossed_emission && scene_.light_index(hit) >= 0) {
         BdptVertex& v = path[n];
         v = surface_vertex(hit, ray, beta);
-        v.bsdf = BlackBsdf{};
+        v.bsdf = SurfaceBsdf(BlackBsdf{});
         v.pdf_fwd = convert_density(pdf_fwd, path[n - 1], v);
         crossed_emission[n + 1] += connect<Sampler>(nullptr, path, 0, n + 1, sampler, counts, ray.time).L;
       }
@@ -168,8 +168,10 @@ int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RG
     BdptVertex& prev = path[n - 1];
     v = surface_vertex(hit, ray, beta);
     v.pdf_fwd = convert_density(pdf_fwd, prev, v);
-    v.bsdf = scene_.bsdf(hit);
-    v.frame = Frame::from_normal_tangent(hit.ns, hit.dpdu);
+    Shading shading = scene_.shading(hit);
+    v.bsdf = shading.bsdf;
+    v.frame = shading.frame;
+    v.ns = shading.frame.n;  // normal and bump maps tilt it
     ++n;
     if (n >= max_vertices || bsdf_is_black(v.bsdf)) break;
 
@@ -337,10 +339,9 @@ RGB BdptIntegrator::scatter(const BdptVertex& v, const BdptVertex& next, Transpo
   if (length_squared(wi) == 0) return RGB(0.0f);
   wi = normalize(wi);
   Vec3 wo_local = v.frame.to_local(v.wo), wi_local = v.frame.to_local(wi);
-  RGB f = bsdf_eval(v.bsdf, wo_local, wi_local);
   if (mode == Transport::Importance)
-    f *= bsdf_adjoint_scale(v.bsdf, wo_local, wi_local) * shading_normal_correction(v, v.wo, wi);
-  return f;
+    return bsdf_eval_adjoint(v.bsdf, wo_local, wi_local) * shading_normal_correction(v, v.wo, wi);
+  return bsdf_eval(v.bsdf, wo_local, wi_local);
 }
 
 bool BdptIntegrator::is_connectible(const BdptVertex& v) const {

@@ -39,7 +39,7 @@ struct BdptVertex {
   Frame frame;  // shading frame (surfaces)
   Vec3 wo;      // surfaces: unit direction towards the previous vertex of the subpath
   SurfaceHit hit;
-  Bsdf bsdf;
+  SurfaceBsdf bsdf;  // with its wrappers resolved (a mask's absent part is a delta vertex)
   RGB beta;           // the subpath's throughput up to here
   float pdf_fwd = 0;  // density of this vertex when sampled from its predecessor (per area, or per solid angle
                       // for vertices at infinity)

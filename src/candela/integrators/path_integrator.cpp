@@ -7,7 +7,7 @@ namespace candela {
 
 struct PathIntegrator::Vertex {
   const SurfaceHit& hit;
-  const Bsdf& bsdf;
+  const SurfaceBsdf& bsdf;
   const Frame& frame;
   Vec3 wo_local;
   LightSampleContext ctx;
@@ -75,14 +75,17 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const
     // Terminate the path at the maximum depth.
     if (depth == max_depth_) break;
     ++depth;
-    const Bsdf bsdf = scene_.bsdf(hit);
+    // The BSDF and its shading frame (normal or bump mapped). A mask's "absent" part is a delta
+    // event of this BSDF: it continues the path straight on and counts as a bounce (as Mitsuba does).
+    const Shading shading = scene_.shading(hit);
+    const SurfaceBsdf& bsdf = shading.bsdf;
     if (bsdf_is_black(bsdf)) break;
 
-    Frame frame = Frame::from_normal_tangent(hit.ns, hit.dpdu);
+    const Frame& frame = shading.frame;
     Vec3 wo_local = frame.to_local(wo);
     if (wo_local.z == 0) break;
     // Light is gathered on the side the path arrived from, or on both for diffusely transmitting BSDFs.
-    Normal3 gather_n = bsdf_has_non_delta_transmission(bsdf) ? Normal3(0.0f) : wo_local.z > 0 ? hit.ns : -hit.ns;
+    Normal3 gather_n = bsdf_has_non_delta_transmission(bsdf) ? Normal3(0.0f) : wo_local.z > 0 ? frame.n : -frame.n;
     Vertex vertex{hit, bsdf, frame, wo_local, {hit.p, gather_n}, ray.time};
 
     // Sample direct illumination with shadow rays (next-event estimation).
@@ -118,7 +121,7 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const
 }
 
 template <typename Sampler>
-std::optional<BsdfSample> PathIntegrator::sample_direction(const Bsdf& bsdf, const Vec3& wo, Sampler& sampler) const {
+std::optional<BsdfSample> PathIntegrator::sample_direction(const SurfaceBsdf& bsdf, const Vec3& wo, Sampler& sampler) const {
   float u_lobe = sampler.get_1d();
   Vec2 u = sampler.get_2d();
   float non_delta = bsdf_non_delta_probability(bsdf, wo);
@@ -135,7 +138,7 @@ std::optional<BsdfSample> PathIntegrator::sample_direction(const Bsdf& bsdf, con
   return BsdfSample{wi, bsdf_eval(bsdf, wo, wi) * (std::abs(wi.z) / pdf), pdf, false, 1};
 }
 
-float PathIntegrator::direction_pdf(const Bsdf& bsdf, const Vec3& wo, const Vec3& wi) const {
+float PathIntegrator::direction_pdf(const SurfaceBsdf& bsdf, const Vec3& wo, const Vec3& wi) const {
   if (direction_sampling_ == DirectionSampling::Bsdf) return bsdf_pdf(bsdf, wo, wi);
   float hemisphere = direction_sampling_ == DirectionSampling::Cosine ? std::abs(wi.z) * kInvPi : kInv2Pi;
   float p = bsdf_non_delta_probability(bsdf, wo) * hemisphere;

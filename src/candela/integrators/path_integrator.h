@@ -50,8 +50,8 @@ class PathIntegrator {
                            float prev_total_importance) const;
 
   template <typename Sampler>
-  std::optional<BsdfSample> sample_direction(const Bsdf& bsdf, const Vec3& wo, Sampler& sampler) const;
-  float direction_pdf(const Bsdf& bsdf, const Vec3& wo, const Vec3& wi) const;
+  std::optional<BsdfSample> sample_direction(const SurfaceBsdf& bsdf, const Vec3& wo, Sampler& sampler) const;
+  float direction_pdf(const SurfaceBsdf& bsdf, const Vec3& wo, const Vec3& wi) const;
 
   const Scene& scene_;
   int max_depth_;

@@ -46,7 +46,7 @@ struct CoatedDiffuseBsdf {
   RGB reflectance{0.5f};  // the diffuse base
   RGB specular{1.0f};     // tints the coat's reflection; 1 = physical
   float eta = 1.5f;       // n_coat / n_outside
-  TrowbridgeReitz distribution;
+  Microfacet distribution;  // GGX or Beckmann
   bool nonlinear = false;
 
   RGB eval(Vec3 wo, Vec3 wi) const {

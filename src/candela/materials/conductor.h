@@ -4,7 +4,8 @@
 // one is the Torrance-Sparrow microfacet BRDF
 //   f(wo, wi) = D(wm) F(wo . wm) G(wo, wi) / (4 cos(theta_o) cos(theta_i)),   wm = normalize(wo + wi),
 // importance-sampled through the distribution of visible normals, which gives the weight
-// f cos(theta_i) / pdf = F G(wo, wi) / G1(wo). Single scattering only: the energy that would
+// f cos(theta_i) / pdf = F G(wo, wi) / G1(wo) (G1: the visible-normal normalisation). D is GGX or
+// Beckmann (microfacet.h). Single scattering only: the energy that would
 // scatter between microfacets several times is lost (noticeable at high roughness).
 // Two-sided: a wo below the surface is handled by mirroring the problem to the upper side.
 #include <optional>
@@ -20,7 +21,7 @@ struct ConductorBsdf {
   // ConductorMaterial). pbrt-v4's artist mode: eta = 1, k = conductor_k_from_reflectance(r).
   RGB eta{0.200438f, 0.924033f, 1.102212f}, k{3.912949f, 2.452848f, 2.142188f};
   RGB tint{1.0f};          // multiplies the reflection (Mitsuba's specular_reflectance); 1 = physical
-  TrowbridgeReitz distribution;
+  Microfacet distribution;  // GGX or Beckmann
 
   RGB eval(Vec3 wo, Vec3 wi) const {
     if (distribution.effectively_smooth() || !same_hemisphere(wo, wi)) return RGB(0.0f);
@@ -66,7 +67,7 @@ struct ConductorBsdf {
     float p = distribution.pdf(wo, wm) / (4 * abs_dot(wo, wm));
     if (!(p > 0)) return std::nullopt;
     RGB F = fresnel_complex(dot(wo, wm), eta, k);
-    RGB weight = tint * F * (distribution.G(wo, wi) / distribution.G1(wo));
+    RGB weight = tint * F * (distribution.G(wo, wi) / distribution.visible_G1(wo));
     if (flipped) wi.z = -wi.z;
     return BsdfSample{wi, weight, p, false, 1};
   }

@@ -29,7 +29,7 @@ struct DielectricBsdf {
   float eta = 1.5f;
   RGB reflectance{1.0f};
   RGB transmittance{1.0f};
-  TrowbridgeReitz distribution;
+  Microfacet distribution;  // GGX or Beckmann
 
   // An index-matched interface does not refract, whatever its roughness.
   bool is_smooth() const { return eta == 1 || distribution.effectively_smooth(); }
@@ -37,7 +37,7 @@ struct DielectricBsdf {
   RGB eval(const Vec3& wo, const Vec3& wi) const {
     HalfVector h;
     if (is_smooth() || !half_vector(wo, wi, h)) return RGB(0.0f);
-    const TrowbridgeReitz& d = distribution;
+    const Microfacet& d = distribution;
     float F = fresnel_dielectric(dot(wo, h.wm), eta);
     if (h.reflect) return reflectance * (d.D(h.wm) * d.G(wo, wi) * F / std::abs(4 * wi.z * wo.z));
     float denom = sqr(dot(wi, h.wm) + dot(wo, h.wm) / h.etap) * wi.z * wo.z;
@@ -57,7 +57,7 @@ struct DielectricBsdf {
   std::optional<BsdfSample> sample(const Vec3& wo, float u_lobe, Vec2 u) const {
     if (is_smooth()) return sample_smooth(wo, u_lobe);
     if (wo.z == 0) return std::nullopt;
-    const TrowbridgeReitz& d = distribution;
+    const Microfacet& d = distribution;
     // Sample a microfacet normal visible from wo; then reflection or refraction about it, chosen
     // with the Fresnel probabilities of that facet.
     Vec3 wm = d.sample_visible_normal(wo, u);

@@ -1,5 +1,7 @@
 #include "candela/materials/material.h"
 
+#include "candela/io/error.h"
+
 namespace candela {
 namespace {
 
@@ -31,7 +33,23 @@ bool has_constant_inputs(const MaterialDesc& desc) {
                  is_constant(m.flatness);
         else if constexpr (std::is_same_v<T, DiffuseTransmissionMaterial>)
           return is_constant(m.reflectance) && is_constant(m.transmittance);
+        else if constexpr (std::is_same_v<T, MaskMaterial>) return is_constant(m.opacity);  // and what it wraps
+        else if constexpr (std::is_same_v<T, BlendMaterial>) return is_constant(m.weight);
         else return true;
+      },
+      desc);
+}
+
+// The wrapped materials of a wrapper (none for other materials).
+std::vector<int> nested_materials(const MaterialDesc& desc) {
+  return std::visit(
+      [](const auto& m) -> std::vector<int> {
+        using T = std::decay_t<decltype(m)>;
+        if constexpr (std::is_same_v<T, BlendMaterial>) return {m.material0, m.material1};
+        else if constexpr (std::is_same_v<T, OneSidedMaterial> || std::is_same_v<T, MaskMaterial> ||
+                           std::is_same_v<T, NormalMapMaterial> || std::is_same_v<T, BumpMapMaterial>)
+          return {m.material};
+        else return {};
       },
       desc);
 }
@@ -41,10 +59,124 @@ bool has_constant_inputs(const MaterialDesc& desc) {
 MaterialTable::MaterialTable(const std::vector<MaterialDesc>& descs, const TextureSet& textures)
     : textures_(&textures) {
   entries_.reserve(descs.size() + 1);
-  for (const auto& d : descs) entries_.push_back({d, std::nullopt, std::holds_alternative<InterfaceMaterial>(d)});
-  entries_.push_back({DiffuseMaterial{RGB(0.5f)}, std::nullopt, false});
-  for (auto& e : entries_)
-    if (has_constant_inputs(e.desc)) e.constant = build(e.desc, TextureEvalContext{});
+  for (const auto& d : descs) entries_.push_back({d, std::nullopt, std::holds_alternative<InterfaceMaterial>(d), {}});
+  entries_.push_back({DiffuseMaterial{RGB(0.5f)}, std::nullopt, false, {}});
+  // Wrappers refer to materials before them, so one pass in order sees every nested material done.
+  std::vector<int> leaves(entries_.size(), 1);
+  std::vector<bool> constant(entries_.size(), true);
+  for (size_t i = 0; i < entries_.size(); ++i) {
+    Entry& e = entries_[i];
+    constant[i] = has_constant_inputs(e.desc);
+    std::vector<int> nested = nested_materials(e.desc);
+    if (nested.empty()) continue;
+    int count = 0;
+    for (int n : nested) {
+      if (n < 0 || size_t(n) >= i)
+        throw SceneError(fmt::format("material {}: wraps material {}, which is not a material before it", i, n));
+      count += leaves[size_t(n)];
+      constant[i] = constant[i] && constant[size_t(n)];
+    }
+    leaves[i] = count;
+    if (count > SurfaceBsdf::kMaxComponents)
+      throw SceneError(fmt::format("material {}: blends {} materials; at most {} can be mixed at one surface", i,
+                                   count, SurfaceBsdf::kMaxComponents));
+    e.perturbations = entries_[size_t(nested[0])].perturbations;
+    if (nested.size() == 2 && entries_[size_t(nested[1])].perturbations != e.perturbations)
+      throw SceneError(fmt::format(
+          "material {}: blends materials with different normal or bump maps (one shading frame per surface point)", i));
+    if (std::holds_alternative<NormalMapMaterial>(e.desc) || std::holds_alternative<BumpMapMaterial>(e.desc)) {
+      const int map = std::holds_alternative<NormalMapMaterial>(e.desc) ? std::get<NormalMapMaterial>(e.desc).normal_map
+                                                                        : std::get<BumpMapMaterial>(e.desc).height;
+      if (map < 0 || size_t(map) >= textures.size())
+        throw SceneError(fmt::format("material {}: the normal or bump map is texture {}, which does not exist", i, map));
+      e.perturbations.insert(e.perturbations.begin(), int(i));
+    }
+  }
+  for (size_t i = 0; i < entries_.size(); ++i)
+    if (constant[i]) entries_[i].constant = resolve(uint32_t(i), TextureEvalContext{});
+}
+
+SurfaceBsdf MaterialTable::resolve(uint32_t material, const TextureEvalContext& ctx) const {
+  const MaterialDesc& desc = entries_[material].desc;
+  if (nested_materials(desc).empty()) return SurfaceBsdf(build(desc, ctx));
+  SurfaceBsdf out;
+  collect(int(material), 1, false, ctx, out);
+  return out;
+}
+
+void MaterialTable::collect(int material, float weight, bool one_sided, const TextureEvalContext& ctx,
+                            SurfaceBsdf& out) const {
+  const MaterialDesc& desc = entries_[size_t(material)].desc;
+  auto clamp01 = [&](const FloatInput& f) { return std::clamp(textures_->eval(f, ctx), 0.0f, 1.0f); };
+  if (const auto* m = std::get_if<OneSidedMaterial>(&desc)) {
+    collect(m->material, weight, true, ctx, out);
+  } else if (const auto* mask = std::get_if<MaskMaterial>(&desc)) {
+    float opacity = clamp01(mask->opacity);
+    out.null_weight += weight * (1 - opacity);
+    if (opacity > 0) collect(mask->material, weight * opacity, one_sided, ctx, out);
+  } else if (const auto* blend = std::get_if<BlendMaterial>(&desc)) {
+    float t = clamp01(blend->weight);
+    if (t < 1) collect(blend->material0, weight * (1 - t), one_sided, ctx, out);
+    if (t > 0) collect(blend->material1, weight * t, one_sided, ctx, out);
+  } else if (const auto* nm = std::get_if<NormalMapMaterial>(&desc)) {
+    collect(nm->material, weight, one_sided, ctx, out);
+  } else if (const auto* bm = std::get_if<BumpMapMaterial>(&desc)) {
+    collect(bm->material, weight, one_sided, ctx, out);
+  } else if (std::holds_alternative<InterfaceMaterial>(desc)) {
+    out.null_weight += weight;  // no surface: a wrapped interface lets the ray pass
+  } else if (out.count < SurfaceBsdf::kMaxComponents) {
+    out.add(build(desc, ctx), weight, one_sided);
+  }
+}
+
+Shading MaterialTable::shading(uint32_t material, const TextureEvalContext& ctx, const SurfaceHit& hit) const {
+  Shading s{bsdf(material, ctx), Frame::from_normal_tangent(hit.ns, hit.dpdu)};
+  const Entry& e = entries_[material];
+  if (e.perturbations.empty()) return s;
+  const Normal3 original = s.frame.n;
+  for (int map : e.perturbations) perturb(map, ctx, hit, s.frame);
+  s.bsdf.check_side = true;
+  s.bsdf.original_normal = s.frame.to_local(original);
+  return s;
+}
+
+void MaterialTable::perturb(int map, const TextureEvalContext& ctx, const SurfaceHit& hit, Frame& frame) const {
+  const TextureSet& tex = *textures_;
+  Vec3 n_local;
+  if (const auto* nm = std::get_if<NormalMapMaterial>(&entries_[size_t(map)].desc)) {
+    ColorInput in;
+    in.texture = nm->normal_map;
+    RGB c = tex.eval(in, ctx);
+    n_local = Vec3(2 * c.r - 1, 2 * c.g - 1, 2 * c.b - 1);
+  } else {
+    const auto& bm = std::get<BumpMapMaterial>(entries_[size_t(map)].desc);
+    FloatInput height;
+    height.texture = bm.height;
+    // The height's gradient in (u, v) by central differences a hundredth of a texel wide (within a
+    // texel a bilinear image is linear, so this is its exact gradient there, as Mitsuba's
+    // eval_1_grad computes it); chain-ruled through the texture's own uv mapping.
+    auto [res_x, res_y] = tex.resolution(bm.height);
+    const float du = 0.01f / float(std::max(1, res_x)), dv = 0.01f / float(std::max(1, res_y));
+    auto h_at = [&](float ou, float ov) {
+      TextureEvalContext c = ctx;
+      c.uv = ctx.uv + Vec2(ou, ov);
+      return tex.eval(height, c);
+    };
+    float grad_u = bm.scale * (h_at(du, 0) - h_at(-du, 0)) / (2 * du);
+    float grad_v = bm.scale * (h_at(0, dv) - h_at(0, -dv)) / (2 * dv);
+    const Vec3 n = frame.n;
+    Vec3 dpdu = hit.dpdu, dpdv = hit.dpdv;
+    if (!(length_squared(dpdu) > 0)) dpdu = frame.s;
+    if (!(length_squared(dpdv) > 0)) dpdv = cross(n, dpdu) * (length(dpdu) > 0 ? 1.0f : 0.0f);
+    Vec3 pu = dpdu + n * (grad_u - dot(n, dpdu)), pv = dpdv + n * (grad_v - dot(n, dpdv));
+    Vec3 c = cross(pu, pv);
+    if (dot(c, hit.ng) < 0) c = -c;
+    n_local = frame.to_local(c);
+  }
+  float len = length(n_local);
+  if (!(len > 0) || !std::isfinite(len)) return;
+  Vec3 n = normalize(frame.to_world(n_local / len));
+  frame = Frame::from_normal_tangent(n, frame.s);
 }
 
 Bsdf MaterialTable::build(const MaterialDesc& desc, const TextureEvalContext& ctx) const {
@@ -61,7 +193,8 @@ Bsdf MaterialTable::build(const MaterialDesc& desc, const TextureEvalContext& ct
       u = TrowbridgeReitz::roughness_to_alpha(u);
       v = TrowbridgeReitz::roughness_to_alpha(v);
     }
-    return TrowbridgeReitz(u, v);
+    return r.distribution == MicrofacetDistribution::Beckmann ? Microfacet(Beckmann(u, v))
+                                                              : Microfacet(TrowbridgeReitz(u, v));
   };
   return std::visit(
       [&](const auto& m) -> Bsdf {
@@ -118,7 +251,7 @@ Bsdf MaterialTable::build(const MaterialDesc& desc, const TextureEvalContext& ct
           }
           return PrincipledBsdf(p);
         } else {
-          return BlackBsdf{};  // black, and interfaces (never shaded: the integrator passes through)
+          return BlackBsdf{};  // black, interfaces (never shaded: the integrator passes through), wrappers (resolve())
         }
       },
       desc);

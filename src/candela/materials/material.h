@@ -2,14 +2,33 @@
 // Materials turn into BSDFs at each hit: a material's parameters may be textures, so the BSDF is
 // built from the description with every input evaluated at the hit's (uv, p). Materials without
 // textures build their BSDF once, up front.
+//
+// Wrappers (one-sided, mask, blend: materials/surface_bsdf.h) resolve into a SurfaceBsdf, a mixture
+// of at most SurfaceBsdf::kMaxComponents BSDFs; normal and bump maps tilt the shading frame of the
+// hit for the whole surface point (shading()). Mitsuba 3's frames: the map's normal n is in the
+// hit's shading frame (s, t, n) (normal map: n = 2 rgb - 1; bump map: n = cross(dp/du + n dh/du,
+// dp/dv + n dh/dv) of the surface displaced by scale * height, the tangents' normal parts replaced
+// by the height's gradient, n turned to the geometric normal's side), and the tilted frame's first
+// axis is the old s made orthogonal to it (Mitsuba's PerturbedBSDF). Nested maps apply outermost
+// first. One frame per point: a blend whose two sides have different normal or bump maps is a
+// SceneError, as is a material (with its wrappers) of more than kMaxComponents BSDFs.
 #include <optional>
 #include <vector>
 
+#include "candela/geometry/surface_hit.h"
 #include "candela/materials/bsdf.h"
+#include "candela/materials/surface_bsdf.h"
+#include "candela/math/frame.h"
 #include "candela/scene/description.h"
 #include "candela/textures/texture.h"
 
 namespace candela {
+
+// The BSDF at a hit and the shading frame it works in (normal and bump mapped).
+struct Shading {
+  SurfaceBsdf bsdf;
+  Frame frame;
+};
 
 class MaterialTable {
  public:
@@ -18,10 +37,16 @@ class MaterialTable {
   // descs.size() (for shapes that name none).
   MaterialTable(const std::vector<MaterialDesc>& descs, const TextureSet& textures);
 
-  Bsdf bsdf(uint32_t material, const TextureEvalContext& ctx) const {
+  // Throws SceneError for wrappers that cannot be resolved (see above).
+  SurfaceBsdf bsdf(uint32_t material, const TextureEvalContext& ctx) const {
     const Entry& e = entries_[material];
-    return e.constant ? *e.constant : build(e.desc, ctx);
+    return e.constant ? *e.constant : resolve(material, ctx);
   }
+  // The BSDF and the shading frame at a hit (its ns, ng, dpdu and dpdv; ctx is where the hit's
+  // textures are looked up).
+  Shading shading(uint32_t material, const TextureEvalContext& ctx, const SurfaceHit& hit) const;
+  // Whether the material tilts shading normals (normal or bump maps).
+  bool perturbs_normals(uint32_t material) const { return !entries_[material].perturbations.empty(); }
   // An interface material has no surface: rays pass through it (pbrt-v4's "interface").
   bool is_interface(uint32_t material) const { return entries_[material].interface; }
   // Whether the BSDF is black whatever the hit (pure emitters, light blockers): paths end there.
@@ -31,10 +56,17 @@ class MaterialTable {
  private:
   struct Entry {
     MaterialDesc desc;
-    std::optional<Bsdf> constant;
+    std::optional<SurfaceBsdf> constant;
     bool interface = false;
+    std::vector<int> perturbations;  // the normal / bump map materials that apply, outermost first
   };
+  // The BSDF of a material that is not a wrapper.
   Bsdf build(const MaterialDesc& desc, const TextureEvalContext& ctx) const;
+  // The mixture a material and its wrappers make.
+  SurfaceBsdf resolve(uint32_t material, const TextureEvalContext& ctx) const;
+  void collect(int material, float weight, bool one_sided, const TextureEvalContext& ctx, SurfaceBsdf& out) const;
+  // Tilts `frame` by the normal or bump map material `map`.
+  void perturb(int map, const TextureEvalContext& ctx, const SurfaceHit& hit, Frame& frame) const;
 
   const TextureSet* textures_ = nullptr;
   std::vector<Entry> entries_;

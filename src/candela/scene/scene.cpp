@@ -380,7 +380,7 @@ bool Scene::intersect(const Ray& world_ray, SurfaceHit& hit) const {
       hit.ng = rec.flip_normal ? -rec.plane.normal : rec.plane.normal;
       hit.ns = hit.ng;
       hit.uv = {0, 0};
-      hit.dpdu = Vec3(0.0f);
+      hit.dpdu = hit.dpdv = Vec3(0.0f);
       break;
     }
   }
@@ -390,6 +390,7 @@ bool Scene::intersect(const Ray& world_ray, SurfaceHit& hit) const {
     hit.ng = normalize(T.normal(hit.ng));
     hit.ns = normalize(T.normal(hit.ns));
     hit.dpdu = T.vector(hit.dpdu);
+    hit.dpdv = T.vector(hit.dpdv);
   }
   return true;
 }
@@ -428,6 +429,7 @@ void Scene::reconstruct_triangle_hit(const ShapeRecord& rec, const EmbreeHit& eh
     // Barycentric uvs in the mesh's own vertex order, whatever winding was baked for orientation.
     hit.uv = rec.winding_swapped ? Vec2(eh.v, eh.u) : Vec2(eh.u, eh.v);
     hit.dpdu = rec.winding_swapped ? p2 - p0 : p1 - p0;
+    hit.dpdv = rec.winding_swapped ? p1 - p0 : p2 - p0;
   } else {
     const Vec2 &uv0 = rec.uvs[i0], &uv1 = rec.uvs[i1], &uv2 = rec.uvs[i2];
     hit.uv = uv0 * b0 + uv1 * eh.u + uv2 * eh.v;
@@ -435,6 +437,7 @@ void Scene::reconstruct_triangle_hit(const ShapeRecord& rec, const EmbreeHit& eh
     Vec2 duv02 = uv0 - uv2, duv12 = uv1 - uv2;
     float det = duv02.x * duv12.y - duv02.y * duv12.x;
     hit.dpdu = std::abs(det) > 1e-12f ? ((p0 - p2) * duv12.y - (p1 - p2) * duv02.y) / det : p1 - p0;
+    hit.dpdv = std::abs(det) > 1e-12f ? ((p1 - p2) * duv02.x - (p0 - p2) * duv12.x) / det : p2 - p0;
   }
 }
 
@@ -460,6 +463,9 @@ void Scene::reconstruct_sphere_hit(const ShapeRecord& rec, const Ray& ray, float
   if (phi < 0) phi += 2 * kPi;
   hit.uv = {phi * kInv2Pi, std::acos(std::clamp(po.z / s.radius, -1.0f, 1.0f)) * kInvPi};
   hit.dpdu = to_world->vector(Vec3(-po.y, po.x, 0) * (2 * kPi));
+  // v = theta / pi: dp/dv = pi (z cos phi, z sin phi, -r sin theta).
+  float rho = std::sqrt(po.x * po.x + po.y * po.y);
+  hit.dpdv = rho > 0 ? to_world->vector(Vec3(po.z * po.x / rho, po.z * po.y / rho, -rho) * kPi) : Vec3(0.0f);
 }
 
 void Scene::reconstruct_quadric_hit(const ShapeRecord& rec, const Ray& ray, float t, SurfaceHit& hit) const {
@@ -480,6 +486,7 @@ void Scene::reconstruct_quadric_hit(const ShapeRecord& rec, const Ray& ray, floa
     if (phi < 0) phi += 2 * kPi;
     hit.uv = {r, phi * kInv2Pi};
     hit.dpdu = M->vector(r > 0 ? Vec3(local.x / r, local.y / r, 0) : Vec3(1, 0, 0));
+    hit.dpdv = M->vector(Vec3(-local.y, local.x, 0) * (2 * kPi));
     hit.ng = normalize(M->normal({0, 0, 1}));
   } else {
     // Mitsuba's cylinder: (u, v) = (phi / 2 pi, height along the axis / its length),
@@ -491,6 +498,7 @@ void Scene::reconstruct_quadric_hit(const ShapeRecord& rec, const Ray& ray, floa
     if (phi < 0) phi += 2 * kPi;
     hit.uv = {phi * kInv2Pi, local.z};
     hit.dpdu = M->vector(Vec3(-y, x, 0) * (2 * kPi));
+    hit.dpdv = M->vector(Vec3(0, 0, 1));
     hit.ng = normalize(M->normal({x, y, 0}));
   }
   hit.p = M->point(local);

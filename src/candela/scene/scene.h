@@ -57,8 +57,12 @@ class Scene {
 
   const ShapeRecord& shape(const SurfaceHit& hit) const { return shapes_[hit.shape]; }
   // The BSDF at the hit, its textured inputs evaluated there.
-  Bsdf bsdf(const SurfaceHit& hit) const {
+  SurfaceBsdf bsdf(const SurfaceHit& hit) const {
     return materials_.bsdf(shapes_[hit.shape].material, texture_context(hit));
+  }
+  // The BSDF at the hit with the shading frame it works in (the hit's, tilted by normal and bump maps).
+  Shading shading(const SurfaceHit& hit) const {
+    return materials_.shading(shapes_[hit.shape].material, texture_context(hit), hit);
   }
   // Where textures are looked up at the hit: its point, uv and (on meshes) the triangle for
   // mesh-attribute textures.
