@@ -119,7 +119,9 @@ void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
          {"uniform", DirectionSampling::Uniform}});
   if (!cmd.light_selection.empty())
     rs.light_selection = parse_choice<LightSelection>("--light-selection", cmd.light_selection,
-                                                      {{"power", LightSelection::Power}, {"paper", LightSelection::Paper}});
+                                                      {{"power", LightSelection::Power},
+                                                       {"paper", LightSelection::Paper},
+                                                       {"uniform", LightSelection::Uniform}});
   if (cmd.no_mis) rs.mis = false;
   if (cmd.mlt_bootstrap) rs.mlt_bootstrap = *cmd.mlt_bootstrap;
   if (cmd.mlt_chains) rs.mlt_chains = *cmd.mlt_chains;
@@ -517,8 +519,9 @@ int main(int argc, char** argv) {
   render_cmd->add_flag("--no-mis", cmd.no_mis,
                        "Turn off multiple importance sampling: direct light from shadow rays only");
   render_cmd->add_option("--light-selection", cmd.light_selection,
-                         "How shadow rays pick lights: power (each ray one light, chosen by power), paper "
-                         "(every light a share proportional to power x projected solid angle)");
+                         "How shadow rays pick lights: power (each ray one light, chosen by power), uniform "
+                         "(each ray one emitter, all equally likely, as Mitsuba), paper (every light a share "
+                         "proportional to power x projected solid angle)");
   render_cmd->add_option("--shadow-rays", cmd.shadow_rays, "Shadow rays per path vertex")->check(CLI::Range(1, 1024));
   render_cmd->add_option("--adaptive-threshold", cmd.adaptive_threshold,
                          "Adaptive sampling: keep adding batches to pixels whose relative standard error "

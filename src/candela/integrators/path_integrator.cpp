@@ -153,7 +153,7 @@ float PathIntegrator::total_light_importance(const LightSampleContext& ctx) cons
 }
 
 float PathIntegrator::expected_shadow_rays(size_t li, const LightSampleContext& ctx, float total_importance) const {
-  if (light_selection_ == LightSelection::Power) return float(shadow_rays_) * scene_.light_distribution().pmf(li);
+  if (light_selection_ != LightSelection::Paper) return float(shadow_rays_) * scene_.light_distribution().pmf(li);
   // The paper's rule, mixed with a uniform share so that every light keeps a non-zero expected
   // number of rays (which keeps the estimator unbiased where the heuristic says "nothing here").
   float uniform = 1.0f / float(scene_.lights().size());
@@ -189,9 +189,10 @@ Vec2 stratified_square(Vec2 u, int k, int n, float rotation) {
 template <typename Sampler>
 RGB PathIntegrator::direct_light(const Vertex& v, Sampler& sampler, RayCounts& counts, float& total_importance) const {
   RGB sum(0.0f);
-  if (light_selection_ == LightSelection::Power) {
-    // Each shadow ray goes to one light chosen with probability proportional to its power; with
-    // several rays, the light choices and the points on the lights are stratified.
+  if (light_selection_ != LightSelection::Paper) {
+    // Each shadow ray goes to one light chosen from the scene's light distribution (by power, or
+    // uniformly over emitters); with several rays, the light choices and the points on the lights
+    // are stratified.
     const Distribution1D& choice = scene_.light_distribution();
     float rotation = shadow_rays_ > 1 ? sampler.get_1d() : 0.0f;
     for (int k = 0; k < shadow_rays_; ++k) {

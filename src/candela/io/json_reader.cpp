@@ -755,7 +755,7 @@ class JsonSceneReader {
     if (const Json* value = render.find("light_selection"))
       settings.light_selection =
           read_name<LightSelection>(report_, *value, render.pointer_of("light_selection"), "light selection",
-                                    {{"power", LightSelection::Power}, {"paper", LightSelection::Paper}});
+                                    {{"power", LightSelection::Power}, {"paper", LightSelection::Paper}, {"uniform", LightSelection::Uniform}});
     settings.shadow_rays = render.integer_or("shadow_rays", settings.shadow_rays, 1, std::numeric_limits<int>::max());
   }
 

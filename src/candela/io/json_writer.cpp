@@ -322,7 +322,8 @@ Json render_json(const SceneDesc& scene) {
   static const char* kDirections[] = {"bsdf", "cosine", "uniform"};
   j["direction_sampling"] = kDirections[int(s.direction_sampling)];
   j["mis"] = s.mis;
-  j["light_selection"] = s.light_selection == LightSelection::Power ? "power" : "paper";
+  static const char* kSelection[] = {"power", "paper", "uniform"};
+  j["light_selection"] = kSelection[int(s.light_selection)];
   j["shadow_rays"] = s.shadow_rays;
   if (s.adaptive()) {
     Json adaptive;

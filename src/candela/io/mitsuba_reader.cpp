@@ -626,6 +626,8 @@ class Converter {
     desc_.settings.spp = 4;  // Mitsuba's independent sampler default
     desc_.settings.max_depth = kUnboundedDepth;
     desc_.settings.integrator = "path";
+    // Mitsuba picks the emitter of a shadow ray (and of a light path) uniformly.
+    desc_.settings.light_selection = LightSelection::Uniform;
     desc_.settings.filter = gaussian_filter(0.5f);
     desc_.film.width = 768;
     desc_.film.height = 576;
@@ -1541,14 +1543,16 @@ class Converter {
       return;
     }
     if (i.type == "path" || i.type == "ptracer" || i.type == "volpath" || i.type == "volpathmis") {
-      rs.integrator = "path";
+      // A particle tracer's strength, paths from the lights connected to the camera, is BDPT's
+      // t = 1 strategy: BDPT renders ptracer scenes with it (and the other strategies, under MIS).
+      rs.integrator = i.type == "ptracer" ? "bdpt" : "path";
       rs.max_depth = candela_depth(get_int(i, "max_depth", -1));
       int rr = get_int(i, "rr_depth", 5);
       rs.rr_start_depth = std::max(1, rr - 1);
       if (get_bool(i, "hide_emitters", false))
         throw_scene_error(i.where.loc(), "{}: hide_emitters is not supported", i.describe());
       if (i.type == "ptracer")
-        warn(i.where, "integrator \"ptracer\": rendering with candela's path tracer (the same expectation)");
+        warn(i.where, "integrator \"ptracer\": rendering with candela's bidirectional path tracer (the same expectation)");
       if (i.type != "path" && i.type != "ptracer")
         warn(i.where, "integrator \"{}\": rendering with candela's path tracer (no participating media)", i.type);
       ignore(i, "samples_per_pass");

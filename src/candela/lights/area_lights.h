@@ -5,8 +5,22 @@
 #include "candela/lights/light_sample.h"
 #include "candela/math/frame.h"
 #include "candela/sampling/warp.h"
+#include "candela/textures/texture.h"
 
 namespace candela {
+
+// A textured emitter (AreaEmission::texture): the radiance times the texture at the point's (u, v).
+// Light selection (power, importance) uses the untextured radiance: it only steers the choice.
+struct EmissionTexture {
+  const TextureSet* textures = nullptr;
+  int texture = -1;
+  RGB operator()(const RGB& radiance, Vec2 uv, const Point3& p) const {
+    if (texture < 0) return radiance;
+    ColorInput input;
+    input.texture = texture;
+    return radiance * textures->eval(input, TextureEvalContext{p, uv, {}});
+  }
+};
 
 // Converts an area density at p_light into a solid-angle density seen from p.
 inline float area_to_solid_angle_pdf(float pdf_area, const Point3& p, const Point3& p_light, const Normal3& n_light) {
@@ -48,18 +62,27 @@ struct TriangleLight {
   float area;
   RGB radiance;
   bool two_sided;
+  // Textured emitters only: the vertices' (u, v) and the texture.
+  Vec2 uv0{0, 0}, uv1{1, 0}, uv2{0, 1};
+  EmissionTexture emission_texture;
 
   LightSample sample_li(const LightSampleContext& ctx, Vec2 u) const {
     // Uniform point on the triangle, then converted to solid angle.
     Vec2 b = square_to_uniform_triangle(u);
-    return flat_light_sample(p0 * b.x + p1 * b.y + p2 * (1 - b.x - b.y), n, area, radiance, two_sided, ctx);
+    Point3 p = p0 * b.x + p1 * b.y + p2 * (1 - b.x - b.y);
+    return flat_light_sample(p, n, area, radiance_at(b, p), two_sided, ctx);
   }
   // Emission: a uniform point, a cosine-weighted direction on the emitting side(s).
   LightEmission sample_le(Vec2 u_pos, Vec2 u_dir, const SceneSphere&) const {
     Vec2 b = square_to_uniform_triangle(u_pos);
+    Point3 p = p0 * b.x + p1 * b.y + p2 * (1 - b.x - b.y);
     float pdf_dir;
     Vec3 w = sample_cosine_emission(n, two_sided, u_dir, pdf_dir);
-    return {radiance, p0 * b.x + p1 * b.y + p2 * (1 - b.x - b.y), w, n, 1 / area, pdf_dir};
+    return {radiance_at(b, p), p, w, n, 1 / area, pdf_dir};
+  }
+  RGB radiance_at(Vec2 b, const Point3& p) const {
+    if (emission_texture.texture < 0) return radiance;
+    return emission_texture(radiance, uv0 * b.x + uv1 * b.y + uv2 * (1 - b.x - b.y), p);
   }
   EmissionPdf pdf_le(const Point3&, const Normal3&, const Vec3& w, const SceneSphere&) const {
     return {1 / area, cosine_emission_pdf(n, two_sided, w)};
@@ -83,14 +106,17 @@ struct RectangleLight {
   float area;
   RGB radiance;
   bool two_sided;
+  EmissionTexture emission_texture;  // textured emitters: the point corner + s edge_u + t edge_v has (u, v) = (s, t)
 
   LightSample sample_li(const LightSampleContext& ctx, Vec2 u) const {
-    return flat_light_sample(corner + edge_u * u.x + edge_v * u.y, n, area, radiance, two_sided, ctx);
+    Point3 p = corner + edge_u * u.x + edge_v * u.y;
+    return flat_light_sample(p, n, area, emission_texture(radiance, u, p), two_sided, ctx);
   }
   LightEmission sample_le(Vec2 u_pos, Vec2 u_dir, const SceneSphere&) const {
     float pdf_dir;
     Vec3 w = sample_cosine_emission(n, two_sided, u_dir, pdf_dir);
-    return {radiance, corner + edge_u * u_pos.x + edge_v * u_pos.y, w, n, 1 / area, pdf_dir};
+    Point3 p = corner + edge_u * u_pos.x + edge_v * u_pos.y;
+    return {emission_texture(radiance, u_pos, p), p, w, n, 1 / area, pdf_dir};
   }
   EmissionPdf pdf_le(const Point3&, const Normal3&, const Vec3& w, const SceneSphere&) const {
     return {1 / area, cosine_emission_pdf(n, two_sided, w)};

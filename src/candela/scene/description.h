@@ -480,8 +480,11 @@ enum class DirectionSampling {
 // How shadow rays are spent at each vertex (sec. 4.5).
 enum class LightSelection {
   Power,   // `shadow_rays` rays, each to one light chosen with probability proportional to its power
-  Paper    // every light gets a share of `shadow_rays` proportional to power x projected solid angle
+  Paper,   // every light gets a share of `shadow_rays` proportional to power x projected solid angle
            // as seen from the vertex (stratified over rectangles), kept unbiased
+  Uniform  // as Power, but every emitter (a light, or an emissive shape with all its triangles) is
+           // equally likely, and a shape's triangles by area (Mitsuba's choice): robust where power
+           // misjudges, as for a small spot beside a large sky
 };
 
 struct RenderSettings {

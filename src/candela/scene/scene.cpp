@@ -85,8 +85,21 @@ Scene::Scene(const SceneDesc& desc)
     }
   }
 
+  // Which light a shadow ray (or a light path) starts from: by power, or (LightSelection::Uniform)
+  // every emitter equally, the triangles of an emissive mesh among themselves by power (= by area).
   std::vector<float> power;
   for (const auto& l : lights_) power.push_back(light_power(l));
+  if (desc.settings.light_selection == LightSelection::Uniform) {
+    std::vector<float> weight(lights_.size(), 1.0f);
+    for (const ShapeRecord& rec : shapes_) {
+      if (!rec.is_emissive() || !(rec.kind == ShapeRecord::Kind::Triangles && rec.light_per_triangle)) continue;
+      size_t first = size_t(rec.first_light), count = rec.indices.size() / 3;
+      double group = 0;
+      for (size_t i = first; i < first + count; ++i) group += power[i];
+      for (size_t i = first; i < first + count; ++i) weight[i] = group > 0 ? float(power[i] / group) : 0.0f;
+    }
+    power = std::move(weight);
+  }
   light_distribution_ = Distribution1D(power);
 
   int w = desc.film.width, h = desc.film.height;
@@ -157,6 +170,17 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int object) {
   if (T_end && desc.emission)
     throw SceneError(fmt::format("{}: {}: area lights must not move (an emissive shape has an end transform)",
                                  source_file_, rec.name));
+  if (desc.emission && desc.emission->texture >= 0) {
+    if (size_t(desc.emission->texture) >= textures_.size())
+      throw SceneError(fmt::format("{}: {}: the emission texture {} does not exist", source_file_, rec.name,
+                                   desc.emission->texture));
+    // Textured emission is sampled on triangles and rectangles, whose (u, v) follow from the point.
+    if (std::holds_alternative<SphereShape>(desc.geometry) || std::holds_alternative<DiskShape>(desc.geometry) ||
+        std::holds_alternative<CylinderShape>(desc.geometry))
+      throw SceneError(fmt::format("{}: {}: textured emission is supported on meshes, boxes and rectangles, not on "
+                                   "spheres, disks or cylinders (use a mesh)",
+                                   source_file_, rec.name));
+  }
 
   if (const auto* s = std::get_if<SphereShape>(&desc.geometry)) {
     add_sphere(std::move(rec), *s, T, T_end, desc.reverse_orientation, desc.emission, object);
@@ -307,6 +331,7 @@ void Scene::add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Trans
     rec.first_light = int(lights_.size());
     rec.radiance = emission->radiance;
     rec.two_sided_emission = emission->two_sided;
+    rec.emission_texture = emission->texture;
   }
   if (emission && rectangle) {
     // One light for the whole parallelogram (its two triangles share it), so that light samples
@@ -316,8 +341,9 @@ void Scene::add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Trans
     Vec3 oriented = cross(b - a, c - a);  // after the winding was baked: the emitting side
     float area = length(cross(p1 - p0, p3 - p0));
     rec.light_per_triangle = false;
-    lights_.push_back(RectangleLight{p0, p1 - p0, p3 - p0, normalize(oriented), area, rec.radiance,
-                                     rec.two_sided_emission});
+    RectangleLight light{p0, p1 - p0, p3 - p0, normalize(oriented), area, rec.radiance, rec.two_sided_emission};
+    light.emission_texture = {&textures_, rec.emission_texture};
+    lights_.push_back(light);
   } else if (emission) {
     for (size_t i = 0; i < rec.indices.size(); i += 3) {
       const Point3 &p0 = rec.positions[rec.indices[i]], &p1 = rec.positions[rec.indices[i + 1]],
@@ -330,7 +356,16 @@ void Scene::add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Trans
         n = face_forward(n, ns);
       }
       // Degenerate triangles get a zero-area light that is never chosen (zero power).
-      lights_.push_back(TriangleLight{p0, p1, p2, n, len / 2, rec.radiance, rec.two_sided_emission});
+      TriangleLight light{p0, p1, p2, n, len / 2, rec.radiance, rec.two_sided_emission};
+      if (rec.emission_texture >= 0) {
+        light.emission_texture = {&textures_, rec.emission_texture};
+        if (!rec.uvs.empty()) {
+          light.uv0 = rec.uvs[rec.indices[i]];
+          light.uv1 = rec.uvs[rec.indices[i + 1]];
+          light.uv2 = rec.uvs[rec.indices[i + 2]];
+        }
+      }
+      lights_.push_back(light);
     }
   }
   if (!rec.indices.empty()) {
@@ -522,8 +557,11 @@ TextureEvalContext Scene::texture_context(const SurfaceHit& hit) const {
 RGB Scene::emitted(const SurfaceHit& hit, const Vec3& wo) const {
   const ShapeRecord& rec = shapes_[hit.shape];
   if (!rec.is_emissive()) return RGB(0.0f);
-  if (rec.two_sided_emission || dot(hit.ng, wo) > 0) return rec.radiance;
-  return RGB(0.0f);
+  if (!rec.two_sided_emission && dot(hit.ng, wo) <= 0) return RGB(0.0f);
+  if (rec.emission_texture < 0) return rec.radiance;
+  ColorInput texture;
+  texture.texture = rec.emission_texture;
+  return rec.radiance * textures_.eval(texture, texture_context(hit));
 }
 
 int Scene::light_index(const SurfaceHit& hit) const {

@@ -24,6 +24,7 @@ struct ShapeRecord {
   bool light_per_triangle = true;  // meshes: one light per triangle; rectangles: one light
   RGB radiance;          // emitted radiance when emissive
   bool two_sided_emission = false;
+  int emission_texture = -1;  // textured emitters: index into the scene's textures
   bool flip_normal = false;  // spheres, planes, disks and cylinders: reverse orientation
   bool winding_swapped = false;  // triangles: indices 1 and 2 swapped to orient the normal
   // Triangles, in world space, winding baked so cross(p1-p0, p2-p0) is the oriented normal.
