@@ -100,7 +100,7 @@ const ConformanceCase kCases[] = {
     {"bsdf_spheres", "test_texturedprincipledthin_path", Expect::MissingFile, "museum.exr"},
     {"instancing", "test_instancing_path", Expect::Pass},
     {"mesh_attributes", "test_mesh_attributes_1_face_direct", Expect::Pass},
-    {"mesh_attributes", "test_mesh_attributes_3_face_direct", Expect::Fail},
+    {"mesh_attributes", "test_mesh_attributes_3_face_direct", Expect::Pass},
     {"mesh_attributes", "test_mesh_attributes_3_vertex_direct", Expect::Pass},
     {"orthographic_sensor", "test_orthographic_path", Expect::Pass},
     {"projector", "test_projector_constant_direct", Expect::Pass},

@@ -875,7 +875,7 @@ class JsonSceneReader {
       mix.amount = float_input_or(t, "amount", Bound::UnitInterval, mix.amount);
       texture = mix;
     } else if (type == "mesh_attribute") {
-      texture = MeshAttributeTexture{t.string("name")};
+      texture = MeshAttributeTexture{t.string("name"), t.boolean_or("per_face", false)};
     } else {
       report_.fail(t.pointer_of("type"),
                    "unknown texture type \"{}\"; expected one of: image, checkerboard, scale, mix, mesh_attribute",

@@ -77,7 +77,9 @@ Json texture_json(const TextureDesc& desc) {
           [](const MixTexture& t) {
             return Json{{"type", "mix"}, {"tex1", color(t.tex1)}, {"tex2", color(t.tex2)}, {"amount", number(t.amount)}};
           },
-          [](const MeshAttributeTexture& t) { return Json{{"type", "mesh_attribute"}, {"name", t.name}}; },
+          [](const MeshAttributeTexture& t) {
+            return Json{{"type", "mesh_attribute"}, {"name", t.name}, {"per_face", t.per_face}};
+          },
       },
       desc);
 }

@@ -907,7 +907,10 @@ class Converter {
       std::string name = get_string(t, "name", "");
       MeshAttributeTexture a;
       if (name.starts_with("vertex_")) a.name = name.substr(7);
-      else if (name.starts_with("face_")) a.name = name.substr(5);
+      else if (name.starts_with("face_")) {
+        a.name = name.substr(5);
+        a.per_face = true;
+      }
       else
         throw_scene_error(t.where.loc(), "mesh_attribute: \"name\" must start with vertex_ or face_ (got \"{}\")", name);
       get_float(t, "scale", 1);  // Mitsuba's mesh_attribute has no scale; accepted when 1

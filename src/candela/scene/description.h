@@ -72,10 +72,12 @@ struct MixTexture {
   FloatInput amount{0.5f};
 };
 
-// A value stored on the mesh itself (Mitsuba's mesh_attribute): TriangleMesh::attributes[name],
-// per vertex (interpolated with the hit's barycentrics) or per face. Zero on other shapes.
+// A value stored on the mesh itself (Mitsuba's mesh_attribute): the TriangleMesh::attributes entry
+// of this name and kind, per vertex (interpolated with the hit's barycentrics) or per face (a mesh
+// may have both of one name, as Mitsuba's "vertex_color" and "face_color"). Zero on other shapes.
 struct MeshAttributeTexture {
   std::string name;  // without the "vertex_" / "face_" prefix
+  bool per_face = false;
 };
 
 using TextureDesc = std::variant<ImageTexture, CheckerboardTexture, ScaleTexture, MixTexture, MeshAttributeTexture>;

@@ -18,6 +18,8 @@ TriangleMesh attributed_quad() {
   m.attributes.push_back({"weight", false, 1, {0, 1, 2, 3}});
   m.attributes.push_back({"id", true, 1, {5, 7}});
   m.attributes.push_back({"tint", true, 3, {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f}});
+  // A face attribute with a vertex attribute's name (Mitsuba's face_color beside vertex_color).
+  m.attributes.push_back({"color", true, 3, {0.7f, 0.8f, 0.9f, 0.2f, 0.3f, 0.4f}});
   return m;
 }
 
@@ -40,9 +42,9 @@ Expected expected_at(float x, float y) {
 }
 
 TEST(MeshAttributeTexture, InterpolatesVertexValuesAndReadsFaceValuesAtHits) {
-  std::vector<TextureDesc> descs{MeshAttributeTexture{"color"}, MeshAttributeTexture{"weight"},
-                                 MeshAttributeTexture{"id"}, MeshAttributeTexture{"tint"},
-                                 MeshAttributeTexture{"missing"}};
+  std::vector<TextureDesc> descs{MeshAttributeTexture{"color"},      MeshAttributeTexture{"weight"},
+                                 MeshAttributeTexture{"id", true},  MeshAttributeTexture{"tint", true},
+                                 MeshAttributeTexture{"missing"},   MeshAttributeTexture{"color", true}};
   TextureSet textures(descs);
   auto color = [&](int i, const TextureEvalContext& ctx) {
     ColorInput in;
@@ -77,6 +79,7 @@ TEST(MeshAttributeTexture, InterpolatesVertexValuesAndReadsFaceValuesAtHits) {
         EXPECT_EQ(color(2, ctx).g, e.id) << what;
         EXPECT_EQ(color(3, ctx), e.tint) << what;
         EXPECT_EQ(color(4, ctx), RGB(0.0f)) << what;  // no such attribute
+        EXPECT_EQ(color(5, ctx), x / 2 + y <= 1 ? RGB(0.7f, 0.8f, 0.9f) : RGB(0.2f, 0.3f, 0.4f)) << what;
       }
   }
   // Off meshes (no triangle in the context) an attribute is zero.

@@ -102,10 +102,10 @@ void for_each_reference(const TextureDesc& desc, F&& f) {
 // A mesh attribute at the hit (Mitsuba's mesh_attribute): per vertex, interpolated with the
 // barycentrics; per face, the triangle's value. One channel reads as grey. Zero off meshes and
 // where the mesh has no attribute of that name.
-RGB eval_mesh_attribute(const std::string& name, const MeshAttributeContext& m) {
+RGB eval_mesh_attribute(const MeshAttributeTexture& t, const MeshAttributeContext& m) {
   if (!m.attributes) return RGB(0.0f);
   for (const TriangleMesh::Attribute& a : *m.attributes) {
-    if (a.name != name) continue;
+    if (a.name != t.name || a.per_face != t.per_face) continue;
     const size_t c = size_t(a.channels == 3 ? 3 : 1);
     auto value = [&](size_t element) {
       size_t i = element * c;
@@ -183,7 +183,7 @@ RGB TextureSet::eval_texture(int index, const TextureEvalContext& ctx) const {
     return eval(even ? t->tex1 : t->tex2, ctx);
   }
   if (const auto* t = std::get_if<ScaleTexture>(&texture)) return eval(t->tex, ctx) * eval(t->scale, ctx);
-  if (const auto* t = std::get_if<MeshAttributeTexture>(&texture)) return eval_mesh_attribute(t->name, ctx.mesh);
+  if (const auto* t = std::get_if<MeshAttributeTexture>(&texture)) return eval_mesh_attribute(*t, ctx.mesh);
   const auto& t = std::get<MixTexture>(texture);
   float amount = eval(t.amount, ctx);
   // A side with weight zero is not evaluated (as in pbrt-v4): cheaper, and an infinite value there
