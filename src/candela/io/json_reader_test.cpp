@@ -657,8 +657,9 @@ TEST(JsonReader, BadStrategiesAndAdaptiveSettingsAreErrors) {
   expect_error_containing(R"({"render": {"direction_sampling": "cos"}})",
                           "at /render/direction_sampling: unknown direction sampling \"cos\"; expected one of: bsdf, "
                           "cosine, uniform");
-  expect_error_containing(R"({"render": {"light_selection": "uniform"}})",
-                          "unknown light selection \"uniform\"; expected one of: power, paper");
+  expect_error_containing(R"({"render": {"light_selection": "random"}})",
+                          "unknown light selection \"random\"; expected one of: power, paper, uniform");
+  EXPECT_EQ(read(R"({"render": {"light_selection": "uniform"}})").settings.light_selection, LightSelection::Uniform);
   expect_error_containing(R"({"render": {"mis": "yes"}})", "at /render/mis: expected true or false");
   expect_error_containing(R"({"render": {"shadow_rays": 0}})", "at /render/shadow_rays: expected an integer >= 1");
   expect_error_containing(R"({"render": {"adaptive": {}}})",
