@@ -29,6 +29,7 @@
 // Dispatch is static: a plain material (one two-sided component, no null part, no tilt) takes one
 // branch and then the usual single std::visit.
 #include <array>
+#include <type_traits>
 #include <optional>
 
 #include "candela/materials/bsdf.h"
@@ -42,7 +43,24 @@ struct SurfaceBsdf {
     float weight = 1;
     bool one_sided = false;
   };
-  std::array<Component, kMaxComponents> components;
+  // Storage for the components: only the first `count` are ever constructed, read or copied, so a
+  // plain BSDF (one component) costs one BSDF to build and to copy, not kMaxComponents.
+  class Components {
+   public:
+    Components() {}  // NOLINT: deliberately leaves the slots unconstructed
+    Component& operator[](size_t k) { return slots_[k].component; }
+    const Component& operator[](size_t k) const { return slots_[k].component; }
+
+   private:
+    union Slot {
+      Slot() {}  // NOLINT: unconstructed until written
+      Component component;
+    };
+    Slot slots_[kMaxComponents];
+  };
+  static_assert(std::is_trivially_copyable_v<Component> && std::is_trivially_destructible_v<Component>,
+                "components are written into raw slots and copied by assignment");
+  Components components;
   int count = 0;
   float null_weight = 0;
   // Normal or bump mapped: the original shading normal in the (tilted) local frame.
@@ -50,7 +68,16 @@ struct SurfaceBsdf {
   Vec3 original_normal{0, 0, 1};
 
   SurfaceBsdf() = default;
-  SurfaceBsdf(const Bsdf& b) : count(1) { components[0].bsdf = b; }  // NOLINT: a plain BSDF converts implicitly
+  SurfaceBsdf(const Bsdf& b) : count(1) { components[0] = {b, 1, false}; }  // NOLINT: a plain BSDF converts implicitly
+  SurfaceBsdf(const SurfaceBsdf& o) { *this = o; }
+  SurfaceBsdf& operator=(const SurfaceBsdf& o) {
+    count = o.count;
+    null_weight = o.null_weight;
+    check_side = o.check_side;
+    original_normal = o.original_normal;
+    for (int k = 0; k < count; ++k) components[size_t(k)] = o.components[size_t(k)];
+    return *this;
+  }
 
   // Appends a component (the caller keeps count <= kMaxComponents).
   void add(const Bsdf& b, float weight, bool one_sided) {
