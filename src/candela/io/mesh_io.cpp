@@ -8,6 +8,7 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cerrno>
 #include <charconv>
@@ -404,9 +405,10 @@ void check_ply_header_complete(const PlyHeader& header) {
     // Assimp would read vertices without coordinates as all zero.
     if (element.name == "vertex" && !(element.has_scalar("x") && element.has_scalar("y") && element.has_scalar("z")))
       fail("malformed PLY: the 'vertex' element lacks an x, y or z property");
-    // Assimp 5.2 turns a strip into the wrong triangles.
-    if (element.name == "tristrips" && element.count > 0)
-      fail("unsupported PLY: triangle strips (a 'tristrips' element) are not supported; use a 'face' element");
+    // Assimp 5.2 turns a strip into the wrong triangles: strips become faces first (strips_as_faces).
+    if (element.name == "tristrips" && element.count > 0 &&
+        !(element.properties.size() == 1 && element.properties[0].list_length && element.properties[0].value.is_integer))
+      fail("unsupported PLY: a 'tristrips' element must hold one list of vertex indices");
   }
   // Without a vertex element Assimp guesses which element holds the vertices and misreads the data.
   if (std::none_of(header.elements.begin(), header.elements.end(),
@@ -633,12 +635,143 @@ void append_assimp_mesh(const aiMesh& source, bool with_normals, bool with_uvs, 
   }
 }
 
-TriangleMesh load_ply(const std::string& bytes) {
-  const PlyHeader header = read_ply_header(bytes);
+// ---- triangle strips (e.g. the Igea scan): rewritten as a 'face' element before Assimp reads the file
+
+// A binary scalar at `at` as a signed 64-bit integer.
+int64_t read_binary_integer(std::string_view data, uint64_t at, PlyScalarType type, bool big_endian) {
+  uint64_t bits = 0;
+  for (unsigned k = 0; k < type.size; ++k)
+    bits = bits << 8 | static_cast<uint8_t>(data[at + (big_endian ? k : type.size - 1u - k)]);
+  if (type.is_signed && type.size < 8 && (bits >> (8 * type.size - 1)) != 0) bits |= ~uint64_t(0) << (8 * type.size);
+  return int64_t(bits);
+}
+
+// The triangles of strips given as one index list with -1 ending each strip: (a, b, c), (c, b, d),
+// (c, d, e), ... every other triangle reversed so that all keep the strip's orientation; triangles
+// with a repeated vertex (the joints of strips stitched by repetition) are dropped.
+void append_strip_triangles(const std::vector<int64_t>& list, std::vector<std::array<int64_t, 3>>& out) {
+  size_t start = 0;
+  for (size_t i = 0; i <= list.size(); ++i) {
+    if (i < list.size() && list[i] >= 0) continue;
+    for (size_t k = start; k + 2 < i; ++k) {
+      std::array<int64_t, 3> t = (k - start) % 2 == 0 ? std::array<int64_t, 3>{list[k], list[k + 1], list[k + 2]}
+                                                      : std::array<int64_t, 3>{list[k + 1], list[k], list[k + 2]};
+      if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) out.push_back(t);
+    }
+    start = i + 1;
+  }
+}
+
+// The same PLY with every 'tristrips' element replaced by a 'face' element of its triangles (the file
+// has been checked to hold all its data).
+std::string strips_as_faces(const std::string& bytes, const PlyHeader& header) {
   const std::string_view data = std::string_view(bytes).substr(header.data_offset);
-  check_ply_counts_fit_data(header, data);
-  if (header.encoding == PlyEncoding::Ascii) check_ascii_ply_data(header, data);
-  else check_binary_ply_data(header, data);
+  const bool ascii = header.encoding == PlyEncoding::Ascii, big_endian = header.encoding == PlyEncoding::BinaryBigEndian;
+  // Each element's data: its bytes (copied as they are), or the triangles of its strips.
+  struct Part {
+    std::string_view raw;
+    bool strips = false;
+    std::vector<std::array<int64_t, 3>> triangles;
+  };
+  std::vector<Part> parts;
+  uint64_t at = 0;
+  for (const PlyElement& element : header.elements) {
+    Part part;
+    part.strips = element.name == "tristrips" && element.count > 0;
+    const uint64_t begin = at;
+    std::vector<int64_t> list;
+    for (uint64_t i = 0; i < element.count; ++i) {
+      if (ascii) {
+        size_t end = at;
+        do {  // the next line that holds anything
+          at = end;
+          end = std::min(data.find('\n', at), data.size());
+          if (data.substr(at, end - at).find_first_not_of(" \t\r") != std::string_view::npos) break;
+          end += 1;
+        } while (end <= data.size());
+        if (part.strips) {
+          const std::vector<std::string_view> words = split_words(data.substr(at, end - at));
+          for (size_t w = 1; w < words.size(); ++w) {
+            int64_t v = 0;
+            std::from_chars(words[w].data(), words[w].data() + words[w].size(), v);
+            list.push_back(v);
+          }
+          list.push_back(-1);
+        }
+        at = end + 1;
+        continue;
+      }
+      for (const PlyProperty& property : element.properties) {
+        if (!property.list_length) {
+          at += property.value.size;
+          continue;
+        }
+        const uint64_t length = read_binary_list_length(data, at, *property.list_length, big_endian);
+        at += property.list_length->size;
+        for (uint64_t k = 0; k < length; ++k, at += property.value.size)
+          if (part.strips) list.push_back(read_binary_integer(data, at, property.value, big_endian));
+        if (part.strips) list.push_back(-1);
+      }
+    }
+    if (part.strips) append_strip_triangles(list, part.triangles);
+    else part.raw = data.substr(std::min<uint64_t>(begin, data.size()), std::min<uint64_t>(at, data.size()) - std::min<uint64_t>(begin, data.size()));
+    parts.push_back(std::move(part));
+  }
+  // The header, with each strips element and its property lines replaced.
+  std::string out;
+  const std::string_view head = std::string_view(bytes).substr(0, header.data_offset);
+  size_t element_index = 0, line_at = 0;
+  bool skipping = false;
+  while (line_at < head.size()) {
+    const size_t end = std::min(head.find('\n', line_at), head.size());
+    const std::string_view line = head.substr(line_at, std::min(end + 1, head.size()) - line_at);
+    line_at = end + 1;
+    const std::vector<std::string_view> words = split_words(line);
+    if (!words.empty() && words[0] == "element") {
+      const Part& part = parts[element_index++];
+      skipping = part.strips;
+      if (skipping) {
+        out += fmt::format("element face {}\nproperty list uchar int vertex_indices\n", part.triangles.size());
+        continue;
+      }
+    } else if (!words.empty() && words[0] != "property") {
+      skipping = false;
+    }
+    if (!skipping) out += line;
+  }
+  for (const Part& part : parts) {
+    if (!part.strips) {
+      out += part.raw;
+      continue;
+    }
+    for (const auto& t : part.triangles) {
+      if (ascii) {
+        out += fmt::format("3 {} {} {}\n", t[0], t[1], t[2]);
+        continue;
+      }
+      out += char(3);
+      for (int64_t v : t) {
+        const uint32_t u = uint32_t(int32_t(v));
+        for (int k = 0; k < 4; ++k) out += char(big_endian ? (u >> (8 * (3 - k))) & 0xff : (u >> (8 * k)) & 0xff);
+      }
+    }
+  }
+  return out;
+}
+
+TriangleMesh load_ply(const std::string& original) {
+  const PlyHeader original_header = read_ply_header(original);
+  {
+    const std::string_view data = std::string_view(original).substr(original_header.data_offset);
+    check_ply_counts_fit_data(original_header, data);
+    if (original_header.encoding == PlyEncoding::Ascii) check_ascii_ply_data(original_header, data);
+    else check_binary_ply_data(original_header, data);
+  }
+  const bool has_strips = std::any_of(original_header.elements.begin(), original_header.elements.end(),
+                                      [](const PlyElement& e) { return e.name == "tristrips" && e.count > 0; });
+  const std::string rewritten = has_strips ? strips_as_faces(original, original_header) : std::string();
+  const std::string& bytes = has_strips ? rewritten : original;
+  const PlyHeader header = has_strips ? read_ply_header(bytes) : original_header;
 
   Assimp::Importer importer;
   if (!importer.ReadFileFromMemory(bytes.data(), bytes.size(), 0, "ply"))
