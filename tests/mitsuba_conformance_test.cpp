@@ -77,7 +77,9 @@ TEST_P(MitsubaConformance, PassesMitsubasRenderTest) {
               "with |var| %.5f)\n",
               c.scene, r.passed() ? "pass" : "FAIL", r.passing_fraction, r.pixel_channels, desc.settings.spp, r.alpha,
               100.0 * negative / double(variance.rgb.size()), abs_var.passing_fraction);
-  if (c.expect == Expect::Pass) EXPECT_TRUE(r.passed()) << c.scene << ": " << r.passing_fraction << " pass";
+  if (c.expect == Expect::Pass) {
+    EXPECT_TRUE(r.passed()) << c.scene << ": " << r.passing_fraction << " pass";
+  }
 }
 
 // The 26 scenes. Expectations are what this checkout achieves; docs/conformance.md explains each Fail.
