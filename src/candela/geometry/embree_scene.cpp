@@ -400,17 +400,26 @@ bool EmbreeScene::occluded(const Ray& r) const {
   return ray.tfar < 0;
 }
 
+namespace {
+
+// A user geometry's box for Embree, padded by a relative epsilon: the box is in float and the
+// intersection in double.
+void write_padded_bounds(const Bounds3& b, RTCBounds& out) {
+  Vec3 pad = Vec3(1e-5f) * (1.0f + max_component(max(b.hi, -b.lo)));
+  out.lower_x = b.lo.x - pad.x;
+  out.lower_y = b.lo.y - pad.y;
+  out.lower_z = b.lo.z - pad.z;
+  out.upper_x = b.hi.x + pad.x;
+  out.upper_y = b.hi.y + pad.y;
+  out.upper_z = b.hi.z + pad.z;
+}
+
+}  // namespace
+
 void EmbreeScene::sphere_bounds(const RTCBoundsFunctionArguments* args) {
   const auto& s = *static_cast<const SphereGeometry*>(args->geometryUserPtr);
   Bounds3 b = sphere_world_bounds(s, args->timeStep == 0 ? s.to_world : *s.to_world_end);
-  // Pad by a relative epsilon: the box is in float and the intersection in double.
-  Vec3 pad = Vec3(1e-5f) * (1.0f + max_component(max(b.hi, -b.lo)));
-  args->bounds_o->lower_x = b.lo.x - pad.x;
-  args->bounds_o->lower_y = b.lo.y - pad.y;
-  args->bounds_o->lower_z = b.lo.z - pad.z;
-  args->bounds_o->upper_x = b.hi.x + pad.x;
-  args->bounds_o->upper_y = b.hi.y + pad.y;
-  args->bounds_o->upper_z = b.hi.z + pad.z;
+  write_padded_bounds(b, *args->bounds_o);
 }
 
 void EmbreeScene::sphere_intersect(const RTCIntersectFunctionNArguments* args) {
@@ -432,13 +441,7 @@ void EmbreeScene::moving_sphere_occluded(const RTCOccludedFunctionNArguments* ar
 void EmbreeScene::quadric_bounds(const RTCBoundsFunctionArguments* args) {
   const auto& q = *static_cast<const QuadricGeometry*>(args->geometryUserPtr);
   Bounds3 b = quadric_world_bounds(q, args->timeStep == 0 ? q.to_world : *q.to_world_end);
-  Vec3 pad = Vec3(1e-5f) * (1.0f + max_component(max(b.hi, -b.lo)));
-  args->bounds_o->lower_x = b.lo.x - pad.x;
-  args->bounds_o->lower_y = b.lo.y - pad.y;
-  args->bounds_o->lower_z = b.lo.z - pad.z;
-  args->bounds_o->upper_x = b.hi.x + pad.x;
-  args->bounds_o->upper_y = b.hi.y + pad.y;
-  args->bounds_o->upper_z = b.hi.z + pad.z;
+  write_padded_bounds(b, *args->bounds_o);
 }
 
 void EmbreeScene::quadric_intersect(const RTCIntersectFunctionNArguments* args) {

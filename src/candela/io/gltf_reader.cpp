@@ -1226,13 +1226,7 @@ class GltfReader {
     // No camera: frame the bounding box from +z (glTF's front), looking down -z.
     Bounds3 b = bounds_;
     if (b.empty()) b.extend(Point3(0.0f));
-    const Point3 center = b.center();
-    const float radius = std::max(0.5f * length(b.diagonal()), 1e-3f);
-    const float fov = 40;
-    const float distance = radius / std::sin(0.5f * fov * kPi / 180) * 1.05f;
-    cam.world_from_camera = Transform::look_at_right_handed(center + Vec3(0, 0, distance), center, {0, 1, 0});
-    cam.fov_degrees = fov;
-    cam.fov_axis = FovAxis::Smaller;
+    cam = camera_framing(b.lo, b.hi, 40, 1.05f);
     scene_.film.width = options_.film_width;
     scene_.film.height = std::max(1, options_.film_width * 3 / 4);
   }

@@ -168,8 +168,11 @@ TEST_P(GltfSampleModel, Loads) {
   EXPECT_GT(scene.film.width, 0);
   EXPECT_GT(scene.film.height, 0);
   // What the renderer will check: every texture file exists, references are in range.
-  for (const TextureDesc& t : scene.textures)
-    if (const auto* image = std::get_if<ImageTexture>(&t)) EXPECT_TRUE(fs::exists(image->filename)) << image->filename;
+  for (const TextureDesc& t : scene.textures) {
+    if (const auto* image = std::get_if<ImageTexture>(&t)) {
+      EXPECT_TRUE(fs::exists(image->filename)) << image->filename;
+    }
+  }
   for (const ShapeDesc& shape : scene.shapes) {
     EXPECT_LT(shape.material, int(scene.materials.size()));
     const TriangleMesh& m = mesh_of(shape);

@@ -11,7 +11,6 @@
 #include <stdexcept>
 #include <system_error>
 
-#include "candela/io/error.h"
 
 namespace candela {
 namespace {
@@ -25,10 +24,6 @@ struct Overloaded : Ts... {
 };
 template <class... Ts>
 Overloaded(Ts...) -> Overloaded<Ts...>;
-
-[[noreturn]] void cannot_express(const std::string& what) {
-  throw SceneError(fmt::format("convert: the JSON format cannot express {}", what));
-}
 
 Json vec3(const Vec3& v) { return Json::array({v.x, v.y, v.z}); }
 Json rgb(const RGB& c) { return Json::array({c.r, c.g, c.b}); }

@@ -12,7 +12,7 @@
 namespace candela {
 
 // The JSON text of `scene`. File names (images, environment maps) are written as absolute paths, so
-// the file can be moved. Throws SceneError for what the JSON format cannot express.
+// the file can be moved. Every SceneDesc can be expressed.
 std::string scene_to_json(const SceneDesc& scene);
 
 // scene_to_json written to `file` atomically (a temporary file renamed over it): an existing file is

@@ -87,22 +87,6 @@ MaterialDesc material_of(const ObjMaterial& m, SceneDesc& scene, std::vector<std
 
 }  // namespace
 
-CameraDesc camera_framing(const Point3& lo, const Point3& hi, float fov_degrees, int width, int height) {
-  const Point3 center = (lo + hi) * 0.5f;
-  const float radius = std::max(1e-3f, 0.5f * length(hi - lo));
-  // The bounding sphere fits the smaller field of view.
-  const float vertical = fov_degrees * 3.14159265f / 180;
-  const float aspect = float(width) / float(height);
-  const float smaller = aspect >= 1 ? vertical : 2 * std::atan(std::tan(vertical / 2) * aspect);
-  const float distance = radius / std::sin(smaller / 2);
-  CameraDesc camera;
-  camera.fov_degrees = fov_degrees;
-  camera.fov_axis = FovAxis::Y;
-  camera.world_from_camera =
-      Transform::look_at_right_handed(center + Vec3(0, 0, distance), center, Vec3(0, 1, 0));
-  return camera;
-}
-
 SceneDesc read_obj_scene(const std::filesystem::path& file) {
   const SourceLocation where{file.string(), 0, 0, {}};
   ObjModel model = load_obj_model(file, where);
@@ -135,7 +119,7 @@ SceneDesc read_obj_scene(const std::filesystem::path& file) {
     shape.geometry = MeshShape{std::move(part.mesh)};
     scene.shapes.push_back(std::move(shape));
   }
-  scene.camera = camera_framing(lo, hi, scene.camera.fov_degrees, scene.film.width, scene.film.height);
+  scene.camera = camera_framing(lo, hi);
   // Without emitters the model would be black: a white sky lights it (and is what the user sees
   // around it).
   if (!any_emitter) scene.lights.push_back(SkyLight{});

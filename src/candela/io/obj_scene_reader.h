@@ -11,8 +11,4 @@ namespace candela {
 // material parameters that cannot be represented) are printed to stderr, as the other readers do.
 SceneDesc read_obj_scene(const std::filesystem::path& file);
 
-// A perspective camera looking at the box from its +z side (up +y, vertical field of view
-// `fov_degrees`), far enough back that the box's bounding sphere fits the smaller image axis.
-CameraDesc camera_framing(const Point3& lo, const Point3& hi, float fov_degrees, int width, int height);
-
 }  // namespace candela

@@ -3,6 +3,7 @@
 // later Mitsuba and glTF) fills in and that scene/build turns into a render scene. Nothing after this
 // point knows which file format a scene came from. Units are whatever the scene uses; colours are linear RGB.
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -432,6 +433,20 @@ struct CameraDesc {
   // Each camera path gets a time uniformly in [shutter_open, shutter_close] (motion blur).
   float shutter_open = 0, shutter_close = 1;
 };
+
+// For models that bring no camera (OBJ, glTF): a perspective camera looking along -z at the box
+// [lo, hi] from its +z side, up +y, `fov_degrees` across the smaller image axis, far enough back that
+// the box's bounding sphere fits, times `margin`.
+inline CameraDesc camera_framing(const Point3& lo, const Point3& hi, float fov_degrees = 40, float margin = 1) {
+  const Point3 center = (lo + hi) * 0.5f;
+  const float radius = std::max(0.5f * length(hi - lo), 1e-3f);
+  const float distance = radius / std::sin(0.5f * fov_degrees * 3.14159265f / 180) * margin;
+  CameraDesc camera;
+  camera.world_from_camera = Transform::look_at_right_handed(center + Vec3(0, 0, distance), center, {0, 1, 0});
+  camera.fov_degrees = fov_degrees;
+  camera.fov_axis = FovAxis::Smaller;
+  return camera;
+}
 
 struct FilmDesc {
   int width = 512;
