@@ -42,6 +42,38 @@ def run(cmd, pattern):
     return float(m.group(1))
 
 
+def compare(build, repeat, spp, threads, candela_args):
+    """Runs candela and Cycles alternately `repeat` times and prints the Markdown table."""
+    candela = os.path.join(build, "candela")
+    pixels = 512 * 512
+    times = {"candela": [], "cycles": []}
+    errors = {"candela": [], "cycles": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        for i in range(repeat):
+            out = os.path.join(tmp, "candela.exr")
+            t = run([candela, "render", os.path.join(ROOT, "scenes/cornell-box.json"), "--spp", str(spp),
+                     "--max-depth", "16", "--resolution", "512x512", "--threads", str(threads), "--seed", str(i + 1),
+                     "-q", "-o", out] + shlex.split(candela_args), r"in ([\d.]+) s:")
+            times["candela"].append(t)
+            errors["candela"].append(rel_mse(out))
+            out = os.path.join(tmp, "cycles.exr")
+            t = run(["blender", "-b", "--factory-startup", "--python", os.path.join(ROOT, "bench/cycles/cornell_box.py"),
+                     "--", "--spp", str(spp), "--threads", str(threads), "--seed", str(i + 1), "--resolution", "512",
+                     "--out", out], r"cycles render seconds: ([\d.]+)")
+            times["cycles"].append(t)
+            errors["cycles"].append(rel_mse(out))
+            print(f"run {i + 1}: candela {times['candela'][-1]:.2f} s, cycles {times['cycles'][-1]:.2f} s", file=sys.stderr)
+    print(f"Cornell box 512 x 512, {spp} spp, max depth 16, {threads} threads, {repeat} alternating runs"
+          f"{' (candela ' + candela_args + ')' if candela_args else ''}\n")
+    print("| renderer | median time s | Msamples/s | relMSE (median) |")
+    print("|---|---|---|---|")
+    for name in ["candela", "cycles"]:
+        t = statistics.median(times[name])
+        print(f"| {name} | {t:.2f} | {pixels * spp / t * 1e-6:.2f} | {statistics.median(errors[name]):.5f} |")
+    ratios = [c / y for c, y in zip(times["candela"], times["cycles"])]
+    print(f"\ncandela / cycles time: median {statistics.median(ratios):.3f} (runs: {', '.join(f'{r:.3f}' for r in ratios)})\n")
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--build", default=os.path.join(ROOT, "build"))
@@ -50,34 +82,7 @@ def main():
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--candela-args", default="", help="extra arguments for candela render")
     a = p.parse_args()
-    candela = os.path.join(a.build, "candela")
-    pixels = 512 * 512
-    times = {"candela": [], "cycles": []}
-    errors = {"candela": [], "cycles": []}
-    with tempfile.TemporaryDirectory() as tmp:
-        for i in range(a.repeat):
-            out = os.path.join(tmp, "candela.exr")
-            t = run([candela, "render", os.path.join(ROOT, "scenes/cornell-box.json"), "--spp", str(a.spp),
-                     "--max-depth", "16", "--resolution", "512x512", "--threads", str(a.threads), "--seed", str(i + 1),
-                     "-q", "-o", out] + shlex.split(a.candela_args), r"in ([\d.]+) s:")
-            times["candela"].append(t)
-            errors["candela"].append(rel_mse(out))
-            out = os.path.join(tmp, "cycles.exr")
-            t = run(["blender", "-b", "--factory-startup", "--python", os.path.join(ROOT, "bench/cycles/cornell_box.py"),
-                     "--", "--spp", str(a.spp), "--threads", str(a.threads), "--seed", str(i + 1), "--resolution", "512",
-                     "--out", out], r"cycles render seconds: ([\d.]+)")
-            times["cycles"].append(t)
-            errors["cycles"].append(rel_mse(out))
-            print(f"run {i + 1}: candela {times['candela'][-1]:.2f} s, cycles {times['cycles'][-1]:.2f} s", file=sys.stderr)
-    print(f"\nCornell box 512 x 512, {a.spp} spp, max depth 16, {a.threads} threads, {a.repeat} alternating runs"
-          f"{' (candela ' + a.candela_args + ')' if a.candela_args else ''}\n")
-    print("| renderer | median time s | Msamples/s | relMSE (median) |")
-    print("|---|---|---|---|")
-    for name in ["candela", "cycles"]:
-        t = statistics.median(times[name])
-        print(f"| {name} | {t:.2f} | {pixels * a.spp / t * 1e-6:.2f} | {statistics.median(errors[name]):.5f} |")
-    ratios = [c / y for c, y in zip(times["candela"], times["cycles"])]
-    print(f"\ncandela / cycles time: median {statistics.median(ratios):.3f} (runs: {', '.join(f'{r:.3f}' for r in ratios)})")
+    compare(a.build, a.repeat, a.spp, a.threads, a.candela_args)
 
 
 if __name__ == "__main__":

@@ -69,7 +69,7 @@ struct RenderCommand {
   std::optional<uint64_t> seed;
   std::string resolution;
   std::string integrator;
-  std::string sampler, filter, direction_sampling, light_selection, spp_map;
+  std::string sampler, filter, direction_sampling, light_selection, spp_map, bvh;
   std::optional<int> shadow_rays, max_spp, adaptive_batch, adaptive_spp;
   std::optional<float> adaptive_threshold;
   bool no_mis = false;
@@ -117,6 +117,8 @@ void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
         "--direction-sampling", cmd.direction_sampling,
         {{"bsdf", DirectionSampling::Bsdf}, {"cosine", DirectionSampling::Cosine},
          {"uniform", DirectionSampling::Uniform}});
+  if (!cmd.bvh.empty())
+    rs.bvh = parse_choice<BvhLayout>("--bvh", cmd.bvh, {{"fast", BvhLayout::Fast}, {"compact", BvhLayout::Compact}});
   if (!cmd.light_selection.empty())
     rs.light_selection = parse_choice<LightSelection>("--light-selection", cmd.light_selection,
                                                       {{"power", LightSelection::Power},
@@ -308,7 +310,8 @@ int run_render(const RenderCommand& cmd) {
                                    resumed->width, resumed->height, desc.film.width, desc.film.height));
   }
 
-  Scene scene(desc);
+  // The meshes move into the scene: every triangle is held once.
+  Scene scene(desc, Scene::MeshData::Take);
   Film film(desc.film.width, desc.film.height);
   uint64_t earlier_non_finite = 0;
   if (resumed) {
@@ -522,6 +525,9 @@ int main(int argc, char** argv) {
                          "How shadow rays pick lights: power (each ray one light, chosen by power), uniform "
                          "(each ray one emitter, all equally likely, as Mitsuba), paper (every light a share "
                          "proportional to power x projected solid angle)");
+  render_cmd->add_option("--bvh", cmd.bvh,
+                         "Acceleration structure: fast (the default) or compact (about half the memory per "
+                         "triangle, traversal about a third slower)");
   render_cmd->add_option("--shadow-rays", cmd.shadow_rays, "Shadow rays per path vertex")->check(CLI::Range(1, 1024));
   render_cmd->add_option("--adaptive-threshold", cmd.adaptive_threshold,
                          "Adaptive sampling: keep adding batches to pixels whose relative standard error "

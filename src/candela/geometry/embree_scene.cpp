@@ -239,15 +239,17 @@ std::optional<Transform> interpolate_transform(const Transform& start, const Tra
   return Transform::from_matrix(m);
 }
 
-EmbreeScene::EmbreeScene(float transform_start_time, float transform_end_time)
+EmbreeScene::EmbreeScene(float transform_start_time, float transform_end_time, bool compact)
     : time_start_(transform_start_time),
       // A zero-length interval leaves every shape at its start transform.
-      time_scale_(transform_end_time > transform_start_time ? 1 / (transform_end_time - transform_start_time) : 0) {
+      time_scale_(transform_end_time > transform_start_time ? 1 / (transform_end_time - transform_start_time) : 0),
+      compact_(compact) {
   device_ = rtcNewDevice(nullptr);
   if (!device_) throw std::runtime_error("cannot create an Embree device");
   rtcSetDeviceErrorFunction(device_, report_embree_error, nullptr);
   scene_ = rtcNewScene(device_);
   rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+  if (compact_) rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_COMPACT);
 }
 
 EmbreeScene::~EmbreeScene() {
@@ -268,13 +270,7 @@ void set_vertex_buffer(RTCGeometry geom, unsigned slot, const std::vector<Point3
 
 }  // namespace
 
-RTCGeometry EmbreeScene::new_triangle_geometry(const std::vector<uint32_t>& indices) {
-  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* tris = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                              3 * sizeof(uint32_t), indices.size() / 3));
-  std::copy(indices.begin(), indices.end(), tris);
-  return geom;
-}
+RTCGeometry EmbreeScene::new_triangle_geometry() { return rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE); }
 
 void EmbreeScene::attach(RTCGeometry geom, uint32_t id, int object) {
   rtcCommitGeometry(geom);
@@ -282,16 +278,22 @@ void EmbreeScene::attach(RTCGeometry geom, uint32_t id, int object) {
   rtcReleaseGeometry(geom);
 }
 
-void EmbreeScene::add_triangles(uint32_t id, const std::vector<Point3>& positions, const std::vector<uint32_t>& indices,
-                                int object) {
-  RTCGeometry geom = new_triangle_geometry(indices);
-  set_vertex_buffer(geom, 0, positions);
+void EmbreeScene::add_shared_triangles(uint32_t id, const std::vector<Point3>& positions,
+                                       const std::vector<uint32_t>& indices, int object) {
+  if (positions.capacity() <= positions.size())
+    throw std::logic_error("EmbreeScene::add_shared_triangles: the positions need one spare element of capacity");
+  RTCGeometry geom = new_triangle_geometry();
+  rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, indices.data(), 0,
+                             3 * sizeof(uint32_t), indices.size() / 3);
+  rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, positions.data(), 0, sizeof(Point3),
+                             positions.size());
   attach(geom, id, object);
 }
 
 int EmbreeScene::add_object() {
   RTCScene object = rtcNewScene(device_);
   rtcSetSceneBuildQuality(object, RTC_BUILD_QUALITY_HIGH);
+  if (compact_) rtcSetSceneFlags(object, RTC_SCENE_FLAG_COMPACT);
   objects_.push_back(object);
   return int(objects_.size() - 1);
 }
@@ -318,7 +320,10 @@ void EmbreeScene::add_instance(uint32_t id, int object, const Transform& to_worl
 
 void EmbreeScene::add_moving_triangles(uint32_t id, const std::vector<Point3>& positions,
                                        const std::vector<Point3>& positions_end, const std::vector<uint32_t>& indices) {
-  RTCGeometry geom = new_triangle_geometry(indices);
+  RTCGeometry geom = new_triangle_geometry();
+  auto* tris = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                              3 * sizeof(uint32_t), indices.size() / 3));
+  std::copy(indices.begin(), indices.end(), tris);
   rtcSetGeometryTimeStepCount(geom, 2);
   set_vertex_buffer(geom, 0, positions);
   set_vertex_buffer(geom, 1, positions_end);
@@ -381,6 +386,7 @@ bool EmbreeScene::intersect(const Ray& r, EmbreeHit& hit) const {
   rayhit.ray = make_rtc_ray(r, normalized_time(r.time));
   rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  if (ray_log_) [[unlikely]] ray_log_->add(rayhit.ray, false);
   rtcIntersect1(scene_, &context, &rayhit);
   if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit = {rayhit.ray.tfar, rayhit.hit.geomID, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v, -1};
@@ -396,6 +402,7 @@ bool EmbreeScene::occluded(const Ray& r) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRay ray = make_rtc_ray(r, normalized_time(r.time));
+  if (ray_log_) [[unlikely]] ray_log_->add(ray, true);
   rtcOccluded1(scene_, &context, &ray);
   return ray.tfar < 0;
 }

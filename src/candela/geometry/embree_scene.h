@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "candela/geometry/ray.h"
+#include "candela/geometry/ray_log.h"
 #include "candela/math/transform.h"
 
 namespace candela {
@@ -63,17 +64,23 @@ class EmbreeScene {
  public:
   // Ray::time is absolute: shapes move between transform_start_time (Embree time 0) and
   // transform_end_time (Embree time 1), and stand still outside.
-  explicit EmbreeScene(float transform_start_time = 0, float transform_end_time = 1);
+  // `compact`: Embree's compact layout (leaves index the shared vertices instead of copying them).
+  explicit EmbreeScene(float transform_start_time = 0, float transform_end_time = 1, bool compact = false);
   ~EmbreeScene();
   EmbreeScene(const EmbreeScene&) = delete;
   EmbreeScene& operator=(const EmbreeScene&) = delete;
 
   // Each attaches a geometry under the caller's id, reported back in hits; ids are unique across
-  // the world and all objects. Vertex and index data are copied into Embree. `object` is the object
-  // (from add_object) the geometry belongs to, or -1 for the world.
-  void add_triangles(uint32_t id, const std::vector<Point3>& positions, const std::vector<uint32_t>& indices,
-                     int object = -1);
-  // Triangles whose vertices move linearly from `positions` at time 0 to `positions_end` at time 1.
+  // the world and all objects. `object` is the object (from add_object) the geometry belongs to, or
+  // -1 for the world.
+  //
+  // Triangles that Embree reads in place, without a copy: both arrays must outlive this scene
+  // unchanged and unmoved (their buffers, that is; the vectors themselves may be moved), and
+  // `positions` must have capacity for one more element (Embree reads vertices with 16-byte loads).
+  void add_shared_triangles(uint32_t id, const std::vector<Point3>& positions, const std::vector<uint32_t>& indices,
+                            int object = -1);
+  // Triangles whose vertices move linearly from `positions` at time 0 to `positions_end` at time 1
+  // (copied into Embree).
   void add_moving_triangles(uint32_t id, const std::vector<Point3>& positions, const std::vector<Point3>& positions_end,
                             const std::vector<uint32_t>& indices);
   void add_sphere(uint32_t id, const SphereGeometry& sphere, int object = -1);  // moving when sphere.to_world_end is set
@@ -91,6 +98,11 @@ class EmbreeScene {
   bool occluded(const Ray& ray) const;  // any hit in (0, ray.t_max)
   // Embree's time in [0,1] for an absolute ray time: where between the two transforms shapes are.
   float normalized_time(float time) const;
+
+  // Records every ray traced from now on into `log` (null: stop recording); for benchmarks.
+  void set_ray_log(RayLog* log) { ray_log_ = log; }
+  // The committed Embree scene, for benchmarks that call Embree directly.
+  RTCScene handle() const { return scene_; }
 
  private:
   static void sphere_bounds(const RTCBoundsFunctionArguments* args);
@@ -110,13 +122,15 @@ class EmbreeScene {
     float extent;
   };
 
-  RTCGeometry new_triangle_geometry(const std::vector<uint32_t>& indices);
+  RTCGeometry new_triangle_geometry();
   void attach(RTCGeometry geom, uint32_t id, int object = -1);
 
   float time_start_ = 0, time_scale_ = 1;  // Embree time = (time - time_start_) * time_scale_
+  bool compact_ = false;
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
   std::vector<RTCScene> objects_;
+  RayLog* ray_log_ = nullptr;
   std::vector<uint32_t> instance_ids_;  // Embree geometry id of each instance, in add_instance order
   // Stable storage for user-geometry data (Embree keeps raw pointers to it).
   std::vector<std::unique_ptr<SphereGeometry>> spheres_;

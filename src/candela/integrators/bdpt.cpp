@@ -200,7 +200,6 @@ int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RG
     }
     prev.pdf_rev = convert_density(pdf_rev, v, prev);
     ray = Ray{offset_ray_origin(hit.p, hit.ng, wi), wi, std::numeric_limits<float>::infinity(), ray.time};
-    ++counts.bounce;
 
     // Possibly terminate the subpath with Russian roulette. The MIS densities ignore it: the
     // weights stay a partition of unity, so the estimate stays unbiased.
@@ -211,6 +210,7 @@ int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RG
       if (sampler.get_1d() < q) break;
       beta = beta / (1 - q);
     }
+    ++counts.bounce;  // counted once the ray is sure to be traced
   }
   return n;
 }

@@ -69,6 +69,7 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const
       specular_bounce = true;
       ray = Ray{offset_ray_origin(hit.p, hit.ng, ray.direction), ray.direction,
                 std::numeric_limits<float>::infinity(), ray.time};
+      ++counts.bounce;
       continue;
     }
 
@@ -105,7 +106,6 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const
     prev_total_importance = total_importance;
     if (bs->eta != 1) eta_scale *= bs->eta * bs->eta;
     ray = Ray{offset_ray_origin(hit.p, hit.ng, wi), wi, std::numeric_limits<float>::infinity(), ray.time};
-    ++counts.bounce;
 
     // Possibly terminate the path with Russian roulette; survivors are reweighted so the estimate
     // stays unbiased. eta_scale undoes the radiance scaling at refractions, which says nothing about
@@ -116,6 +116,7 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const
       if (sampler.get_1d() < q) break;
       beta = beta / (1 - q);
     }
+    ++counts.bounce;  // counted once the ray is sure to be traced
   }
   return L;
 }

@@ -757,6 +757,9 @@ class JsonSceneReader {
           read_name<LightSelection>(report_, *value, render.pointer_of("light_selection"), "light selection",
                                     {{"power", LightSelection::Power}, {"paper", LightSelection::Paper}, {"uniform", LightSelection::Uniform}});
     settings.shadow_rays = render.integer_or("shadow_rays", settings.shadow_rays, 1, std::numeric_limits<int>::max());
+    if (const Json* value = render.find("bvh"))
+      settings.bvh = read_name<BvhLayout>(report_, *value, render.pointer_of("bvh"), "BVH layout",
+                                          {{"fast", BvhLayout::Fast}, {"compact", BvhLayout::Compact}});
   }
 
   // Present = on (RenderSettings): a threshold on the pixels' relative error, a budget of samples

@@ -322,6 +322,7 @@ Json render_json(const SceneDesc& scene) {
   static const char* kSelection[] = {"power", "paper", "uniform"};
   j["light_selection"] = kSelection[int(s.light_selection)];
   j["shadow_rays"] = s.shadow_rays;
+  j["bvh"] = s.bvh == BvhLayout::Compact ? "compact" : "fast";
   if (s.adaptive()) {
     Json adaptive;
     if (s.adaptive_threshold > 0) adaptive["threshold"] = s.adaptive_threshold;

@@ -23,7 +23,8 @@ namespace candela {
 namespace {
 
 constexpr int kTileSize = 16;
-constexpr int kPassSpp = 4;  // samples per pixel per pass in plain renders: a responsive progress bar
+constexpr int kPassSpp = 16;  // samples per pixel per pass in plain renders: a responsive progress bar, and
+                               // runs of one pixel's samples long enough for samplers to reuse per-pixel work
 
 struct Tile {
   int x0, y0, x1, y1;

@@ -21,6 +21,8 @@
 #include <array>
 #include <bit>
 #include <cstdint>
+#include <memory>
+#include <vector>
 
 #include "candela/math/vec.h"
 #include "candela/sampling/rng.h"
@@ -89,18 +91,21 @@ constexpr uint32_t reverse_bits32(uint32_t v) {
 }
 
 // Hash-based Owen scrambling (Laine & Karras 2011; Burley 2020 "Practical Hash-based Owen
-// Scrambling", pbrt-v4's FastOwenScrambler). After reversing the bits, each step (adding or
-// multiplying, v ^= v * even) changes a bit only as a function of the bits below it, which, reversed
-// back, flips each digit as a function of the digits above it: a nested (Owen) scramble, which
-// maps elementary intervals onto elementary intervals and so keeps the net property.
-constexpr uint32_t fast_owen_scramble(uint32_t v, uint32_t seed) {
-  v = reverse_bits32(v);
+// Scrambling", pbrt-v4's FastOwenScrambler). On bit-reversed values, each step (adding or
+// multiplying, v ^= v * even) changes a bit only as a function of the bits below it; reversed back,
+// that flips each digit as a function of the digits above it: a nested (Owen) scramble, which maps
+// elementary intervals onto elementary intervals and so keeps the net property.
+constexpr uint32_t owen_steps(uint32_t reversed, uint32_t seed) {
+  uint32_t v = reversed;
   v ^= v * 0x3d20adeau;
   v += seed;
   v *= (seed >> 16) | 1u;
   v ^= v * 0x05526c56u;
   v ^= v * 0x53a22864u;
-  return reverse_bits32(v);
+  return v;
+}
+constexpr uint32_t fast_owen_scramble(uint32_t v, uint32_t seed) {
+  return reverse_bits32(owen_steps(reverse_bits32(v), seed));
 }
 
 // 24 high bits to a float in [0, 1): exact, so never rounds up to 1.
@@ -156,6 +161,7 @@ class ZSobolSampler {
     uint64_t index_in_set = sample_index & ((uint64_t(1) << log2_n_) - 1);
     uint64_t pixel_code = encode_morton2(uint32_t(x), uint32_t(y));
     morton_index_ = (pixel_code << log2_n_) | index_in_set;
+    low_reversed_ = log2_n_ == 0 ? 0 : sobol::reverse_bits32(uint32_t(index_in_set)) >> (32 - log2_n_);
     // The permuted digits above the sample index depend only on the pixel, the set and the
     // dimension: keep them while the same pixel's samples are drawn one after another. The
     // dimensions' hashes and scramble seeds depend on the set alone.
@@ -176,10 +182,11 @@ class ZSobolSampler {
 
   float get_1d() {
     if (dimension_ >= kScrambledDimensions) return rng_.next_float();
-    uint64_t index = sobol_index(dimension_hashes_[size_t(dimension_)], dimension_);
-    uint64_t seeds = scramble_seeds_[size_t(dimension_)];
-    dimension_ += 1;
-    return scrambled_sample(index, 0, uint32_t(seeds));
+    const int d = dimension_++;
+    const PixelPart& pixel = pixel_part(d);
+    const uint32_t low = scrambled_low_index(pixel.low_seed);
+    return scrambled_sample(pixel.sobol_reversed[0] ^ low_tables_->product_reversed(low, 0),
+                            uint32_t(scramble_seeds_[size_t(d)]));
   }
 
   Vec2 get_2d() {
@@ -187,10 +194,13 @@ class ZSobolSampler {
       float a = rng_.next_float();
       return {a, rng_.next_float()};
     }
-    uint64_t index = sobol_index(dimension_hashes_[size_t(dimension_)], dimension_);
-    uint64_t seeds = scramble_seeds_[size_t(dimension_)];
+    const int d = dimension_;
     dimension_ += 2;
-    return {scrambled_sample(index, 0, uint32_t(seeds)), scrambled_sample(index, 1, uint32_t(seeds >> 32))};
+    const PixelPart& pixel = pixel_part(d);
+    const uint32_t low = scrambled_low_index(pixel.low_seed);
+    const uint64_t seeds = scramble_seeds_[size_t(d)];
+    return {scrambled_sample(pixel.sobol_reversed[0] ^ low_tables_->product_reversed(low, 0), uint32_t(seeds)),
+            scrambled_sample(pixel.sobol_reversed[1] ^ low_tables_->product_reversed(low, 1), uint32_t(seeds >> 32))};
   }
 
   Vec2 get_pixel_2d() { return get_2d(); }
@@ -200,41 +210,81 @@ class ZSobolSampler {
  private:
   // Owen scrambling seeds of a dimension (pair), hashed apart from the digit permutations' hashes.
   static uint64_t scramble_seeds(uint64_t dimension_hash) { return hash_values(dimension_hash); }
-  static float scrambled_sample(uint64_t index, int sobol_dimension, uint32_t seed) {
-    return sobol::bits_to_unit_float(sobol::fast_owen_scramble(sobol::sample_bits(index, sobol_dimension), seed));
+  // The Owen-scrambled sample from its Sobol' bits, given bit-reversed (as owen_steps wants them).
+  static float scrambled_sample(uint32_t reversed_bits, uint32_t seed) {
+    return sobol::bits_to_unit_float(sobol::reverse_bits32(sobol::owen_steps(reversed_bits, seed)));
   }
 
-  // One of the 24 digit permutations for a node of the digit tree: a cheap multiplicative hash (one
-  // per base-4 digit per dimension, so on the hot path), reduced to [0, 24) by multiply-shift.
+  // One of the 24 digit permutations for a node of the digit tree: a cheap multiplicative hash,
+  // reduced to [0, 24) by multiply-shift.
   static uint32_t permutation_choice(uint64_t key) {
     uint64_t h = (key ^ (key >> 29)) * 0xbf58476d1ce4e5b9ULL;
     h ^= h >> 32;
     return uint32_t((uint64_t(uint32_t(h)) * 24) >> 32);
   }
 
-  // The Morton index with its base-4 digits randomly permuted, top digit first, each by one of the 24
-  // permutations of {0,1,2,3} chosen by hashing the dimension and the digits above it. For odd log2(n)
-  // the lowest digit is a single bit, randomly flipped the same way.
-  uint64_t sobol_index(uint64_t dimension_hash, int dimension) {
-    const bool odd_log2 = (log2_n_ & 1) != 0;
-    const int lowest_digit = odd_log2 ? 1 : 0;
-    // Digits whose bits lie wholly above the sample index are the pixel's: cached per dimension.
-    const int first_pixel_digit = (log2_n_ + (odd_log2 ? 1 : 0)) / 2;  // digit i spans bits 2i - odd, 2i - odd + 1
-    uint64_t index;
-    const uint64_t bit = uint64_t(1) << dimension;
-    if (dimension < kScrambledDimensions && (cached_dimensions_ & bit)) {
-      index = cached_high_[size_t(dimension)];
-    } else {
-      index = permuted_digits(dimension_hash, std::max(first_pixel_digit, lowest_digit), base4_digits_ - 1, true);
-      if (dimension < kScrambledDimensions) {
-        cached_high_[size_t(dimension)] = index;
-        cached_dimensions_ |= bit;
-      }
+  // The sample's index in the Sobol' sequence is the Morton index (pixel code, then the sample's
+  // log2(n) bits), randomised so that aligned blocks map onto aligned blocks. The Sobol' product is
+  // linear over GF(2), so it splits at bit log2(n) into the pixel's part and the sample's part.
+  //
+  // The pixel's part of dimension d: its base-4 digits randomly permuted, top digit first, each by
+  // one of the 24 permutations of {0,1,2,3} chosen by hashing the dimension and the digits above it
+  // (pbrt-v4's ZSobol), multiplied by both Sobol' matrices (kept bit-reversed); and the seed of the
+  // sample part's scramble. Computed at the pixel's first sample that uses d and kept while the same
+  // pixel's samples follow one another.
+  struct PixelPart {
+    uint32_t sobol_reversed[2];
+    uint32_t low_seed;
+  };
+  const PixelPart& pixel_part(int d) {
+    const uint64_t bit = uint64_t(1) << d;
+    PixelPart& part = pixel_parts_[size_t(d)];
+    if (!(cached_dimensions_ & bit)) {
+      const uint64_t dimension_hash = dimension_hashes_[size_t(d)];
+      const int first_pixel_digit = (log2_n_ + 1) / 2;  // digit i spans bits 2i - odd, 2i - odd + 1
+      const uint64_t high = permuted_digits(dimension_hash, first_pixel_digit, base4_digits_ - 1, true);
+      part.sobol_reversed[0] = sobol::reverse_bits32(sobol::sample_bits(high, 0));
+      part.sobol_reversed[1] = sobol::reverse_bits32(sobol::sample_bits(high, 1));
+      part.low_seed = uint32_t(hash_values(dimension_hash, morton_index_ >> log2_n_));
+      cached_dimensions_ |= bit;
     }
-    index |= permuted_digits(dimension_hash, lowest_digit, std::max(first_pixel_digit, lowest_digit) - 1, false);
-    if (odd_log2) index |= (morton_index_ & 1) ^ (permutation_choice((morton_index_ >> 1) ^ dimension_hash) & 1);
-    return index;
+    return part;
   }
+
+  // The sample's part: its log2(n) bits under a nested (Owen) scramble in base 2, seeded by the pixel
+  // and the dimension, so each bit is flipped as a function of the bits above it. Worked on the
+  // bit-reversed index (most significant bit at bit 0, as owen_steps wants it), which
+  // start_pixel_sample reverses once for all dimensions; the result stays reversed, and
+  // LowTables multiplies it by the Sobol' matrices in that order.
+  uint32_t scrambled_low_index(uint32_t seed) const {
+    return sobol::owen_steps(low_reversed_, seed) & low_mask_;
+  }
+
+  // The Sobol' products (bit-reversed) of the sample part given bit-reversed, a byte at a time.
+  struct LowTables {
+    std::vector<std::array<uint32_t, 256>> bytes[2];
+    explicit LowTables(int log2_n) {
+      for (int dim = 0; dim < 2; ++dim)
+        for (int byte = 0; byte * 8 < log2_n; ++byte) {
+          std::array<uint32_t, 256> table{};
+          for (uint32_t value = 0; value < 256; ++value) {
+            uint32_t product = 0;
+            for (int b = 0; b < 8; ++b) {
+              const int reversed_bit = 8 * byte + b;  // weighs bit log2_n - 1 - reversed_bit of the index
+              if ((value >> b & 1) && reversed_bit < log2_n)
+                product ^= sobol::sample_bits(uint64_t(1) << (log2_n - 1 - reversed_bit), dim);
+            }
+            table[value] = sobol::reverse_bits32(product);
+          }
+          bytes[dim].push_back(table);
+        }
+    }
+    uint32_t product_reversed(uint32_t low, int dim) const {
+      uint32_t v = 0;
+      for (size_t byte = 0; low != 0; low >>= 8, ++byte) v ^= bytes[dim][byte][low & 0xff];
+      return v;
+    }
+  };
 
   // Digits lo..hi (inclusive) of the Morton index, each permuted by one of the 24 permutations of
   // {0,1,2,3} chosen by hashing the dimension and the digits above it; with `with_top`, also the
@@ -260,11 +310,14 @@ class ZSobolSampler {
   int base4_digits_;  // permuted digits: log2(resolution) + ceil(log2(n) / 2)
   uint64_t seed_;
   uint64_t morton_index_ = 0;
+  uint32_t low_reversed_ = 0;  // the sample's log2(n) index bits, reversed
+  uint32_t low_mask_ = 0;      // 2^log2(n) - 1
+  std::shared_ptr<const LowTables> low_tables_;  // shared by the copies a render makes per tile
   int dimension_ = 0;
   Rng rng_;
   uint64_t cached_pixel_ = ~uint64_t(0), cached_set_ = ~uint64_t(0);
-  uint64_t cached_dimensions_ = 0;  // bit d: cached_high_[d] is valid
-  std::array<uint64_t, kScrambledDimensions> cached_high_{};
+  uint64_t cached_dimensions_ = 0;  // bit d: pixel_parts_[d] is valid
+  std::array<PixelPart, kScrambledDimensions> pixel_parts_{};
   std::array<uint64_t, kScrambledDimensions> dimension_hashes_{}, scramble_seeds_{};
 };
 

@@ -494,6 +494,13 @@ enum class DirectionSampling {
   Uniform   // uniform hemisphere (the paper's eq. 11), weighted by the BSDF
 };
 
+// How Embree lays out the triangles' acceleration structure.
+enum class BvhLayout {
+  Fast,    // leaves hold copies of their triangles' vertices: the fastest traversal
+  Compact  // leaves index into the shared vertex arrays (Embree's RTC_SCENE_FLAG_COMPACT): about half
+           // the memory per triangle, traversal about a third slower (docs/performance.md)
+};
+
 // How shadow rays are spent at each vertex (sec. 4.5).
 enum class LightSelection {
   Power,   // `shadow_rays` rays, each to one light chosen with probability proportional to its power
@@ -516,6 +523,7 @@ struct RenderSettings {
   bool mis = true;  // false: light sampling for direct light, emission found by bounces ignored
   LightSelection light_selection = LightSelection::Power;
   int shadow_rays = 1;
+  BvhLayout bvh = BvhLayout::Fast;
   // Adaptive sampling (sec. 4.3), on when a threshold or a budget is set (then `spp` is unused).
   // Every pixel first gets `adaptive_batch` samples (a power of two). With a threshold, pixels
   // whose relative standard error falls below it get no more. With a budget of `adaptive_spp`

@@ -44,15 +44,36 @@ std::vector<Normal3> world_normals(const std::vector<Normal3>& normals, const Tr
   return world;
 }
 
+// The mesh of a shape, to take its arrays from, or null (not a mesh, or not to be taken).
+TriangleMesh* mesh_to_take(SceneDesc* take_meshes, std::vector<ShapeDesc>& shapes, size_t i) {
+  if (!take_meshes) return nullptr;
+  auto* mesh = std::get_if<MeshShape>(&shapes[i].geometry);
+  return mesh ? &mesh->mesh : nullptr;
+}
+
 }  // namespace
+
+static_assert(std::is_nothrow_move_constructible_v<ShapeRecord>,
+              "Embree shares ShapeRecord's vertex and index arrays: moving records must never copy them");
 
 Scene::Scene(const SceneDesc& desc)
     : source_file_(desc.source_file.empty() ? "scene" : desc.source_file),
-      embree_(desc.transform_start_time, desc.transform_end_time) {
+      embree_(desc.transform_start_time, desc.transform_end_time, desc.settings.bvh == BvhLayout::Compact) {
+  build(desc, nullptr);
+}
+
+Scene::Scene(SceneDesc& desc, MeshData mesh_data)
+    : source_file_(desc.source_file.empty() ? "scene" : desc.source_file),
+      embree_(desc.transform_start_time, desc.transform_end_time, desc.settings.bvh == BvhLayout::Compact) {
+  build(desc, mesh_data == MeshData::Take ? &desc : nullptr);
+}
+
+void Scene::build(const SceneDesc& desc, SceneDesc* take_meshes) {
   textures_ = TextureSet(desc.textures);
   materials_ = MaterialTable(desc.materials, textures_);
-  for (size_t i = 0; i < desc.shapes.size(); ++i) add_shape(desc.shapes[i], i);
-  add_objects_and_instances(desc);
+  for (size_t i = 0; i < desc.shapes.size(); ++i)
+    add_shape(desc.shapes[i], i, -1, take_meshes ? mesh_to_take(take_meshes, take_meshes->shapes, i) : nullptr);
+  add_objects_and_instances(desc, take_meshes);
 
   // Infinite planes get finite bounds far beyond everything else.
   float scene_size = bounds_.empty() ? 1.0f : std::max(1.0f, length(bounds_.diagonal()));
@@ -110,7 +131,7 @@ Scene::Scene(const SceneDesc& desc)
   for (const auto& rec : shapes_) has_interfaces_ = has_interfaces_ || materials_.is_interface(rec.material);
 }
 
-void Scene::add_objects_and_instances(const SceneDesc& desc) {
+void Scene::add_objects_and_instances(const SceneDesc& desc, SceneDesc* take_meshes) {
   // Each object becomes one Embree scene; its shapes' records stay in object space.
   std::vector<int> embree_objects;
   std::vector<Bounds3> object_bounds;
@@ -130,7 +151,8 @@ void Scene::add_objects_and_instances(const SceneDesc& desc) {
                                      source_file_, what));
       if (std::holds_alternative<PlaneShape>(shape.geometry))
         throw SceneError(fmt::format("{}: {}: an infinite plane cannot be instanced", source_file_, what));
-      add_shape(shape, i, embree_objects.back());
+      add_shape(shape, i, embree_objects.back(),
+                take_meshes ? mesh_to_take(take_meshes, take_meshes->objects[o].shapes, i) : nullptr);
     }
     object_bounds.push_back(bounds_);
   }
@@ -158,7 +180,7 @@ void Scene::add_objects_and_instances(const SceneDesc& desc) {
   }
 }
 
-void Scene::add_shape(const ShapeDesc& desc, size_t index, int object) {
+void Scene::add_shape(const ShapeDesc& desc, size_t index, int object, TriangleMesh* take_mesh) {
   ShapeRecord rec;
   rec.name = shape_label(desc, index);
   rec.material = desc.material >= 0 && size_t(desc.material) < materials_.size() - 1 ? uint32_t(desc.material)
@@ -230,8 +252,9 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int object) {
   TriangleMesh mesh;
   if (const auto* b = std::get_if<BoxShape>(&desc.geometry)) mesh = box_mesh(*b);
   else if (const auto* r = std::get_if<RectangleShape>(&desc.geometry)) mesh = rectangle_mesh(*r);
+  else if (take_mesh) mesh = std::move(*take_mesh);
   else mesh = std::get<MeshShape>(desc.geometry).mesh;
-  add_triangles(std::move(rec), mesh, T, T_end, desc.reverse_orientation, desc.emission,
+  add_triangles(std::move(rec), std::move(mesh), T, T_end, desc.reverse_orientation, desc.emission,
                 std::holds_alternative<RectangleShape>(desc.geometry), object);
 }
 
@@ -293,16 +316,10 @@ void Scene::add_quadric(ShapeRecord rec, QuadricGeometry::Kind kind, const Trans
   shapes_.push_back(std::move(rec));
 }
 
-void Scene::add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Transform& T, const Transform* T_end,
+void Scene::add_triangles(ShapeRecord rec, TriangleMesh mesh, const Transform& T, const Transform* T_end,
                           bool reverse, const std::optional<AreaEmission>& emission, bool rectangle,
                           int object) {
   rec.kind = ShapeRecord::Kind::Triangles;
-  rec.positions.reserve(mesh.positions.size());
-  for (const auto& p : mesh.positions) {
-    rec.positions.push_back(T.point(p));
-    bounds_.extend(rec.positions.back());
-  }
-  rec.normals = world_normals(mesh.normals, T, reverse);
   if (T_end) {
     // The winding below is baked once from the start transform: an end transform of the other
     // handedness would turn the shape inside out on the way (flattening it at some time).
@@ -316,10 +333,18 @@ void Scene::add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Trans
     }
     rec.normals_end = world_normals(mesh.normals, *T_end, reverse);
   }
-  rec.uvs = mesh.uvs;
-  rec.indices = mesh.indices;
+  // The mesh's own arrays become the record's, placed in world space where they are.
+  rec.positions = std::move(mesh.positions);
+  for (auto& p : rec.positions) {
+    p = T.point(p);
+    bounds_.extend(p);
+  }
+  rec.normals = std::move(mesh.normals);
+  for (auto& n : rec.normals) n = normalize(T.normal(n)) * (reverse ? -1.0f : 1.0f);
+  rec.uvs = std::move(mesh.uvs);
+  rec.indices = std::move(mesh.indices);
   if (!mesh.attributes.empty())
-    rec.attributes = std::make_shared<const std::vector<TriangleMesh::Attribute>>(mesh.attributes);
+    rec.attributes = std::make_shared<const std::vector<TriangleMesh::Attribute>>(std::move(mesh.attributes));
   // Keep cross(p1-p0, p2-p0) equal to the object-space normal transformed as a normal: a mirroring
   // transform reverses the winding, and so does reverse orientation.
   rec.winding_swapped = T.swaps_handedness() != reverse;
@@ -369,10 +394,14 @@ void Scene::add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Trans
     }
   }
   if (!rec.indices.empty()) {
-    if (rec.is_moving())
+    if (rec.is_moving()) {
       embree_.add_moving_triangles(uint32_t(shapes_.size()), rec.positions, rec.positions_end, rec.indices);
-    else
-      embree_.add_triangles(uint32_t(shapes_.size()), rec.positions, rec.indices, object);
+    } else {
+      // Embree reads the record's arrays in place (they never move: records are moved, not copied),
+      // and reads the last vertex with a 16-byte load, hence one spare vertex of capacity.
+      rec.positions.reserve(rec.positions.size() + 1);
+      embree_.add_shared_triangles(uint32_t(shapes_.size()), rec.positions, rec.indices, object);
+    }
   }
   shapes_.push_back(std::move(rec));
 }

@@ -52,6 +52,11 @@ class Scene {
  public:
   // Throws SceneError for descriptions that cannot be rendered (e.g. an emissive infinite plane).
   explicit Scene(const SceneDesc& desc);
+  // The same, with MeshData::Take moving each mesh's arrays out of `desc` as it is added (the
+  // shapes keep everything else): each triangle is then held once, not twice, while the scene is
+  // built, which is what bounds the peak memory of large scenes.
+  enum class MeshData { Copy, Take };
+  Scene(SceneDesc& desc, MeshData mesh_data);
 
   bool intersect(const Ray& ray, SurfaceHit& hit) const;
   bool occluded(const Ray& ray) const { return embree_.occluded(ray); }
@@ -92,13 +97,17 @@ class Scene {
   // Whether any surface is an interface (rays pass through it): visibility must then look past them.
   bool has_interfaces() const { return has_interfaces_; }
   size_t triangle_count() const { return triangle_count_; }
+  // The acceleration structure, for benchmarks (ray logs, raw Embree queries).
+  EmbreeScene& embree() { return embree_; }
 
  private:
   // `object`: the Embree object the shape goes into (-1 = the world); object shapes keep their
   // object-space coordinates and are placed by instances.
-  void add_shape(const ShapeDesc& desc, size_t index, int object = -1);
-  void add_objects_and_instances(const SceneDesc& desc);
-  void add_triangles(ShapeRecord rec, const TriangleMesh& mesh, const Transform& to_world,
+  // `take_mesh`: the shape's own mesh, to move from (null: copy it).
+  void build(const SceneDesc& desc, SceneDesc* take_meshes);
+  void add_shape(const ShapeDesc& desc, size_t index, int object, TriangleMesh* take_mesh);
+  void add_objects_and_instances(const SceneDesc& desc, SceneDesc* take_meshes);
+  void add_triangles(ShapeRecord rec, TriangleMesh mesh, const Transform& to_world,
                      const Transform* to_world_end, bool reverse, const std::optional<AreaEmission>& emission,
                      bool rectangle, int object);  // rectangle: one RectangleLight instead of a light per triangle
   void add_sphere(ShapeRecord rec, const SphereShape& sphere, const Transform& to_world,
