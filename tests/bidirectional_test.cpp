@@ -551,7 +551,7 @@ TEST(BidirectionalDeterminism, ContinuedRenderEqualsUninterruptedOne) {
   SceneDesc d = scene_at(kScenes + "cornell-box.json", 24, 24);
   d.settings.integrator = "bdpt";
   d.settings.seed = 5;
-  d.settings.spp = 12;
+  d.settings.spp = 40;  // more than one pass (16 samples per pixel)
   Scene scene(d);
   Film whole(24, 24), part(24, 24);
   RenderOptions options;

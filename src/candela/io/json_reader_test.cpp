@@ -230,6 +230,8 @@ TEST(JsonReader, ReadsIntegratorStrategiesAndAdaptiveSampling) {
             DirectionSampling::Cosine);
   EXPECT_EQ(read(R"({"render": {"direction_sampling": "bsdf"}})").settings.direction_sampling, DirectionSampling::Bsdf);
   EXPECT_EQ(read(R"({"render": {"light_selection": "power"}})").settings.light_selection, LightSelection::Power);
+  EXPECT_EQ(read(R"({"render": {"bvh": "compact"}})").settings.bvh, BvhLayout::Compact);
+  EXPECT_EQ(read(R"({"render": {}})").settings.bvh, BvhLayout::Fast);
   // A threshold alone: batch and max_spp keep their defaults (16; 0 = 1024).
   SceneDesc defaults = read(R"({"render": {"adaptive": {"threshold": 0.1}}})");
   EXPECT_EQ(defaults.settings.adaptive_batch, 16);
@@ -660,6 +662,8 @@ TEST(JsonReader, BadStrategiesAndAdaptiveSettingsAreErrors) {
   expect_error_containing(R"({"render": {"light_selection": "random"}})",
                           "unknown light selection \"random\"; expected one of: power, paper, uniform");
   EXPECT_EQ(read(R"({"render": {"light_selection": "uniform"}})").settings.light_selection, LightSelection::Uniform);
+  expect_error_containing(R"({"render": {"bvh": "small"}})",
+                          "at /render/bvh: unknown BVH layout \"small\"; expected one of: fast, compact");
   expect_error_containing(R"({"render": {"mis": "yes"}})", "at /render/mis: expected true or false");
   expect_error_containing(R"({"render": {"shadow_rays": 0}})", "at /render/shadow_rays: expected an integer >= 1");
   expect_error_containing(R"({"render": {"adaptive": {}}})",
