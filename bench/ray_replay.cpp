@@ -169,18 +169,8 @@ std::vector<RTCRay> camera_rays(const Scene& scene, int width, int height, int b
     for (int bx = 0; bx < width; bx += bw)
       for (int y = by; y < std::min(by + bh, height); ++y)
         for (int x = bx; x < std::min(bx + bw, width); ++x) {
-          Ray r = camera.generate_ray({float(x) + 0.5f, float(y) + 0.5f}, {0.5f, 0.5f}, 0);
-          RTCRay e{};
-          e.org_x = r.origin.x;
-          e.org_y = r.origin.y;
-          e.org_z = r.origin.z;
-          e.tnear = r.t_min;
-          e.dir_x = r.direction.x;
-          e.dir_y = r.direction.y;
-          e.dir_z = r.direction.z;
-          e.time = 0;
-          e.tfar = r.t_max;
-          e.mask = 0xffffffffu;
+          RTCRay e = scene.embree().embree_ray(
+              camera.generate_ray({float(x) + 0.5f, float(y) + 0.5f}, {0.5f, 0.5f}, 0));
           rays.push_back(e);
         }
   return rays;

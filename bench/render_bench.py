@@ -63,21 +63,18 @@ def rel_mse(test_path, ref_path):
 
 
 def run_measured(cmd):
-    """Runs cmd; returns (wall seconds, stdout, stderr); exits on failure."""
-    start = time.monotonic()
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    wall = time.monotonic() - start
-    if proc.returncode != 0:
-        sys.exit(f"benchmark failed: {' '.join(cmd)}\n{proc.stderr[-3000:]}")
-    return wall, proc.stdout, proc.stderr
-
-
-def run_with_rss(cmd):
-    """(wall seconds, stdout, max RSS MiB) of one process, measured by GNU time."""
-    with tempfile.NamedTemporaryFile(suffix=".txt") as f:
-        wall, out, err = run_measured(["/usr/bin/time", "-f", "%M", "-o", f.name] + cmd)
-        rss_kib = float(open(f.name).read().strip().splitlines()[-1])
-    return wall, out, rss_kib / 1024.0
+    """Runs cmd; returns (wall seconds, stdout, max RSS of that process in MiB); exits on failure."""
+    with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
+        start = time.monotonic()
+        proc = subprocess.Popen(cmd, stdout=out, stderr=err, text=True)
+        _, status, usage = os.wait4(proc.pid, 0)  # this child's own resource usage (ru_maxrss in KiB)
+        wall = time.monotonic() - start
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        out.seek(0)
+        err.seek(0)
+        if proc.returncode != 0:
+            sys.exit(f"benchmark failed: {' '.join(cmd)}\n{err.read()[-3000:]}")
+        return wall, out.read(), usage.ru_maxrss / 1024.0
 
 
 def render_line(out):
@@ -90,7 +87,7 @@ def render_line(out):
 def candela_render(candela, scene, resolution, spp, extra, threads, out, seed=0):
     cmd = [candela, "render", scene, "-o", out, "--threads", str(threads), "-q", "--resolution", resolution,
            "--spp", str(spp), "--seed", str(seed)] + extra
-    wall, stdout, rss = run_with_rss(cmd)
+    wall, stdout, rss = run_measured(cmd)
     render_s, msps, mrps, rays_per_sample = render_line(stdout)
     return {"wall": wall, "render": render_s, "msps": msps, "mrps": mrps, "rps": rays_per_sample, "rss": rss}
 
@@ -137,7 +134,7 @@ def section_loading(a, candela, tmp):
                               ("MetalRoughSpheres glTF", MILLION, 1040409)]:
         if not os.path.exists(scene):
             continue
-        runs = [run_with_rss([candela, "render", scene, "-o", out, "-q", "--threads", str(a.threads), "--spp", "1",
+        runs = [run_measured([candela, "render", scene, "-o", out, "-q", "--threads", str(a.threads), "--spp", "1",
                               "--resolution", "8x8"]) for _ in range(max(1, a.repeat))]
         wall = statistics.median(r[0] for r in runs)
         rss = statistics.median(r[2] for r in runs)

@@ -188,24 +188,6 @@ void user_occluded(const RTCOccludedFunctionNArguments* args, const Shape& shape
   }
 }
 
-RTCRay make_rtc_ray(const Ray& r, float embree_time) {
-  RTCRay ray;
-  ray.org_x = r.origin.x;
-  ray.org_y = r.origin.y;
-  ray.org_z = r.origin.z;
-  ray.tnear = r.t_min;
-  ray.dir_x = r.direction.x;
-  ray.dir_y = r.direction.y;
-  ray.dir_z = r.direction.z;
-  ray.time = embree_time;
-  ray.tfar = r.t_max;
-  ray.mask = 0xffffffffu;
-  ray.id = 0;
-  ray.flags = 0;
-  return ray;
-}
-
-
 }  // namespace
 
 Bounds3 sphere_world_bounds(const SphereGeometry& s, const Transform& to_world) {
@@ -270,8 +252,6 @@ void set_vertex_buffer(RTCGeometry geom, unsigned slot, const std::vector<Point3
 
 }  // namespace
 
-RTCGeometry EmbreeScene::new_triangle_geometry() { return rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE); }
-
 void EmbreeScene::attach(RTCGeometry geom, uint32_t id, int object) {
   rtcCommitGeometry(geom);
   rtcAttachGeometryByID(object < 0 ? scene_ : objects_.at(size_t(object)), geom, id);
@@ -282,7 +262,7 @@ void EmbreeScene::add_shared_triangles(uint32_t id, const std::vector<Point3>& p
                                        const std::vector<uint32_t>& indices, int object) {
   if (positions.capacity() <= positions.size())
     throw std::logic_error("EmbreeScene::add_shared_triangles: the positions need one spare element of capacity");
-  RTCGeometry geom = new_triangle_geometry();
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
   rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, indices.data(), 0,
                              3 * sizeof(uint32_t), indices.size() / 3);
   rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, positions.data(), 0, sizeof(Point3),
@@ -320,7 +300,7 @@ void EmbreeScene::add_instance(uint32_t id, int object, const Transform& to_worl
 
 void EmbreeScene::add_moving_triangles(uint32_t id, const std::vector<Point3>& positions,
                                        const std::vector<Point3>& positions_end, const std::vector<uint32_t>& indices) {
-  RTCGeometry geom = new_triangle_geometry();
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* tris = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                               3 * sizeof(uint32_t), indices.size() / 3));
   std::copy(indices.begin(), indices.end(), tris);
@@ -375,6 +355,23 @@ void EmbreeScene::add_plane(uint32_t id, const PlaneGeometry& plane, float exten
 
 void EmbreeScene::commit() { rtcCommitScene(scene_); }
 
+RTCRay EmbreeScene::embree_ray(const Ray& r) const {
+  RTCRay ray;
+  ray.org_x = r.origin.x;
+  ray.org_y = r.origin.y;
+  ray.org_z = r.origin.z;
+  ray.tnear = r.t_min;
+  ray.dir_x = r.direction.x;
+  ray.dir_y = r.direction.y;
+  ray.dir_z = r.direction.z;
+  ray.time = normalized_time(r.time);
+  ray.tfar = r.t_max;
+  ray.mask = 0xffffffffu;
+  ray.id = 0;
+  ray.flags = 0;
+  return ray;
+}
+
 float EmbreeScene::normalized_time(float time) const {
   return std::clamp((time - time_start_) * time_scale_, 0.0f, 1.0f);
 }
@@ -383,7 +380,7 @@ bool EmbreeScene::intersect(const Ray& r, EmbreeHit& hit) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rayhit;
-  rayhit.ray = make_rtc_ray(r, normalized_time(r.time));
+  rayhit.ray = embree_ray(r);
   rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   if (ray_log_) [[unlikely]] ray_log_->add(rayhit.ray, false);
@@ -401,7 +398,7 @@ bool EmbreeScene::intersect(const Ray& r, EmbreeHit& hit) const {
 bool EmbreeScene::occluded(const Ray& r) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  RTCRay ray = make_rtc_ray(r, normalized_time(r.time));
+  RTCRay ray = embree_ray(r);
   if (ray_log_) [[unlikely]] ray_log_->add(ray, true);
   rtcOccluded1(scene_, &context, &ray);
   return ray.tfar < 0;

@@ -99,6 +99,9 @@ class EmbreeScene {
   // Embree's time in [0,1] for an absolute ray time: where between the two transforms shapes are.
   float normalized_time(float time) const;
 
+  // The ray as Embree takes it: Embree's time, every mask bit set.
+  RTCRay embree_ray(const Ray& ray) const;
+
   // Records every ray traced from now on into `log` (null: stop recording); for benchmarks.
   void set_ray_log(RayLog* log) { ray_log_ = log; }
   // The committed Embree scene, for benchmarks that call Embree directly.
@@ -122,7 +125,6 @@ class EmbreeScene {
     float extent;
   };
 
-  RTCGeometry new_triangle_geometry();
   void attach(RTCGeometry geom, uint32_t id, int object = -1);
 
   float time_start_ = 0, time_scale_ = 1;  // Embree time = (time - time_start_) * time_scale_

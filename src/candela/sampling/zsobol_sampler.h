@@ -3,10 +3,11 @@
 // blue-noise diffusion of Monte Carlo sampling error via hierarchical ordering of pixels"; pbrt-v4's
 // ZSobolSampler). Pixel (x, y)'s samples are one aligned block of 2^m consecutive indices of the
 // Sobol' (0,2)-sequence, at block number Morton(x, y), so they form a (0,m,2)-net, and neighbouring
-// pixels' blocks are neighbours in the sequence, so their union is a net too. The index's base-4
-// digits are randomly permuted level by level (each permutation chosen by the digits above it, so
-// aligned blocks still map onto aligned blocks) to decorrelate pixels and dimensions, and each
-// dimension gets its own Owen scrambling. Every dimension, the pixel position included, uses Sobol'
+// pixels' blocks are neighbours in the sequence, so their union is a net too. The index is randomised
+// per dimension so that aligned blocks still map onto aligned blocks, to decorrelate pixels and
+// dimensions: the pixel's base-4 digits are permuted level by level (each permutation chosen by the
+// digits above it, as pbrt-v4 does), the sample's own log2(n) bits get a nested (Owen) scramble in
+// base 2 seeded by the pixel; and each dimension gets its own Owen scrambling of the sample value. Every dimension, the pixel position included, uses Sobol'
 // dimensions 0 and 1 only, with those two different randomisations.
 //
 // All pixels share each dimension's scramble (that is what lets neighbouring pixels' samples form a
@@ -149,8 +150,8 @@ class ZSobolSampler {
   ZSobolSampler(int samples_per_set, uint64_t seed, int width, int height);
 
   // Dimensions from this one on come from a PCG stream per (pixel, sample, seed) instead: they are
-  // the deep bounces of a path, where stratification gains little and the scrambled index (one hash
-  // per base-4 digit) would cost more than the path itself. The first 32 cover the pixel, lens and
+  // the deep bounces of a path, where stratification gains little and the scrambled sample (three
+  // hashes per 2D draw) would cost more than the path itself. The first 32 cover the pixel, lens and
   // time and the first two path vertices (light choice and point, lobe, direction, roulette), or the
   // first vertex with up to 8 shadow rays.
   static constexpr int kScrambledDimensions = 32;
@@ -242,7 +243,7 @@ class ZSobolSampler {
     if (!(cached_dimensions_ & bit)) {
       const uint64_t dimension_hash = dimension_hashes_[size_t(d)];
       const int first_pixel_digit = (log2_n_ + 1) / 2;  // digit i spans bits 2i - odd, 2i - odd + 1
-      const uint64_t high = permuted_digits(dimension_hash, first_pixel_digit, base4_digits_ - 1, true);
+      const uint64_t high = permuted_pixel_digits(dimension_hash, first_pixel_digit);
       part.sobol_reversed[0] = sobol::reverse_bits32(sobol::sample_bits(high, 0));
       part.sobol_reversed[1] = sobol::reverse_bits32(sobol::sample_bits(high, 1));
       part.low_seed = uint32_t(hash_values(dimension_hash, morton_index_ >> log2_n_));
@@ -286,17 +287,14 @@ class ZSobolSampler {
     }
   };
 
-  // Digits lo..hi (inclusive) of the Morton index, each permuted by one of the 24 permutations of
-  // {0,1,2,3} chosen by hashing the dimension and the digits above it; with `with_top`, also the
-  // bits above all permuted digits, passed through.
-  uint64_t permuted_digits(uint64_t dimension_hash, int lo, int hi, bool with_top) const {
+  // Digits lo.. of the Morton index, each permuted by one of the 24 permutations of {0,1,2,3} chosen
+  // by hashing the dimension and the digits above it, and the bits above all permuted digits, passed
+  // through.
+  uint64_t permuted_pixel_digits(uint64_t dimension_hash, int lo) const {
     const int odd = (log2_n_ & 1) != 0 ? 1 : 0;
-    uint64_t index = 0;
-    if (with_top) {
-      const int permuted_bits = 2 * base4_digits_ - odd;
-      index = permuted_bits >= 64 ? 0 : (morton_index_ >> permuted_bits) << permuted_bits;
-    }
-    for (int i = hi; i >= lo; --i) {
+    const int permuted_bits = 2 * base4_digits_ - odd;
+    uint64_t index = permuted_bits >= 64 ? 0 : (morton_index_ >> permuted_bits) << permuted_bits;
+    for (int i = base4_digits_ - 1; i >= lo; --i) {
       int shift = 2 * i - odd;
       uint32_t digit = uint32_t(morton_index_ >> shift) & 3u;
       uint64_t higher_digits = shift + 2 >= 64 ? 0 : morton_index_ >> (shift + 2);

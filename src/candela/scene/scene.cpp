@@ -37,11 +37,9 @@ const Transform* moving_end_transform(const ShapeDesc& desc) {
 
 Vec3 lerp(float t, const Vec3& a, const Vec3& b) { return a * (1 - t) + b * t; }
 
-std::vector<Normal3> world_normals(const std::vector<Normal3>& normals, const Transform& T, bool reverse) {
-  std::vector<Normal3> world;
-  world.reserve(normals.size());
-  for (const auto& n : normals) world.push_back(normalize(T.normal(n)) * (reverse ? -1.0f : 1.0f));
-  return world;
+// Object-space shading normals to world space, in place (flipped by reverse orientation).
+void place_normals(std::vector<Normal3>& normals, const Transform& T, bool reverse) {
+  for (auto& n : normals) n = normalize(T.normal(n)) * (reverse ? -1.0f : 1.0f);
 }
 
 // The mesh of a shape, to take its arrays from, or null (not a mesh, or not to be taken).
@@ -331,7 +329,8 @@ void Scene::add_triangles(ShapeRecord rec, TriangleMesh mesh, const Transform& T
       rec.positions_end.push_back(T_end->point(p));
       bounds_.extend(rec.positions_end.back());
     }
-    rec.normals_end = world_normals(mesh.normals, *T_end, reverse);
+    rec.normals_end = mesh.normals;
+    place_normals(rec.normals_end, *T_end, reverse);
   }
   // The mesh's own arrays become the record's, placed in world space where they are.
   rec.positions = std::move(mesh.positions);
@@ -340,7 +339,7 @@ void Scene::add_triangles(ShapeRecord rec, TriangleMesh mesh, const Transform& T
     bounds_.extend(p);
   }
   rec.normals = std::move(mesh.normals);
-  for (auto& n : rec.normals) n = normalize(T.normal(n)) * (reverse ? -1.0f : 1.0f);
+  place_normals(rec.normals, T, reverse);
   rec.uvs = std::move(mesh.uvs);
   rec.indices = std::move(mesh.indices);
   if (!mesh.attributes.empty())

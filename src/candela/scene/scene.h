@@ -99,6 +99,7 @@ class Scene {
   size_t triangle_count() const { return triangle_count_; }
   // The acceleration structure, for benchmarks (ray logs, raw Embree queries).
   EmbreeScene& embree() { return embree_; }
+  const EmbreeScene& embree() const { return embree_; }
 
  private:
   // `object`: the Embree object the shape goes into (-1 = the world); object shapes keep their
