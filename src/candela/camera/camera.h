@@ -65,6 +65,7 @@ class Camera {
   Vec2 margin() const { return margin_; }
   // The viewing direction (the lens normal) in world space, and the lens area (1 for a pinhole).
   const Vec3& forward() const { return forward_; }
+  bool has_lens() const { return lens_radius_ > 0 && !orthographic_; }
   float lens_area() const { return lens_radius_ > 0 ? kPi * lens_radius_ * lens_radius_ : 1.0f; }
 
   float shutter_open() const { return shutter_open_; }

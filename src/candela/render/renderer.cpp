@@ -88,9 +88,12 @@ void render_pixel(const PassContext& pc, S& sampler, int x, int y, uint64_t firs
     // Place the sample in the pixel by importance-sampling the reconstruction filter (eq. 9 with a
     // filter); the sample counts for this pixel only, with the filter's weight.
     Filter::Sample fs = pc.filter.sample(sampler.get_pixel_2d());
-    Vec2 lens = sampler.get_2d();
+    // Only effects that exist take sampler dimensions: a pinhole needs no lens sample, a scene where
+    // nothing moves no time (the path's first vertices then get the better-stratified dimensions).
+    Vec2 lens = camera.has_lens() ? sampler.get_2d() : Vec2(0.5f, 0.5f);
     // Pick the path's time in the shutter interval (sec. 4.2); every object is seen at it.
-    float time = lerp(sampler.get_1d(), camera.shutter_open(), camera.shutter_close());
+    float time = pc.scene.has_motion() ? lerp(sampler.get_1d(), camera.shutter_open(), camera.shutter_close())
+                                       : camera.shutter_open();
     Ray ray = camera.generate_ray({float(x) + 0.5f + fs.offset.x, float(y) + 0.5f + fs.offset.y}, lens, time);
     RGB L = pc.bdpt ? pc.bdpt->radiance(ray, sampler, counts, pc.bdpt_target, x, y, fs.weight)
                     : pc.path->radiance(ray, sampler, counts);

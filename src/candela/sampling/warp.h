@@ -24,19 +24,26 @@ inline Vec3 square_to_uniform_hemisphere(Vec2 u) {
 }
 inline float uniform_hemisphere_pdf(const Vec3& w) { return w.z >= 0 ? kInv2Pi : 0.0f; }
 
+// sin and cos of a in [-pi/4, pi/4] by their Taylor series to a^11 and a^12 (truncation error below
+// 2e-9, under float's rounding), with no range reduction and no libm call: the concentric disk's
+// angles are always in this range, and it is on the hot path (every diffuse bounce).
+inline Vec2 cos_sin_quarter_pi(float a) {
+  float a2 = a * a;
+  float s = a * (1 + a2 * (-1.0f / 6 + a2 * (1.0f / 120 + a2 * (-1.0f / 5040 + a2 * (1.0f / 362880 + a2 * (-1.0f / 39916800))))));
+  float c = 1 + a2 * (-0.5f + a2 * (1.0f / 24 + a2 * (-1.0f / 720 + a2 * (1.0f / 40320 + a2 * (-1.0f / 3628800 + a2 * (1.0f / 479001600))))));
+  return {c, s};
+}
+
 // Shirley-Chiu concentric mapping: area preserving, low distortion.
 inline Vec2 square_to_concentric_disk(Vec2 u) {
   float ox = 2 * u.x - 1, oy = 2 * u.y - 1;
   if (ox == 0 && oy == 0) return {0, 0};
-  float r, theta;
   if (std::abs(ox) > std::abs(oy)) {
-    r = ox;
-    theta = (kPi / 4) * (oy / ox);
-  } else {
-    r = oy;
-    theta = kPi / 2 - (kPi / 4) * (ox / oy);
+    Vec2 cs = cos_sin_quarter_pi((kPi / 4) * (oy / ox));  // theta = a
+    return {ox * cs.x, ox * cs.y};
   }
-  return {r * std::cos(theta), r * std::sin(theta)};
+  Vec2 cs = cos_sin_quarter_pi((kPi / 4) * (ox / oy));  // theta = pi/2 - a: cos theta = sin a, sin theta = cos a
+  return {oy * cs.y, oy * cs.x};
 }
 inline float concentric_disk_pdf(Vec2 p) { return p.x * p.x + p.y * p.y <= 1 ? kInvPi : 0.0f; }
 

@@ -157,7 +157,11 @@ class ZSobolSampler {
   static constexpr int kScrambledDimensions = 32;
 
   void start_pixel_sample(int x, int y, uint64_t sample_index) {
-    rng_.set_sequence(hash_values(uint64_t(x), uint64_t(y), seed_), mix_bits(sample_index));
+    // The PCG stream of the deep dimensions is seeded when the first one is drawn (many paths end
+    // before): set_sequence costs two hashes.
+    rng_pixel_ = {x, y};
+    rng_sample_ = sample_index;
+    rng_seeded_ = false;
     uint64_t set = sample_index >> log2_n_;
     uint64_t index_in_set = sample_index & ((uint64_t(1) << log2_n_) - 1);
     uint64_t pixel_code = encode_morton2(uint32_t(x), uint32_t(y));
@@ -182,7 +186,7 @@ class ZSobolSampler {
   }
 
   float get_1d() {
-    if (dimension_ >= kScrambledDimensions) return rng_.next_float();
+    if (dimension_ >= kScrambledDimensions) return deep_rng().next_float();
     const int d = dimension_++;
     const PixelPart& pixel = pixel_part(d);
     const uint32_t low = scrambled_low_index(pixel.low_seed);
@@ -192,8 +196,9 @@ class ZSobolSampler {
 
   Vec2 get_2d() {
     if (dimension_ + 1 >= kScrambledDimensions) {
-      float a = rng_.next_float();
-      return {a, rng_.next_float()};
+      Rng& rng = deep_rng();
+      float a = rng.next_float();
+      return {a, rng.next_float()};
     }
     const int d = dimension_;
     dimension_ += 2;
@@ -312,7 +317,17 @@ class ZSobolSampler {
   uint32_t low_mask_ = 0;      // 2^log2(n) - 1
   std::shared_ptr<const LowTables> low_tables_;  // shared by the copies a render makes per tile
   int dimension_ = 0;
+  Rng& deep_rng() {
+    if (!rng_seeded_) {
+      rng_.set_sequence(hash_values(uint64_t(rng_pixel_[0]), uint64_t(rng_pixel_[1]), seed_), mix_bits(rng_sample_));
+      rng_seeded_ = true;
+    }
+    return rng_;
+  }
   Rng rng_;
+  std::array<int, 2> rng_pixel_{};
+  uint64_t rng_sample_ = 0;
+  bool rng_seeded_ = false;
   uint64_t cached_pixel_ = ~uint64_t(0), cached_set_ = ~uint64_t(0);
   uint64_t cached_dimensions_ = 0;  // bit d: pixel_parts_[d] is valid
   std::array<PixelPart, kScrambledDimensions> pixel_parts_{};

@@ -126,7 +126,11 @@ void Scene::build(const SceneDesc& desc, SceneDesc* take_meshes) {
   Vec2 r = desc.settings.filter.radius;
   camera_ = PerspectiveCamera(desc.camera, w, h, {std::max(0.0f, r.x - 0.5f), std::max(0.0f, r.y - 0.5f)});
   bounding_sphere_ = {bounds_.empty() ? Point3(0.0f) : bounds_.center(), radius};
-  for (const auto& rec : shapes_) has_interfaces_ = has_interfaces_ || materials_.is_interface(rec.material);
+  for (const auto& rec : shapes_) {
+    has_interfaces_ = has_interfaces_ || materials_.is_interface(rec.material);
+    has_motion_ = has_motion_ || rec.is_moving();
+  }
+  for (const auto& inst : instances_) has_motion_ = has_motion_ || inst.to_world_end.has_value();
 }
 
 void Scene::add_objects_and_instances(const SceneDesc& desc, SceneDesc* take_meshes) {

@@ -96,6 +96,8 @@ class Scene {
   const SceneSphere& bounding_sphere() const { return bounding_sphere_; }
   // Whether any surface is an interface (rays pass through it): visibility must then look past them.
   bool has_interfaces() const { return has_interfaces_; }
+  // Whether anything moves during the shutter interval (then each path needs its own time).
+  bool has_motion() const { return has_motion_; }
   size_t triangle_count() const { return triangle_count_; }
   // The acceleration structure, for benchmarks (ray logs, raw Embree queries).
   EmbreeScene& embree() { return embree_; }
@@ -137,6 +139,7 @@ class Scene {
   Bounds3 bounds_;
   SceneSphere bounding_sphere_;
   bool has_interfaces_ = false;
+  bool has_motion_ = false;
   size_t triangle_count_ = 0;
 };
 
