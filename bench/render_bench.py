@@ -63,18 +63,21 @@ def rel_mse(test_path, ref_path):
 
 
 def run_measured(cmd):
-    """Runs cmd; returns (wall seconds, stdout, max RSS of that process in MiB); exits on failure."""
-    with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
+    """Runs cmd; returns (wall seconds, stdout, max RSS of that process in MiB); exits on failure.
+
+    The peak memory comes from GNU time (Debian's package `time`), which starts the program from a
+    small process: a child started straight from this Python would report Python's own RSS as its
+    high-water mark (the mark survives fork and exec)."""
+    with tempfile.NamedTemporaryFile("r", suffix=".txt") as rss:
+        timed = ["/usr/bin/time", "-f", "%M", "-o", rss.name] + cmd if os.path.exists("/usr/bin/time") else cmd
         start = time.monotonic()
-        proc = subprocess.Popen(cmd, stdout=out, stderr=err, text=True)
-        _, status, usage = os.wait4(proc.pid, 0)  # this child's own resource usage (ru_maxrss in KiB)
+        proc = subprocess.run(timed, capture_output=True, text=True)
         wall = time.monotonic() - start
-        proc.returncode = os.waitstatus_to_exitcode(status)
-        out.seek(0)
-        err.seek(0)
         if proc.returncode != 0:
-            sys.exit(f"benchmark failed: {' '.join(cmd)}\n{err.read()[-3000:]}")
-        return wall, out.read(), usage.ru_maxrss / 1024.0
+            sys.exit(f"benchmark failed: {' '.join(cmd)}\n{proc.stderr[-3000:]}")
+        lines = rss.read().strip().splitlines()
+        peak = float(lines[-1]) / 1024.0 if timed is not cmd and lines else float("nan")
+    return wall, proc.stdout, peak
 
 
 def render_line(out):
@@ -130,12 +133,13 @@ def section_loading(a, candela, tmp):
     print("|---|---|---|---|---|")
     out = os.path.join(tmp, "load.exr")
     base = None
-    for name, scene, tris in [("one quad", ONE_QUAD, 2), ("dragon + Igea", MESHES, 368690),
-                              ("MetalRoughSpheres glTF", MILLION, 1040409)]:
+    for name, scene, tris, extra in [("one quad", ONE_QUAD, 2, []), ("dragon + Igea", MESHES, 368690, []),
+                                     ("MetalRoughSpheres glTF", MILLION, 1040409, []),
+                                     ("MetalRoughSpheres glTF, `--bvh compact`", MILLION, 1040409, ["--bvh", "compact"])]:
         if not os.path.exists(scene):
             continue
         runs = [run_measured([candela, "render", scene, "-o", out, "-q", "--threads", str(a.threads), "--spp", "1",
-                              "--resolution", "8x8"]) for _ in range(max(1, a.repeat))]
+                              "--resolution", "8x8"] + extra) for _ in range(max(1, a.repeat))]
         wall = statistics.median(r[0] for r in runs)
         rss = statistics.median(r[2] for r in runs)
         if base is None:
