@@ -151,8 +151,8 @@ class ZSobolSampler {
 
   // Dimensions from this one on come from a PCG stream per (pixel, sample, seed) instead: they are
   // the deep bounces of a path, where stratification gains little and the scrambled sample (three
-  // hashes per 2D draw) would cost more than the path itself. The first 32 cover the pixel, lens and
-  // time and the first two path vertices (light choice and point, lobe, direction, roulette), or the
+  // hashes per 2D draw) would cost more than the path itself. The first 32 cover the pixel (and the lens
+  // and time, where they are drawn) and the first two path vertices (light choice and point, lobe, direction, roulette), or the
   // first vertex with up to 8 shadow rays.
   static constexpr int kScrambledDimensions = 32;
 
