@@ -1170,6 +1170,9 @@ class JsonSceneReader {
     c.ior = m.number_or("ior", c.ior, Bound::Positive);
     c.roughness = read_roughness(m);
     c.nonlinear = m.boolean_or("nonlinear", c.nonlinear);
+    c.tabulated_coat = m.boolean_or("tabulated_coat", c.tabulated_coat);
+    if (c.tabulated_coat && !(c.roughness.u.is_constant() && c.roughness.v.is_constant()))
+      m.report().fail(m.pointer_of("tabulated_coat"), "a tabulated coat needs a constant roughness");
     return c;
   }
 

@@ -1086,6 +1086,16 @@ TEST(JsonReader, ReadsCoatedDiffuseWithPlasticAlias) {
   EXPECT_EQ(plain.specular.value, RGB(1));
   EXPECT_FLOAT_EQ(plain.ior, 1.5f);
   EXPECT_FALSE(plain.nonlinear);
+  EXPECT_FALSE(plain.tabulated_coat);
+}
+
+TEST(JsonReader, TabulatedCoatNeedsAConstantRoughness) {
+  SceneDesc scene = read(with_material(R"({"type": "plastic", "roughness": 0.1, "tabulated_coat": true})"));
+  EXPECT_TRUE(std::get<CoatedDiffuseMaterial>(scene.materials[0]).tabulated_coat);
+  expect_error_containing(
+      with_material(R"({"type": "plastic", "tabulated_coat": true,
+          "roughness": {"type": "checkerboard", "tex1": 0.1, "tex2": 0.3}})"),
+      "/tabulated_coat: a tabulated coat needs a constant roughness");
 }
 
 TEST(JsonReader, ReadsDiffuseTransmissionAndInterface) {

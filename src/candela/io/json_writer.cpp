@@ -129,6 +129,7 @@ Json material_json(const MaterialDesc& desc) {
                    {"ior", m.ior}};
             write_roughness(m.roughness, j);
             if (m.nonlinear) j["nonlinear"] = true;
+            if (m.tabulated_coat) j["tabulated_coat"] = true;
             return j;
           },
           [](const DiffuseTransmissionMaterial& m) {

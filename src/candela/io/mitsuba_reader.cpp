@@ -1052,6 +1052,7 @@ class Converter {
         c.roughness = roughness(b, 0.1f);
         if (!c.roughness.u.is_constant() || c.roughness.u.value != c.roughness.v.value)
           throw_scene_error(b.where.loc(), "roughplastic: Mitsuba's roughplastic is isotropic with a constant alpha");
+        c.tabulated_coat = true;  // Mitsuba's tables of the rough coat
       }
       index = one_sided(c, two_sided);
     } else if (type == "twosided") {

@@ -129,6 +129,7 @@ TEST(MitsubaReader, Bsdfs) {
       s.materials[std::get<OneSidedMaterial>(s.materials[s.shapes[2].material]).material]);
   EXPECT_EQ(p.roughness.distribution, MicrofacetDistribution::Beckmann);  // Mitsuba's default
   EXPECT_TRUE(p.nonlinear);
+  EXPECT_TRUE(p.tabulated_coat);  // Mitsuba's roughplastic integrates its rough coat into tables
   EXPECT_NEAR(p.ior, 1.49f / 1.000277f, 1e-5);
   EXPECT_TRUE(std::get<DielectricMaterial>(s.materials[s.shapes[3].material]).thin);
   EXPECT_TRUE(std::holds_alternative<InterfaceMaterial>(s.materials[s.shapes[4].material]));

@@ -26,6 +26,9 @@
 // (alpha ~ 0.02-0.1, 40-60 degrees) the albedo of a perfectly white base (R = 1) exceeds 1 by up
 // to ~7e-4 (measured for eta 1.33-2.5); at higher roughness or grazing angles the rough coat
 // reflects less than F and the model loses energy (single scattering, like every microfacet BSDF here).
+// Materials with a constant roughness can instead ask for Mitsuba's tables (`coat_table`, built
+// once per material by rough_coat.h): then 1 - F(cos) becomes the tabulated rough transmittance
+// and Fdr the tabulated internal reflectance, in the diffuse lobe and in the lobe selection alike.
 //
 // Lobe selection (Mitsuba): with s = mean(specular) / (mean(specular) + mean(R)), the specular lobe
 // is sampled with probability proportional to F(wo) s and the diffuse one proportional to
@@ -37,6 +40,7 @@
 
 #include "candela/materials/bsdf_sample.h"
 #include "candela/materials/microfacet.h"
+#include "candela/materials/rough_coat.h"
 #include "candela/materials/specular.h"
 #include "candela/sampling/warp.h"
 
@@ -48,6 +52,7 @@ struct CoatedDiffuseBsdf {
   float eta = 1.5f;       // n_coat / n_outside
   Microfacet distribution;  // GGX or Beckmann
   bool nonlinear = false;
+  const RoughCoatTable* coat_table = nullptr;  // Mitsuba's tabulated rough coat; null: smooth Fresnel
 
   RGB eval(Vec3 wo, Vec3 wi) const {
     if (!same_hemisphere(wo, wi)) return RGB(0.0f);
@@ -114,8 +119,8 @@ struct CoatedDiffuseBsdf {
     float s_mean = specular.average(), d_mean = reflectance.average();
     if (!(s_mean + d_mean > 0)) return 1;
     float s = s_mean / (s_mean + d_mean);
-    float F = fresnel_dielectric(wo.z, eta);
-    float p_specular = F * s, p_diffuse = (1 - F) * (1 - s);
+    float t = coat_transmittance(wo.z);
+    float p_specular = (1 - t) * s, p_diffuse = t * (1 - s);
     if (!(p_specular + p_diffuse > 0)) return 1;
     return p_diffuse / (p_specular + p_diffuse);
   }
@@ -128,12 +133,18 @@ struct CoatedDiffuseBsdf {
     }
   }
 
+  // The fraction of light the coat lets through from the outside at cos theta (upper hemisphere).
+  float coat_transmittance(float cos_theta) const {
+    return coat_table ? coat_table->transmittance_at(cos_theta) : 1 - fresnel_dielectric(cos_theta, eta);
+  }
+
   // The diffuse lobe for wo, wi in the upper hemisphere.
   RGB diffuse(const Vec3& wo, const Vec3& wi) const {
-    float fdr = fresnel_diffuse_reflectance(1 / eta);  // inside the coat, looking out
+    // Inside the coat, looking out.
+    float fdr = coat_table ? coat_table->internal_reflectance : fresnel_diffuse_reflectance(1 / eta);
     RGB R = reflectance;
     RGB denom = nonlinear ? RGB(1.0f) - R * fdr : RGB(1 - fdr);
-    float t = (1 - fresnel_dielectric(wo.z, eta)) * (1 - fresnel_dielectric(wi.z, eta));
+    float t = coat_transmittance(wo.z) * coat_transmittance(wi.z);
     float s = t * kInvPi / (eta * eta);
     RGB f;
     for (int c = 0; c < 3; ++c) f[c] = denom[c] > 0 ? R[c] * s / denom[c] : 0.0f;

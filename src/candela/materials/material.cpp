@@ -54,6 +54,17 @@ std::vector<int> nested_materials(const MaterialDesc& desc) {
       desc);
 }
 
+// The microfacet distribution a roughness input gives at a hit.
+Microfacet microfacet(const Roughness& r, const TextureSet& tex, const TextureEvalContext& ctx) {
+  float u = std::max(0.0f, tex.eval(r.u, ctx)), v = std::max(0.0f, tex.eval(r.v, ctx));
+  if (r.remap) {
+    u = TrowbridgeReitz::roughness_to_alpha(u);
+    v = TrowbridgeReitz::roughness_to_alpha(v);
+  }
+  return r.distribution == MicrofacetDistribution::Beckmann ? Microfacet(Beckmann(u, v))
+                                                            : Microfacet(TrowbridgeReitz(u, v));
+}
+
 }  // namespace
 
 MaterialTable::MaterialTable(const std::vector<MaterialDesc>& descs, const TextureSet& textures)
@@ -67,6 +78,12 @@ MaterialTable::MaterialTable(const std::vector<MaterialDesc>& descs, const Textu
   for (size_t i = 0; i < entries_.size(); ++i) {
     Entry& e = entries_[i];
     constant[i] = has_constant_inputs(e.desc);
+    if (const auto* coated = std::get_if<CoatedDiffuseMaterial>(&e.desc); coated && coated->tabulated_coat) {
+      if (!is_constant(coated->roughness))
+        throw SceneError(fmt::format("material {}: a tabulated coat needs a constant roughness", i));
+      e.coat_table = std::make_shared<const RoughCoatTable>(
+          make_rough_coat_table(microfacet(coated->roughness, textures, TextureEvalContext{}), coated->ior));
+    }
     std::vector<int> nested = nested_materials(e.desc);
     if (nested.empty()) continue;
     int count = 0;
@@ -98,7 +115,7 @@ MaterialTable::MaterialTable(const std::vector<MaterialDesc>& descs, const Textu
 
 SurfaceBsdf MaterialTable::resolve(uint32_t material, const TextureEvalContext& ctx) const {
   const MaterialDesc& desc = entries_[material].desc;
-  if (nested_materials(desc).empty()) return SurfaceBsdf(build(desc, ctx));
+  if (nested_materials(desc).empty()) return SurfaceBsdf(build(entries_[material], ctx));
   SurfaceBsdf out;
   collect(int(material), 1, false, ctx, out);
   return out;
@@ -106,7 +123,8 @@ SurfaceBsdf MaterialTable::resolve(uint32_t material, const TextureEvalContext& 
 
 void MaterialTable::collect(int material, float weight, bool one_sided, const TextureEvalContext& ctx,
                             SurfaceBsdf& out) const {
-  const MaterialDesc& desc = entries_[size_t(material)].desc;
+  const Entry& entry = entries_[size_t(material)];
+  const MaterialDesc& desc = entry.desc;
   auto clamp01 = [&](const FloatInput& f) { return std::clamp(textures_->eval(f, ctx), 0.0f, 1.0f); };
   if (const auto* m = std::get_if<OneSidedMaterial>(&desc)) {
     collect(m->material, weight, true, ctx, out);
@@ -125,7 +143,7 @@ void MaterialTable::collect(int material, float weight, bool one_sided, const Te
   } else if (std::holds_alternative<InterfaceMaterial>(desc)) {
     out.null_weight += weight;  // no surface: a wrapped interface lets the ray pass
   } else if (out.count < SurfaceBsdf::kMaxComponents) {
-    out.add(build(desc, ctx), weight, one_sided);
+    out.add(build(entry, ctx), weight, one_sided);
   }
 }
 
@@ -179,7 +197,8 @@ void MaterialTable::perturb(int map, const TextureEvalContext& ctx, const Surfac
   frame = Frame::from_normal_tangent(n, frame.s);
 }
 
-Bsdf MaterialTable::build(const MaterialDesc& desc, const TextureEvalContext& ctx) const {
+Bsdf MaterialTable::build(const Entry& entry, const TextureEvalContext& ctx) const {
+  const MaterialDesc& desc = entry.desc;
   const TextureSet& tex = *textures_;
   auto color = [&](const ColorInput& c) { return tex.eval(c, ctx); };
   // Clamp reflectances to [0, 1]: a texture brighter than 1 would create energy.
@@ -187,15 +206,7 @@ Bsdf MaterialTable::build(const MaterialDesc& desc, const TextureEvalContext& ct
     RGB v = tex.eval(c, ctx);
     return RGB(std::clamp(v.r, 0.0f, 1.0f), std::clamp(v.g, 0.0f, 1.0f), std::clamp(v.b, 0.0f, 1.0f));
   };
-  auto distribution = [&](const Roughness& r) {
-    float u = std::max(0.0f, tex.eval(r.u, ctx)), v = std::max(0.0f, tex.eval(r.v, ctx));
-    if (r.remap) {
-      u = TrowbridgeReitz::roughness_to_alpha(u);
-      v = TrowbridgeReitz::roughness_to_alpha(v);
-    }
-    return r.distribution == MicrofacetDistribution::Beckmann ? Microfacet(Beckmann(u, v))
-                                                              : Microfacet(TrowbridgeReitz(u, v));
-  };
+  auto distribution = [&](const Roughness& r) { return microfacet(r, tex, ctx); };
   return std::visit(
       [&](const auto& m) -> Bsdf {
         using T = std::decay_t<decltype(m)>;
@@ -217,7 +228,7 @@ Bsdf MaterialTable::build(const MaterialDesc& desc, const TextureEvalContext& ct
           return ConductorBsdf{eta, k, albedo(m.specular_tint), distribution(m.roughness)};
         } else if constexpr (std::is_same_v<T, CoatedDiffuseMaterial>) {
           return CoatedDiffuseBsdf{albedo(m.reflectance), albedo(m.specular), m.ior, distribution(m.roughness),
-                                   m.nonlinear};
+                                   m.nonlinear, entry.coat_table.get()};
         } else if constexpr (std::is_same_v<T, DiffuseTransmissionMaterial>) {
           return DiffuseTransmissionBsdf{albedo(m.reflectance), albedo(m.transmittance)};
         } else if constexpr (std::is_same_v<T, PrincipledMaterial>) {

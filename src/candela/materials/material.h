@@ -12,6 +12,7 @@
 // axis is the old s made orthogonal to it (Mitsuba's PerturbedBSDF). Nested maps apply outermost
 // first. One frame per point: a blend whose two sides have different normal or bump maps is a
 // SceneError, as is a material (with its wrappers) of more than kMaxComponents BSDFs.
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -59,9 +60,10 @@ class MaterialTable {
     std::optional<SurfaceBsdf> constant;
     bool interface = false;
     std::vector<int> perturbations;  // the normal / bump map materials that apply, outermost first
+    std::shared_ptr<const RoughCoatTable> coat_table;  // for a tabulated coated diffuse
   };
   // The BSDF of a material that is not a wrapper.
-  Bsdf build(const MaterialDesc& desc, const TextureEvalContext& ctx) const;
+  Bsdf build(const Entry& entry, const TextureEvalContext& ctx) const;
   // The mixture a material and its wrappers make.
   SurfaceBsdf resolve(uint32_t material, const TextureEvalContext& ctx) const;
   void collect(int material, float weight, bool one_sided, const TextureEvalContext& ctx, SurfaceBsdf& out) const;

@@ -524,6 +524,38 @@ TEST(CoatedDiffuse, LobeSelectionFollowsNonDeltaProbability) {
   EXPECT_EQ(plastic(0.2f).non_delta_probability(direction(70)), 1.0f);
 }
 
+TEST(CoatedDiffuse, TabulatedCoatSamplesItsPdfAndWeights) {
+  // Mitsuba's roughplastic: the rough coat's tables replace the Fresnel factors in the diffuse
+  // lobe and in the lobe selection; sampling must still match the pdf and the weights eval cos / pdf.
+  static const RoughCoatTable ggx_table = make_rough_coat_table(TrowbridgeReitz(0.3f, 0.3f), 1.5f);
+  static const RoughCoatTable beckmann_table = make_rough_coat_table(Beckmann(0.05f, 0.05f), 1.49f);
+  CoatedDiffuseBsdf rough = plastic(0.3f, RGB(0.7f, 0.5f, 0.3f));
+  rough.coat_table = &ggx_table;
+  CoatedDiffuseBsdf shiny{RGB(0.5f), RGB(1.0f), 1.49f, Beckmann(0.05f, 0.05f), false, &beckmann_table};
+  const Vec3 up(0, 0, 1);
+  EXPECT_GT(bsdf_chi_square(rough, direction(0), {up, 2, 0, 12}), kAlpha);
+  EXPECT_GT(bsdf_chi_square(rough, direction(80), {up, 1, 0, 16}), kAlpha);
+  EXPECT_GT(bsdf_chi_square(shiny, direction(45), {up, 1, 0, 32}), kAlpha);
+  for (Vec3 wo : {direction(0), direction(60), direction(87), below(direction(40))}) {
+    EXPECT_GT(check_sample_weights(rough, wo), 4000);
+    EXPECT_GT(check_sample_weights(shiny, wo), 4000);
+  }
+  // The diffuse lobe is the table's: R t(wo) t(wi) / (pi eta^2 (1 - Ri)), here far from the
+  // highlight so that the glossy lobe is negligible.
+  CoatedDiffuseBsdf diffuse_only = shiny;
+  Vec3 wo = direction(30, 0), wi = direction(50, 90);
+  float expected = 0.5f * beckmann_table.transmittance_at(wo.z) * beckmann_table.transmittance_at(wi.z) /
+                   (kPi * 1.49f * 1.49f * (1 - beckmann_table.internal_reflectance));
+  EXPECT_NEAR(diffuse_only.eval(wo, wi).g, expected, 1e-5f * expected);
+  // A white base loses energy under the rough coat and never gains any.
+  CoatedDiffuseBsdf white = rough;
+  white.reflectance = RGB(1.0f);
+  for (float theta : {0.0f, 45.0f, 85.0f}) {
+    Albedo a = albedo(white, direction(theta));
+    EXPECT_LE(a.mean, 1.0 + 3 * a.standard_error) << theta;
+  }
+}
+
 // ---------------------------------------------------------------- diffuse transmission
 
 TEST(DiffuseTransmission, SamplingMatchesPdf) {

@@ -156,6 +156,10 @@ struct CoatedDiffuseMaterial {
   float ior = 1.5f;
   Roughness roughness;
   bool nonlinear = false;  // Mitsuba's "nonlinear": account for the colour shift of internal bounces
+  // Mitsuba 3's roughplastic: the rough coat's transmittance and internal reflectance integrated
+  // over its microfacets and tabulated (materials/rough_coat.h) instead of the smooth Fresnel
+  // factors. Needs a constant roughness.
+  bool tabulated_coat = false;
 };
 
 // Lambertian reflection and Lambertian transmission to the other side (leaves, paper, lamp shades).
