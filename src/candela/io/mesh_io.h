@@ -1,5 +1,6 @@
 #pragma once
-// Triangle meshes from files: .obj through tinyobjloader, .ply through Assimp.
+// Triangle meshes from files: .obj through tinyobjloader, .ply through Assimp, Mitsuba's .serialized
+// through zlib.
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -11,8 +12,11 @@ namespace candela {
 
 // Loads every triangle of the file into one mesh (polygons are triangulated; per-vertex normals and
 // uvs kept when present). `referenced_from` is where the scene named the file, for messages.
-// Throws SceneError naming both places for a missing, unreadable, malformed or empty file.
-TriangleMesh load_mesh_file(const std::filesystem::path& file, const SourceLocation& referenced_from);
+// A .serialized file holds several meshes: `shape_index` picks one (Mitsuba's parameter; 0 for
+// other formats). Throws SceneError naming both places for a missing, unreadable, malformed or
+// empty file.
+TriangleMesh load_mesh_file(const std::filesystem::path& file, const SourceLocation& referenced_from,
+                            int shape_index = 0);
 
 // A material of an OBJ file's MTL library, as written there (the meaning of each is in
 // io/obj_scene_reader.cpp, which turns them into candela materials).

@@ -1170,21 +1170,20 @@ class Converter {
     const Property* name = find(s, "filename");
     SourceLocation at = name->where.loc();
     std::string ext = lower(file.extension().string());
-    if (s.type == "serialized" || ext == ".serialized")
-      throw_scene_error(at, "shape \"serialized\" ({}): Mitsuba's compressed mesh format is not supported yet; "
-                            "convert the mesh to PLY",
-                        file.string());
+    if (s.type == "serialized" && ext != ".serialized")
+      throw_scene_error(at, "shape \"serialized\": \"{}\" is not a .serialized file", file.string());
     if (s.type == "obj" && ext != ".obj")
       throw_scene_error(at, "shape \"obj\": \"{}\" is not an .obj file", file.string());
     if (s.type == "ply" && ext != ".ply")
       throw_scene_error(at, "shape \"ply\": \"{}\" is not a .ply file", file.string());
-    TriangleMesh mesh = load_mesh_file(file, at);
+    const int shape_index = s.type == "serialized" ? get_int(s, "shape_index", 0) : 0;
+    TriangleMesh mesh = load_mesh_file(file, at, shape_index);
     if (s.type == "obj") {
       // Mitsuba's OBJ loader flips v (flip_tex_coords, on by default) so that its images, looked
       // up with v = 0 at the top row, appear upright; candela keeps Mitsuba's uvs.
       if (get_bool(s, "flip_tex_coords", true))
         for (Vec2& t : mesh.uvs) t.y = 1 - t.y;
-    } else {
+    } else if (s.type == "ply") {
       read_ply_attributes(file, at, mesh);
     }
     if (get_bool(s, "face_normals", false)) mesh.normals.clear();
@@ -1202,7 +1201,6 @@ class Converter {
     const std::string& type = s.type;
     if (type == "obj" || type == "ply" || type == "serialized") {
       out.geometry = MeshShape{mesh_file(s)};
-      ignore(s, "shape_index");
     } else if (type == "sphere") {
       SphereShape sp;
       if (std::optional<Vec3> c = get_vector(s, "center"); c) sp.center = *c;

@@ -186,6 +186,24 @@ TEST(MitsubaReader, Emitters) {
   EXPECT_NEAR(spot.up.z, 1, 1e-5);
 }
 
+TEST(MitsubaReader, SerializedShapesPickTheirMeshByIndex) {
+  const std::string file = (fs::path(CANDELA_SHARED_DIR) / "scenes/mitsuba-tests/common/meshes/matpreview.serialized").string();
+  SceneDesc s = read_text(R"(<shape type="serialized"><string name="filename" value=")" + file + R"("/>
+      <integer name="shape_index" value="2"/></shape>
+    <shape type="serialized"><string name="filename" value=")" + file + R"("/><boolean name="face_normals" value="true"/></shape>)");
+  ASSERT_EQ(s.shapes.size(), 2u);
+  const TriangleMesh& big = std::get<MeshShape>(s.shapes[0].geometry).mesh;
+  EXPECT_EQ(big.triangle_count(), 57152u);
+  EXPECT_EQ(big.normals.size(), big.positions.size());
+  const TriangleMesh& first = std::get<MeshShape>(s.shapes[1].geometry).mesh;
+  EXPECT_EQ(first.triangle_count(), 512u);
+  EXPECT_TRUE(first.normals.empty());
+  EXPECT_NE(error_of(R"(<shape type="serialized"><string name="filename" value=")" + file +
+                     R"("/><integer name="shape_index" value="7"/></shape>)")
+                .find("shape_index 7 is out of range"),
+            std::string::npos);
+}
+
 TEST(MitsubaReader, ErrorsNameFileAndLine) {
   EXPECT_NE(error_of("<shape type=\"sphere\">\n<float name=\"radiuss\" value=\"1\"/></shape>").find("test.xml:3"),
             std::string::npos);
