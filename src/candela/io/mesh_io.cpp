@@ -764,6 +764,179 @@ std::string strips_as_faces(const std::string& bytes, const PlyHeader& header) {
   return out;
 }
 
+// ---------------------------------------------------------------- PLY extra properties
+// Vertex and face properties beyond the geometry (colours, scalar fields, per-face ids) become
+// TriangleMesh::attributes, as Mitsuba's mesh attributes define them: "name_0 name_1 name_2" group
+// into one 3-channel attribute "name", "r g b" / "red green blue" into "color", any other property
+// is a 1-channel attribute of its own name. Attributes follow the file's vertex and face order,
+// which Assimp does not keep, so a file that has any is read here, after the checks above made
+// sure its data holds everything the header declares; polygons become fans, as Assimp makes them.
+
+bool is_geometry_property(const std::string& element, const std::string& name) {
+  static const std::array<const char*, 14> vertex = {"x", "y", "z", "nx", "ny", "nz", "u", "v", "s", "t",
+                                                     "texture_u", "texture_v", "texture_s", "texture_t"};
+  if (element == "vertex")
+    return std::any_of(vertex.begin(), vertex.end(), [&](const char* g) { return name == g; });
+  return name == "vertex_indices" || name == "vertex_index";
+}
+
+struct PropertyGroup {
+  std::string name;
+  std::vector<size_t> columns;
+};
+
+std::vector<PropertyGroup> attribute_groups(const PlyElement& element) {
+  std::vector<PropertyGroup> groups;
+  for (size_t i = 0; i < element.properties.size(); ++i) {
+    const PlyProperty& p = element.properties[i];
+    if (p.list_length || is_geometry_property(element.name, p.name)) continue;
+    std::string base = p.name;
+    if (p.name == "r" || p.name == "g" || p.name == "b" || p.name == "red" || p.name == "green" || p.name == "blue")
+      base = "color";
+    else if (size_t us = p.name.rfind('_');
+             us != std::string::npos && us + 2 == p.name.size() && std::isdigit(static_cast<unsigned char>(p.name.back())))
+      base = p.name.substr(0, us);
+    auto it = std::find_if(groups.begin(), groups.end(), [&](const PropertyGroup& g) { return g.name == base; });
+    if (it == groups.end()) groups.push_back({base, {i}});
+    else it->columns.push_back(i);
+  }
+  // Only 1- and 3-channel attributes exist.
+  std::erase_if(groups, [](const PropertyGroup& g) { return g.columns.size() != 1 && g.columns.size() != 3; });
+  return groups;
+}
+
+const PlyElement* find_element(const PlyHeader& header, std::string_view name) {
+  for (const PlyElement& e : header.elements)
+    if (e.name == name) return &e;
+  return nullptr;
+}
+
+bool has_ply_attributes(const PlyHeader& header) {
+  if (find_element(header, "tristrips")) return false;  // strips carry no per-face values to keep
+  const PlyElement* vertex = find_element(header, "vertex");
+  const PlyElement* face = find_element(header, "face");
+  return (vertex && !attribute_groups(*vertex).empty()) || (face && !attribute_groups(*face).empty());
+}
+
+// Sequential reader of the data's numbers, binary or ASCII (one record per non-blank line, as
+// Assimp reads it: values beyond the declared ones are ignored).
+class PlyNumbers {
+ public:
+  PlyNumbers(const PlyHeader& header, std::string_view data) : header_(header), data_(data) {}
+  void begin_record() {
+    if (header_.encoding != PlyEncoding::Ascii) return;
+    at_ = line_end_ == 0 ? 0 : line_end_ + 1;
+    while (at_ < data_.size()) {
+      line_end_ = std::min(data_.find('\n', at_), data_.size());
+      if (data_.substr(at_, line_end_ - at_).find_first_not_of(" \t\r") != std::string_view::npos) return;
+      at_ = line_end_ + 1;
+    }
+    fail("truncated PLY: the data ends early");
+  }
+  double next(PlyScalarType type) {
+    if (header_.encoding == PlyEncoding::Ascii) {
+      const std::string_view line = data_.substr(0, line_end_);
+      const size_t start = line.find_first_not_of(" \t\r", at_);
+      if (start == std::string_view::npos) fail("malformed PLY: a line has fewer values than the header declares");
+      size_t end = line.find_first_of(" \t\r", start);
+      if (end == std::string_view::npos) end = line.size();
+      at_ = end;
+      double v = 0;
+      std::from_chars(data_.data() + start, data_.data() + end, v);
+      return v;
+    }
+    if (!fits(at_, type.size, data_.size())) fail("truncated PLY: the data ends early");
+    uint64_t bits = 0;
+    const bool big = header_.encoding == PlyEncoding::BinaryBigEndian;
+    for (unsigned k = 0; k < type.size; ++k)
+      bits = bits << 8 | static_cast<uint8_t>(data_[at_ + (big ? k : type.size - 1u - k)]);
+    at_ += type.size;
+    if (!type.is_integer) return type.size == 4 ? double(std::bit_cast<float>(uint32_t(bits))) : std::bit_cast<double>(bits);
+    if (type.is_signed && type.size < 8 && (bits >> (8 * type.size - 1)))
+      return double(int64_t(bits) - (int64_t(1) << (8 * type.size)));
+    return double(bits);
+  }
+
+ private:
+  const PlyHeader& header_;
+  std::string_view data_;
+  size_t at_ = 0, line_end_ = 0;
+};
+
+TriangleMesh load_ply_with_attributes(std::string_view bytes, const PlyHeader& header) {
+  PlyNumbers numbers(header, bytes.substr(header.data_offset));
+  std::vector<std::vector<double>> vertex_rows, face_rows;
+  std::vector<std::vector<uint32_t>> faces;
+  for (const PlyElement& e : header.elements) {
+    const bool is_vertex = e.name == "vertex", is_face = e.name == "face";
+    for (uint64_t r = 0; r < e.count; ++r) {
+      numbers.begin_record();
+      std::vector<double> row(e.properties.size(), 0.0);
+      for (size_t k = 0; k < e.properties.size(); ++k) {
+        const PlyProperty& p = e.properties[k];
+        if (!p.list_length) {
+          row[k] = numbers.next(p.value);
+          continue;
+        }
+        const auto n = uint64_t(numbers.next(*p.list_length));
+        std::vector<uint32_t> items;
+        for (uint64_t j = 0; j < n; ++j) {
+          const double index = numbers.next(p.value);
+          if (!(index >= 0 && index <= double(std::numeric_limits<uint32_t>::max())))
+            fail("malformed PLY: face {} has a vertex index {}", r, index);
+          items.push_back(uint32_t(index));
+        }
+        // One index list per face record: the first vertex_indices list (any other list is ignored).
+        if (is_face && is_geometry_property("face", p.name) && faces.size() == face_rows.size())
+          faces.push_back(std::move(items));
+      }
+      if (is_vertex) vertex_rows.push_back(std::move(row));
+      if (is_face) {
+        if (faces.size() == face_rows.size()) faces.emplace_back();  // a record without indices
+        face_rows.push_back(std::move(row));
+      }
+    }
+  }
+  const PlyElement& vertex = *find_element(header, "vertex");
+  auto column = [&](std::initializer_list<const char*> names) -> int {
+    for (const char* n : names)
+      for (size_t i = 0; i < vertex.properties.size(); ++i)
+        if (vertex.properties[i].name == n && !vertex.properties[i].list_length) return int(i);
+    return -1;
+  };
+  const int x = column({"x"}), y = column({"y"}), z = column({"z"});
+  const int nx = column({"nx"}), ny = column({"ny"}), nz = column({"nz"});
+  const int u = column({"u", "s", "texture_u", "texture_s"}), v = column({"v", "t", "texture_v", "texture_t"});
+  TriangleMesh mesh;
+  for (const std::vector<double>& row : vertex_rows) {
+    mesh.positions.push_back({float(row[size_t(x)]), float(row[size_t(y)]), float(row[size_t(z)])});
+    if (nx >= 0 && ny >= 0 && nz >= 0)
+      mesh.normals.push_back({float(row[size_t(nx)]), float(row[size_t(ny)]), float(row[size_t(nz)])});
+    if (u >= 0 && v >= 0) mesh.uvs.push_back({float(row[size_t(u)]), float(row[size_t(v)])});
+  }
+  std::vector<size_t> face_of_triangle;
+  for (size_t f = 0; f < faces.size(); ++f)
+    for (size_t k = 1; k + 1 < faces[f].size(); ++k) {
+      for (uint32_t index : {faces[f][0], faces[f][k], faces[f][k + 1]}) mesh.indices.push_back(index);
+      face_of_triangle.push_back(f);
+    }
+  if (mesh.indices.empty()) fail("the PLY file contains no triangles{}", describe_elements(header));
+  for (const PropertyGroup& g : attribute_groups(vertex)) {
+    TriangleMesh::Attribute a{g.name, false, int(g.columns.size()), {}};
+    for (const std::vector<double>& row : vertex_rows)
+      for (size_t c : g.columns) a.values.push_back(float(row[c]));
+    mesh.attributes.push_back(std::move(a));
+  }
+  if (const PlyElement* face = find_element(header, "face"))
+    for (const PropertyGroup& g : attribute_groups(*face)) {
+      TriangleMesh::Attribute a{g.name, true, int(g.columns.size()), {}};
+      for (size_t f : face_of_triangle)
+        for (size_t c : g.columns) a.values.push_back(float(face_rows[f][c]));
+      mesh.attributes.push_back(std::move(a));
+    }
+  return mesh;
+}
+
 TriangleMesh load_ply(const std::string& original) {
   const PlyHeader original_header = read_ply_header(original);
   {
@@ -772,6 +945,7 @@ TriangleMesh load_ply(const std::string& original) {
     if (original_header.encoding == PlyEncoding::Ascii) check_ascii_ply_data(original_header, data);
     else check_binary_ply_data(original_header, data);
   }
+  if (has_ply_attributes(original_header)) return load_ply_with_attributes(original, original_header);
   const bool has_strips = std::any_of(original_header.elements.begin(), original_header.elements.end(),
                                       [](const PlyElement& e) { return e.name == "tristrips" && e.count > 0; });
   const std::string rewritten = has_strips ? strips_as_faces(original, original_header) : std::string();

@@ -251,7 +251,7 @@ TEST_F(MeshIo, PlyUvsAndNormalsAreRead) {
   EXPECT_EQ(wuson.normals.size(), wuson.positions.size());
 }
 
-TEST_F(MeshIo, PlyColoursAreIgnored) {
+TEST_F(MeshIo, PlyColoursBecomeAColorAttribute) {
   const TriangleMesh triangle = load(kShared / "ply-tests" / "float-color.ply");
   ASSERT_EQ(triangle.triangle_count(), 1u);
   ASSERT_EQ(triangle.positions.size(), 3u);
@@ -260,6 +260,61 @@ TEST_F(MeshIo, PlyColoursAreIgnored) {
   EXPECT_EQ(triangle.positions[triangle.indices[2]], Vec3(200, 200, 0));
   EXPECT_TRUE(triangle.normals.empty());
   EXPECT_TRUE(triangle.uvs.empty());
+  ASSERT_EQ(triangle.attributes.size(), 2u);  // red green blue, and alpha on its own
+  EXPECT_EQ(triangle.attributes[0].name, "color");
+  EXPECT_FALSE(triangle.attributes[0].per_face);
+  EXPECT_EQ(triangle.attributes[0].channels, 3);
+  EXPECT_EQ(triangle.attributes[0].values, (std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, 1}));
+  EXPECT_EQ(triangle.attributes[1].name, "alpha");
+  EXPECT_EQ(triangle.attributes[1].channels, 1);
+}
+
+TEST_F(MeshIo, PlyExtraPropertiesBecomeAttributesInFileOrder) {
+  // Vertex and face properties beyond the geometry, ASCII and big-endian binary alike: name_0..2
+  // group into 3 channels, a lone property is one channel, a quad's value goes to both triangles.
+  const std::string header_tail =
+      "element vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float u\nproperty float v\n"
+      "property float weight\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+      "element face 1\nproperty list uchar int vertex_indices\nproperty float tint_0\nproperty float tint_1\n"
+      "property float tint_2\nproperty short id\nend_header\n";
+  const std::string ascii = "ply\nformat ascii 1.0\n" + header_tail +
+                            "0 0 0 0 0 0.5 255 0 0\n1 0 0 1 0 1.5 0 255 0\n\n1 1 0 1 1 2.5 0 0 255 7\n"
+                            "0 1 0 0 1 3.5 1 2 3\n4 0 1 2 3 0.25 0.5 0.75 -12\n";
+  std::string binary = "ply\nformat binary_big_endian 1.0\n" + header_tail;
+  auto put = [&](auto value) {
+    auto bits = std::bit_cast<std::array<char, sizeof value>>(value);
+    std::reverse(bits.begin(), bits.end());
+    binary.append(bits.data(), bits.size());
+  };
+  const float positions[4][6] = {{0, 0, 0, 0, 0, 0.5f}, {1, 0, 0, 1, 0, 1.5f}, {1, 1, 0, 1, 1, 2.5f}, {0, 1, 0, 0, 1, 3.5f}};
+  const uint8_t colours[4][3] = {{255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {1, 2, 3}};
+  for (int i = 0; i < 4; ++i) {
+    for (float f : positions[i]) put(f);
+    for (uint8_t c : colours[i]) put(c);
+  }
+  put(uint8_t(4));
+  for (int32_t i : {0, 1, 2, 3}) put(i);
+  for (float f : {0.25f, 0.5f, 0.75f}) put(f);
+  put(int16_t(-12));
+  for (const std::string& contents : {ascii, binary}) {
+    const TriangleMesh mesh = load(write("attributes.ply", contents));
+    ASSERT_EQ(mesh.triangle_count(), 2u);
+    EXPECT_EQ(mesh.indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3}));
+    EXPECT_EQ(mesh.positions[2], Vec3(1, 1, 0));
+    ASSERT_EQ(mesh.uvs.size(), 4u);
+    EXPECT_EQ(mesh.uvs[3].y, 1.0f);
+    ASSERT_EQ(mesh.attributes.size(), 4u);
+    EXPECT_EQ(mesh.attributes[0].name, "weight");
+    EXPECT_EQ(mesh.attributes[0].values, (std::vector<float>{0.5f, 1.5f, 2.5f, 3.5f}));
+    EXPECT_EQ(mesh.attributes[1].name, "color");
+    EXPECT_EQ(mesh.attributes[1].channels, 3);
+    EXPECT_EQ(mesh.attributes[1].values[11], 3.0f);
+    EXPECT_EQ(mesh.attributes[2].name, "tint");
+    EXPECT_TRUE(mesh.attributes[2].per_face);
+    EXPECT_EQ(mesh.attributes[2].values, (std::vector<float>{0.25f, 0.5f, 0.75f, 0.25f, 0.5f, 0.75f}));
+    EXPECT_EQ(mesh.attributes[3].name, "id");
+    EXPECT_EQ(mesh.attributes[3].values, (std::vector<float>{-12, -12}));
+  }
 }
 
 TEST_F(MeshIo, PlyPointCloudHasNoTriangles) {
