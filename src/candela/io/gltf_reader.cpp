@@ -927,14 +927,19 @@ class GltfReader {
         sx = v.Get("scale").Get(0).GetNumberAsDouble();
         sy = v.Get("scale").Get(1).GetNumberAsDouble();
       }
-      double rotation = number_or(v, "rotation", 0);
-      if (rotation != 0)
-        warn(pointer + "/extensions/KHR_texture_transform/rotation",
-             "texture rotation ({} rad) is not supported; only the offset and scale are applied", rotation);
+      const double rotation = number_or(v, "rotation", 0);
       if (v.Has("texCoord")) tex_coord = v.Get("texCoord").GetNumberAsInt();
-      // glTF: (u', v') = (sx u + ox, sy v + oy) with v down the image; candela's t = 1 - v, so
-      // t' = 1 - v' = sy t + (1 - sy - oy).
-      image.mapping = {float(sx), float(sy), float(ox), float(1 - sy - oy)};
+      // glTF: uv' = T(offset) R(rotation) S(scale) uv, i.e.
+      //   u' = cos sx u + sin sy v + ox,   v' = -sin sx u + cos sy v + oy,
+      // with v down the image; candela's t = 1 - v, so with v = 1 - t and t' = 1 - v':
+      //   s' = cos sx u - sin sy t + (sin sy + ox),   t' = sin sx u + cos sy t + (1 - cos sy - oy).
+      const double c = std::cos(rotation), sn = std::sin(rotation);
+      image.mapping.su = float(c * sx);
+      image.mapping.s_from_v = float(-sn * sy);
+      image.mapping.du = float(sn * sy + ox);
+      image.mapping.t_from_u = float(sn * sx);
+      image.mapping.sv = float(c * sy);
+      image.mapping.dv = float(1 - c * sy - oy);
     }
     if (uv_set < 0) uv_set = tex_coord;
     else if (tex_coord != uv_set)

@@ -351,17 +351,17 @@ TEST(GltfMaterials, TexturesMapChannelsAndColourSpaces) {
   EXPECT_FALSE(mesh_of(scene.shapes[0]).uvs.empty());
 }
 
-TEST(GltfMaterials, TextureTransformOffsetsAndScales) {
+TEST(GltfMaterials, TextureTransformOffsetsRotatesAndScales) {
   std::vector<std::string> warnings;
   SceneDesc scene = load(asset("TextureTransformTest"), &warnings);
   Json j = read_json(asset("TextureTransformTest"));
-  // Material name -> expected mapping (glTF v runs down the image; candela's t = 1 - v).
-  auto expected = [](float ox, float oy, float sx, float sy) { return UVMapping{sx, sy, ox, 1 - sy - oy}; };
-  std::map<std::string, UVMapping> want = {{"Offset U", expected(0.5f, 0, 1, 1)},
-                                           {"Offset V", expected(0, 0.5f, 1, 1)},
-                                           {"Offset UV", expected(0.5f, 0.5f, 1, 1)},
-                                           {"Scale", expected(0, 0, 1.5f, 1.5f)},
-                                           {"All", expected(-0.2f, -0.1f, 1.5f, 1.5f)}};
+  // Material name -> the glTF transform (offset, rotation, scale), as the file states it.
+  struct Transform {
+    double ox, oy, rotation, sx, sy;
+  };
+  std::map<std::string, Transform> want = {{"Offset U", {0.5, 0, 0, 1, 1}},   {"Offset V", {0, 0.5, 0, 1, 1}},
+                                           {"Offset UV", {0.5, 0.5, 0, 1, 1}}, {"Rotation", {0, 0, 0.39269908169872414, 1, 1}},
+                                           {"Scale", {0, 0, 0, 1.5, 1.5}},     {"All", {-0.2, -0.1, 0.3, 1.5, 1.5}}};
   int checked = 0;
   for (const ShapeDesc& shape : scene.shapes) {
     // The shape's material's base colour texture; shapes name their mesh, whose material names the case.
@@ -375,18 +375,27 @@ TEST(GltfMaterials, TextureTransformOffsetsAndScales) {
       std::string material = j["materials"][mesh["primitives"][0]["material"].get<int>()].value("name", "");
       auto w = want.find(material);
       if (w == want.end()) continue;
-      EXPECT_FLOAT_EQ(tex.mapping.su, w->second.su) << material;
-      EXPECT_FLOAT_EQ(tex.mapping.sv, w->second.sv) << material;
-      EXPECT_FLOAT_EQ(tex.mapping.du, w->second.du) << material;
-      EXPECT_FLOAT_EQ(tex.mapping.dv, w->second.dv) << material;
+      // The glTF matrix T R S with R = [[cos, sin], [-sin, cos]] (the extension's definition), applied
+      // to glTF uvs (v down the image), must equal candela's mapping on t = 1 - v, read back as 1 - t'.
+      const Transform& g = w->second;
+      const double c = std::cos(g.rotation), sn = std::sin(g.rotation);
+      for (Vec2 uv : {Vec2(0, 0), Vec2(1, 0), Vec2(0, 1), Vec2(0.3f, 0.7f)}) {
+        const double su = g.sx * uv.x, sv = g.sy * uv.y;
+        const double u_gltf = c * su + sn * sv + g.ox, v_gltf = -sn * su + c * sv + g.oy;
+        const UVMapping& mp = tex.mapping;
+        const float t = 1 - uv.y;
+        const float s_out = mp.su * uv.x + mp.s_from_v * t + mp.du, t_out = mp.t_from_u * uv.x + mp.sv * t + mp.dv;
+        EXPECT_NEAR(s_out, u_gltf, 1e-5) << material << " at " << uv.x << ", " << uv.y;
+        EXPECT_NEAR(1 - t_out, v_gltf, 1e-5) << material << " at " << uv.x << ", " << uv.y;
+      }
+      EXPECT_EQ(tex.mapping.is_axis_aligned(), g.rotation == 0) << material;
       ++checked;
     }
   }
-  EXPECT_EQ(checked, 5);
-  // The two rotations are warned about.
+  EXPECT_EQ(checked, 6);
   EXPECT_EQ(std::count_if(warnings.begin(), warnings.end(),
                           [](const std::string& w) { return w.find("rotation") != std::string::npos; }),
-            2);
+            0);
 }
 
 TEST(GltfMaterials, EmissiveStrengthMultipliesTheFactor) {

@@ -913,6 +913,23 @@ class JsonSceneReader {
   // "uv_scale": [su, sv] (or one number for both) and "uv_offset": [du, dv].
   UVMapping read_uv_mapping(CheckedObject& t) const {
     UVMapping mapping;
+    if (const Json* matrix = t.find("uv_matrix")) {
+      // [[su, s_from_v, du], [t_from_u, sv, dv]]: any affine map (rotations, shears).
+      const std::string pointer = t.pointer_of("uv_matrix");
+      if (t.find("uv_scale") || t.find("uv_offset"))
+        report_.fail(pointer, "give either uv_matrix or uv_scale / uv_offset, not both");
+      if (!matrix->is_array() || matrix->size() != 2 || !(*matrix)[0].is_array() || (*matrix)[0].size() != 3 ||
+          !(*matrix)[1].is_array() || (*matrix)[1].size() != 3)
+        report_.fail(pointer, "expected [[su, s_from_v, du], [t_from_u, sv, dv]], got {}", describe(*matrix));
+      float m[2][3];
+      for (size_t r = 0; r < 2; ++r)
+        for (size_t c = 0; c < 3; ++c)
+          m[r][c] = read_float(report_, (*matrix)[r][c], fmt::format("{}/{}/{}", pointer, r, c));
+      if (m[0][0] * m[1][1] - m[0][1] * m[1][0] == 0)
+        report_.fail(pointer, "the uv matrix is singular (it maps the surface onto a line)");
+      mapping = {m[0][0], m[1][1], m[0][2], m[1][2], m[0][1], m[1][0]};
+      return mapping;
+    }
     if (const Json* scale = t.find("uv_scale")) {
       std::string pointer = t.pointer_of("uv_scale");
       Vec2 s = scale->is_number() ? Vec2(read_float(report_, *scale, pointer), read_float(report_, *scale, pointer))

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "candela/io/error.h"
+#include "candela/io/json_writer.h"
 #include "candela/io/scene_reader.h"
 
 namespace candela {
@@ -932,10 +933,34 @@ TEST(JsonReader, MaterialParametersTakeConstantsNamesOrInlineTextures) {
   EXPECT_EQ(std::get<MirrorMaterial>(scene.materials[3]).reflectance.texture, 0);
 }
 
+TEST(JsonReader, UvMatrixRotatesTextureCoordinates) {
+  SceneDesc scene = read_textured(R"({"textures": {"t": {"type": "checkerboard", "uv_matrix": [[0, -2, 1], [2, 0, 0.5]]}},
+      "materials": {"m": {"type": "diffuse", "reflectance": "t"}}, "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]})");
+  const auto& c = std::get<CheckerboardTexture>(scene.textures[0]);
+  EXPECT_FLOAT_EQ(c.mapping.su, 0);
+  EXPECT_FLOAT_EQ(c.mapping.s_from_v, -2);
+  EXPECT_FLOAT_EQ(c.mapping.du, 1);
+  EXPECT_FLOAT_EQ(c.mapping.t_from_u, 2);
+  EXPECT_FLOAT_EQ(c.mapping.sv, 0);
+  EXPECT_FLOAT_EQ(c.mapping.dv, 0.5f);
+  // Written back as a matrix and read again unchanged.
+  SceneDesc back = read_json_scene(scene_to_json(scene), "back.json", kTextureDir);
+  const auto& b = std::get<CheckerboardTexture>(back.textures[0]);
+  EXPECT_EQ(b.mapping.s_from_v, -2);
+  EXPECT_EQ(b.mapping.t_from_u, 2);
+  EXPECT_EQ(b.mapping.dv, 0.5f);
+  expect_textured_error(R"({"textures": {"t": {"type": "checkerboard", "uv_matrix": [[1, 2, 0], [2, 4, 0]]}}})",
+                        "at /textures/t/uv_matrix: the uv matrix is singular");
+  expect_textured_error(R"({"textures": {"t": {"type": "checkerboard", "uv_matrix": [[1, 0, 0], [0, 1, 0]], "uv_scale": 2}}})",
+                        "either uv_matrix or uv_scale");
+  expect_textured_error(R"({"textures": {"t": {"type": "checkerboard", "uv_matrix": [1, 0, 0, 1]}}})",
+                        "expected [[su, s_from_v, du], [t_from_u, sv, dv]]");
+}
+
 TEST(JsonReader, TextureErrorsNameTheirJsonPointer) {
   expect_textured_error(with_texture(R"({"type": "image", "filename": "checker.ppm", "wrapp": "clamp"})"),
                         "at /textures/t/wrapp: unknown key; expected one of: type, filename, wrap, encoding, filter, "
-                        "scale, invert, uv_scale, uv_offset");
+                        "scale, invert, uv_matrix, uv_scale, uv_offset");
   expect_textured_error(with_texture(R"({"type": "image", "filename": "checker.ppm", "wrap": "tile"})"),
                         "at /textures/t/wrap: unknown wrap mode \"tile\"; expected one of: repeat, clamp, black, "
                         "mirror");

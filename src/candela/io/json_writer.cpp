@@ -44,6 +44,10 @@ Json number(const FloatInput& in) { return in.is_constant() ? Json(in.value) : J
 std::string absolute(const std::string& file) { return fs::absolute(file).lexically_normal().string(); }
 
 void write_mapping(const UVMapping& m, Json& j) {
+  if (!m.is_axis_aligned()) {
+    j["uv_matrix"] = Json::array({Json::array({m.su, m.s_from_v, m.du}), Json::array({m.t_from_u, m.sv, m.dv})});
+    return;
+  }
   if (m.su != 1 || m.sv != 1) j["uv_scale"] = Json::array({m.su, m.sv});
   if (m.du != 0 || m.dv != 0) j["uv_offset"] = Json::array({m.du, m.dv});
 }

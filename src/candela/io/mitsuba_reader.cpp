@@ -854,21 +854,19 @@ class Converter {
     return add_texture(s);
   }
 
-  // Mitsuba's to_uv, which must be a scale and a translation: uv' = (su u + du, sv v + dv).
+  // Mitsuba's to_uv, an affine map of the texture coordinates (its 2D part; z is ignored):
+  // uv' = (a00 u + a01 v + a03, a10 u + a11 v + a13).
   UVMapping to_uv(const Object& o) {
     const Property* p = find(o, "to_uv");
     UVMapping m;
     if (!p) return m;
     if (p->kind != Property::Kind::Transform) wrong_kind(o, *p, "a <transform>");
     const Matrix4& a = p->transform.matrix();
-    auto nonzero = [](double x) { return std::abs(x) > 1e-9; };
-    if (nonzero(a.m[0][1]) || nonzero(a.m[1][0]))
-      throw_scene_error(p->where.loc(), "{}: \"to_uv\" rotates or shears the texture coordinates; candela supports "
-                                        "scale and translate only",
-                        o.describe());
     m.su = float(a.m[0][0]);
-    m.sv = float(a.m[1][1]);
+    m.s_from_v = float(a.m[0][1]);
     m.du = float(a.m[0][3]);
+    m.t_from_u = float(a.m[1][0]);
+    m.sv = float(a.m[1][1]);
     m.dv = float(a.m[1][3]);
     return m;
   }
@@ -890,8 +888,12 @@ class Converter {
       else throw_scene_error(t.where.loc(), "bitmap: wrap_mode \"{}\" (use repeat, mirror or clamp)", wrap);
       if (get_bool(t, "raw", false)) img.encoding = ColorEncoding::Linear;
       UVMapping m = to_uv(t);
-      // Mitsuba looks images up with v = 0 at the top row; candela's t = 0 is the bottom row.
-      img.mapping = {m.su, -m.sv, m.du, 1 - m.dv};
+      // Mitsuba looks images up with v = 0 at the top row; candela's t = 0 is the bottom row, so
+      // t' = 1 - v' (the surface's uvs are Mitsuba's).
+      img.mapping = m;
+      img.mapping.t_from_u = -m.t_from_u;
+      img.mapping.sv = -m.sv;
+      img.mapping.dv = 1 - m.dv;
       ignore(t, "format");  // "variant" / "rgb": the channels are read as RGB either way
       ignore(t, "accel");
       index = add_texture(img);
@@ -901,7 +903,7 @@ class Converter {
       c.tex2 = color(t, "color1", RGB(0.2f));
       // Mitsuba: color0 where (u mod 1 < 0.5) == (v mod 1 < 0.5), i.e. where floor(2u) + floor(2v) is even.
       UVMapping m = to_uv(t);
-      c.mapping = {2 * m.su, 2 * m.sv, 2 * m.du, 2 * m.dv};
+      c.mapping = {2 * m.su, 2 * m.sv, 2 * m.du, 2 * m.dv, 2 * m.s_from_v, 2 * m.t_from_u};
       index = add_texture(c);
     } else if (t.type == "mesh_attribute") {
       std::string name = get_string(t, "name", "");

@@ -147,6 +147,22 @@ TEST(MitsubaReader, CheckerboardMapsToCandelasSquares) {
   EXPECT_FLOAT_EQ(c.mapping.sv, 6);
 }
 
+TEST(MitsubaReader, RotatedToUvOfABitmap) {
+  // A quarter turn: Mitsuba's uv' = (-v, u); candela looks images up with t = 1 - v', so
+  // s = -v and t = 1 - u.
+  const std::string image = (fs::path(CANDELA_SOURCE_DIR) / "tests/data/textures/checker.ppm").string();
+  SceneDesc s = read_text(R"(<bsdf type="diffuse" id="b"><texture name="reflectance" type="bitmap">
+      <string name="filename" value=")" + image + R"("/><transform name="to_uv"><rotate z="1" angle="90"/></transform>
+      </texture></bsdf><shape type="rectangle"><ref id="b"/></shape>)");
+  const auto& t = std::get<ImageTexture>(s.textures[0]);
+  EXPECT_NEAR(t.mapping.su, 0, 1e-6);
+  EXPECT_NEAR(t.mapping.s_from_v, -1, 1e-6);
+  EXPECT_NEAR(t.mapping.du, 0, 1e-6);
+  EXPECT_NEAR(t.mapping.t_from_u, -1, 1e-6);
+  EXPECT_NEAR(t.mapping.sv, 0, 1e-6);
+  EXPECT_NEAR(t.mapping.dv, 1, 1e-6);
+}
+
 TEST(MitsubaReader, SpectraAsMitsubasRgbVariant) {
   // A flat reflectance of 0.78 given on 400..700 nm only (zero outside, as Mitsuba integrates it).
   SceneDesc s = read_text(R"(<shape type="rectangle"><bsdf type="diffuse">

@@ -33,9 +33,14 @@ struct Textured {
 using ColorInput = Textured<RGB>;
 using FloatInput = Textured<float>;
 
-// Texture coordinates (s, t) = (su * u + du, sv * v + dv) from the surface's (u, v).
+// Texture coordinates from the surface's (u, v) by an affine map:
+//   s = su u + s_from_v v + du,   t = t_from_u u + sv v + dv.
+// The cross terms are zero unless the texture is rotated or sheared (glTF's KHR_texture_transform
+// rotation, Mitsuba's to_uv, JSON's uv_matrix).
 struct UVMapping {
   float su = 1, sv = 1, du = 0, dv = 0;
+  float s_from_v = 0, t_from_u = 0;
+  bool is_axis_aligned() const { return s_from_v == 0 && t_from_u == 0; }
 };
 
 // What happens outside [0,1]^2.

@@ -19,7 +19,9 @@
 namespace candela {
 namespace {
 
-Vec2 apply_mapping(const UVMapping& m, Vec2 uv) { return {m.su * uv.x + m.du, m.sv * uv.y + m.dv}; }
+Vec2 apply_mapping(const UVMapping& m, Vec2 uv) {
+  return {m.su * uv.x + m.s_from_v * uv.y + m.du, m.t_from_u * uv.x + m.sv * uv.y + m.dv};
+}
 
 // floor(x) as an int, kept far inside int's range (and NaN made definite) so that the index
 // arithmetic below never overflows; coordinates that large have no precision left anyway.

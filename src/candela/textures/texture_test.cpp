@@ -339,6 +339,24 @@ TEST(TextureSet, ConstantInputsNeedNoTextures) {
   EXPECT_EQ(set.eval(FloatInput(0.75f), ctx), 0.75f);
 }
 
+TEST(TextureSet, RotatedMappingTurnsTheSquares) {
+  // s = -v, t = u (a quarter turn), scaled by 2: a point lands on the square its rotated
+  // coordinates name, which an axis-aligned map would get wrong.
+  CheckerboardTexture checker;
+  checker.tex1 = RGB(1, 0, 0);
+  checker.tex2 = RGB(0, 0, 1);
+  checker.mapping.su = 0;
+  checker.mapping.sv = 0;
+  checker.mapping.s_from_v = -2;
+  checker.mapping.t_from_u = 2;
+  TextureSet set({checker});
+  const RGB red(1, 0, 0), blue(0, 0, 1);
+  EXPECT_EQ(at(set, 0, 0.25f, 0.25f), blue);  // (s, t) = (-0.5, 0.5): floor -1 + 0
+  EXPECT_EQ(at(set, 0, 0.75f, 0.25f), red);   // (-0.5, 1.5): -1 + 1
+  EXPECT_EQ(at(set, 0, 0.25f, 0.75f), red);   // (-1.5, 0.5): -2 + 0
+  EXPECT_EQ(at(set, 0, 0.6f, 0.6f), blue);    // (-1.2, 1.2): -2 + 1
+}
+
 TEST(TextureSet, CheckerboardAlternatesOnUnitSquares) {
   CheckerboardTexture checker;
   checker.tex1 = RGB(1, 0, 0);
