@@ -541,9 +541,12 @@ class XmlParser {
     if (tag == "spectrum") {
       check_attributes(doc, node, {"name", "value", "filename"});
       Property p = named(Property::Kind::Spectrum);
-      if (node.attribute("filename"))
-        throw_scene_error(where.loc(), "<spectrum filename=...>: spectra from files are not supported; write the "
-                                       "wavelength:value pairs inline");
+      if (node.attribute("filename")) {
+        if (node.attribute("value")) throw_scene_error(where.loc(), "<spectrum>: give a value or a filename, not both");
+        read_spectrum_file(doc, node.attribute("filename").value(), where, p);
+        add(std::move(p));
+        return;
+      }
       std::vector<std::string> list = tokenize(required(doc, node, "value"));
       if (list.empty()) throw_scene_error(where.loc(), "<spectrum>: empty value");
       if (list.size() == 1 && list[0].find(':') == std::string::npos) {
@@ -573,6 +576,41 @@ class XmlParser {
     if (tag == "translate" || tag == "rotate" || tag == "scale" || tag == "lookat" || tag == "matrix")
       throw_scene_error(where.loc(), "<{}> can only occur inside a <transform>", tag);
     throw_scene_error(where.loc(), "unknown element <{}>", tag);
+  }
+
+  // Mitsuba's spectrum files: one "wavelength value" pair per line (nm), increasing; '#' starts a
+  // comment. The pairs then mean exactly what inline wavelength:value pairs mean.
+  void read_spectrum_file(const Document& doc, const std::string& name, const Where& where, Property& p) {
+    fs::path file = doc.dir / name;
+    if (!fs::exists(file)) {
+      std::optional<fs::path> found = resolve(name);
+      if (!found) throw_scene_error(where.loc(), "<spectrum>: file \"{}\" not found (searched {})", name, search_path_text());
+      file = *found;
+    }
+    std::ifstream in(file);
+    if (!in) throw_scene_error(where.loc(), "<spectrum>: cannot open \"{}\"", file.string());
+    std::string line;
+    for (int line_number = 1; std::getline(in, line); ++line_number) {
+      if (size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+      std::vector<std::string> words = tokenize(line, " \t\r,");
+      if (words.empty()) continue;
+      double w = 0, v = 0;
+      auto parse = [&](const std::string& word, double& out) {
+        const char* end = word.data() + word.size();
+        auto [stop, error] = std::from_chars(word.data(), end, out);
+        return error == std::errc() && stop == end && std::isfinite(out);
+      };
+      if (words.size() != 2 || !parse(words[0], w) || !parse(words[1], v))
+        throw_scene_error(SourceLocation{file.string(), line_number, 1, {}},
+                          "expected \"wavelength value\" (two numbers), got \"{}\"", line);
+      if (!p.wavelengths.empty() && w <= p.wavelengths.back())
+        throw_scene_error(SourceLocation{file.string(), line_number, 1, {}}, "wavelengths must increase ({} after {})",
+                          w, p.wavelengths.back());
+      p.wavelengths.push_back(w);
+      p.values.push_back(v);
+    }
+    if (p.wavelengths.size() < 2)
+      throw_scene_error(where.loc(), "<spectrum>: \"{}\" holds fewer than two wavelength-value pairs", file.string());
   }
 
   void include(const Document& doc, pugi::xml_node node, Object& parent, int depth, const Where& where) {
@@ -783,6 +821,28 @@ class Converter {
 
   // ------------------------------------------------ colours and textures
 
+  // Mitsuba's blackbody spectrum: Planck's law in W m^-2 sr^-1 nm^-1 (physical units: the scene
+  // should be in metres), zero outside [lambda_min, lambda_max]. Mitsuba's RGB variants refuse it;
+  // here it becomes the RGB a spectral variant's film would record, through the same CIE
+  // integration as a tabulated spectrum (1 nm steps).
+  RGB blackbody(const Object& t) {
+    const Property* temperature = find(t, "temperature");
+    if (!temperature) throw_scene_error(t.where.loc(), "blackbody: \"temperature\" (in kelvin) is required");
+    const double kelvin = get_float(t, "temperature", 0);
+    if (!(kelvin > 0)) throw_scene_error(temperature->where.loc(), "blackbody: the temperature must be positive");
+    const double lo = get_float(t, "lambda_min", 360), hi = get_float(t, "lambda_max", 830);
+    if (!(lo < hi)) throw_scene_error(t.where.loc(), "blackbody: lambda_min must be below lambda_max");
+    constexpr double c = 2.99792458e8, h = 6.62607004e-34, k = 1.38064852e-23;  // Mitsuba's constants
+    std::vector<double> wavelengths, values;
+    for (double nm = std::floor(lo); nm <= std::ceil(hi); nm += 1) {
+      const double l = nm * 1e-9;
+      const double radiance = nm < lo || nm > hi ? 0.0 : 1e-9 * 2 * h * c * c / (std::pow(l, 5) * std::expm1(h * c / (l * k * kelvin)));
+      wavelengths.push_back(nm);
+      values.push_back(radiance * ms::kCieYNormalization);
+    }
+    return ms::spectrum_list_to_srgb(wavelengths, values, false);
+  }
+
   RGB spectrum_rgb(const Property& p, bool within_emitter) {
     bool bounded = !(within_emitter || is_unbounded_name(p.name));
     if (p.wavelengths.empty()) return RGB(float(p.number));
@@ -804,6 +864,7 @@ class Converter {
         const Object& t = deref(*p);
         if (t.tag != "texture") throw_scene_error(p->where.loc(), "{}: \"{}\" must be a texture, not a <{}>",
                                                   o.describe(), name, t.tag);
+        if (t.type == "blackbody") return ColorInput(blackbody(t));  // a constant: no texture lookups
         ColorInput c;
         c.texture = texture(t);
         return c;
@@ -926,8 +987,7 @@ class Converter {
       }
       index = constant_texture(v);
     } else if (t.type == "blackbody") {
-      throw_scene_error(t.where.loc(), "blackbody spectra are not supported (Mitsuba's RGB variants do not support "
-                                       "them either); give an rgb value");
+      index = constant_texture(blackbody(t));
     } else {
       throw_scene_error(t.where.loc(), "unknown texture type \"{}\" (supported: bitmap, checkerboard, "
                                        "mesh_attribute, rawconstant)",
