@@ -168,7 +168,7 @@ int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RG
     BdptVertex& prev = path[n - 1];
     v = surface_vertex(hit, ray, beta);
     v.pdf_fwd = convert_density(pdf_fwd, prev, v);
-    Shading shading = scene_.shading(hit);
+    Shading shading = scene_.shading(hit, v.wo);
     v.bsdf = shading.bsdf;
     v.frame = shading.frame;
     v.ns = shading.frame.n;  // normal and bump maps tilt it

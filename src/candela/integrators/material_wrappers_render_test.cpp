@@ -68,6 +68,23 @@ TEST(MaterialWrappersRender, WhatAMaskShowsAtTheLastBounceGetsNoDirectLight) {
   }
 }
 
+TEST(MaterialWrappersRender, TwoSidedShowsEachSideItsOwnMaterial) {
+  // Front albedo 0.6, back 0.2 (each lit by the sky on its side): the camera sees the side it faces.
+  for (const char* integrator : {"path", "bdpt", "mlt"}) {
+    for (bool facing_up : {true, false}) {
+      SceneDesc d = plane_scene({DiffuseMaterial{RGB(0.6f)}, DiffuseMaterial{RGB(0.2f)}, TwoSidedMaterial{0, 1}},
+                                facing_up);
+      d.settings.integrator = integrator;
+      expect_mean(region_mean(render_description(d).mean_image(), -1), facing_up ? 0.6 : 0.2,
+                  std::string(facing_up ? "front, " : "back, ") + integrator);
+    }
+  }
+  // Wrapping it is refused: the side is chosen per hit, before any other wrapper.
+  SceneDesc wrapped = plane_scene({DiffuseMaterial{RGB(0.6f)}, DiffuseMaterial{RGB(0.2f)}, TwoSidedMaterial{0, 1},
+                                   mask_of(2, 0.5f)});
+  EXPECT_THROW(render_description(wrapped), SceneError);
+}
+
 TEST(MaterialWrappersRender, OneSidedSurfaceIsBlackFromTheBack) {
   for (const char* integrator : {"path", "bdpt"}) {
     // The plane faces away from the camera; the sky lights the side the camera sees.

@@ -78,7 +78,7 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const
     ++depth;
     // The BSDF and its shading frame (normal or bump mapped). A mask's "absent" part is a delta
     // event of this BSDF: it continues the path straight on and counts as a bounce (as Mitsuba does).
-    const Shading shading = scene_.shading(hit);
+    const Shading shading = scene_.shading(hit, wo);
     const SurfaceBsdf& bsdf = shading.bsdf;
     if (bsdf_is_black(bsdf)) break;
 

@@ -1057,6 +1057,8 @@ class JsonSceneReader {
       material = read_principled(m);
     else if (type == "one_sided")
       material = OneSidedMaterial{wrapped_material(m, "material")};
+    else if (type == "two_sided")
+      material = TwoSidedMaterial{wrapped_material(m, "front"), wrapped_material(m, "back")};
     else if (type == "mask") {
       MaskMaterial mask;
       mask.opacity = float_input_or(m, "opacity", Bound::UnitInterval, mask.opacity);
@@ -1079,7 +1081,7 @@ class JsonSceneReader {
       report_.fail(m.pointer_of("type"),
                    "unknown material type \"{}\"; expected one of: diffuse, phong, mirror, conductor, dielectric, "
                    "glass, coated_diffuse, plastic, diffuse_transmission, interface, null, black, principled, "
-                   "one_sided, mask, blend, normal_map, bump_map",
+                   "one_sided, two_sided, mask, blend, normal_map, bump_map",
                    type);
     m.finish();
     return material;
@@ -1231,9 +1233,13 @@ class JsonSceneReader {
   int wrapped_material(CheckedObject& m, std::string_view key) {
     const Json& value = m.require(key);
     std::string pointer = m.pointer_of(key);
-    if (value.is_string()) return material_by_name(value.get<std::string>(), pointer);
-    if (value.is_object()) return add_material(read_material(value, pointer));
-    report_.fail(pointer, "expected a material name or a material object, got {}", describe(value));
+    int index = -1;
+    if (value.is_string()) index = material_by_name(value.get<std::string>(), pointer);
+    else if (value.is_object()) index = add_material(read_material(value, pointer));
+    else report_.fail(pointer, "expected a material name or a material object, got {}", describe(value));
+    if (std::holds_alternative<TwoSidedMaterial>(scene_.materials[size_t(index)]))
+      report_.fail(pointer, "a two_sided material cannot be wrapped (it picks its side per hit, so it must be outermost)");
+    return index;
   }
 
   // A texture given by name or inline object (not a constant): normal and bump maps.

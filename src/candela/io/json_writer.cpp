@@ -166,6 +166,9 @@ Json material_json(const MaterialDesc& desc) {
             return j;
           },
           [](const OneSidedMaterial& m) { return Json{{"type", "one_sided"}, {"material", material_name(m.material)}}; },
+          [](const TwoSidedMaterial& m) {
+            return Json{{"type", "two_sided"}, {"front", material_name(m.front)}, {"back", material_name(m.back)}};
+          },
           [](const MaskMaterial& m) {
             return Json{{"type", "mask"}, {"opacity", number(m.opacity)}, {"material", material_name(m.material)}};
           },

@@ -80,12 +80,14 @@ TEST(ConvertJson, WrappersAndNewShapesRoundTrip) {
   mask.opacity.texture = 0;
   mask.material = 1;
   scene.materials.push_back(mask);
+  scene.materials.push_back(TwoSidedMaterial{2, 0});
   ShapeDesc disk;
   disk.geometry = DiskShape{};
   disk.material = 2;
   scene.shapes.push_back(disk);
   ShapeDesc tube;
   tube.geometry = CylinderShape{{0, 0, 0}, {0, 1, 0}, 0.5f};
+  tube.material = 3;
   scene.shapes.push_back(tube);
   scene.camera.projection = Projection::Orthographic;
   scene.camera.near_clip = 0.5f;
@@ -103,6 +105,9 @@ TEST(ConvertJson, WrappersAndNewShapesRoundTrip) {
             RGB(0.2f, 0.4f, 0.6f));
   EXPECT_EQ(back.camera.projection, Projection::Orthographic);
   EXPECT_EQ(back.camera.near_clip, 0.5f);
+  const auto& sides = std::get<TwoSidedMaterial>(back.materials[size_t(back.shapes[1].material)]);
+  EXPECT_TRUE(std::holds_alternative<MaskMaterial>(back.materials[size_t(sides.front)]));
+  EXPECT_TRUE(std::holds_alternative<DiffuseMaterial>(back.materials[size_t(sides.back)]));
 }
 
 }  // namespace

@@ -1119,11 +1119,12 @@ class Converter {
       index = one_sided(c, two_sided);
     } else if (type == "twosided") {
       auto bsdfs = nested(b, "bsdf");
-      if (bsdfs.size() == 2 && bsdfs[0].second != bsdfs[1].second)
-        throw_scene_error(b.where.loc(), "twosided with different front and back BSDFs is not supported");
       if (bsdfs.empty() || bsdfs.size() > 2)
-        throw_scene_error(b.where.loc(), "twosided needs one nested bsdf, got {}", bsdfs.size());
+        throw_scene_error(b.where.loc(), "twosided needs one or two nested bsdfs, got {}", bsdfs.size());
       index = bsdf(*bsdfs[0].second, true);
+      // Two BSDFs: the first for the front, the second for the back, each seen as from its front.
+      if (bsdfs.size() == 2 && bsdfs[0].second != bsdfs[1].second)
+        index = add_material(TwoSidedMaterial{index, bsdf(*bsdfs[1].second, true)});
     } else if (type == "mask") {
       MaskMaterial m;
       m.opacity = float_input(b, "opacity", 0.5f);

@@ -135,6 +135,15 @@ TEST(MitsubaReader, Bsdfs) {
   EXPECT_TRUE(std::holds_alternative<InterfaceMaterial>(s.materials[s.shapes[4].material]));
 }
 
+TEST(MitsubaReader, TwosidedWithTwoBsdfs) {
+  SceneDesc s = read_text(R"(<shape type="rectangle"><bsdf type="twosided">
+      <bsdf type="diffuse"><rgb name="reflectance" value="0.8, 0.1, 0.1"/></bsdf>
+      <bsdf type="roughconductor"/></bsdf></shape>)");
+  const auto& sides = std::get<TwoSidedMaterial>(s.materials[s.shapes[0].material]);
+  EXPECT_FLOAT_EQ(std::get<DiffuseMaterial>(s.materials[size_t(sides.front)]).reflectance.value.r, 0.8f);
+  EXPECT_TRUE(std::holds_alternative<ConductorMaterial>(s.materials[size_t(sides.back)]));
+}
+
 TEST(MitsubaReader, CheckerboardMapsToCandelasSquares) {
   SceneDesc s = read_text(R"(<bsdf type="diffuse" id="b"><texture name="reflectance" type="checkerboard">
       <transform name="to_uv"><scale x="5" y="3"/></transform><rgb name="color0" value="0.8"/><float name="color1" value="0.1"/>

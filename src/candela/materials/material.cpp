@@ -46,6 +46,7 @@ std::vector<int> nested_materials(const MaterialDesc& desc) {
       [](const auto& m) -> std::vector<int> {
         using T = std::decay_t<decltype(m)>;
         if constexpr (std::is_same_v<T, BlendMaterial>) return {m.material0, m.material1};
+        else if constexpr (std::is_same_v<T, TwoSidedMaterial>) return {m.front, m.back};
         else if constexpr (std::is_same_v<T, OneSidedMaterial> || std::is_same_v<T, MaskMaterial> ||
                            std::is_same_v<T, NormalMapMaterial> || std::is_same_v<T, BumpMapMaterial>)
           return {m.material};
@@ -90,8 +91,16 @@ MaterialTable::MaterialTable(const std::vector<MaterialDesc>& descs, const Textu
     for (int n : nested) {
       if (n < 0 || size_t(n) >= i)
         throw SceneError(fmt::format("material {}: wraps material {}, which is not a material before it", i, n));
+      if (std::holds_alternative<TwoSidedMaterial>(entries_[size_t(n)].desc))
+        throw SceneError(fmt::format("material {}: wraps material {}, which has two sides; a two-sided material must be "
+                                     "the outermost (it is chosen per hit by the side seen)",
+                                     i, n));
       count += leaves[size_t(n)];
       constant[i] = constant[i] && constant[size_t(n)];
+    }
+    if (std::holds_alternative<TwoSidedMaterial>(e.desc)) {
+      constant[i] = false;  // never resolved itself: shading() picks a side first
+      continue;
     }
     leaves[i] = count;
     if (count > SurfaceBsdf::kMaxComponents)
@@ -147,7 +156,10 @@ void MaterialTable::collect(int material, float weight, bool one_sided, const Te
   }
 }
 
-Shading MaterialTable::shading(uint32_t material, const TextureEvalContext& ctx, const SurfaceHit& hit) const {
+Shading MaterialTable::shading(uint32_t material, const TextureEvalContext& ctx, const SurfaceHit& hit,
+                               const Vec3& wo) const {
+  if (const auto* sides = std::get_if<TwoSidedMaterial>(&entries_[material].desc))
+    material = uint32_t(dot(wo, hit.ng) >= 0 ? sides->front : sides->back);
   Shading s{bsdf(material, ctx), Frame::from_normal_tangent(hit.ns, hit.dpdu)};
   const Entry& e = entries_[material];
   if (e.perturbations.empty()) return s;

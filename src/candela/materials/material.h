@@ -38,14 +38,16 @@ class MaterialTable {
   // descs.size() (for shapes that name none).
   MaterialTable(const std::vector<MaterialDesc>& descs, const TextureSet& textures);
 
-  // Throws SceneError for wrappers that cannot be resolved (see above).
+  // Throws SceneError for wrappers that cannot be resolved (see above). A two-sided material gives
+  // its front's BSDF here (use shading() to see the side the viewer is on).
   SurfaceBsdf bsdf(uint32_t material, const TextureEvalContext& ctx) const {
+    if (const auto* sides = std::get_if<TwoSidedMaterial>(&entries_[material].desc)) material = uint32_t(sides->front);
     const Entry& e = entries_[material];
     return e.constant ? *e.constant : resolve(material, ctx);
   }
   // The BSDF and the shading frame at a hit (its ns, ng, dpdu and dpdv; ctx is where the hit's
-  // textures are looked up).
-  Shading shading(uint32_t material, const TextureEvalContext& ctx, const SurfaceHit& hit) const;
+  // textures are looked up) for light leaving towards the world direction wo.
+  Shading shading(uint32_t material, const TextureEvalContext& ctx, const SurfaceHit& hit, const Vec3& wo) const;
   // Whether the material tilts shading normals (normal or bump maps).
   bool perturbs_normals(uint32_t material) const { return !entries_[material].perturbations.empty(); }
   // An interface material has no surface: rays pass through it (pbrt-v4's "interface").

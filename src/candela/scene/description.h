@@ -214,6 +214,14 @@ struct OneSidedMaterial {
   int material = -1;
 };
 
+// Different materials on the two sides (Mitsuba's "twosided" with two BSDFs): `front` where the
+// direction the light leaves towards (the viewer) is on the side the geometric normal points to,
+// `back` on the other side, each seen as from its own front. Chosen per hit, so it must be the
+// outermost wrapper (no mask, blend or map around it).
+struct TwoSidedMaterial {
+  int front = -1, back = -1;
+};
+
 // Alpha masking (Mitsuba's "mask"): with probability 1 - opacity the surface is not there and the
 // ray passes straight through; otherwise `material` scatters.
 struct MaskMaterial {
@@ -246,7 +254,7 @@ struct BumpMapMaterial {
 using MaterialDesc = std::variant<DiffuseMaterial, PhongMaterial, MirrorMaterial, DielectricMaterial, BlackMaterial,
                                   ConductorMaterial, CoatedDiffuseMaterial, DiffuseTransmissionMaterial,
                                   InterfaceMaterial, PrincipledMaterial, OneSidedMaterial, MaskMaterial,
-                                  BlendMaterial, NormalMapMaterial, BumpMapMaterial>;
+                                  BlendMaterial, NormalMapMaterial, BumpMapMaterial, TwoSidedMaterial>;
 
 // ---------------------------------------------------------------- shapes
 

@@ -66,9 +66,10 @@ class Scene {
   SurfaceBsdf bsdf(const SurfaceHit& hit) const {
     return materials_.bsdf(shapes_[hit.shape].material, texture_context(hit));
   }
-  // The BSDF at the hit with the shading frame it works in (the hit's, tilted by normal and bump maps).
-  Shading shading(const SurfaceHit& hit) const {
-    return materials_.shading(shapes_[hit.shape].material, texture_context(hit), hit);
+  // The BSDF at the hit with the shading frame it works in (the hit's, tilted by normal and bump
+  // maps), for light leaving towards wo (which side of a two-sided material is seen).
+  Shading shading(const SurfaceHit& hit, const Vec3& wo) const {
+    return materials_.shading(shapes_[hit.shape].material, texture_context(hit), hit, wo);
   }
   // Where textures are looked up at the hit: its point, uv and (on meshes) the triangle for
   // mesh-attribute textures.
