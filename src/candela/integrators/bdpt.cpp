@@ -44,7 +44,10 @@ class Restore {
 }  // namespace
 
 BdptIntegrator::BdptIntegrator(const Scene& scene, const RenderSettings& settings)
-    : scene_(scene), max_depth_(settings.max_depth), rr_start_depth_(settings.rr_start_depth) {}
+    : scene_(scene),
+      max_depth_(settings.max_depth),
+      rr_start_depth_(settings.rr_start_depth),
+      hide_emitters_(settings.hide_emitters) {}
 
 // ------------------------------------------------------------------------------------------ subpaths
 
@@ -492,7 +495,7 @@ RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts
   const float camera_part_scale = float(camera.width()) * float(camera.height()) / camera.importance_film_pixels();
   RGB L(0.0f);
   for (int t = 2; t <= max_depth_ + 2; ++t) {
-    if (crossed[size_t(t)].is_black()) continue;
+    if (crossed[size_t(t)].is_black() || (t == 2 && hide_emitters_)) continue;
     L += crossed[size_t(t)];
     if (target.strategies && strategy_index(0, t) < int(target.strategies->size()) && !target.unweighted)
       (*target.strategies)[size_t(strategy_index(0, t))].add_to_pixel(
@@ -501,7 +504,7 @@ RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts
   for (int t = 1; t <= nc; ++t)
     for (int s = 0; s <= nl; ++s) {
       int depth = s + t - 2;
-      if ((s == 1 && t == 1) || depth < 0 || depth > max_depth_) continue;
+      if ((s == 1 && t == 1) || depth < 0 || depth > max_depth_ || (depth == 0 && hide_emitters_)) continue;
       Connection c = connect(lv, cv, s, t, sampler, counts, ray.time);
       if (t == 1) {
         if (!c.L.is_black()) target.film->splats().add(c.raster, c.L, *target.filter);

@@ -131,6 +131,7 @@ class BdptIntegrator {
   const Scene& scene_;
   int max_depth_;
   int rr_start_depth_;
+  bool hide_emitters_;  // no depth-0 strategies: emitters seen directly are not shown
 };
 
 }  // namespace candela

@@ -11,6 +11,7 @@ namespace candela {
 namespace {
 
 using testing::look_at_camera;
+using testing::MeanEstimate;
 using testing::region_mean;
 using testing::render_description;
 
@@ -83,6 +84,41 @@ TEST(MaterialWrappersRender, TwoSidedShowsEachSideItsOwnMaterial) {
   SceneDesc wrapped = plane_scene({DiffuseMaterial{RGB(0.6f)}, DiffuseMaterial{RGB(0.2f)}, TwoSidedMaterial{0, 1},
                                    mask_of(2, 0.5f)});
   EXPECT_THROW(render_description(wrapped), SceneError);
+}
+
+TEST(MaterialWrappersRender, HiddenEmittersStillLightTheScene) {
+  // A black emissive square (radiance 4) between the camera and the plane, facing the camera, over
+  // the plane lit by the sky: with hide_emitters the square the camera sees is black, and every
+  // other pixel is bitwise what it was (the same random numbers, the same light).
+  for (const char* integrator : {"path", "bdpt", "mlt"}) {
+    SceneDesc d = plane_scene({BlackMaterial{}, DiffuseMaterial{RGB(0.6f)}});
+    ShapeDesc seen;
+    seen.geometry = RectangleShape{{-0.2f, -0.2f, 1}, {0.4f, 0, 0}, {0, 0.4f, 0}};
+    seen.material = 0;
+    seen.emission = AreaEmission{RGB(4.0f)};
+    d.shapes.push_back(seen);
+    d.settings.integrator = integrator;
+    d.settings.max_depth = 2;
+    SceneDesc hidden = d;
+    hidden.settings.hide_emitters = true;
+    Image shown = render_description(d).mean_image(), dark = render_description(hidden).mean_image();
+    auto in_square = [](int x, int y) { return x >= 6 && x < 10 && y >= 6 && y < 10; };  // inside the seen square
+    expect_mean(region_mean(shown, -1, in_square), 4.0, std::string("emitter shown, ") + integrator);
+    expect_mean(region_mean(dark, -1, in_square), 0.0, std::string("emitter hidden, ") + integrator);
+    auto outside = [](int x, int y) { return x < 3 || x >= 13 || y < 3 || y >= 13; };  // clear of the square
+    MeanEstimate lit = region_mean(shown, -1, outside);
+    EXPECT_GT(lit.mean, 0.01) << integrator;  // the lamp lights the plane
+    if (std::string(integrator) != "mlt") {
+      size_t differing = 0;
+      for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x)
+          if (outside(x, y))
+            for (int c = 0; c < 3; ++c) differing += shown.at(x, y)[c] != dark.at(x, y)[c];
+      EXPECT_EQ(differing, 0u) << integrator;
+    } else {
+      expect_mean(region_mean(dark, -1, outside), lit.mean, std::string("plane, emitters hidden, ") + integrator);
+    }
+  }
 }
 
 TEST(MaterialWrappersRender, OneSidedSurfaceIsBlackFromTheBack) {

@@ -20,6 +20,7 @@ PathIntegrator::PathIntegrator(const Scene& scene, const RenderSettings& setting
       rr_start_depth_(settings.rr_start_depth),
       direction_sampling_(settings.direction_sampling),
       mis_(settings.mis),
+      hide_emitters_(settings.hide_emitters),
       light_selection_(settings.light_selection),
       shadow_rays_(std::max(1, settings.shadow_rays)) {}
 
@@ -38,6 +39,7 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const
       // The ray escapes: add the radiance of the lights at infinity, weighted by MIS against light
       // sampling where that could have produced the same direction.
       for (uint32_t li : scene_.infinite_lights()) {
+        if (depth == 0 && hide_emitters_) break;
         RGB Le = scene_.escaped_radiance(li, ray.direction);
         if (Le.is_black()) continue;
         if (depth == 0 || specular_bounce)
@@ -52,7 +54,7 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const
 
     // Add emission from a surface the path hit, again MIS-weighted after non-delta bounces.
     Vec3 wo = -ray.direction;
-    RGB Le = scene_.emitted(hit, wo);
+    RGB Le = depth == 0 && hide_emitters_ ? RGB(0.0f) : scene_.emitted(hit, wo);
     if (!Le.is_black()) {
       if (depth == 0 || specular_bounce) {
         L += beta * Le;

@@ -58,6 +58,7 @@ class PathIntegrator {
   int rr_start_depth_;
   DirectionSampling direction_sampling_;
   bool mis_;
+  bool hide_emitters_;
   LightSelection light_selection_;
   int shadow_rays_;
 };

@@ -1608,8 +1608,7 @@ class Converter {
       rs.max_depth = candela_depth(get_int(i, "max_depth", -1));
       int rr = get_int(i, "rr_depth", 5);
       rs.rr_start_depth = std::max(1, rr - 1);
-      if (get_bool(i, "hide_emitters", false))
-        throw_scene_error(i.where.loc(), "{}: hide_emitters is not supported", i.describe());
+      rs.hide_emitters = get_bool(i, "hide_emitters", false);
       if (i.type == "ptracer")
         warn(i.where, "integrator \"ptracer\": rendering with candela's bidirectional path tracer (the same expectation)");
       if (i.type != "path" && i.type != "ptracer")
@@ -1622,8 +1621,7 @@ class Converter {
       int bs = get_int(i, "bsdf_samples", find(i, "shading_samples") ? es : 1);
       if (es != 1 || bs != 1)
         warn(i.where, "integrator \"direct\": emitter_samples/bsdf_samples are ignored (one of each, with MIS)");
-      if (get_bool(i, "hide_emitters", false))
-        throw_scene_error(i.where.loc(), "direct: hide_emitters is not supported");
+      rs.hide_emitters = get_bool(i, "hide_emitters", false);
     } else {
       throw_scene_error(i.where.loc(), "unknown integrator type \"{}\" (supported: path, direct, ptracer, moment)",
                         i.type);

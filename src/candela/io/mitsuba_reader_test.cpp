@@ -84,6 +84,11 @@ TEST(MitsubaReader, MaxDepthMapping) {
   EXPECT_EQ(read_text(R"(<integrator type="path"><integer name="max_depth" value="5"/></integrator>)")
                 .settings.max_depth, 4);
   EXPECT_EQ(read_text(R"(<integrator type="direct"/>)").settings.max_depth, 1);
+  EXPECT_FALSE(read_text(R"(<integrator type="path"/>)").settings.hide_emitters);
+  EXPECT_TRUE(read_text(R"(<integrator type="path"><boolean name="hide_emitters" value="true"/></integrator>)")
+                  .settings.hide_emitters);
+  EXPECT_TRUE(read_text(R"(<integrator type="direct"><boolean name="hide_emitters" value="true"/></integrator>)")
+                  .settings.hide_emitters);
 }
 
 TEST(MitsubaReader, RefsIncludeAndOneSidedWrapping) {

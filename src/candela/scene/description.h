@@ -538,6 +538,7 @@ struct RenderSettings {
   FilterDesc filter;
   DirectionSampling direction_sampling = DirectionSampling::Bsdf;
   bool mis = true;  // false: light sampling for direct light, emission found by bounces ignored
+  bool hide_emitters = false;  // emitters seen directly by the camera (depth 0) are not shown (Mitsuba's)
   LightSelection light_selection = LightSelection::Power;
   int shadow_rays = 1;
   BvhLayout bvh = BvhLayout::Fast;
