@@ -678,6 +678,15 @@ TEST_F(MeshIo, PlyControlBytesInTheHeaderAreAnError) {
             1u);
 }
 
+TEST_F(MeshIo, PlyCarriageReturnInsideADataLineIsAnError) {
+  // Assimp would end the record there and read the rest as the next one (found by the fuzzer: a
+  // 30-digit "list length" and a 14 GB allocation).
+  expect_error_mentions(write("cr.ply", kPlyTriangleHeader + "0 0 0\n1 0 0\r0666666666666666 1 0\n0 1 0\n3 0 1 2\n"),
+                        {"malformed PLY: line 11 has a carriage return inside it"});
+  // At the end of a line (CRLF files) it is fine.
+  EXPECT_EQ(load(write("crlf.ply", kPlyTriangleHeader + "0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2\r\n")).triangle_count(), 1u);
+}
+
 TEST_F(MeshIo, PlyUnrecognisedLineInsideAnElementIsAnError) {
   expect_error_mentions(write("garbled.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
                                              "propeofy ltrat ny\nproperty float y\nproperty float z\n"
