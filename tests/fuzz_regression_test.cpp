@@ -3,6 +3,7 @@
 // or throw SceneError. Under the ASan+UBSan build in CI a memory error fails the test as well.
 #include <gtest/gtest.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -104,6 +105,33 @@ TEST_F(FuzzRegression, ObjReader) {
 TEST_F(FuzzRegression, PlyReader) {
   expect_no_crash("ply_reader", [&](const fs::path& input) {
     (void)load_mesh_file(copy_in(input, "input.ply"), SourceLocation{"fuzz", 1, 1, {}});
+  });
+}
+
+TEST_F(FuzzRegression, SerializedReader) {
+  // As fuzz/serialized_reader_fuzz.cpp reads its input: an odd first byte, the rest is the whole
+  // file; an even one, the rest is one mesh's stream, compressed and wrapped (version 3 or 4 by bit 1).
+  expect_no_crash("serialized_reader", [&](const fs::path& input) {
+    const std::string data = read_bytes(input);
+    if (data.empty()) return;
+    std::string file = data.substr(1);
+    if (!(data[0] & 1)) {
+      const char version = data[0] & 2 ? 4 : 3;
+      uLongf size = compressBound(uLong(file.size()));
+      std::string packed(size, '\0');
+      ASSERT_EQ(compress(reinterpret_cast<Bytef*>(packed.data()), &size, reinterpret_cast<const Bytef*>(file.data()),
+                         uLong(file.size())),
+                Z_OK);
+      file = std::string{'\x1c', '\x04', version, '\0'} + packed.substr(0, size) +
+             std::string(version == 3 ? 4 : 8, '\0') + std::string{'\x01', '\0', '\0', '\0'};
+    }
+    write(dir_ / "input.serialized", file);
+    for (int shape_index : {0, 1}) {
+      try {
+        (void)load_mesh_file(dir_ / "input.serialized", SourceLocation{"fuzz", 1, 1, {}}, shape_index);
+      } catch (const SceneError&) {
+      }
+    }
   });
 }
 

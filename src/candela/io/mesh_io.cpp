@@ -1063,7 +1063,7 @@ TriangleMesh load_serialized(std::string_view bytes, int shape_index) {
     fail("shape_index {} is out of range: the file holds {} mesh{}", shape_index, count, count == 1 ? "" : "es");
   const char* entry = bytes.data() + bytes.size() - 4 - size_t(count - shape_index) * offset_size;
   const uint64_t at = version == 3 ? little_endian<uint32_t>(entry) : little_endian<uint64_t>(entry);
-  if (at + 4 >= bytes.size() || little_endian<uint16_t>(bytes.data() + at) != kSerializedMagic)
+  if (at >= bytes.size() || bytes.size() - at <= 4 || little_endian<uint16_t>(bytes.data() + at) != kSerializedMagic)
     fail("corrupt .serialized file: mesh {} does not start where the table says (byte {})", shape_index, at);
 
   SerializedInflater in(bytes, size_t(at) + 4);
