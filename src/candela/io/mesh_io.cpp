@@ -479,10 +479,15 @@ PlyHeader read_ply_header(std::string_view bytes) {
 
 bool fits(uint64_t at, uint64_t bytes, size_t size) { return at <= size && size - at >= bytes; }
 
-uint64_t read_binary_list_length(std::string_view data, uint64_t at, PlyScalarType type, bool big_endian) {
+// The raw bits of one binary value of `size` bytes at `at` (in bounds), in either byte order.
+uint64_t read_binary_bits(std::string_view data, uint64_t at, unsigned size, bool big_endian) {
   uint64_t bits = 0;
-  for (unsigned k = 0; k < type.size; ++k)
-    bits = bits << 8 | static_cast<uint8_t>(data[at + (big_endian ? k : type.size - 1u - k)]);
+  for (unsigned k = 0; k < size; ++k) bits = bits << 8 | static_cast<uint8_t>(data[at + (big_endian ? k : size - 1u - k)]);
+  return bits;
+}
+
+uint64_t read_binary_list_length(std::string_view data, uint64_t at, PlyScalarType type, bool big_endian) {
+  const uint64_t bits = read_binary_bits(data, at, type.size, big_endian);
   if (type.is_signed && (bits >> (8 * type.size - 1)) != 0) fail("malformed PLY: negative list length");
   return bits;
 }
@@ -851,10 +856,7 @@ class PlyNumbers {
       return v;
     }
     if (!fits(at_, type.size, data_.size())) fail("truncated PLY: the data ends early");
-    uint64_t bits = 0;
-    const bool big = header_.encoding == PlyEncoding::BinaryBigEndian;
-    for (unsigned k = 0; k < type.size; ++k)
-      bits = bits << 8 | static_cast<uint8_t>(data_[at_ + (big ? k : type.size - 1u - k)]);
+    const uint64_t bits = read_binary_bits(data_, at_, type.size, header_.encoding == PlyEncoding::BinaryBigEndian);
     at_ += type.size;
     if (!type.is_integer) return type.size == 4 ? double(std::bit_cast<float>(uint32_t(bits))) : std::bit_cast<double>(bits);
     if (type.is_signed && type.size < 8 && (bits >> (8 * type.size - 1)))
@@ -991,7 +993,7 @@ bool is_finite_uv(const Vec2& v) { return std::isfinite(v.x) && std::isfinite(v.
 // vertex colours, 0x10 face normals, 0x1000 / 0x2000 single / double precision); from version 4 a
 // NUL-terminated name; uint64 vertex and triangle counts; positions, then the normals, uvs and
 // colours the flags announce (3, 2, 3 numbers per vertex); 3 indices per triangle (uint32, or
-// uint64 beyond 2^32 vertices). The file ends with a table of where each mesh starts (uint32 in
+// uint64 beyond 2^32 vertices, which is refused). The file ends with a table of where each mesh starts (uint32 in
 // version 3, uint64 in version 4) and a uint32 count of meshes.
 
 constexpr uint16_t kSerializedMagic = 0x041C;
@@ -1083,9 +1085,10 @@ TriangleMesh load_serialized(std::string_view bytes, int shape_index) {
   const uint64_t triangles = little_endian<uint64_t>(in.data().data() + header + 8);
   header += 16;
   const bool doubles = (flags & kDoublePrecision) != 0;
-  const uint64_t real = doubles ? 8 : 4, index = vertices > std::numeric_limits<uint32_t>::max() ? 8 : 4;
+  // Indices are uint64 only beyond 2^32 vertices, which candela's uint32 indices cannot hold anyway.
   if (vertices > std::numeric_limits<uint32_t>::max())
     fail("mesh {} has {} vertices; candela indexes at most 2^32", shape_index, vertices);
+  const uint64_t real = doubles ? 8 : 4, index = 4;
   const uint64_t per_vertex =
       real * (3 + ((flags & kHasNormals) ? 3 : 0) + ((flags & kHasUvs) ? 2 : 0) + ((flags & kHasColors) ? 3 : 0));
   uint64_t vertex_bytes = 0, index_bytes = 0, total = 0;
@@ -1123,7 +1126,7 @@ TriangleMesh load_serialized(std::string_view bytes, int shape_index) {
   }
   mesh.indices.resize(size_t(triangles) * 3);
   for (uint32_t& i : mesh.indices) {
-    i = uint32_t(index == 8 ? little_endian<uint64_t>(p) : little_endian<uint32_t>(p));
+    i = little_endian<uint32_t>(p);
     p += index;
   }
   return mesh;

@@ -160,7 +160,7 @@ Shading MaterialTable::shading(uint32_t material, const TextureEvalContext& ctx,
                                const Vec3& wo) const {
   if (const auto* sides = std::get_if<TwoSidedMaterial>(&entries_[material].desc))
     material = uint32_t(dot(wo, hit.ng) >= 0 ? sides->front : sides->back);
-  Shading s{bsdf(material, ctx), Frame::from_normal_tangent(hit.ns, hit.dpdu)};
+  Shading s{one_side_bsdf(material, ctx), Frame::from_normal_tangent(hit.ns, hit.dpdu)};
   const Entry& e = entries_[material];
   if (e.perturbations.empty()) return s;
   const Normal3 original = s.frame.n;

@@ -42,8 +42,7 @@ class MaterialTable {
   // its front's BSDF here (use shading() to see the side the viewer is on).
   SurfaceBsdf bsdf(uint32_t material, const TextureEvalContext& ctx) const {
     if (const auto* sides = std::get_if<TwoSidedMaterial>(&entries_[material].desc)) material = uint32_t(sides->front);
-    const Entry& e = entries_[material];
-    return e.constant ? *e.constant : resolve(material, ctx);
+    return one_side_bsdf(material, ctx);
   }
   // The BSDF and the shading frame at a hit (its ns, ng, dpdu and dpdv; ctx is where the hit's
   // textures are looked up) for light leaving towards the world direction wo.
@@ -64,6 +63,11 @@ class MaterialTable {
     std::vector<int> perturbations;  // the normal / bump map materials that apply, outermost first
     std::shared_ptr<const RoughCoatTable> coat_table;  // for a tabulated coated diffuse
   };
+  // The BSDF of a material that is not two-sided: cached when constant.
+  SurfaceBsdf one_side_bsdf(uint32_t material, const TextureEvalContext& ctx) const {
+    const Entry& e = entries_[material];
+    return e.constant ? *e.constant : resolve(material, ctx);
+  }
   // The BSDF of a material that is not a wrapper.
   Bsdf build(const Entry& entry, const TextureEvalContext& ctx) const;
   // The mixture a material and its wrappers make.

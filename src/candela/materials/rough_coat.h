@@ -32,8 +32,9 @@ namespace candela {
 // hemisphere, eta = n_below / n_above): the energy reflected, or transmitted (without the
 // eta^2 radiance scaling), integrated over the visible microfacet normals.
 inline double rough_interface_albedo(const Microfacet& distribution, const Vec3& wi, float eta, bool transmitted) {
-  const int n = eta > 1 ? 32 : 128;
-  const QuadratureRule rule = gauss_legendre(n);
+  static const QuadratureRule rule_outside = gauss_legendre(32), rule_inside = gauss_legendre(128);
+  const QuadratureRule& rule = eta > 1 ? rule_outside : rule_inside;
+  const int n = int(rule.nodes.size());
   double sum = 0;
   for (int a = 0; a < n; ++a) {
     for (int b = 0; b < n; ++b) {
