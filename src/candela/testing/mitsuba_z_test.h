@@ -22,18 +22,14 @@ struct MitsubaZTestResult {
   bool passed() const { return passing_fraction >= 0.9975; }
 };
 
-// `image`, `reference` and `variance` must have the same size. The shared references' variance images
-// are negative in 3-40% of their pixel-channels (docs/conformance.md), which the protocol floors at
-// 1e-4; `absolute_variance` uses |var| instead, as a diagnostic (the protocol itself uses the value).
-inline MitsubaZTestResult mitsuba_z_test(const Image& image, const Image& reference, const Image& variance, int spp,
-                                         bool absolute_variance = false) {
+// `image`, `reference` and `variance` must have the same size.
+inline MitsubaZTestResult mitsuba_z_test(const Image& image, const Image& reference, const Image& variance, int spp) {
   MitsubaZTestResult r;
   const double pixels = double(image.width) * image.height;
   r.alpha = 1 - std::pow(0.99, 1 / pixels);
   int passing = 0;
   for (size_t i = 0; i < image.rgb.size(); ++i) {
-    double v = absolute_variance ? std::abs(double(variance.rgb[i])) : double(variance.rgb[i]);
-    double var = std::max(v, 1e-4);
+    double var = std::max(double(variance.rgb[i]), 1e-4);
     double z = std::abs(double(image.rgb[i]) - reference.rgb[i]) * std::sqrt(spp / var);
     // 2 (1 - Phi(z)) = erfc(z / sqrt 2); a NaN pixel fails (the comparison is false).
     double p = std::erfc(z / std::sqrt(2.0));
@@ -42,6 +38,17 @@ inline MitsubaZTestResult mitsuba_z_test(const Image& image, const Image& refere
   r.pixel_channels = int(image.rgb.size());
   r.passing_fraction = r.pixel_channels > 0 ? double(passing) / r.pixel_channels : 0;
   return r;
+}
+
+// The shared references' variance images are negative in 3-40% of their pixel-channels
+// (docs/conformance.md), which the protocol floors at 1e-4. This is `variance` with each negative
+// value replaced by the same pixel-channel of `substitute` (|var| itself, or an independent estimate
+// of the per-sample variance): the diagnostic variants of the protocol.
+inline Image replace_negative_variance(const Image& variance, const Image& substitute) {
+  Image out = variance;
+  for (size_t i = 0; i < out.rgb.size(); ++i)
+    if (out.rgb[i] < 0) out.rgb[i] = substitute.rgb[i];
+  return out;
 }
 
 }  // namespace candela::testing
