@@ -10,6 +10,8 @@
 
 #include "candela/io/error.h"
 #include "candela/io/named_spectra.h"
+#include "candela/lights/light.h"
+#include "candela/scene/scene.h"
 
 namespace candela {
 namespace {
@@ -282,6 +284,27 @@ TEST(MitsubaReader, Emitters) {
   EXPECT_FLOAT_EQ(spot.cone_delta, 30 - 22.5f);  // beam_width defaults to 3/4 of the cutoff
   EXPECT_NEAR(spot.direction.y, -1, 1e-5);
   EXPECT_NEAR(spot.up.z, 1, 1e-5);
+}
+
+TEST(MitsubaReader, TexturedAreaEmittersOnAnalyticShapes) {
+  // The lights of spheres, disks and cylinders read the texture at their samples' (u, v)
+  // (TexturedEmission.AnalyticEmittersCarryTheTextureRaysFindAtTheirSamples checks the values).
+  for (std::string shape : {"sphere", "disk", "cylinder"}) {
+    SceneDesc s = read_text("<shape type=\"" + shape + "\"><emitter type=\"area\">"
+                            "<texture type=\"checkerboard\" name=\"radiance\"/></emitter></shape>");
+    ASSERT_EQ(s.shapes.size(), 1u) << shape;
+    ASSERT_TRUE(s.shapes[0].emission && s.shapes[0].emission->texture >= 0) << shape;
+    Scene scene(s);
+    ASSERT_EQ(scene.lights().size(), 1u) << shape;
+    float lo = 1e30f, hi = 0;
+    for (int i = 0; i < 64; ++i) {
+      LightEmission le = light_sample_le(scene.lights()[0], {(i % 8 + 0.5f) / 8, (i / 8 + 0.5f) / 8}, {0.5f, 0.5f},
+                                         scene.bounding_sphere());
+      lo = std::min(lo, le.radiance.g);
+      hi = std::max(hi, le.radiance.g);
+    }
+    EXPECT_LT(lo, hi) << shape << ": the checkerboard's two colours";
+  }
 }
 
 TEST(MitsubaReader, SerializedShapesPickTheirMeshByIndex) {

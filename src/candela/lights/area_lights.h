@@ -1,7 +1,8 @@
 #pragma once
 // Diffuse area lights on shapes: one TriangleLight per emissive triangle (meshes and boxes become
 // triangles), RectangleLight, SphereLight, DiskLight and CylinderLight for those shapes. Radiance is constant over the
-// surface and emitted on the side of `n` (both sides if two_sided).
+// surface (or a texture at the point's (u, v) times it) and emitted on the side of `n` (both sides if two_sided).
+#include "candela/geometry/quadric_uv.h"
 #include "candela/lights/light_sample.h"
 #include "candela/math/frame.h"
 #include "candela/sampling/warp.h"
@@ -138,6 +139,17 @@ struct SphereLight {
   RGB radiance;
   bool two_sided;
   bool emits_inward;  // reverse orientation: the emitting side faces the centre
+  // Textured emitters: the texture, and the world directions of the sphere's own x, y, z axes
+  // (orthonormal: emissive spheres are only moved, turned, mirrored and scaled uniformly), which
+  // place its (u, v).
+  EmissionTexture emission_texture;
+  Vec3 object_x{1, 0, 0}, object_y{0, 1, 0}, object_z{0, 0, 1};
+
+  RGB emission_at(const Point3& p) const {
+    if (emission_texture.texture < 0) return radiance;
+    Vec3 d = p - center;
+    return emission_texture(radiance, sphere_uv({dot(d, object_x), dot(d, object_y), dot(d, object_z)}), p);
+  }
 
   bool emits_from(const Normal3& outward, const Vec3& w) const {
     return two_sided || ((dot(outward, w) > 0) != emits_inward);
@@ -175,7 +187,7 @@ struct SphereLight {
     if (dist == 0 || !(pdf > 0) || !std::isfinite(pdf)) return {};
     Vec3 wi = d / dist;
     if (!emits_from(n, -wi)) return {};
-    return {radiance, wi, dist, pdf, p, n, false};
+    return {emission_at(p), wi, dist, pdf, p, n, false};
   }
   // Emission: a uniform point on the sphere, a cosine-weighted direction on its emitting side(s).
   LightEmission sample_le(Vec2 u_pos, Vec2 u_dir, const SceneSphere&) const {
@@ -183,7 +195,8 @@ struct SphereLight {
     Normal3 n = emits_inward ? -outward : outward;
     float pdf_dir;
     Vec3 w = sample_cosine_emission(n, two_sided, u_dir, pdf_dir);
-    return {radiance, center + outward * radius, w, n, 1 / (4 * kPi * radius * radius), pdf_dir};
+    Point3 p = center + outward * radius;
+    return {emission_at(p), p, w, n, 1 / (4 * kPi * radius * radius), pdf_dir};
   }
   EmissionPdf pdf_le(const Point3& p, const Normal3&, const Vec3& w, const SceneSphere&) const {
     Vec3 outward = normalize(p - center);
@@ -213,18 +226,26 @@ struct DiskLight {
   float area;
   RGB radiance;
   bool two_sided;
+  EmissionTexture emission_texture;  // textured emitters
 
-  Point3 point(Vec2 u) const {
+  // A uniform point, and the radiance it emits.
+  Point3 point(Vec2 u, RGB& emitted) const {
     Vec2 d = square_to_concentric_disk(u);
-    return center + axis_u * d.x + axis_v * d.y;
+    Point3 p = center + axis_u * d.x + axis_v * d.y;
+    emitted = emission_texture.texture < 0 ? radiance : emission_texture(radiance, disk_uv(d.x, d.y), p);
+    return p;
   }
   LightSample sample_li(const LightSampleContext& ctx, Vec2 u) const {
-    return flat_light_sample(point(u), n, area, radiance, two_sided, ctx);
+    RGB emitted;
+    Point3 p = point(u, emitted);
+    return flat_light_sample(p, n, area, emitted, two_sided, ctx);
   }
   LightEmission sample_le(Vec2 u_pos, Vec2 u_dir, const SceneSphere&) const {
     float pdf_dir;
     Vec3 w = sample_cosine_emission(n, two_sided, u_dir, pdf_dir);
-    return {radiance, point(u_pos), w, n, 1 / area, pdf_dir};
+    RGB emitted;
+    Point3 p = point(u_pos, emitted);
+    return {emitted, p, w, n, 1 / area, pdf_dir};
   }
   EmissionPdf pdf_le(const Point3&, const Normal3&, const Vec3& w, const SceneSphere&) const {
     return {1 / area, cosine_emission_pdf(n, two_sided, w)};
@@ -251,6 +272,7 @@ struct CylinderLight {
   RGB radiance;
   bool two_sided;
   bool emits_inward;  // flipped normals: the emitting side faces the axis
+  EmissionTexture emission_texture;  // textured emitters
 
   Normal3 emitting_normal(const Point3& p) const {
     Vec3 d = p - base;
@@ -259,23 +281,28 @@ struct CylinderLight {
     Normal3 out = len > 0 ? radial / len : axis_u;
     return emits_inward ? -out : out;
   }
-  Point3 point(Vec2 u, Normal3& n) const {
-    float phi = 2 * kPi * u.y;
-    Vec3 radial = axis_u * std::cos(phi) + axis_v * std::sin(phi);
+  // A uniform point, its emitting normal and the radiance it emits.
+  Point3 point(Vec2 u, Normal3& n, RGB& emitted) const {
+    float phi = 2 * kPi * u.y, c = std::cos(phi), s = std::sin(phi);
+    Vec3 radial = axis_u * c + axis_v * s;
     n = emits_inward ? -radial : radial;
-    return base + radial * radius + axis * u.x;
+    Point3 p = base + radial * radius + axis * u.x;
+    emitted = emission_texture.texture < 0 ? radiance : emission_texture(radiance, cylinder_uv(c, s, u.x), p);
+    return p;
   }
   LightSample sample_li(const LightSampleContext& ctx, Vec2 u) const {
     Normal3 n;
-    Point3 p = point(u, n);
-    return flat_light_sample(p, n, area, radiance, two_sided, ctx);
+    RGB emitted;
+    Point3 p = point(u, n, emitted);
+    return flat_light_sample(p, n, area, emitted, two_sided, ctx);
   }
   LightEmission sample_le(Vec2 u_pos, Vec2 u_dir, const SceneSphere&) const {
     Normal3 n;
-    Point3 p = point(u_pos, n);
+    RGB emitted;
+    Point3 p = point(u_pos, n, emitted);
     float pdf_dir;
     Vec3 w = sample_cosine_emission(n, two_sided, u_dir, pdf_dir);
-    return {radiance, p, w, n, 1 / area, pdf_dir};
+    return {emitted, p, w, n, 1 / area, pdf_dir};
   }
   EmissionPdf pdf_le(const Point3& p, const Normal3&, const Vec3& w, const SceneSphere&) const {
     return {1 / area, cosine_emission_pdf(emitting_normal(p), two_sided, w)};

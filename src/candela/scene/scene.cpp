@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "candela/film/image_io.h"
+#include "candela/geometry/quadric_uv.h"
 #include "candela/io/error.h"
 
 namespace candela {
@@ -198,12 +199,6 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int object, TriangleM
     if (size_t(desc.emission->texture) >= textures_.size())
       throw SceneError(fmt::format("{}: {}: the emission texture {} does not exist", source_file_, rec.name,
                                    desc.emission->texture));
-    // Textured emission is sampled on triangles and rectangles, whose (u, v) follow from the point.
-    if (std::holds_alternative<SphereShape>(desc.geometry) || std::holds_alternative<DiskShape>(desc.geometry) ||
-        std::holds_alternative<CylinderShape>(desc.geometry))
-      throw SceneError(fmt::format("{}: {}: textured emission is supported on meshes, boxes and rectangles, not on "
-                                   "spheres, disks or cylinders (use a mesh)",
-                                   source_file_, rec.name));
   }
 
   if (const auto* s = std::get_if<SphereShape>(&desc.geometry)) {
@@ -277,7 +272,13 @@ void Scene::add_sphere(ShapeRecord rec, const SphereShape& s, const Transform& T
     rec.first_light = int(lights_.size());
     rec.radiance = emission->radiance;
     rec.two_sided_emission = emission->two_sided;
-    lights_.push_back(SphereLight{T.point(s.center), s.radius * lx, rec.radiance, rec.two_sided_emission, reverse});
+    rec.emission_texture = emission->texture;
+    SphereLight light{T.point(s.center), s.radius * lx, rec.radiance, rec.two_sided_emission, reverse};
+    light.emission_texture = {&textures_, rec.emission_texture};
+    light.object_x = ex / lx;
+    light.object_y = ey / ly;
+    light.object_z = ez / lz;
+    lights_.push_back(light);
   }
   embree_.add_sphere(uint32_t(shapes_.size()), rec.sphere, object);
   shapes_.push_back(std::move(rec));
@@ -296,12 +297,14 @@ void Scene::add_quadric(ShapeRecord rec, QuadricGeometry::Kind kind, const Trans
     rec.first_light = int(lights_.size());
     rec.radiance = emission->radiance;
     rec.two_sided_emission = emission->two_sided;
+    rec.emission_texture = emission->texture;
+    const EmissionTexture texture{&textures_, rec.emission_texture};
     Vec3 eu = M.vector({1, 0, 0}), ev = M.vector({0, 1, 0}), ez = M.vector({0, 0, 1});
     if (disk) {
       Normal3 n = normalize(M.normal({0, 0, 1}));
       if (rec.flip_normal) n = -n;
       lights_.push_back(DiskLight{M.point(Point3(0.0f)), eu, ev, n, kPi * length(cross(eu, ev)), rec.radiance,
-                                  rec.two_sided_emission});
+                                  rec.two_sided_emission, texture});
     } else {
       // Uniform sampling by area needs a circular, right cylinder in world space.
       float lu = length(eu), lv = length(ev), lz = length(ez);
@@ -311,7 +314,7 @@ void Scene::add_quadric(ShapeRecord rec, QuadricGeometry::Kind kind, const Trans
             "{}: {}: an emissive cylinder must stay circular (no non-uniform scale across its axis, no shear)",
             source_file_, rec.name));
       lights_.push_back(CylinderLight{M.point(Point3(0.0f)), eu / lu, ev / lv, ez, lu, 2 * kPi * lu * lz,
-                                      rec.radiance, rec.two_sided_emission, rec.flip_normal});
+                                      rec.radiance, rec.two_sided_emission, rec.flip_normal, texture});
     }
   }
   embree_.add_quadric(uint32_t(shapes_.size()), rec.quadric, object);
@@ -526,9 +529,7 @@ void Scene::reconstruct_sphere_hit(const ShapeRecord& rec, const Ray& ray, float
   hit.ng = normalize(to_world->normal(po));
   if (rec.flip_normal) hit.ng = -hit.ng;
   hit.ns = hit.ng;
-  float phi = std::atan2(po.y, po.x);
-  if (phi < 0) phi += 2 * kPi;
-  hit.uv = {phi * kInv2Pi, std::acos(std::clamp(po.z / s.radius, -1.0f, 1.0f)) * kInvPi};
+  hit.uv = sphere_uv(po);
   hit.dpdu = to_world->vector(Vec3(-po.y, po.x, 0) * (2 * kPi));
   // v = theta / pi: dp/dv = pi (z cos phi, z sin phi, -r sin theta).
   float rho = std::sqrt(po.x * po.x + po.y * po.y);
@@ -548,10 +549,8 @@ void Scene::reconstruct_quadric_hit(const ShapeRecord& rec, const Ray& ray, floa
   if (q.kind == QuadricGeometry::Kind::Disk) {
     // Mitsuba's disk: (u, v) = (r, phi / 2 pi), dp/du the radial direction.
     local.z = 0;
-    float r = std::sqrt(local.x * local.x + local.y * local.y);
-    float phi = std::atan2(local.y, local.x);
-    if (phi < 0) phi += 2 * kPi;
-    hit.uv = {r, phi * kInv2Pi};
+    hit.uv = disk_uv(local.x, local.y);
+    float r = hit.uv.x;
     hit.dpdu = M->vector(r > 0 ? Vec3(local.x / r, local.y / r, 0) : Vec3(1, 0, 0));
     hit.dpdv = M->vector(Vec3(-local.y, local.x, 0) * (2 * kPi));
     hit.ng = normalize(M->normal({0, 0, 1}));
@@ -561,9 +560,7 @@ void Scene::reconstruct_quadric_hit(const ShapeRecord& rec, const Ray& ray, floa
     float rho = std::sqrt(local.x * local.x + local.y * local.y);
     float x = rho > 0 ? local.x / rho : 1.0f, y = rho > 0 ? local.y / rho : 0.0f;
     local = {x, y, std::clamp(local.z, 0.0f, 1.0f)};
-    float phi = std::atan2(y, x);
-    if (phi < 0) phi += 2 * kPi;
-    hit.uv = {phi * kInv2Pi, local.z};
+    hit.uv = cylinder_uv(x, y, local.z);
     hit.dpdu = M->vector(Vec3(-y, x, 0) * (2 * kPi));
     hit.dpdv = M->vector(Vec3(0, 0, 1));
     hit.ng = normalize(M->normal({x, y, 0}));
