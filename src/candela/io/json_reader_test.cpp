@@ -1441,6 +1441,18 @@ TEST(JsonReader, ReadsTheRoomScene) {
   EXPECT_EQ(scene.settings.spp, 64);
 }
 
+// Every JSON scene shipped with the sources (scenes/, bench/scenes/) reads.
+TEST(JsonReader, EveryShippedSceneReads) {
+  int scenes = 0;
+  for (const char* folder : {"scenes", "bench/scenes"})
+    for (const auto& entry : fs::directory_iterator(kSourceDir / folder)) {
+      if (entry.path().extension() != ".json") continue;
+      EXPECT_NO_THROW(read_scene_file(entry.path())) << entry.path();
+      ++scenes;
+    }
+  EXPECT_GE(scenes, 10);
+}
+
 // Keeps docs/scene-format.md honest: each of its json blocks is a complete scene that reads.
 TEST(JsonReader, EveryExampleInTheFormatDocumentReads) {
   std::ifstream in(kSourceDir / "docs/scene-format.md");
