@@ -435,6 +435,17 @@ TEST(BidirectionalAgreement, VeachMis) {
   expect_metropolis_agrees(d, 256, 256, "veach-mis");
 }
 
+TEST(BidirectionalAgreement, MetropolisWithLensAndCausticPerturbations) {
+  // The perturbations, and the small steps that stand in for them where they would move nothing
+  // (accepted with Hastings' ratio, MltSampler::small_step_probability), keep the chains' target.
+  SceneDesc d = scene_at(kScenes + "cornell-box.json", 48, 48);
+  d.settings.mlt_bootstrap = 20000;
+  d.settings.mlt_chains = 256;
+  d.settings.mlt_lens = 0.3f;
+  d.settings.mlt_caustic = 0.2f;
+  expect_metropolis_agrees(d, 256, 256, "cornell-box with perturbations");
+}
+
 TEST(BidirectionalAgreement, GlassSphereCaustic) {
   // The path tracer finds the caustic only by hitting the small light through the glass: rare,
   // bright samples, hence its high spp.

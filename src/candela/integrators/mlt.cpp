@@ -22,7 +22,12 @@ namespace {
 struct PathState {
   RGB L;
   Vec2 raster;
+  int s = 0, t = 0;  // the strategy the numbers chose
   float luminance() const { return L.luminance(); }
+  // Whether a lens or a caustic perturbation changes anything: a light-traced path (t = 1) does not
+  // read its film position, a light subpath of fewer than two vertices not its direction.
+  bool lens_moves() const { return t >= 2; }
+  bool caustic_moves() const { return s >= 2; }
 };
 
 // The contribution of the path the sampler's current numbers describe, at a given depth: the
@@ -57,7 +62,7 @@ class MltPathSampler {
     Vec2 lens = sampler.get_2d();
     float time = lerp(sampler.get_1d(), camera.shutter_open(), camera.shutter_close());
     Ray ray = camera.generate_ray(raster, lens, time);
-    PathState state{RGB(0.0f), raster};
+    PathState state{RGB(0.0f), raster, s, t};
     if (bdpt_.camera_subpath(ray, sampler, counts, t, camera_path.data()) != t) return state;
     sampler.start_stream(MltSampler::kLightStream);
     if (bdpt_.light_subpath(sampler, counts, s, time, light_path.data()) != s) return state;
@@ -337,10 +342,19 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
         RayCounts& counts = ray_counts.local();
         if (first_round) c.current = paths.sample(c.sampler, c.depth, counts);
         for (uint64_t m = 0; m < steps; ++m) {
-          c.sampler.start_iteration();
+          c.sampler.start_iteration(c.current.lens_moves(), c.current.caustic_moves());
           PathState proposed = paths.sample(c.sampler, c.depth, counts);
           float y_current = c.current.luminance(), y_proposed = proposed.luminance();
-          float accept = y_current > 0 ? std::min(1.0f, y_proposed / y_current) : 1.0f;
+          // A small step's chance depends on the path it leaves (MltSampler::start_iteration):
+          // Hastings' ratio of those chances keeps detailed balance (1 without perturbations).
+          float accept = 1;
+          if (y_current > 0) {
+            float ratio = y_proposed / y_current;
+            if (c.sampler.mutation() == MltSampler::Mutation::Small)
+              ratio *= c.sampler.small_step_probability(proposed.lens_moves(), proposed.caustic_moves()) /
+                       c.sampler.small_step_probability(c.current.lens_moves(), c.current.caustic_moves());
+            accept = std::min(1.0f, ratio);
+          }
           // Deposit both states, weighted by the probability that the chain moves or stays, with
           // Kelemen et al.'s weights: a large step is also an independent sample of the film, and
           // the two estimators are combined by their densities (p_large against f / b), so dim

@@ -60,19 +60,25 @@ class MltSampler {
     if (perturbed_.light_direction < 0) probabilities_.caustic = 0;
   }
 
-  // Starts a proposal, of a kind drawn with the fixed probabilities.
-  void start_iteration() {
+  // Starts a proposal, of a kind drawn with the fixed probabilities. A perturbation that would move
+  // only numbers the current path does not read (the film position of a light-traced path, t = 1;
+  // the light's direction when the light subpath has fewer than two vertices) would propose the same
+  // path again: it becomes a small step instead. The chance of a small step then depends on the
+  // current path, which the acceptance must weigh (small_step_probability).
+  void start_iteration(bool lens_moves_path = true, bool caustic_moves_path = true) {
     ++iteration_;
     float u = rng_.next_float();
+    const float lens = lens_moves_path ? probabilities_.lens : 0;
+    const float caustic = caustic_moves_path ? probabilities_.caustic : 0;
     if (u < probabilities_.large_step) {
       mutation_ = Mutation::Large;
-    } else if ((u -= probabilities_.large_step) < probabilities_.lens) {
+    } else if ((u -= probabilities_.large_step) < lens) {
       mutation_ = Mutation::Lens;
       // Radii in pixels, then in units of the film's extent.
       float r = exponential_radius(0.1f, 0.1f * std::max(perturbed_.film_pixels.x, perturbed_.film_pixels.y));
       Vec2 d = random_direction(r);
       offset_ = {d.x / perturbed_.film_pixels.x, d.y / perturbed_.film_pixels.y};
-    } else if ((u -= probabilities_.lens) < probabilities_.caustic) {
+    } else if ((u -= lens) < caustic) {
       mutation_ = Mutation::Caustic;
       offset_ = random_direction(exponential_radius(5e-5f, 0.05f));
     } else {
@@ -96,6 +102,13 @@ class MltSampler {
   void start_stream(int stream) {
     stream_ = stream;
     sample_in_stream_ = 0;
+  }
+  // The probability that start_iteration makes a small step from a path where the perturbations
+  // would (or would not) move anything. A small step from path x to path y is accepted with
+  // min(1, f(y) P(y) / (f(x) P(x))) for P this probability, which keeps detailed balance.
+  float small_step_probability(bool lens_moves_path, bool caustic_moves_path) const {
+    return std::max(0.0f, 1 - probabilities_.large_step - (lens_moves_path ? probabilities_.lens : 0) -
+                              (caustic_moves_path ? probabilities_.caustic : 0));
   }
   bool large_step() const { return mutation_ == Mutation::Large; }
   Mutation mutation() const { return mutation_; }
