@@ -17,6 +17,7 @@
 // 0.05 of the direction numbers' unit square), wrapped around the unit square: a symmetric
 // proposal, so the acceptance probability stays min(1, f(new) / f(old)) and every mixture of the
 // four kinds of mutation, chosen with fixed probabilities, leaves the chain's target unchanged.
+// (Where a perturbation would move nothing, a small step stands in for it: start_iteration.)
 //
 // Numbers come in interleaved streams (camera subpath, light subpath, connection), so a change in
 // how many numbers one subpath uses does not shift the numbers of the others.
