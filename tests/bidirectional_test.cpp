@@ -538,6 +538,62 @@ TEST(BidirectionalAgreement, EnvironmentMap) {
   std::filesystem::remove(map);
 }
 
+// -------------------------------------------------------------------------------- spectral transport
+
+// Spectral transport (spectral/wavelengths.h) in every integrator: grey materials under a white sky
+// keep their analytic answers (the constant spectra of grey reflectances, and D65 for white light,
+// whose colour through the CIE tables is white within 2e-3: Cie.TablesGiveTheStandardIntegrals...).
+TEST(SpectralTransport, FurnacesKeepTheirAnalyticAnswers) {
+  for (const char* integrator : {"path", "bdpt"}) {
+    for (auto [material, expected] : {std::pair<MaterialDesc, double>{DiffuseMaterial{RGB(0.7f)}, 0.7},
+                                      std::pair<MaterialDesc, double>{DielectricMaterial{1.5f, RGB(1.0f), RGB(1.0f)}, 1.0}}) {
+      SceneDesc d = sphere_under_sky(material);
+      d.settings.spectral = true;
+      Image img = render_image(d, integrator, 32, 5);
+      for (int c = 0; c < 3; ++c) {
+        testing::MeanEstimate e = region_mean(img, c, inside_disk);
+        EXPECT_NEAR(e.mean, expected, 4 * e.standard_error + 2e-3)
+            << integrator << " channel " << c << ": standard error " << e.standard_error;
+      }
+    }
+  }
+  // Metropolis: the closed emissive sphere, over seeds (its pixels are correlated).
+  const float albedo = 0.6f, Le = 0.5f;
+  SceneDesc d = closed_sphere(albedo);
+  d.shapes[0].emission = AreaEmission{RGB(Le), true};
+  d.settings.spectral = true;
+  d.settings.max_depth = 30;
+  d.settings.mlt_bootstrap = 4000;
+  d.settings.mlt_chains = 64;
+  std::vector<double> means;
+  for (uint64_t seed = 1; seed <= 4; ++seed) means.push_back(image_mean(render_image(d, "mlt", 64, seed)));
+  double m = 0, v = 0;
+  for (double x : means) m += x / means.size();
+  for (double x : means) v += (x - m) * (x - m) / (means.size() - 1);
+  double expected = Le * (1 - std::pow(albedo, 31)) / (1 - albedo);
+  EXPECT_NEAR(m, expected, 5 * std::sqrt(v / means.size()) + 2e-3 * expected) << "seed-to-seed deviation " << std::sqrt(v);
+}
+
+TEST(BidirectionalAgreement, SpectralCornellBox) {
+  // Spectral transport with saturated walls: the path tracer, BDPT and MLT sample the same spectra.
+  SceneDesc d = scene_at(kScenes + "cornell-box.json", 32, 32);
+  d.settings.spectral = true;
+  d.settings.mlt_bootstrap = 20000;
+  d.settings.mlt_chains = 256;
+  expect_integrators_agree(d, {{"path", 256}, {"bdpt", 64}, {"mlt", 256}}, 0.005, "spectral cornell-box");
+}
+
+TEST(SpectralTransport, OneAndTwoThreadsGiveBitwiseIdenticalImages) {
+  SceneDesc d = scene_at(kScenes + "cornell-box.json", 24, 16);
+  d.settings.spectral = true;
+  d.settings.mlt_bootstrap = 2000;
+  d.settings.mlt_chains = 16;
+  for (const char* integrator : {"path", "bdpt", "mlt"}) {
+    Image one = render_image(d, integrator, 8, 7, 1), two = render_image(d, integrator, 8, 7, 2);
+    EXPECT_TRUE(std::memcmp(one.rgb.data(), two.rgb.data(), one.rgb.size() * sizeof(float)) == 0) << integrator;
+  }
+}
+
 // ----------------------------------------------------------------------------------- determinism
 
 bool bitwise_equal(const Image& a, const Image& b) {

@@ -69,7 +69,7 @@ struct RenderCommand {
   std::optional<uint64_t> seed;
   std::string resolution;
   std::string integrator;
-  std::string sampler, filter, direction_sampling, light_selection, spp_map, bvh;
+  std::string sampler, filter, direction_sampling, light_selection, spp_map, bvh, transport;
   std::optional<int> shadow_rays, max_spp, adaptive_batch, adaptive_spp;
   std::optional<float> adaptive_threshold;
   bool no_mis = false;
@@ -125,6 +125,8 @@ void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
                                                        {"paper", LightSelection::Paper},
                                                        {"uniform", LightSelection::Uniform}});
   if (cmd.no_mis) rs.mis = false;
+  if (!cmd.transport.empty())
+    rs.spectral = parse_choice<bool>("--transport", cmd.transport, {{"rgb", false}, {"spectral", true}});
   if (cmd.mlt_bootstrap) rs.mlt_bootstrap = *cmd.mlt_bootstrap;
   if (cmd.mlt_chains) rs.mlt_chains = *cmd.mlt_chains;
   if (cmd.mlt_sigma) rs.mlt_sigma = *cmd.mlt_sigma;
@@ -235,6 +237,7 @@ RenderFingerprint make_fingerprint(const std::string& scene_bytes, const SceneDe
       {"rr-start-depth", std::to_string(rs.rr_start_depth)},
       {"direction-sampling", std::to_string(int(rs.direction_sampling))},
       {"mis", rs.mis ? "on" : "off"},
+      {"transport", rs.spectral ? "spectral" : "rgb"},
       {"light-selection", std::to_string(int(rs.light_selection))},
       {"shadow-rays", std::to_string(rs.shadow_rays)},
       {"adaptive-threshold", fmt::format("{}", rs.adaptive_threshold)},
@@ -519,6 +522,11 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--direction-sampling", cmd.direction_sampling,
                          "Next-direction sampling at non-delta surfaces: bsdf (importance), cosine, uniform "
                          "(the paper's eq. 11)");
+  render_cmd->add_option("--transport", cmd.transport,
+                         "Light transport: rgb (three colour channels) or spectral (three sampled wavelengths "
+                         "per path, RGB parameters as smooth spectra, as pbrt-v4); default: the scene's "
+                         "(spectral for pbrt-v4 files, rgb otherwise)")
+      ->check(CLI::IsMember({"rgb", "spectral"}));
   render_cmd->add_flag("--no-mis", cmd.no_mis,
                        "Turn off multiple importance sampling: direct light from shadow rays only");
   render_cmd->add_option("--light-selection", cmd.light_selection,

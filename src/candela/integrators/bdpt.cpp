@@ -1,5 +1,7 @@
 #include "candela/integrators/bdpt.h"
 
+#include "candela/materials/spectral_bsdf.h"
+
 #include "candela/integrators/mlt_sampler.h"
 #include "candela/sampling/samplers.h"
 
@@ -66,7 +68,7 @@ BdptVertex BdptIntegrator::surface_vertex(const SurfaceHit& hit, const Ray& ray,
 
 template <typename Sampler>
 int BdptIntegrator::camera_subpath(const Ray& ray, Sampler& sampler, RayCounts& counts, int max_vertices,
-                                   BdptVertex* path, RGB* crossed_emission) const {
+                                   BdptVertex* path, RGB* crossed_emission, const Wavelengths* wl) const {
   if (max_vertices == 0) return 0;
   BdptVertex& camera = path[0];
   camera = BdptVertex{};
@@ -81,12 +83,12 @@ int BdptIntegrator::camera_subpath(const Ray& ray, Sampler& sampler, RayCounts& 
   r.direction = normalize(r.direction);
   float pdf_dir = scene_.camera().pdf_importance(r.origin, r.direction).dir;
   return random_walk(r, sampler, counts, RGB(1.0f), pdf_dir, max_vertices, Transport::Radiance, path,
-                     crossed_emission);
+                     crossed_emission, wl);
 }
 
 template <typename Sampler>
 int BdptIntegrator::light_subpath(Sampler& sampler, RayCounts& counts, int max_vertices, float time,
-                                  BdptVertex* path) const {
+                                  BdptVertex* path, const Wavelengths* wl) const {
   if (max_vertices == 0 || scene_.lights().empty()) return 0;
   // Choose a light by power, then a ray leaving it.
   float u_light = sampler.get_1d();
@@ -97,6 +99,7 @@ int BdptIntegrator::light_subpath(Sampler& sampler, RayCounts& counts, int max_v
   const Light& light = scene_.lights()[li];
   LightEmission e = light_sample_le(light, u_pos, u_dir, scene_.bounding_sphere());
   if (!(e.pdf_pos > 0) || !(e.pdf_dir > 0) || e.radiance.is_black() || pmf <= 0) return 0;
+  e.radiance = illuminant_at(e.radiance, wl);
 
   BdptVertex& v = path[0];
   v = BdptVertex{};
@@ -111,7 +114,7 @@ int BdptIntegrator::light_subpath(Sampler& sampler, RayCounts& counts, int max_v
   RGB beta = e.radiance * (cos_light / (pmf * e.pdf_pos * e.pdf_dir));
   Point3 origin = v.on_surface() ? offset_ray_origin(e.p, e.n, e.w) : e.p;
   int n = random_walk(Ray{origin, e.w, std::numeric_limits<float>::infinity(), time}, sampler, counts, beta,
-                      e.pdf_dir, max_vertices, Transport::Importance, path, nullptr);
+                      e.pdf_dir, max_vertices, Transport::Importance, path, nullptr, wl);
 
   // Lights at infinity: the first vertex's density is the disk's per-area density projected onto
   // it, and the light's own "position" is its direction, with the density all lights at infinity
@@ -128,7 +131,8 @@ int BdptIntegrator::light_subpath(Sampler& sampler, RayCounts& counts, int max_v
 
 template <typename Sampler>
 int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RGB beta, float pdf,
-                                int max_vertices, Transport mode, BdptVertex* path, RGB* crossed_emission) const {
+                                int max_vertices, Transport mode, BdptVertex* path, RGB* crossed_emission,
+                                const Wavelengths* wl) const {
   int n = 1;
   float pdf_fwd = pdf;
   float eta_scale = 1;
@@ -160,7 +164,7 @@ int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RG
         v = surface_vertex(hit, ray, beta);
         v.bsdf = SurfaceBsdf(BlackBsdf{});
         v.pdf_fwd = convert_density(pdf_fwd, path[n - 1], v);
-        crossed_emission[n + 1] += connect<Sampler>(nullptr, path, 0, n + 1, sampler, counts, ray.time).L;
+        crossed_emission[n + 1] += connect<Sampler>(nullptr, path, 0, n + 1, sampler, counts, ray.time, wl).L;
       }
       ray.origin = offset_ray_origin(hit.p, hit.ng, ray.direction);
       ray.t_max = std::numeric_limits<float>::infinity();
@@ -172,6 +176,7 @@ int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RG
     v = surface_vertex(hit, ray, beta);
     v.pdf_fwd = convert_density(pdf_fwd, prev, v);
     Shading shading = scene_.shading(hit, v.wo);
+    bsdf_at_wavelengths(shading.bsdf, wl);
     v.bsdf = shading.bsdf;
     v.frame = shading.frame;
     v.ns = shading.frame.n;  // normal and bump maps tilt it
@@ -324,7 +329,7 @@ float BdptIntegrator::mis_weight(BdptVertex* light, BdptVertex* camera, BdptVert
 
 // ------------------------------------------------------------------------------------- connections
 
-RGB BdptIntegrator::emitted(const BdptVertex& v, const BdptVertex& towards) const {
+RGB BdptIntegrator::emitted(const BdptVertex& v, const BdptVertex& towards, const Wavelengths* wl) const {
   if (!is_light(v)) return RGB(0.0f);
   Vec3 w = towards.p - v.p;
   if (length_squared(w) == 0) return RGB(0.0f);
@@ -332,9 +337,9 @@ RGB BdptIntegrator::emitted(const BdptVertex& v, const BdptVertex& towards) cons
   if (v.at_infinity) {
     RGB L(0.0f);
     for (uint32_t li : scene_.infinite_lights()) L += scene_.escaped_radiance(li, -w);
-    return L;
+    return illuminant_at(L, wl);
   }
-  return scene_.emitted(v.hit, w);
+  return illuminant_at(scene_.emitted(v.hit, w), wl);
 }
 
 RGB BdptIntegrator::scatter(const BdptVertex& v, const BdptVertex& next, Transport mode) const {
@@ -407,7 +412,8 @@ float BdptIntegrator::geometry_term(const BdptVertex& a, const BdptVertex& b) co
 
 template <typename Sampler>
 BdptIntegrator::Connection BdptIntegrator::connect(BdptVertex* light, BdptVertex* camera, int s, int t,
-                                                   Sampler& sampler, RayCounts& counts, float time) const {
+                                                   Sampler& sampler, RayCounts& counts, float time,
+                                                   const Wavelengths* wl) const {
   Connection c;
   // A camera subpath that escaped can only be completed by itself (s = 0).
   if (t > 1 && s != 0 && camera[t - 1].kind == Kind::Light) return c;
@@ -416,7 +422,7 @@ BdptIntegrator::Connection BdptIntegrator::connect(BdptVertex* light, BdptVertex
   if (s == 0) {
     // The camera subpath hit a light.
     const BdptVertex& pt = camera[t - 1];
-    if (is_light(pt)) L = pt.beta * emitted(pt, camera[t - 2]);
+    if (is_light(pt)) L = pt.beta * emitted(pt, camera[t - 2], wl);
   } else if (t == 1) {
     // Light tracing: join the light vertex to a point on the lens.
     const BdptVertex& qs = light[s - 1];
@@ -453,7 +459,7 @@ BdptIntegrator::Connection BdptIntegrator::connect(BdptVertex* light, BdptVertex
     sampled.at_infinity = std::isinf(ls.distance);
     sampled.p = sampled.at_infinity ? pt.p + ls.wi * (2 * scene_.bounding_sphere().radius) : ls.p_light;
     sampled.ng = sampled.ns = sampled.at_infinity ? Normal3(0.0f) : ls.n_light;
-    sampled.beta = ls.radiance / (ls.pdf * pmf);
+    sampled.beta = illuminant_at(ls.radiance, wl) / (ls.pdf * pmf);
     sampled.pdf_fwd = light_origin_pdf(sampled, pt);
     L = pt.beta * scatter(pt, sampled, Transport::Radiance) * sampled.beta * std::abs(dot(ls.wi, pt.ns));
     if (L.is_black() || !unoccluded(pt, sampled, time, counts)) return c;
@@ -478,7 +484,7 @@ BdptIntegrator::Connection BdptIntegrator::connect(BdptVertex* light, BdptVertex
 
 template <typename Sampler>
 RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts, const BdptTarget& target, int x,
-                             int y, float filter_weight) const {
+                             int y, float filter_weight, const Wavelengths* wl) const {
   thread_local std::vector<BdptVertex> camera_path, light_path;
   camera_path.resize(size_t(max_depth_) + 2);
   light_path.resize(size_t(max_depth_) + 1);
@@ -486,8 +492,10 @@ RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts
   BdptVertex* lv = light_path.data();
   thread_local std::vector<RGB> crossed;
   crossed.assign(size_t(max_depth_) + 3, RGB(0.0f));
-  int nc = camera_subpath(ray, sampler, counts, max_depth_ + 2, cv, crossed.data());
-  int nl = light_subpath(sampler, counts, max_depth_ + 1, ray.time, lv);
+  int nc = camera_subpath(ray, sampler, counts, max_depth_ + 2, cv, crossed.data(), wl);
+  int nl = light_subpath(sampler, counts, max_depth_ + 1, ray.time, lv, wl);
+  // What reaches an image directly (splats, strategy images) is RGB.
+  auto to_rgb = [wl](const RGB& v) { return wl ? wavelengths_to_rgb(v, *wl) : v; };
 
   // Strategy images are scaled like the light image (importance film area / light paths); camera
   // samples of a pixel count per pixel, hence the ratio of the image's area to the importance film's.
@@ -499,22 +507,22 @@ RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts
     L += crossed[size_t(t)];
     if (target.strategies && strategy_index(0, t) < int(target.strategies->size()) && !target.unweighted)
       (*target.strategies)[size_t(strategy_index(0, t))].add_to_pixel(
-          x, y, crossed[size_t(t)] * (filter_weight / target.filter->integral() * camera_part_scale));
+          x, y, to_rgb(crossed[size_t(t)]) * (filter_weight / target.filter->integral() * camera_part_scale));
   }
   for (int t = 1; t <= nc; ++t)
     for (int s = 0; s <= nl; ++s) {
       int depth = s + t - 2;
       if ((s == 1 && t == 1) || depth < 0 || depth > max_depth_ || (depth == 0 && hide_emitters_)) continue;
-      Connection c = connect(lv, cv, s, t, sampler, counts, ray.time);
+      Connection c = connect(lv, cv, s, t, sampler, counts, ray.time, wl);
       if (t == 1) {
-        if (!c.L.is_black()) target.film->splats().add(c.raster, c.L, *target.filter);
+        if (!c.L.is_black()) target.film->splats().add(c.raster, to_rgb(c.L), *target.filter);
       } else {
         L += c.L;
       }
       if (target.strategies) {
         int index = strategy_index(s, t);
         if (index < int(target.strategies->size())) {
-          RGB v = target.unweighted ? c.unweighted : c.L;
+          RGB v = to_rgb(target.unweighted ? c.unweighted : c.L);
           SplatImage& img = (*target.strategies)[size_t(index)];
           if (v.is_black() || !v.is_finite()) continue;
           if (t == 1) img.add(c.raster, v, *target.filter);
@@ -527,11 +535,13 @@ RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts
 
 // One instantiation per pixel sampler, and one for Metropolis light transport's sampler.
 #define CANDELA_INSTANTIATE(S)                                                                              \
-  template RGB BdptIntegrator::radiance<S>(const Ray&, S&, RayCounts&, const BdptTarget&, int, int, float) const; \
-  template int BdptIntegrator::camera_subpath<S>(const Ray&, S&, RayCounts&, int, BdptVertex*, RGB*) const;    \
-  template int BdptIntegrator::light_subpath<S>(S&, RayCounts&, int, float, BdptVertex*) const;                \
+  template RGB BdptIntegrator::radiance<S>(const Ray&, S&, RayCounts&, const BdptTarget&, int, int, float,         \
+                                           const Wavelengths*) const;                                           \
+  template int BdptIntegrator::camera_subpath<S>(const Ray&, S&, RayCounts&, int, BdptVertex*, RGB*,            \
+                                                 const Wavelengths*) const;                                     \
+  template int BdptIntegrator::light_subpath<S>(S&, RayCounts&, int, float, BdptVertex*, const Wavelengths*) const; \
   template BdptIntegrator::Connection BdptIntegrator::connect<S>(BdptVertex*, BdptVertex*, int, int, S&,       \
-                                                                 RayCounts&, float) const;
+                                                                 RayCounts&, float, const Wavelengths*) const;
 CANDELA_FOR_EACH_SAMPLER(CANDELA_INSTANTIATE)
 CANDELA_INSTANTIATE(MltSampler)
 #undef CANDELA_INSTANTIATE

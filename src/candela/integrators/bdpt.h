@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "candela/film/film.h"
+#include "candela/spectral/wavelengths.h"
 #include "candela/film/filter.h"
 #include "candela/geometry/ray.h"
 #include "candela/integrators/path_integrator.h"
@@ -66,21 +67,24 @@ class BdptIntegrator {
 
   // The estimate of the strategies with t >= 2 for the camera ray of pixel (x, y) (added to that
   // pixel with the filter weight by the caller); the t = 1 strategies are splatted onto target.film.
+  // With wavelengths (a spectral render) the estimate is their values; splats are converted to RGB.
   template <typename Sampler>
   RGB radiance(const Ray& ray, Sampler& sampler, RayCounts& counts, const BdptTarget& target, int x, int y,
-               float filter_weight) const;
+               float filter_weight, const Wavelengths* wl = nullptr) const;
 
-  // The building blocks, shared with Metropolis light transport.
+  // The building blocks, shared with Metropolis light transport. `wl`: the wavelengths of a spectral
+  // render (null: RGB), at which BSDFs and emission are evaluated.
   // A camera subpath from `ray` (vertex 0 on the lens) of at most max_vertices vertices; returns how many.
   // Emitters without a surface of their own (interface material) are passed through, not made
   // vertices: the MIS-weighted light of the one the path would have ended on as its t-th vertex is
   // added to crossed_emission[t] (an array of max_vertices + 1, when given).
   template <typename Sampler>
   int camera_subpath(const Ray& ray, Sampler& sampler, RayCounts& counts, int max_vertices, BdptVertex* path,
-                     RGB* crossed_emission = nullptr) const;
+                     RGB* crossed_emission = nullptr, const Wavelengths* wl = nullptr) const;
   // A light subpath of at most max_vertices vertices, starting on a light chosen by power.
   template <typename Sampler>
-  int light_subpath(Sampler& sampler, RayCounts& counts, int max_vertices, float time, BdptVertex* path) const;
+  int light_subpath(Sampler& sampler, RayCounts& counts, int max_vertices, float time, BdptVertex* path,
+                    const Wavelengths* wl = nullptr) const;
   struct Connection {
     RGB L;                // the MIS-weighted contribution
     RGB unweighted;       // the same without the weight
@@ -91,7 +95,7 @@ class BdptIntegrator {
   // modified during the call (the densities the MIS weight needs) and restored before it returns.
   template <typename Sampler>
   Connection connect(BdptVertex* light, BdptVertex* camera, int s, int t, Sampler& sampler, RayCounts& counts,
-                     float time) const;
+                     float time, const Wavelengths* wl = nullptr) const;
 
   int max_depth() const { return max_depth_; }
   // Strategies (s, t) with s + t = depth + 2, numbered depth by depth: depth (depth + 5) / 2 + s.
@@ -104,7 +108,7 @@ class BdptIntegrator {
  private:
   template <typename Sampler>
   int random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RGB beta, float pdf, int max_vertices,
-                  Transport mode, BdptVertex* path, RGB* crossed_emission) const;
+                  Transport mode, BdptVertex* path, RGB* crossed_emission, const Wavelengths* wl) const;
 
   // A surface vertex reached by `ray` (its BSDF, frame and densities are the caller's).
   BdptVertex surface_vertex(const SurfaceHit& hit, const Ray& ray, const RGB& beta) const;
@@ -118,7 +122,7 @@ class BdptIntegrator {
   float mis_weight(BdptVertex* light, BdptVertex* camera, BdptVertex& sampled, int s, int t) const;
 
   // Light emitted by a light vertex (or an emitter that was hit) towards `towards`.
-  RGB emitted(const BdptVertex& v, const BdptVertex& towards) const;
+  RGB emitted(const BdptVertex& v, const BdptVertex& towards, const Wavelengths* wl) const;
   // The BSDF at a surface vertex towards `next`, adjoint when mode is Importance.
   RGB scatter(const BdptVertex& v, const BdptVertex& next, Transport mode) const;
   bool is_connectible(const BdptVertex& v) const;

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <chrono>
 #include <limits>
+#include <optional>
 
 #include "candela/film/filter.h"
 #include "candela/integrators/bdpt.h"
@@ -35,7 +36,8 @@ struct PathState {
 // subpaths are traced with exactly s and t vertices and joined.
 class MltPathSampler {
  public:
-  MltPathSampler(const Scene& scene, const BdptIntegrator& bdpt) : scene_(scene), bdpt_(bdpt) {}
+  MltPathSampler(const Scene& scene, const BdptIntegrator& bdpt, bool spectral)
+      : scene_(scene), bdpt_(bdpt), spectral_(spectral) {}
 
   // The numbers the perturbations move: the film position is the camera stream's numbers 1-2 (after
   // the strategy, drawn at every depth >= 1, the only depths chains run), the direction leaving the
@@ -61,15 +63,19 @@ class MltPathSampler {
                 -margin.y + u.y * (float(camera.height()) + 2 * margin.y)};
     Vec2 lens = sampler.get_2d();
     float time = lerp(sampler.get_1d(), camera.shutter_open(), camera.shutter_close());
+    std::optional<Wavelengths> wl;  // a spectral render's wavelengths are part of the state
+    if (spectral_) wl = sample_visible_wavelengths(sampler.get_1d());
+    const Wavelengths* wlp = wl ? &*wl : nullptr;
     Ray ray = camera.generate_ray(raster, lens, time);
     PathState state{RGB(0.0f), raster, s, t};
-    if (bdpt_.camera_subpath(ray, sampler, counts, t, camera_path.data()) != t) return state;
+    if (bdpt_.camera_subpath(ray, sampler, counts, t, camera_path.data(), nullptr, wlp) != t) return state;
     sampler.start_stream(MltSampler::kLightStream);
-    if (bdpt_.light_subpath(sampler, counts, s, time, light_path.data()) != s) return state;
+    if (bdpt_.light_subpath(sampler, counts, s, time, light_path.data(), wlp) != s) return state;
     sampler.start_stream(MltSampler::kConnectionStream);
-    BdptIntegrator::Connection c = bdpt_.connect(light_path.data(), camera_path.data(), s, t, sampler, counts, time);
+    BdptIntegrator::Connection c =
+        bdpt_.connect(light_path.data(), camera_path.data(), s, t, sampler, counts, time, wlp);
     if (t == 1) state.raster = c.raster;
-    state.L = c.L * float(strategies);
+    state.L = (wl ? wavelengths_to_rgb(c.L, *wl) : c.L) * float(strategies);
     if (!state.L.is_finite() || !(state.luminance() > 0)) state.L = RGB(0.0f);
     return state;
   }
@@ -77,6 +83,7 @@ class MltPathSampler {
  private:
   const Scene& scene_;
   const BdptIntegrator& bdpt_;
+  bool spectral_;
 };
 
 // The luminance of the whole image function, averaged over the film (margin included): every
@@ -117,20 +124,24 @@ Normalization estimate_normalization(const Scene& scene, const BdptIntegrator& b
         Vec2 raster{-margin.x + (float(cx) + u.x) / float(gx) * width, -margin.y + (float(cy) + u.y) / float(gy) * height};
         Vec2 lens = sampler.get_2d();
         float time = lerp(sampler.get_1d(), camera.shutter_open(), camera.shutter_close());
+        std::optional<Wavelengths> wl;
+        if (settings.spectral) wl = sample_visible_wavelengths(sampler.get_1d());
+        const Wavelengths* wlp = wl ? &*wl : nullptr;
+        auto luminance_of = [&](const RGB& v) { return (wl ? wavelengths_to_rgb(v, *wl) : v).luminance(); };
         Ray ray = camera.generate_ray(raster, lens, time);
         crossed.assign(size_t(max_depth) + 3, RGB(0.0f));
-        int nc = bdpt.camera_subpath(ray, sampler, counts, max_depth + 2, camera_path.data(), crossed.data());
-        int nl = bdpt.light_subpath(sampler, counts, max_depth + 1, time, light_path.data());
+        int nc = bdpt.camera_subpath(ray, sampler, counts, max_depth + 2, camera_path.data(), crossed.data(), wlp);
+        int nl = bdpt.light_subpath(sampler, counts, max_depth + 1, time, light_path.data(), wlp);
         double* by_depth = &luminance[i * depths];
         for (int t = 1; t <= nc; ++t)
           for (int s = 0; s <= nl; ++s) {
             int depth = s + t - 2;
             if ((s == 1 && t == 1) || depth < 0 || depth > max_depth) continue;
-            RGB L = bdpt.connect(light_path.data(), camera_path.data(), s, t, sampler, counts, time).L;
-            if (L.is_finite()) by_depth[depth] += L.luminance();
+            RGB L = bdpt.connect(light_path.data(), camera_path.data(), s, t, sampler, counts, time, wlp).L;
+            if (L.is_finite()) by_depth[depth] += luminance_of(L);
           }
         for (size_t t = 2; t < crossed.size(); ++t)
-          if (t - 2 <= size_t(max_depth) && crossed[t].is_finite()) by_depth[t - 2] += crossed[t].luminance();
+          if (t - 2 <= size_t(max_depth) && crossed[t].is_finite()) by_depth[t - 2] += luminance_of(crossed[t]);
       }
     });
   });
@@ -182,7 +193,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   RenderSettings bdpt_settings = settings;
   bdpt_settings.rr_start_depth = std::numeric_limits<int>::max();
   const BdptIntegrator bdpt(scene, bdpt_settings);
-  const MltPathSampler paths(scene, bdpt);
+  const MltPathSampler paths(scene, bdpt, settings.spectral);
   const Filter filter(settings.filter);
   const int depths = settings.max_depth + 1;
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);

@@ -1,5 +1,6 @@
 #include "candela/integrators/path_integrator.h"
 
+#include "candela/materials/spectral_bsdf.h"
 #include "candela/sampling/samplers.h"
 #include "candela/sampling/warp.h"
 
@@ -12,6 +13,7 @@ struct PathIntegrator::Vertex {
   Vec3 wo_local;
   LightSampleContext ctx;
   float time;
+  const Wavelengths* wl;
 };
 
 PathIntegrator::PathIntegrator(const Scene& scene, const RenderSettings& settings)
@@ -25,7 +27,7 @@ PathIntegrator::PathIntegrator(const Scene& scene, const RenderSettings& setting
       shadow_rays_(std::max(1, settings.shadow_rays)) {}
 
 template <typename Sampler>
-RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const {
+RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, const Wavelengths* wl) const {
   RGB L(0.0f), beta(1.0f);
   bool specular_bounce = false;
   float eta_scale = 1;
@@ -40,7 +42,7 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const
       // sampling where that could have produced the same direction.
       for (uint32_t li : scene_.infinite_lights()) {
         if (depth == 0 && hide_emitters_) break;
-        RGB Le = scene_.escaped_radiance(li, ray.direction);
+        RGB Le = illuminant_at(scene_.escaped_radiance(li, ray.direction), wl);
         if (Le.is_black()) continue;
         if (depth == 0 || specular_bounce)
           L += beta * Le;
@@ -54,7 +56,7 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const
 
     // Add emission from a surface the path hit, again MIS-weighted after non-delta bounces.
     Vec3 wo = -ray.direction;
-    RGB Le = depth == 0 && hide_emitters_ ? RGB(0.0f) : scene_.emitted(hit, wo);
+    RGB Le = depth == 0 && hide_emitters_ ? RGB(0.0f) : illuminant_at(scene_.emitted(hit, wo), wl);
     if (!Le.is_black()) {
       if (depth == 0 || specular_bounce) {
         L += beta * Le;
@@ -80,7 +82,8 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const
     ++depth;
     // The BSDF and its shading frame (normal or bump mapped). A mask's "absent" part is a delta
     // event of this BSDF: it continues the path straight on and counts as a bounce (as Mitsuba does).
-    const Shading shading = scene_.shading(hit, wo);
+    Shading shading = scene_.shading(hit, wo);
+    bsdf_at_wavelengths(shading.bsdf, wl);
     const SurfaceBsdf& bsdf = shading.bsdf;
     if (bsdf_is_black(bsdf)) break;
 
@@ -89,7 +92,7 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts) const
     if (wo_local.z == 0) break;
     // Light is gathered on the side the path arrived from, or on both for diffusely transmitting BSDFs.
     Normal3 gather_n = bsdf_has_non_delta_transmission(bsdf) ? Normal3(0.0f) : wo_local.z > 0 ? frame.n : -frame.n;
-    Vertex vertex{hit, bsdf, frame, wo_local, {hit.p, gather_n}, ray.time};
+    Vertex vertex{hit, bsdf, frame, wo_local, {hit.p, gather_n}, ray.time, wl};
 
     // Sample direct illumination with shadow rays (next-event estimation).
     float total_importance = 0;
@@ -225,6 +228,7 @@ RGB PathIntegrator::shadow_ray_estimate(const Vertex& v, size_t li, const Vec2& 
   const Light& light = scene_.lights()[li];
   LightSample ls = light_sample_li(light, v.ctx, u);
   if (ls.pdf <= 0 || ls.radiance.is_black()) return RGB(0.0f);
+  ls.radiance = illuminant_at(ls.radiance, v.wl);
   Vec3 wi_local = v.frame.to_local(ls.wi);
   RGB f = bsdf_eval(v.bsdf, v.wo_local, wi_local) * std::abs(wi_local.z);
   if (f.is_black()) return RGB(0.0f);
@@ -244,7 +248,8 @@ RGB PathIntegrator::shadow_ray_estimate(const Vertex& v, size_t li, const Vec2& 
 }
 
 // One instantiation per sampler type of the variant.
-#define CANDELA_INSTANTIATE(S) template RGB PathIntegrator::radiance<S>(Ray, S&, RayCounts&) const;
+#define CANDELA_INSTANTIATE(S) \
+  template RGB PathIntegrator::radiance<S>(Ray, S&, RayCounts&, const Wavelengths*) const;
 CANDELA_FOR_EACH_SAMPLER(CANDELA_INSTANTIATE)
 #undef CANDELA_INSTANTIATE
 

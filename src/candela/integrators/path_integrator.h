@@ -12,6 +12,7 @@
 #include "candela/geometry/ray.h"
 #include "candela/math/color.h"
 #include "candela/scene/scene.h"
+#include "candela/spectral/wavelengths.h"
 
 namespace candela {
 
@@ -30,9 +31,10 @@ class PathIntegrator {
  public:
   PathIntegrator(const Scene& scene, const RenderSettings& settings);
 
-  // Radiance arriving along the camera ray.
+  // Radiance arriving along the camera ray: RGB, or with wavelengths (a spectral render) the values
+  // at those wavelengths (spectral/wavelengths.h).
   template <typename Sampler>
-  RGB radiance(Ray ray, Sampler& sampler, RayCounts& counts) const;
+  RGB radiance(Ray ray, Sampler& sampler, RayCounts& counts, const Wavelengths* wl = nullptr) const;
 
  private:
   struct Vertex;  // what direct lighting needs to know about the current path vertex

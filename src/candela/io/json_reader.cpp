@@ -753,6 +753,7 @@ class JsonSceneReader {
            {"uniform", DirectionSampling::Uniform}});
     settings.mis = render.boolean_or("mis", settings.mis);
     settings.hide_emitters = render.boolean_or("hide_emitters", settings.hide_emitters);
+    settings.spectral = render.boolean_or("spectral", settings.spectral);
     if (const Json* value = render.find("light_selection"))
       settings.light_selection =
           read_name<LightSelection>(report_, *value, render.pointer_of("light_selection"), "light selection",

@@ -328,6 +328,7 @@ Json render_json(const SceneDesc& scene) {
   j["direction_sampling"] = kDirections[int(s.direction_sampling)];
   j["mis"] = s.mis;
   if (s.hide_emitters) j["hide_emitters"] = true;
+  if (s.spectral) j["spectral"] = true;
   static const char* kSelection[] = {"power", "paper", "uniform"};
   j["light_selection"] = kSelection[int(s.light_selection)];
   j["shadow_rays"] = s.shadow_rays;

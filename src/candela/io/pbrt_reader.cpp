@@ -763,6 +763,7 @@ SceneDesc PbrtParser::parse(const fs::path& file) {
   scene_.settings.filter = default_filter(FilterType::Gaussian);
   scene_.settings.max_depth = 5;
   scene_.settings.integrator = "path";
+  scene_.settings.spectral = true;  // pbrt-v4 renders spectrally; RGB parameters become spectra as there
 
   top_directory_ = file.parent_path();
   SourceLocation end = parse_file(file, nullptr);

@@ -75,6 +75,7 @@ struct PassContext {
   NonFiniteLog& non_finite_log;
   float clamp;
   const std::atomic<bool>* cancel;
+  bool spectral;
 };
 
 bool cancelled(const PassContext& pc) { return pc.cancel && pc.cancel->load(std::memory_order_relaxed); }
@@ -95,8 +96,13 @@ void render_pixel(const PassContext& pc, S& sampler, int x, int y, uint64_t firs
     float time = pc.scene.has_motion() ? lerp(sampler.get_1d(), camera.shutter_open(), camera.shutter_close())
                                        : camera.shutter_open();
     Ray ray = camera.generate_ray({float(x) + 0.5f + fs.offset.x, float(y) + 0.5f + fs.offset.y}, lens, time);
-    RGB L = pc.bdpt ? pc.bdpt->radiance(ray, sampler, counts, pc.bdpt_target, x, y, fs.weight)
-                    : pc.path->radiance(ray, sampler, counts);
+    // A spectral render draws the path's wavelengths next; its radiance comes back as their values.
+    std::optional<Wavelengths> wl;
+    if (pc.spectral) wl = sample_visible_wavelengths(sampler.get_1d());
+    const Wavelengths* wlp = wl ? &*wl : nullptr;
+    RGB L = pc.bdpt ? pc.bdpt->radiance(ray, sampler, counts, pc.bdpt_target, x, y, fs.weight, wlp)
+                    : pc.path->radiance(ray, sampler, counts, wlp);
+    if (wl) L = wavelengths_to_rgb(L, *wl);
     if (!L.is_finite()) {
       // Never reaches the film: counted, the first few logged, and the sample counts as black.
       pc.non_finite.fetch_add(1, std::memory_order_relaxed);
@@ -373,7 +379,7 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
   std::atomic<uint64_t> non_finite{0};
   NonFiniteLog non_finite_log(options.max_reported_non_finite);
   PassContext pc{scene,      path ? &*path : nullptr, bdpt ? &*bdpt : nullptr, bdpt_target, filter, prototype, film,
-                 ray_counts, non_finite,            non_finite_log,          options.clamp, options.cancel};
+                 ray_counts, non_finite,            non_finite_log,          options.clamp, options.cancel, settings.spectral};
   const uint64_t samples_before = film.total_samples();
   const uint64_t expected_spp = adaptive && settings.adaptive_spp > 0 ? uint64_t(settings.adaptive_spp) : uint64_t(max_spp);
   ProgressBar progress(pixel_count * expected_spp, options.progress);

@@ -539,6 +539,9 @@ struct RenderSettings {
   DirectionSampling direction_sampling = DirectionSampling::Bsdf;
   bool mis = true;  // false: light sampling for direct light, emission found by bounces ignored
   bool hide_emitters = false;  // emitters seen directly by the camera (depth 0) are not shown (Mitsuba's)
+  // Spectral transport (spectral/wavelengths.h): each sample carries three wavelengths and RGB
+  // parameters become smooth spectra, as in pbrt-v4; off = RGB transport.
+  bool spectral = false;
   LightSelection light_selection = LightSelection::Power;
   int shadow_rays = 1;
   BvhLayout bvh = BvhLayout::Fast;

@@ -1,0 +1,47 @@
+#pragma once
+// A BSDF's RGB parameters turned into their values at a spectral sample's wavelengths
+// (spectral/wavelengths.h), as pbrt-v4 reads RGB material parameters: colours as reflectance
+// spectra, a conductor's eta and k as unbounded ones. Weights, roughness and indices of refraction
+// are scalars and stay as they are.
+#include "candela/materials/surface_bsdf.h"
+#include "candela/spectral/wavelengths.h"
+
+namespace candela {
+
+inline void bsdf_at_wavelengths(Bsdf& bsdf, const Wavelengths& wl) {
+  auto reflectance = [&](RGB& c) { c = reflectance_at(c, wl); };
+  std::visit(
+      [&](auto& b) {
+        using T = std::decay_t<decltype(b)>;
+        if constexpr (std::is_same_v<T, DiffuseBsdf> || std::is_same_v<T, MirrorBsdf>) {
+          reflectance(b.reflectance);
+        } else if constexpr (std::is_same_v<T, PhongBsdf>) {
+          reflectance(b.diffuse);
+          reflectance(b.specular);
+          reflectance(b.transmission);
+        } else if constexpr (std::is_same_v<T, DielectricBsdf> || std::is_same_v<T, DiffuseTransmissionBsdf>) {
+          reflectance(b.reflectance);
+          reflectance(b.transmittance);
+        } else if constexpr (std::is_same_v<T, ConductorBsdf>) {
+          b.eta = unbounded_at(b.eta, wl);
+          b.k = unbounded_at(b.k, wl);
+          reflectance(b.tint);
+        } else if constexpr (std::is_same_v<T, CoatedDiffuseBsdf>) {
+          reflectance(b.reflectance);
+          reflectance(b.specular);
+        } else if constexpr (std::is_same_v<T, PrincipledBsdf> || std::is_same_v<T, PrincipledThinBsdf>) {
+          reflectance(b.base_color);
+        } else {
+          static_assert(std::is_same_v<T, BlackBsdf>, "a BSDF with colours must say how they become spectra");
+        }
+      },
+      bsdf);
+}
+
+// Every component of a surface's mixture; wl null (an RGB render) leaves it as it is.
+inline void bsdf_at_wavelengths(SurfaceBsdf& bsdf, const Wavelengths* wl) {
+  if (!wl) return;
+  for (int k = 0; k < bsdf.count; ++k) bsdf_at_wavelengths(bsdf.components[size_t(k)].bsdf, *wl);
+}
+
+}  // namespace candela
