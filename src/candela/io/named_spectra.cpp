@@ -6,48 +6,35 @@
 #include <cmath>
 #include <string>
 
+#include "candela/spectral/cie.h"
+
 namespace candela::pbrt_spectra {
 namespace {
 
 // ---------------------------------------------------------------- colour matching
 
-// The CIE 1931 2-degree colour matching functions as the multi-lobe Gaussian fit of Wyman, Sloan
-// and Shirley, "Simple Analytic Approximations to the CIE XYZ Color Matching Functions" (JCGT 2013),
-// accurate to about 1% of the tabulated functions: plenty for the few conversions done here.
-double lobe(double lambda, double mu, double sigma_below, double sigma_above) {
-  double t = (lambda - mu) / (lambda < mu ? sigma_below : sigma_above);
-  return std::exp(-0.5 * t * t);
-}
-double cie_x(double l) {
-  return 1.056 * lobe(l, 599.8, 37.9, 31.0) + 0.362 * lobe(l, 442.0, 16.0, 26.7) - 0.065 * lobe(l, 501.1, 20.4, 26.2);
-}
-double cie_y(double l) { return 0.821 * lobe(l, 568.8, 46.9, 40.5) + 0.286 * lobe(l, 530.9, 16.3, 31.1); }
-double cie_z(double l) { return 1.217 * lobe(l, 437.0, 11.8, 36.0) + 0.681 * lobe(l, 459.0, 26.0, 13.8); }
+using cie::Xyz;
 
-struct Xyz {
-  double x = 0, y = 0, z = 0;
-};
-
-// Integrates f against the matching functions over pbrt's visible range, 360 to 830 nm, in 1 nm steps.
+// Integrates f against the CIE 1931 matching functions (spectral/cie.h) over pbrt's visible range,
+// 360 to 830 nm, in 1 nm steps.
 template <typename F>
 Xyz integrate(F f) {
   Xyz sum;
   for (int nm = 360; nm <= 830; ++nm) {
     double v = f(double(nm));
-    sum.x += v * cie_x(nm);
-    sum.y += v * cie_y(nm);
-    sum.z += v * cie_z(nm);
+    Xyz m = cie::matching(nm);
+    sum.x += v * m.x;
+    sum.y += v * m.y;
+    sum.z += v * m.z;
   }
   return sum;
 }
 
-RGB to_rgb(const Xyz& xyz) {
-  return xyz_to_linear_srgb(static_cast<float>(xyz.x), static_cast<float>(xyz.y), static_cast<float>(xyz.z));
-}
+RGB to_rgb(const Xyz& xyz) { return cie::xyz_to_linear_srgb(xyz); }
 
 // A colour of chromaticity (x, y) and luminance 1.
 RGB chromaticity_rgb(double x, double y) {
-  return xyz_to_linear_srgb(static_cast<float>(x / y), 1.0f, static_cast<float>((1 - x - y) / y));
+  return cie::xyz_to_linear_srgb(x / y, 1.0, (1 - x - y) / y);
 }
 
 // ---------------------------------------------------------------- the named spectra
@@ -121,11 +108,6 @@ const std::vector<Entry>& table() {
 
 }  // namespace
 
-RGB xyz_to_linear_srgb(float x, float y, float z) {
-  return {3.2404542f * x - 1.5371385f * y - 0.4985314f * z, -0.9692660f * x + 1.8760108f * y + 0.0415560f * z,
-          0.0556434f * x - 0.2040259f * y + 1.0572252f * z};
-}
-
 std::optional<NamedSpectrum> find_named(std::string_view name) {
   for (const Entry& entry : table())
     if (entry.name == name) return entry.spectrum;
@@ -194,49 +176,8 @@ RGB sampled_spectrum_rgb(std::span<const double> pairs, Role role) {
 namespace candela::mitsuba_spectra {
 namespace {
 
-// The CIE 1931 2-degree colour matching functions tabulated every 5 nm from 360 to 830 nm (the
-// CIE's own table, which Mitsuba interpolates linearly).
-constexpr int kCieSamples = 95;
-constexpr double kCieMin = 360, kCieMax = 830;
-constexpr float kCieX[kCieSamples] = {
-    0.0001299f, 0.0002321f, 0.0004149f, 0.0007416f, 0.001368f, 0.002236f, 0.004243f, 0.00765f, 0.01431f,
-    0.02319f, 0.04351f, 0.07763f, 0.13438f, 0.21477f, 0.2839f, 0.3285f, 0.34828f, 0.34806f, 0.3362f, 0.3187f,
-    0.2908f, 0.2511f, 0.19536f, 0.1421f, 0.09564f, 0.05795001f, 0.03201f, 0.0147f, 0.0049f, 0.0024f, 0.0093f,
-    0.0291f, 0.06327f, 0.1096f, 0.1655f, 0.2257499f, 0.2904f, 0.3597f, 0.4334499f, 0.5120501f, 0.5945f, 0.6784f,
-    0.7621f, 0.8425f, 0.9163f, 0.9786f, 1.0263f, 1.0567f, 1.0622f, 1.0456f, 1.0026f, 0.9384f, 0.8544499f, 0.7514f,
-    0.6424f, 0.5419f, 0.4479f, 0.3608f, 0.2835f, 0.2187f, 0.1649f, 0.1212f, 0.0874f, 0.0636f, 0.04677f, 0.0329f,
-    0.0227f, 0.01584f, 0.01135916f, 0.008110916f, 0.005790346f, 0.004109457f, 0.002899327f, 0.00204919f,
-    0.001439971f, 0.0009999493f, 0.0006900786f, 0.0004760213f, 0.0003323011f, 0.0002348261f, 0.0001661505f,
-    0.000117413f, 8.307527e-05f, 5.870652e-05f, 4.150994e-05f, 2.935326e-05f, 2.067383e-05f, 1.455977e-05f,
-    1.025398e-05f, 7.221456e-06f, 5.085868e-06f, 3.581652e-06f, 2.522525e-06f, 1.776509e-06f, 1.251141e-06f};
-constexpr float kCieY[kCieSamples] = {
-    3.917e-06f, 6.965e-06f, 1.239e-05f, 2.202e-05f, 3.9e-05f, 6.4e-05f, 0.00012f, 0.000217f, 0.000396f, 0.00064f,
-    0.00121f, 0.00218f, 0.004f, 0.0073f, 0.0116f, 0.01684f, 0.023f, 0.0298f, 0.038f, 0.048f, 0.06f, 0.0739f,
-    0.09098f, 0.1126f, 0.13902f, 0.1693f, 0.20802f, 0.2586f, 0.323f, 0.4073f, 0.503f, 0.6082f, 0.71f, 0.7932f,
-    0.862f, 0.9148501f, 0.954f, 0.9803f, 0.9949501f, 1.0f, 0.995f, 0.9786f, 0.952f, 0.9154f, 0.87f, 0.8163f,
-    0.757f, 0.6949f, 0.631f, 0.5668f, 0.503f, 0.4412f, 0.381f, 0.321f, 0.265f, 0.217f, 0.175f, 0.1382f, 0.107f,
-    0.0816f, 0.061f, 0.04458f, 0.032f, 0.0232f, 0.017f, 0.01192f, 0.00821f, 0.005723f, 0.004102f, 0.002929f,
-    0.002091f, 0.001484f, 0.001047f, 0.00074f, 0.00052f, 0.0003611f, 0.0002492f, 0.0001719f, 0.00012f, 8.48e-05f,
-    6e-05f, 4.24e-05f, 3e-05f, 2.12e-05f, 1.499e-05f, 1.06e-05f, 7.4657e-06f, 5.2578e-06f, 3.7029e-06f,
-    2.6078e-06f, 1.8366e-06f, 1.2934e-06f, 9.1093e-07f, 6.4153e-07f, 4.5181e-07f};
-constexpr float kCieZ[kCieSamples] = {
-    0.0006061f, 0.001086f, 0.001946f, 0.003486f, 0.006450001f, 0.01054999f, 0.02005001f, 0.03621f, 0.06785001f,
-    0.1102f, 0.2074f, 0.3713f, 0.6456f, 1.0390501f, 1.3856f, 1.62296f, 1.74706f, 1.7826f, 1.77211f, 1.7441f,
-    1.6692f, 1.5281f, 1.28764f, 1.0419f, 0.8129501f, 0.6162f, 0.46518f, 0.3533f, 0.272f, 0.2123f, 0.1582f, 0.1117f,
-    0.07824999f, 0.05725001f, 0.04216f, 0.02984f, 0.0203f, 0.0134f, 0.008749999f, 0.005749999f, 0.0039f,
-    0.002749999f, 0.0021f, 0.0018f, 0.001650001f, 0.0014f, 0.0011f, 0.001f, 0.0008f, 0.0006f, 0.00034f, 0.00024f,
-    0.00019f, 0.0001f, 4.999999e-05f, 3e-05f, 2e-05f, 1e-05f};  // zero from 650 nm on
-
-struct CieXyz {
-  double x, y, z;
-};
-CieXyz cie_at(double nm) {
-  double t = (nm - kCieMin) * ((kCieSamples - 1) / (kCieMax - kCieMin));
-  int i0 = std::clamp(int(t), 0, kCieSamples - 2);
-  double w1 = t - i0, w0 = 1 - w1;
-  return {w0 * kCieX[i0] + w1 * kCieX[i0 + 1], w0 * kCieY[i0] + w1 * kCieY[i0 + 1],
-          w0 * kCieZ[i0] + w1 * kCieZ[i0 + 1]};
-}
+// Mitsuba interpolates the CIE's 5 nm tables linearly, as cie::matching does.
+constexpr double kCieMin = cie::kLambdaMin, kCieMax = cie::kLambdaMax;
 
 }  // namespace
 
@@ -252,7 +193,7 @@ RGB spectrum_list_to_srgb(std::span<const double> wavelengths, std::span<const d
     while (k + 2 < n && wavelengths[k + 1] <= w) ++k;
     double w0 = wavelengths[k], w1 = wavelengths[k + 1], v0 = values[k], v1 = values[k + 1];
     double v = ((w - w1) * v0 + (w0 - w) * v1) / (w0 - w1);
-    CieXyz c = cie_at(w);
+    cie::Xyz c = cie::matching(w);
     x += c.x * v;
     y += c.y * v;
     z += c.z * v;

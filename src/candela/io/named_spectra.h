@@ -41,9 +41,6 @@ RGB sampled_spectrum_rgb(std::span<const double> pairs, Role role);
 // Its value at `lambda` nm (linear interpolation, constant beyond the ends).
 float sampled_spectrum_at(std::span<const double> pairs, float lambda);
 
-// CIE 1931 XYZ (Y = luminance) to linear sRGB (Rec. 709 primaries, D65 white).
-RGB xyz_to_linear_srgb(float x, float y, float z);
-
 }  // namespace candela::pbrt_spectra
 
 // Mitsuba 3's spectral values as its RGB variants (scalar_rgb) see them (docs/mitsuba-format.md).

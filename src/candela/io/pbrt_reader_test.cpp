@@ -19,6 +19,7 @@
 #include "candela/io/pbrt_reader.h"
 #include "candela/io/scene_reader.h"
 #include "candela/scene/description.h"
+#include "candela/spectral/cie.h"
 
 namespace candela {
 namespace {
@@ -1853,7 +1854,7 @@ TEST(PbrtNamedSpectra, SampledSpectraAndBlackbodies) {
   EXPECT_GT(candle.r, candle.b);
   EXPECT_GT(sky.b, sky.r);
   // Tungsten's copper, reproduced from pbrt-v4's copper table by the same conversion to about 1%.
-  RGB xyz_white = xyz_to_linear_srgb(0.95047f, 1.0f, 1.08883f);
+  RGB xyz_white = cie::xyz_to_linear_srgb(0.95047, 1.0, 1.08883);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(xyz_white[c], 1, 1e-3f);
 }
 
