@@ -85,6 +85,7 @@ TEST_F(CommandLine, RendersAndWritesMetadata) {
   EXPECT_EQ(meta["candela:spp"], "3");
   EXPECT_EQ(meta["candela:seed"], "5");
   EXPECT_EQ(meta["candela:scene"], scene);
+  EXPECT_EQ(meta["candela:transport"], "rgb");
   EXPECT_TRUE(meta.count("candela:render_time_seconds"));
   Image img = read_image(out());
   EXPECT_EQ(img.width, 16);
@@ -151,8 +152,22 @@ TEST_F(CommandLine, HelpDocumentsEveryOption) {
                           "--shadow-rays", "--adaptive-threshold", "--adaptive-spp", "--adaptive-batch", "--max-spp", "--spp-map",
                           "--checkpoint", "--checkpoint-every", "--resume", "--time-limit", "--clamp", "--pixel",
                           "--bdpt-strategies", "--bdpt-unweighted", "--mlt-bootstrap", "--mlt-chains", "--mlt-sigma",
-                          "--mlt-large-step", "--mlt-lens", "--mlt-caustic"})
+                          "--mlt-large-step", "--mlt-lens", "--mlt-caustic", "--transport"})
     EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
+}
+
+TEST_F(CommandLine, TransportOption) {
+  // JSON scenes render in RGB unless asked; --transport overrides the scene either way.
+  std::string scene = write("good.json", kGoodJson);
+  expect_failure("render " + scene + " -o " + out() + " --transport hyperspectral",
+                 "--transport: unknown value 'hyperspectral' \\(expected one of: rgb, spectral\\)");
+  ASSERT_EQ(run_cli("render " + scene + " -o " + out() + " --spp 2 -q --transport spectral").exit_code, 0);
+  EXPECT_EQ(read_image_metadata(out())["candela:transport"], "spectral");
+  const std::string pbrt = std::string(CANDELA_SHARED_DIR) + "/scenes/cornell-box/cornell-box.pbrt";
+  ASSERT_EQ(run_cli("render " + pbrt + " -o " + out() + " --spp 1 --resolution 8x8 -q").exit_code, 0);
+  EXPECT_EQ(read_image_metadata(out())["candela:transport"], "spectral") << "pbrt-v4 files render spectrally";
+  ASSERT_EQ(run_cli("render " + pbrt + " -o " + out() + " --spp 1 --resolution 8x8 -q --transport rgb").exit_code, 0);
+  EXPECT_EQ(read_image_metadata(out())["candela:transport"], "rgb");
 }
 
 TEST_F(CommandLine, RenderControlOptionsAreChecked) {

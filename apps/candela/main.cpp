@@ -414,6 +414,7 @@ int run_render(const RenderCommand& cmd) {
       {"candela:spp_mean", fmt::format("{:.4f}", mean_spp)},
       {"candela:render_time_seconds", fmt::format("{:.3f}", stats.seconds)},
       {"candela:integrator", desc.settings.integrator},
+      {"candela:transport", desc.settings.spectral ? "spectral" : "rgb"},
       {"candela:max_depth", std::to_string(desc.settings.max_depth)},
       {"candela:seed", std::to_string(desc.settings.seed)},
       {"Software", "candela " CANDELA_VERSION}};
@@ -525,8 +526,7 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--transport", cmd.transport,
                          "Light transport: rgb (three colour channels) or spectral (three sampled wavelengths "
                          "per path, RGB parameters as smooth spectra, as pbrt-v4); default: the scene's "
-                         "(spectral for pbrt-v4 files, rgb otherwise)")
-      ->check(CLI::IsMember({"rgb", "spectral"}));
+                         "(spectral for pbrt-v4 files, rgb otherwise)");
   render_cmd->add_flag("--no-mis", cmd.no_mis,
                        "Turn off multiple importance sampling: direct light from shadow rays only");
   render_cmd->add_option("--light-selection", cmd.light_selection,

@@ -1,8 +1,7 @@
 #include "candela/integrators/bdpt.h"
 
-#include "candela/materials/spectral_bsdf.h"
-
 #include "candela/integrators/mlt_sampler.h"
+#include "candela/materials/spectral_bsdf.h"
 #include "candela/sampling/samplers.h"
 
 namespace candela {
@@ -495,7 +494,7 @@ RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts
   int nc = camera_subpath(ray, sampler, counts, max_depth_ + 2, cv, crossed.data(), wl);
   int nl = light_subpath(sampler, counts, max_depth_ + 1, ray.time, lv, wl);
   // What reaches an image directly (splats, strategy images) is RGB.
-  auto to_rgb = [wl](const RGB& v) { return wl ? wavelengths_to_rgb(v, *wl) : v; };
+  auto to_rgb = [wl](const RGB& v) { return wavelengths_to_rgb(v, wl); };
 
   // Strategy images are scaled like the light image (importance film area / light paths); camera
   // samples of a pixel count per pixel, hence the ratio of the image's area to the importance film's.

@@ -19,13 +19,13 @@
 #include <vector>
 
 #include "candela/film/film.h"
-#include "candela/spectral/wavelengths.h"
 #include "candela/film/filter.h"
 #include "candela/geometry/ray.h"
 #include "candela/integrators/path_integrator.h"
 #include "candela/materials/bsdf.h"
 #include "candela/math/frame.h"
 #include "candela/scene/scene.h"
+#include "candela/spectral/wavelengths.h"
 
 namespace candela {
 

@@ -8,7 +8,6 @@
 #include <atomic>
 #include <chrono>
 #include <limits>
-#include <optional>
 
 #include "candela/film/filter.h"
 #include "candela/integrators/bdpt.h"
@@ -63,19 +62,18 @@ class MltPathSampler {
                 -margin.y + u.y * (float(camera.height()) + 2 * margin.y)};
     Vec2 lens = sampler.get_2d();
     float time = lerp(sampler.get_1d(), camera.shutter_open(), camera.shutter_close());
-    std::optional<Wavelengths> wl;  // a spectral render's wavelengths are part of the state
-    if (spectral_) wl = sample_visible_wavelengths(sampler.get_1d());
-    const Wavelengths* wlp = wl ? &*wl : nullptr;
+    Wavelengths storage;  // a spectral render's wavelengths are part of the state
+    const Wavelengths* wl = sample_wavelengths_if(spectral_, sampler, storage);
     Ray ray = camera.generate_ray(raster, lens, time);
     PathState state{RGB(0.0f), raster, s, t};
-    if (bdpt_.camera_subpath(ray, sampler, counts, t, camera_path.data(), nullptr, wlp) != t) return state;
+    if (bdpt_.camera_subpath(ray, sampler, counts, t, camera_path.data(), nullptr, wl) != t) return state;
     sampler.start_stream(MltSampler::kLightStream);
-    if (bdpt_.light_subpath(sampler, counts, s, time, light_path.data(), wlp) != s) return state;
+    if (bdpt_.light_subpath(sampler, counts, s, time, light_path.data(), wl) != s) return state;
     sampler.start_stream(MltSampler::kConnectionStream);
     BdptIntegrator::Connection c =
-        bdpt_.connect(light_path.data(), camera_path.data(), s, t, sampler, counts, time, wlp);
+        bdpt_.connect(light_path.data(), camera_path.data(), s, t, sampler, counts, time, wl);
     if (t == 1) state.raster = c.raster;
-    state.L = (wl ? wavelengths_to_rgb(c.L, *wl) : c.L) * float(strategies);
+    state.L = wavelengths_to_rgb(c.L, wl) * float(strategies);
     if (!state.L.is_finite() || !(state.luminance() > 0)) state.L = RGB(0.0f);
     return state;
   }
@@ -124,20 +122,19 @@ Normalization estimate_normalization(const Scene& scene, const BdptIntegrator& b
         Vec2 raster{-margin.x + (float(cx) + u.x) / float(gx) * width, -margin.y + (float(cy) + u.y) / float(gy) * height};
         Vec2 lens = sampler.get_2d();
         float time = lerp(sampler.get_1d(), camera.shutter_open(), camera.shutter_close());
-        std::optional<Wavelengths> wl;
-        if (settings.spectral) wl = sample_visible_wavelengths(sampler.get_1d());
-        const Wavelengths* wlp = wl ? &*wl : nullptr;
-        auto luminance_of = [&](const RGB& v) { return (wl ? wavelengths_to_rgb(v, *wl) : v).luminance(); };
+        Wavelengths storage;
+        const Wavelengths* wl = sample_wavelengths_if(settings.spectral, sampler, storage);
+        auto luminance_of = [&](const RGB& v) { return wavelengths_to_rgb(v, wl).luminance(); };
         Ray ray = camera.generate_ray(raster, lens, time);
         crossed.assign(size_t(max_depth) + 3, RGB(0.0f));
-        int nc = bdpt.camera_subpath(ray, sampler, counts, max_depth + 2, camera_path.data(), crossed.data(), wlp);
-        int nl = bdpt.light_subpath(sampler, counts, max_depth + 1, time, light_path.data(), wlp);
+        int nc = bdpt.camera_subpath(ray, sampler, counts, max_depth + 2, camera_path.data(), crossed.data(), wl);
+        int nl = bdpt.light_subpath(sampler, counts, max_depth + 1, time, light_path.data(), wl);
         double* by_depth = &luminance[i * depths];
         for (int t = 1; t <= nc; ++t)
           for (int s = 0; s <= nl; ++s) {
             int depth = s + t - 2;
             if ((s == 1 && t == 1) || depth < 0 || depth > max_depth) continue;
-            RGB L = bdpt.connect(light_path.data(), camera_path.data(), s, t, sampler, counts, time, wlp).L;
+            RGB L = bdpt.connect(light_path.data(), camera_path.data(), s, t, sampler, counts, time, wl).L;
             if (L.is_finite()) by_depth[depth] += luminance_of(L);
           }
         for (size_t t = 2; t < crossed.size(); ++t)

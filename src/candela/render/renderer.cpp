@@ -97,12 +97,11 @@ void render_pixel(const PassContext& pc, S& sampler, int x, int y, uint64_t firs
                                        : camera.shutter_open();
     Ray ray = camera.generate_ray({float(x) + 0.5f + fs.offset.x, float(y) + 0.5f + fs.offset.y}, lens, time);
     // A spectral render draws the path's wavelengths next; its radiance comes back as their values.
-    std::optional<Wavelengths> wl;
-    if (pc.spectral) wl = sample_visible_wavelengths(sampler.get_1d());
-    const Wavelengths* wlp = wl ? &*wl : nullptr;
-    RGB L = pc.bdpt ? pc.bdpt->radiance(ray, sampler, counts, pc.bdpt_target, x, y, fs.weight, wlp)
-                    : pc.path->radiance(ray, sampler, counts, wlp);
-    if (wl) L = wavelengths_to_rgb(L, *wl);
+    Wavelengths storage;
+    const Wavelengths* wl = sample_wavelengths_if(pc.spectral, sampler, storage);
+    RGB L = wavelengths_to_rgb(pc.bdpt ? pc.bdpt->radiance(ray, sampler, counts, pc.bdpt_target, x, y, fs.weight, wl)
+                                       : pc.path->radiance(ray, sampler, counts, wl),
+                               wl);
     if (!L.is_finite()) {
       // Never reaches the film: counted, the first few logged, and the sample counts as black.
       pc.non_finite.fetch_add(1, std::memory_order_relaxed);

@@ -36,5 +36,17 @@ RGB illuminant_at(const RGB& rgb, const Wavelengths& wl);
 
 // The same for a render that may be RGB (wl null): then the colour is returned as it is.
 inline RGB illuminant_at(const RGB& rgb, const Wavelengths* wl) { return wl ? illuminant_at(rgb, *wl) : rgb; }
+inline RGB wavelengths_to_rgb(const RGB& values, const Wavelengths* wl) {
+  return wl ? wavelengths_to_rgb(values, *wl) : values;
+}
+
+// A sample's wavelengths in a render that may be RGB: when spectral, drawn into `storage` with the
+// sampler's next number and returned; null otherwise (an RGB render consumes no number for them).
+template <typename Sampler>
+const Wavelengths* sample_wavelengths_if(bool spectral, Sampler& sampler, Wavelengths& storage) {
+  if (!spectral) return nullptr;
+  storage = sample_visible_wavelengths(sampler.get_1d());
+  return &storage;
+}
 
 }  // namespace candela
