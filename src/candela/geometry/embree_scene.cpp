@@ -258,13 +258,36 @@ void EmbreeScene::attach(RTCGeometry geom, uint32_t id, int object) {
   rtcReleaseGeometry(geom);
 }
 
+RTCGeometry EmbreeScene::new_triangle_geometry(uint32_t id, const std::vector<Point3>& positions,
+                                               const std::vector<uint32_t>& indices, bool shared) {
+  if (compact_) {
+    // The compact layout indexes vertices from its leaves, triangles or quads alike: pairs would
+    // only add their own index buffer.
+    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    if (shared) {
+      rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, indices.data(), 0,
+                                 3 * sizeof(uint32_t), indices.size() / 3);
+    } else {
+      auto* tris = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                  3 * sizeof(uint32_t), indices.size() / 3));
+      std::copy(indices.begin(), indices.end(), tris);
+    }
+    return geom;
+  }
+  if (triangle_pairs_.size() <= id) triangle_pairs_.resize(size_t(id) + 1);
+  triangle_pairs_[id] = std::make_unique<TrianglePairs>(pair_triangles(indices, positions));
+  const std::vector<uint32_t>& quads = triangle_pairs_[id]->quads;
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_QUAD);
+  rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4, quads.data(), 0, 4 * sizeof(uint32_t),
+                             quads.size() / 4);
+  return geom;
+}
+
 void EmbreeScene::add_shared_triangles(uint32_t id, const std::vector<Point3>& positions,
                                        const std::vector<uint32_t>& indices, int object) {
   if (positions.capacity() <= positions.size())
     throw std::logic_error("EmbreeScene::add_shared_triangles: the positions need one spare element of capacity");
-  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-  rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, indices.data(), 0,
-                             3 * sizeof(uint32_t), indices.size() / 3);
+  RTCGeometry geom = new_triangle_geometry(id, positions, indices, /*shared=*/true);
   rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, positions.data(), 0, sizeof(Point3),
                              positions.size());
   attach(geom, id, object);
@@ -300,10 +323,7 @@ void EmbreeScene::add_instance(uint32_t id, int object, const Transform& to_worl
 
 void EmbreeScene::add_moving_triangles(uint32_t id, const std::vector<Point3>& positions,
                                        const std::vector<Point3>& positions_end, const std::vector<uint32_t>& indices) {
-  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* tris = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                              3 * sizeof(uint32_t), indices.size() / 3));
-  std::copy(indices.begin(), indices.end(), tris);
+  RTCGeometry geom = new_triangle_geometry(id, positions, indices, /*shared=*/false);
   rtcSetGeometryTimeStepCount(geom, 2);
   set_vertex_buffer(geom, 0, positions);
   set_vertex_buffer(geom, 1, positions_end);
@@ -387,6 +407,13 @@ bool EmbreeScene::intersect(const Ray& r, EmbreeHit& hit) const {
   rtcIntersect1(scene_, &context, &rayhit);
   if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit = {rayhit.ray.tfar, rayhit.hit.geomID, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v, -1};
+  if (hit.geometry < triangle_pairs_.size() && triangle_pairs_[hit.geometry]) {
+    // A quad of paired triangles: report the triangle and its own barycentrics.
+    TriangleHit th = quad_hit_to_triangle(triangle_pairs_[hit.geometry]->halves[hit.primitive], hit.u, hit.v);
+    hit.primitive = th.triangle;
+    hit.u = th.b1;
+    hit.v = th.b2;
+  }
   if (rayhit.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) {
     // Instance ids are handed out in increasing order, so the index is a binary search away.
     auto it = std::lower_bound(instance_ids_.begin(), instance_ids_.end(), rayhit.hit.instID[0]);

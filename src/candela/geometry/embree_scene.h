@@ -1,6 +1,7 @@
 #pragma once
 // The acceleration structure: every intersection and occlusion query goes through Embree.
-// Triangle meshes are Embree triangle geometry; spheres, disks, open cylinders and infinite planes
+// Triangle meshes are Embree quad geometry, their triangles paired across shared edges
+// (triangle_pairs.h; hits are reported per triangle), or with the compact layout Embree triangles; spheres, disks, open cylinders and infinite planes
 // are Embree user geometry intersected analytically in double precision (exact, not tessellated).
 // Moving shapes (motion blur, the paper's sec. 4.2) have two Embree time steps: their transform is
 // interpolated linearly between the start and end transforms, as Embree interpolates vertices.
@@ -13,6 +14,7 @@
 
 #include "candela/geometry/ray.h"
 #include "candela/geometry/ray_log.h"
+#include "candela/geometry/triangle_pairs.h"
 #include "candela/math/transform.h"
 
 namespace candela {
@@ -74,9 +76,11 @@ class EmbreeScene {
   // the world and all objects. `object` is the object (from add_object) the geometry belongs to, or
   // -1 for the world.
   //
-  // Triangles that Embree reads in place, without a copy: both arrays must outlive this scene
-  // unchanged and unmoved (their buffers, that is; the vectors themselves may be moved), and
+  // Triangles whose vertices Embree reads in place, without a copy: both arrays must outlive this
+  // scene unchanged and unmoved (their buffers, that is; the vectors themselves may be moved), and
   // `positions` must have capacity for one more element (Embree reads vertices with 16-byte loads).
+  // Embree sees them as quads of paired triangles (not with the compact layout); hits name the
+  // triangle either way (index into `indices` / 3).
   void add_shared_triangles(uint32_t id, const std::vector<Point3>& positions, const std::vector<uint32_t>& indices,
                             int object = -1);
   // Triangles whose vertices move linearly from `positions` at time 0 to `positions_end` at time 1
@@ -126,6 +130,11 @@ class EmbreeScene {
   };
 
   void attach(RTCGeometry geom, uint32_t id, int object = -1);
+  // The Embree geometry for the triangles `indices` (vertices still to be set): quads of paired
+  // triangles, the pairing kept under `id` for intersect(); with the compact layout, the triangles
+  // themselves (reading `indices` in place when `shared`, else copying them).
+  RTCGeometry new_triangle_geometry(uint32_t id, const std::vector<Point3>& positions,
+                                    const std::vector<uint32_t>& indices, bool shared);
 
   float time_start_ = 0, time_scale_ = 1;  // Embree time = (time - time_start_) * time_scale_
   bool compact_ = false;
@@ -138,6 +147,8 @@ class EmbreeScene {
   std::vector<std::unique_ptr<SphereGeometry>> spheres_;
   std::vector<std::unique_ptr<QuadricGeometry>> quadrics_;
   std::vector<std::unique_ptr<PlaneRecord>> planes_;
+  // By geometry id: the triangle pairs of a mesh (Embree reads their quads in place), or null.
+  std::vector<std::unique_ptr<TrianglePairs>> triangle_pairs_;
 };
 
 }  // namespace candela
