@@ -1,6 +1,7 @@
 #include "candela/spectral/rgb_to_spectrum.h"
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -142,7 +143,7 @@ struct Table {
   Table() : z_nodes(kRes), coefficients(size_t(3) * kRes * kRes * kRes) {
     auto smoothstep = [](double x) { return x * x * (3 - 2 * x); };
     for (int k = 0; k < kRes; ++k) z_nodes[k] = float(smoothstep(smoothstep(double(k) / (kRes - 1))));
-    tbb::parallel_for(0, 3 * kRes, [&](int row) {
+    auto fit_row = [&](int row) {
       int l = row / kRes, yi = row % kRes;
       double y = double(yi) / (kRes - 1);
       for (int xi = 0; xi < kRes; ++xi) {
@@ -164,7 +165,10 @@ struct Table {
         c = {0, 0, 0};
         for (int zi = start; zi >= 0; --zi) solve_at(zi, c);
       }
-    });
+    };
+    // Isolated: a thread waiting here must not pick up an outer task (a render tile) that would ask
+    // for the table again while it is being built.
+    tbb::this_task_arena::isolate([&] { tbb::parallel_for(0, 3 * kRes, fit_row); });
   }
 };
 
