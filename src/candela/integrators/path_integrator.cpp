@@ -228,7 +228,6 @@ RGB PathIntegrator::shadow_ray_estimate(const Vertex& v, size_t li, const Vec2& 
   const Light& light = scene_.lights()[li];
   LightSample ls = light_sample_li(light, v.ctx, u);
   if (ls.pdf <= 0 || ls.radiance.is_black()) return RGB(0.0f);
-  ls.radiance = illuminant_at(ls.radiance, v.wl);
   Vec3 wi_local = v.frame.to_local(ls.wi);
   RGB f = bsdf_eval(v.bsdf, v.wo_local, wi_local) * std::abs(wi_local.z);
   if (f.is_black()) return RGB(0.0f);
@@ -240,11 +239,13 @@ RGB PathIntegrator::shadow_ray_estimate(const Vertex& v, size_t li, const Vec2& 
   ++counts.shadow;
   if (scene_.occluded(shadow)) return RGB(0.0f);
 
-  // One sample of the light strategy, of which `expected_rays` are taken on average here.
+  // One sample of the light strategy, of which `expected_rays` are taken on average here (its
+  // emission at the path's wavelengths only now that it counts).
+  const RGB Le = illuminant_at(ls.radiance, v.wl);
   float light_pdf = expected_rays * ls.pdf;
-  if (ls.is_delta || !mis_) return f * ls.radiance / light_pdf;
+  if (ls.is_delta || !mis_) return f * Le / light_pdf;
   float w = power_heuristic(light_pdf, direction_pdf(v.bsdf, v.wo_local, wi_local));
-  return f * ls.radiance * (w / light_pdf);
+  return f * Le * (w / light_pdf);
 }
 
 // One instantiation per sampler type of the variant.

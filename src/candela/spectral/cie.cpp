@@ -92,4 +92,9 @@ RGB xyz_to_linear_srgb(double x, double y, double z) {
              float(0.0556434 * x - 0.2040259 * y + 1.0572252 * z));
 }
 
+Xyz linear_srgb_to_xyz(double r, double g, double b) {
+  return {0.4124564 * r + 0.3575761 * g + 0.1804375 * b, 0.2126729 * r + 0.7151522 * g + 0.0721750 * b,
+          0.0193339 * r + 0.1191920 * g + 0.9503041 * b};
+}
+
 }  // namespace candela::cie

@@ -23,5 +23,7 @@ double d65(double lambda);
 // Linear sRGB (Rec. 709 primaries, D65 white) from CIE XYZ.
 RGB xyz_to_linear_srgb(double x, double y, double z);
 inline RGB xyz_to_linear_srgb(const Xyz& c) { return xyz_to_linear_srgb(c.x, c.y, c.z); }
+// Its inverse.
+Xyz linear_srgb_to_xyz(double r, double g, double b);
 
 }  // namespace candela::cie

@@ -60,13 +60,6 @@ std::array<double, 3> to_lab(const cie::Xyz& c, const cie::Xyz& white) {
   return {116 * fy - 16, 500 * (fx - fy), 200 * (fy - fz)};
 }
 
-// XYZ of linear sRGB (the inverse of cie::xyz_to_linear_srgb).
-cie::Xyz srgb_to_xyz(const std::array<double, 3>& rgb) {
-  return {0.4124564 * rgb[0] + 0.3575761 * rgb[1] + 0.1804375 * rgb[2],
-          0.2126729 * rgb[0] + 0.7151522 * rgb[1] + 0.0721750 * rgb[2],
-          0.0193339 * rgb[0] + 0.1191920 * rgb[1] + 0.9503041 * rgb[2]};
-}
-
 // CIELAB of the sigmoid spectrum with coefficients c (normalised t) under D65.
 std::array<double, 3> spectrum_lab(const std::array<double, 3>& c) {
   const Quadrature& q = quadrature();
@@ -83,7 +76,7 @@ std::array<double, 3> spectrum_lab(const std::array<double, 3>& c) {
 
 // Gauss-Newton on the CIELAB difference (forward-difference Jacobian), starting from c.
 void fit(const std::array<double, 3>& rgb, std::array<double, 3>& c) {
-  const std::array<double, 3> target = to_lab(srgb_to_xyz(rgb), quadrature().white);
+  const std::array<double, 3> target = to_lab(cie::linear_srgb_to_xyz(rgb[0], rgb[1], rgb[2]), quadrature().white);
   for (int iteration = 0; iteration < 30; ++iteration) {
     std::array<double, 3> lab = spectrum_lab(c), r;
     for (int k = 0; k < 3; ++k) r[k] = lab[k] - target[k];

@@ -62,9 +62,7 @@ RGB reflectance_at(const RGB& rgb, const Wavelengths& wl) {
 }
 
 RGB illuminant_at(const RGB& rgb, const Wavelengths& wl) {
-  float scale = 2 * rgb.max_component();
-  if (scale <= 0) return RGB(0.0f);
-  RGB s = sigmoid_at(rgb_to_sigmoid(rgb / scale), wl) * scale;
+  RGB s = unbounded_at(rgb, wl);
   return {s.r * float(cie::d65(wl.lambda[0])), s.g * float(cie::d65(wl.lambda[1])), s.b * float(cie::d65(wl.lambda[2]))};
 }
 
