@@ -17,6 +17,7 @@ seeds="${3:-8}"
 candela=./build/candela
 out="${OUT_DIR:-/tmp/candela-mlt-perturbations}/$(basename "$scene" .json)"
 mkdir -p "$out"
+rm -f "$out"/mlt-*.exr  # a previous run's seeds would join this one's
 settings=("off:" "lens:--mlt-lens 0.3" "caustic:--mlt-caustic 0.3" "lens+caustic:--mlt-lens 0.3 --mlt-caustic 0.3")
 if [ -n "${EXTRA_SETTINGS:-}" ]; then
   IFS=';' read -r -a extra <<< "$EXTRA_SETTINGS"
@@ -45,5 +46,5 @@ for integrator in path bdpt; do
   "$candela" render "$scene" --integrator "$integrator" --spp 1000000 --time-limit "$limit" -q -o "$out/$integrator.exr" > /dev/null
 done
 # shellcheck disable=SC2086
-/usr/bin/python3 bench/mlt_seed_variance.py "$out/mlt-NAME-*.exr" "${names[@]}" \
+/usr/bin/python3 bench/mlt_seed_variance.py "$out/mlt-NAME-[0-9]*.exr" "${names[@]}" \
   --also "$out/path.exr" "$out/bdpt.exr" ${CROP:+--crop $CROP}

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Compare MLT settings by their error over seeds, where no converged reference can be rendered.
 
-  mlt_seed_variance.py 'DIR/mlt-NAME-*.exr' off lens ... [--also IMAGE ...]
+  mlt_seed_variance.py 'DIR/mlt-NAME-[0-9]*.exr' off lens ... [--crop X0 X1 Y0 Y1] [--also IMAGE ...]
 
 For each setting NAME, the images matching the pattern (one per seed) are scaled to the common image
 mean (MLT's normalisation is estimated by a bootstrap that does not depend on the mutations: every
