@@ -872,73 +872,87 @@ class PlyNumbers {
 
 TriangleMesh load_ply_with_attributes(std::string_view bytes, const PlyHeader& header) {
   PlyNumbers numbers(header, bytes.substr(header.data_offset));
-  std::vector<std::vector<double>> vertex_rows, face_rows;
-  std::vector<std::vector<uint32_t>> faces;
+  // The first vertex and face elements' records, flat: a row per record, a column per property (lists
+  // hold 0 there), and each face's vertex indices, face f's at [face_starts[f], face_starts[f + 1]).
+  // Flat arrays rather than a vector per record: millions of small allocations, freed after loading,
+  // would leave the heap fragmented and the process larger for the whole render.
+  const PlyElement* vertex = find_element(header, "vertex");
+  const PlyElement* face = find_element(header, "face");
+  std::vector<double> vertex_values, face_values;
+  std::vector<uint32_t> face_indices;
+  std::vector<size_t> face_starts{0};
   for (const PlyElement& e : header.elements) {
-    const bool is_vertex = e.name == "vertex", is_face = e.name == "face";
+    const bool is_vertex = &e == vertex, is_face = &e == face;
+    std::vector<double>* values = is_vertex ? &vertex_values : is_face ? &face_values : nullptr;
+    if (values) values->reserve(e.count * e.properties.size());  // the counts were checked against the data
     for (uint64_t r = 0; r < e.count; ++r) {
       numbers.begin_record();
-      std::vector<double> row(e.properties.size(), 0.0);
-      for (size_t k = 0; k < e.properties.size(); ++k) {
-        const PlyProperty& p = e.properties[k];
+      bool has_indices = false;
+      for (const PlyProperty& p : e.properties) {
         if (!p.list_length) {
-          row[k] = numbers.next(p.value);
+          const double value = numbers.next(p.value);
+          if (values) values->push_back(value);
           continue;
         }
+        if (values) values->push_back(0.0);
+        // One index list per face record: the first vertex_indices list (any other list is ignored).
+        const bool keep = is_face && !has_indices && is_geometry_property("face", p.name);
         const auto n = uint64_t(numbers.next(*p.list_length));
-        std::vector<uint32_t> items;
         for (uint64_t j = 0; j < n; ++j) {
           const double index = numbers.next(p.value);
           if (!(index >= 0 && index <= double(std::numeric_limits<uint32_t>::max())))
             fail("malformed PLY: face {} has a vertex index {}", r, index);
-          items.push_back(uint32_t(index));
+          if (keep) face_indices.push_back(uint32_t(index));
         }
-        // One index list per face record: the first vertex_indices list (any other list is ignored).
-        if (is_face && is_geometry_property("face", p.name) && faces.size() == face_rows.size())
-          faces.push_back(std::move(items));
+        has_indices = has_indices || keep;
       }
-      if (is_vertex) vertex_rows.push_back(std::move(row));
-      if (is_face) {
-        if (faces.size() == face_rows.size()) faces.emplace_back();  // a record without indices
-        face_rows.push_back(std::move(row));
-      }
+      if (is_face) face_starts.push_back(face_indices.size());  // a record without indices has none
     }
   }
-  const PlyElement& vertex = *find_element(header, "vertex");
+  const size_t vertex_width = vertex->properties.size();
   auto column = [&](std::initializer_list<const char*> names) -> int {
     for (const char* n : names)
-      for (size_t i = 0; i < vertex.properties.size(); ++i)
-        if (vertex.properties[i].name == n && !vertex.properties[i].list_length) return int(i);
+      for (size_t i = 0; i < vertex_width; ++i)
+        if (vertex->properties[i].name == n && !vertex->properties[i].list_length) return int(i);
     return -1;
   };
   const int x = column({"x"}), y = column({"y"}), z = column({"z"});
   const int nx = column({"nx"}), ny = column({"ny"}), nz = column({"nz"});
   const int u = column({"u", "s", "texture_u", "texture_s"}), v = column({"v", "t", "texture_v", "texture_t"});
   TriangleMesh mesh;
-  for (const std::vector<double>& row : vertex_rows) {
-    mesh.positions.push_back({float(row[size_t(x)]), float(row[size_t(y)]), float(row[size_t(z)])});
-    if (nx >= 0 && ny >= 0 && nz >= 0)
-      mesh.normals.push_back({float(row[size_t(nx)]), float(row[size_t(ny)]), float(row[size_t(nz)])});
-    if (u >= 0 && v >= 0) mesh.uvs.push_back({float(row[size_t(u)]), float(row[size_t(v)])});
+  const size_t vertex_count = vertex->count;
+  auto at = [&](size_t row, int c) { return float(vertex_values[row * vertex_width + size_t(c)]); };
+  mesh.positions.reserve(vertex_count);
+  for (size_t row = 0; row < vertex_count; ++row) {
+    mesh.positions.push_back({at(row, x), at(row, y), at(row, z)});
+    if (nx >= 0 && ny >= 0 && nz >= 0) mesh.normals.push_back({at(row, nx), at(row, ny), at(row, nz)});
+    if (u >= 0 && v >= 0) mesh.uvs.push_back({at(row, u), at(row, v)});
   }
+  size_t triangle_count = 0;
+  for (size_t f = 0; f + 1 < face_starts.size(); ++f)
+    triangle_count += std::max<size_t>(face_starts[f + 1] - face_starts[f], 2) - 2;
+  mesh.indices.reserve(3 * triangle_count);
   std::vector<size_t> face_of_triangle;
-  for (size_t f = 0; f < faces.size(); ++f)
-    for (size_t k = 1; k + 1 < faces[f].size(); ++k) {
-      for (uint32_t index : {faces[f][0], faces[f][k], faces[f][k + 1]}) mesh.indices.push_back(index);
+  face_of_triangle.reserve(triangle_count);
+  for (size_t f = 0; f + 1 < face_starts.size(); ++f) {
+    const uint32_t* indices = face_indices.data() + face_starts[f];
+    for (size_t k = 1; k + 1 < face_starts[f + 1] - face_starts[f]; ++k) {
+      for (uint32_t index : {indices[0], indices[k], indices[k + 1]}) mesh.indices.push_back(index);
       face_of_triangle.push_back(f);
     }
+  }
   if (mesh.indices.empty()) fail("the PLY file contains no triangles{}", describe_elements(header));
-  for (const PropertyGroup& g : attribute_groups(vertex)) {
+  for (const PropertyGroup& g : attribute_groups(*vertex)) {
     TriangleMesh::Attribute a{g.name, false, int(g.columns.size()), {}};
-    for (const std::vector<double>& row : vertex_rows)
-      for (size_t c : g.columns) a.values.push_back(float(row[c]));
+    for (size_t row = 0; row < vertex_count; ++row)
+      for (size_t c : g.columns) a.values.push_back(float(vertex_values[row * vertex_width + c]));
     mesh.attributes.push_back(std::move(a));
   }
-  if (const PlyElement* face = find_element(header, "face"))
+  if (face)
     for (const PropertyGroup& g : attribute_groups(*face)) {
       TriangleMesh::Attribute a{g.name, true, int(g.columns.size()), {}};
       for (size_t f : face_of_triangle)
-        for (size_t c : g.columns) a.values.push_back(float(face_rows[f][c]));
+        for (size_t c : g.columns) a.values.push_back(float(face_values[f * face->properties.size() + c]));
       mesh.attributes.push_back(std::move(a));
     }
   return mesh;
