@@ -921,7 +921,7 @@ TriangleMesh load_ply_with_attributes(std::string_view bytes, const PlyHeader& h
   const int u = column({"u", "s", "texture_u", "texture_s"}), v = column({"v", "t", "texture_v", "texture_t"});
   TriangleMesh mesh;
   const size_t vertex_count = vertex->count;
-  auto at = [&](size_t row, int c) { return float(vertex_values[row * vertex_width + size_t(c)]); };
+  auto at = [&](size_t row, auto column) { return float(vertex_values[row * vertex_width + size_t(column)]); };
   mesh.positions.reserve(vertex_count);
   for (size_t row = 0; row < vertex_count; ++row) {
     mesh.positions.push_back({at(row, x), at(row, y), at(row, z)});
@@ -945,7 +945,7 @@ TriangleMesh load_ply_with_attributes(std::string_view bytes, const PlyHeader& h
   for (const PropertyGroup& g : attribute_groups(*vertex)) {
     TriangleMesh::Attribute a{g.name, false, int(g.columns.size()), {}};
     for (size_t row = 0; row < vertex_count; ++row)
-      for (size_t c : g.columns) a.values.push_back(float(vertex_values[row * vertex_width + c]));
+      for (size_t c : g.columns) a.values.push_back(at(row, c));
     mesh.attributes.push_back(std::move(a));
   }
   if (face)
