@@ -37,6 +37,11 @@ Camera::Camera(const CameraDesc& desc, int width, int height, Vec2 margin)
       tan_half_y_ = t / diag;
     }
   }
+  // A pinhole ray's world direction is linear in the film position: precompute it as
+  // pinhole_dir0_ + film.x * pinhole_dx_ + film.y * pinhole_dy_ (no matrix product per camera ray).
+  pinhole_dir0_ = world_from_camera_.vector(Vec3(-tan_half_x_, tan_half_y_, 1));
+  pinhole_dx_ = world_from_camera_.vector(Vec3(2 * tan_half_x_ / float(width), 0, 0));
+  pinhole_dy_ = world_from_camera_.vector(Vec3(0, -2 * tan_half_y_ / float(height), 0));
 }
 
 float Camera::near_t(const Point3& o, const Vec3& d) const {
@@ -54,14 +59,12 @@ Ray Camera::generate_ray(Vec2 film, Vec2 lens, float time) const {
     ray.t_min = near_t(o, d);
     return ray;
   }
-  float sx = (2 * film.x / float(width_) - 1) * tan_half_x_;
-  float sy = (1 - 2 * film.y / float(height_)) * tan_half_y_;
-  Vec3 dir(sx, sy, 1);  // camera space, z = 1
   if (lens_radius_ <= 0) {
-    Ray ray{origin_, normalize(world_from_camera_.vector(dir)), inf, time};
-    ray.t_min = near_t(Point3(0.0f), dir);
+    Ray ray{origin_, normalize(pinhole_dir0_ + film.x * pinhole_dx_ + film.y * pinhole_dy_), inf, time};
+    if (near_clip_ > 0) ray.t_min = near_t(Point3(0.0f), camera_direction(film));
     return ray;
   }
+  Vec3 dir = camera_direction(film);
   // Thin lens: start on the lens disk and aim at the point of the pinhole ray on the plane of focus.
   Vec2 d = square_to_concentric_disk(lens);
   Point3 lens_point(lens_radius_ * d.x, lens_radius_ * d.y, 0);

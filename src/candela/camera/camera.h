@@ -83,12 +83,18 @@ class Camera {
   // whose world direction has length world_len: the near plane's distance along the world ray.
   float near_t(const Point3& o, const Vec3& d) const;
 
+  // The pinhole ray through film position `film` in camera space, at depth z = 1.
+  Vec3 camera_direction(Vec2 film) const {
+    return {(2 * film.x / float(width_) - 1) * tan_half_x_, (1 - 2 * film.y / float(height_)) * tan_half_y_, 1};
+  }
+
   Transform world_from_camera_, camera_from_world_;
   bool orthographic_ = false;
   float near_clip_ = 0;
   float ortho_half_y_ = 1;  // orthographic: the film spans [-1, 1] x [-ortho_half_y, ortho_half_y]
   Vec3 forward_{0, 0, 1};
   Point3 origin_;
+  Vec3 pinhole_dir0_, pinhole_dx_, pinhole_dy_;  // see the constructor
   float tan_half_x_ = 1, tan_half_y_ = 1;
   float lens_radius_ = 0, focus_distance_ = 1;
   float shutter_open_ = 0, shutter_close_ = 1;
