@@ -225,8 +225,10 @@ class XmlParser {
 
   std::string search_path_text() const {
     std::string s;
-    for (auto it = search_paths_.rbegin(); it != search_paths_.rend(); ++it)
-      s += (s.empty() ? "" : ", ") + it->string();
+    for (auto it = search_paths_.rbegin(); it != search_paths_.rend(); ++it) {
+      if (!s.empty()) s += ", ";
+      s += it->string();
+    }
     return s;
   }
 
