@@ -11,6 +11,9 @@
 //    rtcIntersect1: packets (rtcIntersect4/8/16) on coherent camera rays, one per pixel traced in
 //    pixel blocks, and ray streams (rtcIntersect1M / rtcOccluded1M, coherent and incoherent
 //    hints) on the recorded bounce and shadow rays.
+// 4. The floor: the least a path tracer can do around Embree (see floor_paths), timed, then its
+//    own rays replayed through raw Embree the same way. Its efficiency bounds what any path tracer
+//    that draws a direction per hit can reach on this scene and machine.
 //
 // Usage: candela_ray_replay SCENE [--spp N] [--resolution WxH] [--threads T] [--repeat R]
 // (prints a Markdown table; the fastest of R replays counts).
@@ -29,6 +32,9 @@
 #include <vector>
 
 #include "candela/film/film.h"
+#include "candela/math/frame.h"
+#include "candela/sampling/rng.h"
+#include "candela/sampling/warp.h"
 #include "candela/io/scene_reader.h"
 #include "candela/render/renderer.h"
 #include "candela/scene/scene.h"
@@ -176,6 +182,105 @@ std::vector<RTCRay> camera_rays(const Scene& scene, int width, int height, int b
   return rays;
 }
 
+// The floor path tracer: per sample a PCG stream, a jittered pinhole camera ray, then at each hit the
+// geometric normal as Embree returns it (no hit reconstruction, no material, no light, no film), one
+// shadow ray in a cosine-distributed direction (the cheapest next-event estimate: a sky's) and a
+// cosine-distributed bounce, to max_depth or until a ray escapes, surviving Russian roulette with
+// probability 0.7 from the second bounce on. Rows [y0, y1) of the image; counts its rays, and logs
+// them when `log` is set.
+void floor_paths(RTCScene rtc, const Scene& scene, int width, int y0, int y1, int spp, int max_depth,
+                 std::vector<RecordedRay>* log, uint64_t& rays, uint64_t& sink) {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  const PerspectiveCamera& camera = scene.camera();
+  for (int y = y0; y < y1; ++y)
+    for (int x = 0; x < width; ++x)
+      for (int s = 0; s < spp; ++s) {
+        Rng rng(hash_values(uint64_t(x), uint64_t(y)), uint64_t(s));
+        const float jx = rng.next_float(), jy = rng.next_float();
+        RTCRayHit rh = to_rayhit(scene.embree().embree_ray(camera.generate_ray({float(x) + jx, float(y) + jy}, {0.5f, 0.5f}, 0)));
+        for (int depth = 0; depth < max_depth; ++depth) {
+          if (log) log->push_back({rh.ray, false});
+          rtcIntersect1(rtc, &context, &rh);
+          ++rays;
+          if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
+          const Vec3 d(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
+          const Point3 p = Point3(rh.ray.org_x, rh.ray.org_y, rh.ray.org_z) + d * rh.ray.tfar;
+          Vec3 n = normalize(Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
+          if (dot(n, d) > 0) n = -n;
+          const Frame frame(n);
+          const Point3 origin = p + n * (2e-5f * (1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)})));
+          const float u0 = rng.next_float(), u1 = rng.next_float();
+          Ray shadow{origin, frame.to_world(square_to_cosine_hemisphere({u0, u1}))};
+          RTCRay sr = scene.embree().embree_ray(shadow);
+          if (log) log->push_back({sr, true});
+          rtcOccluded1(rtc, &context, &sr);
+          ++rays;
+          sink += sr.tfar < 0;
+          if (depth >= 1 && rng.next_float() >= 0.7f) break;
+          const float v0 = rng.next_float(), v1 = rng.next_float();
+          rh = to_rayhit(scene.embree().embree_ray(Ray{origin, frame.to_world(square_to_cosine_hemisphere({v0, v1}))}));
+        }
+      }
+}
+
+// The same paths (the same random numbers, so the same rays) traced as a wavefront: all camera rays
+// of the rows at once, then every hit's shadow ray and the surviving bounces, one depth at a time,
+// until no path is left. Each batch goes through Embree's ray stream API (`streams`) or
+// rtcIntersect1/rtcOccluded1 per ray, which tells the stream API's share of the gain from the
+// wavefront's order (no path waits on its own traversal).
+void floor_wavefront(RTCScene rtc, const Scene& scene, int width, int y0, int y1, int spp, int max_depth,
+                     bool streams, uint64_t& rays, uint64_t& sink) {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  const PerspectiveCamera& camera = scene.camera();
+  std::vector<RTCRayHit> active, next;
+  std::vector<Rng> rngs, next_rngs;
+  std::vector<RTCRay> shadows;
+  for (int y = y0; y < y1; ++y)
+    for (int x = 0; x < width; ++x)
+      for (int s = 0; s < spp; ++s) {
+        Rng rng(hash_values(uint64_t(x), uint64_t(y)), uint64_t(s));
+        const float jx = rng.next_float(), jy = rng.next_float();
+        active.push_back(to_rayhit(scene.embree().embree_ray(camera.generate_ray({float(x) + jx, float(y) + jy}, {0.5f, 0.5f}, 0))));
+        rngs.push_back(rng);
+      }
+  for (int depth = 0; depth < max_depth && !active.empty(); ++depth) {
+    if (streams) rtcIntersect1M(rtc, &context, active.data(), unsigned(active.size()), sizeof(RTCRayHit));
+    else
+      for (RTCRayHit& rh : active) rtcIntersect1(rtc, &context, &rh);
+    rays += active.size();
+    shadows.clear();
+    next.clear();
+    next_rngs.clear();
+    for (size_t k = 0; k < active.size(); ++k) {
+      const RTCRayHit& rh = active[k];
+      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+      Rng& rng = rngs[k];
+      const Vec3 d(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
+      const Point3 p = Point3(rh.ray.org_x, rh.ray.org_y, rh.ray.org_z) + d * rh.ray.tfar;
+      Vec3 n = normalize(Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
+      if (dot(n, d) > 0) n = -n;
+      const Frame frame(n);
+      const Point3 origin = p + n * (2e-5f * (1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)})));
+      const float u0 = rng.next_float(), u1 = rng.next_float();
+      shadows.push_back(scene.embree().embree_ray(Ray{origin, frame.to_world(square_to_cosine_hemisphere({u0, u1}))}));
+      if (depth >= 1 && rng.next_float() >= 0.7f) continue;
+      const float v0 = rng.next_float(), v1 = rng.next_float();
+      next.push_back(to_rayhit(scene.embree().embree_ray(Ray{origin, frame.to_world(square_to_cosine_hemisphere({v0, v1}))})));
+      next_rngs.push_back(rng);
+    }
+    if (streams) rtcOccluded1M(rtc, &context, shadows.data(), unsigned(shadows.size()), sizeof(RTCRay));
+    else
+      for (RTCRay& r : shadows) rtcOccluded1(rtc, &context, &r);
+    rays += shadows.size();
+    for (const RTCRay& r : shadows) sink += r.tfar < 0;
+    std::swap(active, next);
+    std::swap(rngs, next_rngs);
+  }
+}
+
 int usage() {
   std::fprintf(stderr, "usage: candela_ray_replay SCENE [--spp N] [--resolution WxH] [--threads T] [--repeat R]\n");
   return 2;
@@ -229,9 +334,11 @@ int run(int argc, char** argv) {
   uint64_t sink = 0;
   std::atomic<uint64_t> atomic_sink{0};
   auto replay_all = [&] {
-    std::vector<uint64_t> hits(rays.size() / 4096 + 1, 0);
-    parallel_chunks(arena, rays.size(), 4096, [&](size_t b, size_t e) { replay_single(rtc, &rays[b], e - b, hits[b / 4096]); });
-    for (uint64_t h : hits) sink += h;
+    parallel_chunks(arena, rays.size(), 4096, [&](size_t b, size_t e) {
+      uint64_t h = 0;
+      replay_single(rtc, &rays[b], e - b, h);
+      atomic_sink += h;
+    });
   };
   double raw_s = best_of(repeat, replay_all);
   size_t shadow_count = size_t(std::count_if(rays.begin(), rays.end(), [](const RecordedRay& r) { return r.occlusion; }));
@@ -302,6 +409,64 @@ int run(int argc, char** argv) {
     std::printf("| rtcIntersect1 | %zu | %.4f | %.2f | 100%% |\n", cam.size(), single, double(cam.size()) / single * 1e-6);
     std::printf("| %s | %zu | %.4f | %.2f | %.1f%% |\n", p.name, cam.size(), packet, double(cam.size()) / packet * 1e-6,
                 100 * single / packet);
+  }
+
+  // 4. The floor path tracer (floor_paths), one path at a time and as a wavefront, then its rays
+  // through raw Embree.
+  const int rows_total = desc.film.height;
+  const int max_depth = desc.settings.max_depth;
+  const size_t rows = 4;  // per chunk at most; chunks may start at any row, so counts are kept per row
+  // {seconds (fastest of `repeat`), rays} of trace(first row, end row, rays, occluded).
+  auto time_rows = [&](auto trace) {
+    std::vector<uint64_t> per_row(static_cast<size_t>(rows_total));
+    double seconds = best_of(repeat, [&] {
+      std::fill(per_row.begin(), per_row.end(), 0);
+      parallel_chunks(arena, size_t(rows_total), rows, [&](size_t b, size_t e) {
+        uint64_t h = 0;
+        trace(int(b), int(e), per_row[b], h);
+        atomic_sink += h;
+      });
+    });
+    uint64_t total = 0;
+    for (uint64_t r : per_row) total += r;
+    return std::pair<double, uint64_t>(seconds, total);
+  };
+  const auto one_at_a_time = time_rows([&](int y0, int y1, uint64_t& n, uint64_t& h) {
+    floor_paths(rtc, scene, desc.film.width, y0, y1, spp, max_depth, nullptr, n, h);
+  });
+  const auto wavefront_streams = time_rows([&](int y0, int y1, uint64_t& n, uint64_t& h) {
+    floor_wavefront(rtc, scene, desc.film.width, y0, y1, spp, max_depth, true, n, h);
+  });
+  const auto wavefront_single = time_rows([&](int y0, int y1, uint64_t& n, uint64_t& h) {
+    floor_wavefront(rtc, scene, desc.film.width, y0, y1, spp, max_depth, false, n, h);
+  });
+  std::vector<std::vector<RecordedRay>> floor_logs(static_cast<size_t>(rows_total));
+  parallel_chunks(arena, size_t(rows_total), rows, [&](size_t b, size_t e) {
+    uint64_t n = 0, h = 0;
+    floor_paths(rtc, scene, desc.film.width, int(b), int(e), spp, max_depth, &floor_logs[b], n, h);
+  });
+  std::vector<RecordedRay> floor_log;
+  for (auto& l : floor_logs) floor_log.insert(floor_log.end(), l.begin(), l.end());
+  double floor_raw_s = best_of(repeat, [&] {
+    parallel_chunks(arena, floor_log.size(), 4096, [&](size_t b, size_t e) {
+      uint64_t h = 0;
+      replay_single(rtc, &floor_log[b], e - b, h);
+      atomic_sink += h;
+    });
+  });
+  const double floor_raw_mrays = double(floor_log.size()) / floor_raw_s * 1e-6;
+  std::printf("\n| the floor (PCG, Embree's normal, cosine shadow ray and bounce; %.2f rays/sample) | rays | seconds | Mrays/s | vs raw Embree |\n"
+              "|---|---|---|---|---|\n",
+              double(one_at_a_time.second) / (double(desc.film.width) * rows_total * spp));
+  std::printf("| raw rtcIntersect1/rtcOccluded1, the floor's rays | %zu | %.3f | %.2f | 100%% |\n", floor_log.size(),
+              floor_raw_s, floor_raw_mrays);
+  for (const auto& [what, result] :
+       {std::pair("floor path tracer, one path at a time", one_at_a_time),
+        std::pair("floor as a wavefront, rtcIntersect1M/rtcOccluded1M streams", wavefront_streams),
+        std::pair("floor as a wavefront, rtcIntersect1/rtcOccluded1 per ray", wavefront_single)}) {
+    const double mrays = double(result.second) / result.first * 1e-6;
+    std::printf("| %s | %llu | %.3f | %.2f | %.1f%% |\n", what, (unsigned long long)result.second, result.first, mrays,
+                100 * mrays / floor_raw_mrays);
   }
   if (sink + atomic_sink == 42) std::printf(" ");  // keeps the traversals from being optimised away
   return 0;
