@@ -9,7 +9,8 @@
    made once and kept in BUILD/bench-references/ (so those figures measure noise, not bias).
 2. Loading: load + BVH build time, and the peak memory per triangle above a one-quad scene's.
 3. The limit (build/bench/candela_ray_replay): candela's Mrays/s against raw Embree on the very
-   rays it traced, and what Embree's packet and stream APIs gain on them.
+   rays it traced, what Embree's packet and stream APIs gain on them, and the floor: a path tracer
+   with no shading, one path at a time and as a wavefront, against raw Embree on its own rays.
 4. Thread scaling: the Cornell box with 1 and 2 threads.
 5. The peer (--cycles, needs Debian's blender): Cycles and candela on the same Cornell box,
    alternately --cycles-repeat times, median time ratio and each one's relMSE.
