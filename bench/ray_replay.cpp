@@ -28,6 +28,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -186,40 +187,57 @@ std::vector<RTCRay> camera_rays(const Scene& scene, int width, int height, int b
 // geometric normal as Embree returns it (no hit reconstruction, no material, no light, no film), one
 // shadow ray in a cosine-distributed direction (the cheapest next-event estimate: a sky's) and a
 // cosine-distributed bounce, to max_depth or until a ray escapes, surviving Russian roulette with
-// probability 0.7 from the second bounce on. Rows [y0, y1) of the image; counts its rays, and logs
-// them when `log` is set.
+// probability 0.7 from the second bounce on.
+
+// The camera ray of sample s of pixel (x, y), and the PCG stream its path continues with.
+RTCRayHit floor_camera_ray(const Scene& scene, int x, int y, int s, Rng& rng) {
+  rng = Rng(hash_values(uint64_t(x), uint64_t(y)), uint64_t(s));
+  const float jx = rng.next_float(), jy = rng.next_float();
+  return to_rayhit(scene.embree().embree_ray(scene.camera().generate_ray({float(x) + jx, float(y) + jy}, {0.5f, 0.5f}, 0)));
+}
+
+// The work at a hit: the shadow ray, and the bounce unless Russian roulette ends the path.
+struct FloorVertex {
+  RTCRay shadow;
+  std::optional<RTCRayHit> bounce;
+};
+FloorVertex floor_vertex(const Scene& scene, const RTCRayHit& rh, int depth, Rng& rng) {
+  const Vec3 d(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
+  const Point3 p = Point3(rh.ray.org_x, rh.ray.org_y, rh.ray.org_z) + d * rh.ray.tfar;
+  Vec3 n = normalize(Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
+  if (dot(n, d) > 0) n = -n;
+  const Frame frame(n);
+  const Point3 origin = p + n * (2e-5f * (1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)})));
+  const float u0 = rng.next_float(), u1 = rng.next_float();
+  FloorVertex v{scene.embree().embree_ray(Ray{origin, frame.to_world(square_to_cosine_hemisphere({u0, u1}))}), {}};
+  if (depth >= 1 && rng.next_float() >= 0.7f) return v;
+  const float v0 = rng.next_float(), v1 = rng.next_float();
+  v.bounce = to_rayhit(scene.embree().embree_ray(Ray{origin, frame.to_world(square_to_cosine_hemisphere({v0, v1}))}));
+  return v;
+}
+
+// Rows [y0, y1) of the image, one path at a time; counts the rays, and logs them when `log` is set.
 void floor_paths(RTCScene rtc, const Scene& scene, int width, int y0, int y1, int spp, int max_depth,
                  std::vector<RecordedRay>* log, uint64_t& rays, uint64_t& sink) {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  const PerspectiveCamera& camera = scene.camera();
   for (int y = y0; y < y1; ++y)
     for (int x = 0; x < width; ++x)
       for (int s = 0; s < spp; ++s) {
-        Rng rng(hash_values(uint64_t(x), uint64_t(y)), uint64_t(s));
-        const float jx = rng.next_float(), jy = rng.next_float();
-        RTCRayHit rh = to_rayhit(scene.embree().embree_ray(camera.generate_ray({float(x) + jx, float(y) + jy}, {0.5f, 0.5f}, 0)));
+        Rng rng;
+        RTCRayHit rh = floor_camera_ray(scene, x, y, s, rng);
         for (int depth = 0; depth < max_depth; ++depth) {
           if (log) log->push_back({rh.ray, false});
           rtcIntersect1(rtc, &context, &rh);
           ++rays;
           if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
-          const Vec3 d(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
-          const Point3 p = Point3(rh.ray.org_x, rh.ray.org_y, rh.ray.org_z) + d * rh.ray.tfar;
-          Vec3 n = normalize(Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
-          if (dot(n, d) > 0) n = -n;
-          const Frame frame(n);
-          const Point3 origin = p + n * (2e-5f * (1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)})));
-          const float u0 = rng.next_float(), u1 = rng.next_float();
-          Ray shadow{origin, frame.to_world(square_to_cosine_hemisphere({u0, u1}))};
-          RTCRay sr = scene.embree().embree_ray(shadow);
-          if (log) log->push_back({sr, true});
-          rtcOccluded1(rtc, &context, &sr);
+          FloorVertex v = floor_vertex(scene, rh, depth, rng);
+          if (log) log->push_back({v.shadow, true});
+          rtcOccluded1(rtc, &context, &v.shadow);
           ++rays;
-          sink += sr.tfar < 0;
-          if (depth >= 1 && rng.next_float() >= 0.7f) break;
-          const float v0 = rng.next_float(), v1 = rng.next_float();
-          rh = to_rayhit(scene.embree().embree_ray(Ray{origin, frame.to_world(square_to_cosine_hemisphere({v0, v1}))}));
+          sink += v.shadow.tfar < 0;
+          if (!v.bounce) break;
+          rh = *v.bounce;
         }
       }
 }
@@ -234,17 +252,14 @@ void floor_wavefront(RTCScene rtc, const Scene& scene, int width, int y0, int y1
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-  const PerspectiveCamera& camera = scene.camera();
   std::vector<RTCRayHit> active, next;
   std::vector<Rng> rngs, next_rngs;
   std::vector<RTCRay> shadows;
   for (int y = y0; y < y1; ++y)
     for (int x = 0; x < width; ++x)
       for (int s = 0; s < spp; ++s) {
-        Rng rng(hash_values(uint64_t(x), uint64_t(y)), uint64_t(s));
-        const float jx = rng.next_float(), jy = rng.next_float();
-        active.push_back(to_rayhit(scene.embree().embree_ray(camera.generate_ray({float(x) + jx, float(y) + jy}, {0.5f, 0.5f}, 0))));
-        rngs.push_back(rng);
+        rngs.emplace_back();
+        active.push_back(floor_camera_ray(scene, x, y, s, rngs.back()));
       }
   for (int depth = 0; depth < max_depth && !active.empty(); ++depth) {
     if (streams) rtcIntersect1M(rtc, &context, active.data(), unsigned(active.size()), sizeof(RTCRayHit));
@@ -255,21 +270,12 @@ void floor_wavefront(RTCScene rtc, const Scene& scene, int width, int y0, int y1
     next.clear();
     next_rngs.clear();
     for (size_t k = 0; k < active.size(); ++k) {
-      const RTCRayHit& rh = active[k];
-      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
-      Rng& rng = rngs[k];
-      const Vec3 d(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z);
-      const Point3 p = Point3(rh.ray.org_x, rh.ray.org_y, rh.ray.org_z) + d * rh.ray.tfar;
-      Vec3 n = normalize(Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
-      if (dot(n, d) > 0) n = -n;
-      const Frame frame(n);
-      const Point3 origin = p + n * (2e-5f * (1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)})));
-      const float u0 = rng.next_float(), u1 = rng.next_float();
-      shadows.push_back(scene.embree().embree_ray(Ray{origin, frame.to_world(square_to_cosine_hemisphere({u0, u1}))}));
-      if (depth >= 1 && rng.next_float() >= 0.7f) continue;
-      const float v0 = rng.next_float(), v1 = rng.next_float();
-      next.push_back(to_rayhit(scene.embree().embree_ray(Ray{origin, frame.to_world(square_to_cosine_hemisphere({v0, v1}))})));
-      next_rngs.push_back(rng);
+      if (active[k].hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+      FloorVertex v = floor_vertex(scene, active[k], depth, rngs[k]);
+      shadows.push_back(v.shadow);
+      if (!v.bounce) continue;
+      next.push_back(*v.bounce);
+      next_rngs.push_back(rngs[k]);
     }
     if (streams) rtcOccluded1M(rtc, &context, shadows.data(), unsigned(shadows.size()), sizeof(RTCRay));
     else
