@@ -11,9 +11,10 @@
 //    rtcIntersect1: packets (rtcIntersect4/8/16) on coherent camera rays, one per pixel traced in
 //    pixel blocks, and ray streams (rtcIntersect1M / rtcOccluded1M, coherent and incoherent
 //    hints) on the recorded bounce and shadow rays.
-// 4. The floor: the least a path tracer can do around Embree (see floor_paths), timed, then its
-//    own rays replayed through raw Embree the same way. Its efficiency bounds what any path tracer
-//    that draws a direction per hit can reach on this scene and machine.
+// 4. The floor: the least a path tracer can do around Embree (see floor_paths), one path at a time
+//    and as a wavefront, timed, then its own rays replayed through raw Embree the same way. Its
+//    efficiency bounds, to within a few points of code generation, what any path tracer that draws
+//    directions per hit can reach on this scene and machine.
 //
 // Usage: candela_ray_replay SCENE [--spp N] [--resolution WxH] [--threads T] [--repeat R]
 // (prints a Markdown table; the fastest of R replays counts).
@@ -33,11 +34,11 @@
 #include <vector>
 
 #include "candela/film/film.h"
+#include "candela/io/scene_reader.h"
 #include "candela/math/frame.h"
+#include "candela/render/renderer.h"
 #include "candela/sampling/rng.h"
 #include "candela/sampling/warp.h"
-#include "candela/io/scene_reader.h"
-#include "candela/render/renderer.h"
 #include "candela/scene/scene.h"
 
 namespace candela {
@@ -207,7 +208,7 @@ FloorVertex floor_vertex(const Scene& scene, const RTCRayHit& rh, int depth, Rng
   Vec3 n = normalize(Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
   if (dot(n, d) > 0) n = -n;
   const Frame frame(n);
-  const Point3 origin = p + n * (2e-5f * (1.0f + std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)})));
+  const Point3 origin = offset_ray_origin(p, n, n);  // both new rays leave on n's side
   const float u0 = rng.next_float(), u1 = rng.next_float();
   FloorVertex v{scene.embree().embree_ray(Ray{origin, frame.to_world(square_to_cosine_hemisphere({u0, u1}))}), {}};
   if (depth >= 1 && rng.next_float() >= 0.7f) return v;
