@@ -39,12 +39,16 @@ TEST(MltSampler, EachPerturbationMovesOnlyItsPair) {
     for (int k = 0; k < 3; ++k) {
       bool moves = mutation == MltSampler::Mutation::Large || mutation == MltSampler::Mutation::Small ||
                    (mutation == MltSampler::Mutation::Lens && k >= 1);
-      if (!moves) EXPECT_EQ(next.camera[k], current.camera[k]) << i << " camera " << k;
+      if (!moves) {
+        EXPECT_EQ(next.camera[k], current.camera[k]) << i << " camera " << k;
+      }
     }
     for (int k = 0; k < 5; ++k) {
       bool moves = mutation == MltSampler::Mutation::Large || mutation == MltSampler::Mutation::Small ||
                    (mutation == MltSampler::Mutation::Caustic && k >= 3);
-      if (!moves) EXPECT_EQ(next.light[k], current.light[k]) << i << " light " << k;
+      if (!moves) {
+        EXPECT_EQ(next.light[k], current.light[k]) << i << " light " << k;
+      }
     }
     if (mutation == MltSampler::Mutation::Lens) {
       ++lens;

@@ -697,7 +697,9 @@ TEST_F(MeshIo, PlyUnrecognisedLineInsideAnElementIsAnError) {
                         {"unrecognised header line"});
   // Before the first element, a stray line (Blender 2.4's broken comment) is still skipped.
   const fs::path wuson = kShared / "ply-tests" / "Wuson.ply";
-  if (fs::exists(wuson)) EXPECT_GT(load(wuson).triangle_count(), 0u);
+  if (fs::exists(wuson)) {
+    EXPECT_GT(load(wuson).triangle_count(), 0u);
+  }
 }
 
 // ---------------------------------------------------------------- file names and places

@@ -92,7 +92,9 @@ TEST(RoughCoat, ReflectedAndTransmittedNeverExceedOne) {
                    rough_interface_albedo(d, at_cosine(mu), 1.5f, true);
       EXPECT_LE(sum, 1 + 1e-6) << alpha << " " << mu;
       // Only masking is lost: little for a smooth-ish coat away from grazing angles.
-      if (alpha <= 0.1f && mu >= 0.3f) EXPECT_GT(sum, 0.97) << alpha << " " << mu;
+      if (alpha <= 0.1f && mu >= 0.3f) {
+        EXPECT_GT(sum, 0.97) << alpha << " " << mu;
+      }
     }
 }
 
@@ -105,7 +107,9 @@ TEST(RoughCoat, TableFollowsMitsubasSixtyFourPointMean) {
   for (int i = 0; i < 64; ++i) {
     float mu = std::max(1e-6f, float(i) / 63);
     mean += fresnel_dielectric(mu, 1 / eta) * mu;
-    if (i > 0) EXPECT_NEAR(table.transmittance[size_t(i)], 1 - fresnel_dielectric(mu, eta), 1e-3) << mu;
+    if (i > 0) {
+      EXPECT_NEAR(table.transmittance[size_t(i)], 1 - fresnel_dielectric(mu, eta), 1e-3) << mu;
+    }
   }
   EXPECT_NEAR(table.internal_reflectance, 2 * mean / 64, 1e-3);
   EXPECT_GT(fresnel_diffuse_reflectance(1 / eta) - table.internal_reflectance, 0.008);  // the mean's known deficit
