@@ -60,8 +60,11 @@ Ray Camera::generate_ray(Vec2 film, Vec2 lens, float time) const {
     return ray;
   }
   if (lens_radius_ <= 0) {
-    Ray ray{origin_, normalize(pinhole_dir0_ + film.x * pinhole_dx_ + film.y * pinhole_dy_), inf, time};
-    if (near_clip_ > 0) ray.t_min = near_t(Point3(0.0f), camera_direction(film));
+    // The world image of the camera-space direction at depth z = 1, so the near plane (z = near_clip)
+    // is near_clip times its length away along the ray.
+    const Vec3 w = pinhole_dir0_ + film.x * pinhole_dx_ + film.y * pinhole_dy_;
+    Ray ray{origin_, normalize(w), inf, time};
+    if (near_clip_ > 0) ray.t_min = near_clip_ * length(w);
     return ray;
   }
   Vec3 dir = camera_direction(film);
