@@ -1765,6 +1765,7 @@ class JsonSceneReader {
       environment.mapping =
           read_name<EnvironmentMapping>(report_, *mapping, light.pointer_of("mapping"), "environment mapping",
                                         {{"equirectangular", EnvironmentMapping::Equirectangular},
+                                         {"equirectangular_pole_rows", EnvironmentMapping::EquirectangularPoleRows},
                                          {"equal_area", EnvironmentMapping::EqualAreaOctahedral}});
     environment.scale = light.rgb_or("scale", ColorKind::Emission, environment.scale);
     environment.to_world = read_environment_orientation(light, environment.mapping);
@@ -1782,7 +1783,7 @@ class JsonSceneReader {
       check_rotation(transform, pointer);
       return transform;
     }
-    Vec3 local_up = mapping == EnvironmentMapping::Equirectangular ? Vec3(0, 1, 0) : Vec3(0, 0, 1);
+    Vec3 local_up = mapping == EnvironmentMapping::EqualAreaOctahedral ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
     Vec3 up = normalize(light.direction_or("up", local_up));
     float degrees = light.number_or("rotate", 0);
     Transform spin = degrees == 0 ? Transform() : Transform::rotate(degrees, local_up);

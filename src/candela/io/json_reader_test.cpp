@@ -1286,7 +1286,7 @@ TEST(JsonReader, BadSpotDistantAndEnvironmentLightsAreErrors) {
   expect_textured_error(with_light(R"({"type": "environment"})"), "at /lights/0: missing required key \"filename\"");
   expect_environment_error(R"(, "mapping": "cube")",
                            "at /lights/0/mapping: unknown environment mapping \"cube\"; expected one of: "
-                           "equirectangular, equal_area");
+                           "equirectangular, equirectangular_pole_rows, equal_area");
   expect_environment_error(R"(, "scale": -1)", "at /lights/0/scale: colour components must be >= 0");
   expect_environment_error(R"(, "scale": [1, 1e39, 1])",
                            "at /lights/0/scale/1: 1e+39 is out of range for a 32-bit float");

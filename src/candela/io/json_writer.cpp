@@ -252,6 +252,15 @@ Json shape_json(const ShapeDesc& shape) {
   return j;
 }
 
+const char* environment_mapping_name(EnvironmentMapping mapping) {
+  switch (mapping) {
+    case EnvironmentMapping::Equirectangular: return "equirectangular";
+    case EnvironmentMapping::EquirectangularPoleRows: return "equirectangular_pole_rows";
+    case EnvironmentMapping::EqualAreaOctahedral: return "equal_area";
+  }
+  return "equirectangular";
+}
+
 Json light_json(const LightDesc& light) {
   return std::visit(
       Overloaded{
@@ -274,7 +283,7 @@ Json light_json(const LightDesc& light) {
           [](const EnvironmentMap& l) {
             Json j{{"type", "environment"},
                    {"filename", absolute(l.filename)},
-                   {"mapping", l.mapping == EnvironmentMapping::Equirectangular ? "equirectangular" : "equal_area"},
+                   {"mapping", environment_mapping_name(l.mapping)},
                    {"scale", rgb(l.scale)}};
             if (!l.to_world.is_identity()) j["transform"] = matrix(l.to_world);
             return j;

@@ -1371,7 +1371,7 @@ class Converter {
       l.filename = resolve_file(e, "filename").string();
       l.scale = RGB(get_float(e, "scale", 1.0f));
       l.to_world = get_transform(e, "to_world");
-      l.mapping = EnvironmentMapping::Equirectangular;
+      l.mapping = EnvironmentMapping::EquirectangularPoleRows;
       ignore(e, "filter_type");
       desc_.lights.push_back(l);
     } else if (type == "directional") {

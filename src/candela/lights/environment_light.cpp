@@ -44,8 +44,11 @@ struct EnvironmentLight::Data {
 
   // The texel at integer coordinates one step outside the image at most, wrapped as the mapping
   // continues across the image's edges.
+  bool latitude_longitude() const { return mapping != EnvironmentMapping::EqualAreaOctahedral; }
+  bool pole_rows() const { return mapping == EnvironmentMapping::EquirectangularPoleRows; }
+
   const RGB& texel(int x, int y) const {
-    if (mapping == EnvironmentMapping::Equirectangular) {
+    if (latitude_longitude()) {
       // Periodic in phi; the top and bottom rows extend to the poles.
       x = x < 0 ? x + width : (x >= width ? x - width : x);
       y = std::clamp(y, 0, height - 1);
@@ -68,11 +71,15 @@ struct EnvironmentLight::Data {
   }
 
   RGB bilinear(Vec2 uv) const {
-    // Continuous pixel coordinates with texel centres at integers.
-    float x = uv.x * float(width) - 0.5f, y = uv.y * float(height) - 0.5f;
+    // Continuous pixel coordinates with texel centres at integers (Mitsuba's rows: row 0 at v = 0,
+    // the last row at v = 1).
+    float x = uv.x * float(width) - 0.5f;
+    float y = pole_rows() ? uv.y * float(height - 1) : uv.y * float(height) - 0.5f;
     float fx0 = std::floor(x), fy0 = std::floor(y);
     float dx = x - fx0, dy = y - fy0;
-    int x0 = std::clamp(int(fx0), -1, width - 1), y0 = std::clamp(int(fy0), -1, height - 1);
+    int x0 = std::clamp(int(fx0), -1, width - 1);
+    int y0 = pole_rows() ? std::clamp(int(fy0), 0, height - 2) : std::clamp(int(fy0), -1, height - 1);
+    if (pole_rows()) dy = std::clamp(y - float(y0), 0.0f, 1.0f);
     return (texel(x0, y0) * (1 - dx) + texel(x0 + 1, y0) * dx) * (1 - dy) +
            (texel(x0, y0 + 1) * (1 - dx) + texel(x0 + 1, y0 + 1) * dx) * dy;
   }
@@ -91,6 +98,22 @@ struct EnvironmentLight::Data {
     float sin_theta = std::sin(theta);
     return {sin_theta * std::sin(phi), std::cos(theta), -sin_theta * std::cos(phi)};
   }
+  // The sampling distribution's cells. Centred rows: the pixels themselves. Pole rows: the
+  // (height - 1) x width patches between texel centres, patch (i, j) spanning u in
+  // [(i + 1/2) / width, (i + 3/2) / width] (wrapping) and v in [j / (height - 1), (j + 1) / (height - 1)].
+  // Both grids cover the unit square, so a density over one is the same density over (u, v).
+  int cells_y() const { return pole_rows() ? height - 1 : height; }
+  Vec2 cell_to_image(Vec2 p) const {
+    if (!pole_rows()) return p;
+    float u = p.x + 0.5f / float(width);
+    return {u >= 1 ? u - 1 : u, p.y};
+  }
+  Vec2 image_to_cell(Vec2 uv) const {
+    if (!pole_rows()) return uv;
+    float u = uv.x - 0.5f / float(width);
+    return {u < 0 ? u + 1 : u, uv.y};
+  }
+
   // Converts a density over (u, v) into one over solid angle at the local direction d.
   float solid_angle_pdf(float pdf_uv, const Vec3& d) const {
     if (mapping == EnvironmentMapping::EqualAreaOctahedral) return pdf_uv * kInv4Pi;
@@ -107,6 +130,10 @@ EnvironmentLight::EnvironmentLight(const Image& image, EnvironmentMapping mappin
   if (mapping == EnvironmentMapping::EqualAreaOctahedral && image.width != image.height)
     throw SceneError(fmt::format("environment map: an equal-area octahedral map must be square, not {}x{}",
                                  image.width, image.height));
+  if (mapping == EnvironmentMapping::EquirectangularPoleRows && image.height < 2)
+    throw SceneError(fmt::format("environment map: a map whose rows run from pole to pole needs at least 2 rows, "
+                                 "not {}",
+                                 image.height));
   auto d = std::make_shared<Data>();
   const int w = image.width, h = image.height;
   d->width = w;
@@ -123,29 +150,35 @@ EnvironmentLight::EnvironmentLight(const Image& image, EnvironmentMapping mappin
       d->texels[size_t(y) * size_t(w) + size_t(x)] = RGB(non_negative(s.r), non_negative(s.g), non_negative(s.b));
     }
 
-  // Sampling weights. Over a pixel the bilinear radiance averages to the separable [1 6 1] / 8
-  // filter of the texels (a neighbour's tent reaches halfway into the pixel with 1/8 of its area),
-  // so a pixel's weight is the luminance of that average, with the same wrapping as lookups, times
-  // the pixel's solid angle: positive wherever the radiance is, however dark the pixel's own texel.
-  std::vector<float> weights(size_t(w) * size_t(h));
+  // Sampling weights, one per cell (cell_to_image), each the luminance the bilinear radiance has on
+  // average over the cell, with the same wrapping as lookups, times the cell's solid angle: positive
+  // wherever the radiance is, however dark one texel. Over a pixel of centred rows that average is the
+  // separable [1 6 1] / 8 filter of the texels (a neighbour's tent reaches halfway into the pixel with
+  // 1/8 of its area); over a patch between texel centres it is the mean of its four corners.
+  const int cells_y = d->cells_y();
+  std::vector<float> weights(size_t(w) * size_t(cells_y));
   const float k[3] = {0.125f, 0.75f, 0.125f};
   constexpr double pi = std::numbers::pi;
   double integral = 0;  // of the luminance over solid angle
-  for (int y = 0; y < h; ++y) {
-    // The pixel's share of the sphere's solid angle (4 pi in all).
-    double pixel_solid_angle;
-    if (mapping == EnvironmentMapping::Equirectangular)
-      pixel_solid_angle = 2 * pi / w * (std::cos(pi * y / h) - std::cos(pi * (y + 1) / h));
+  for (int y = 0; y < cells_y; ++y) {
+    // The cell's share of the sphere's solid angle (4 pi in all): for latitude-longitude maps the
+    // exact solid angle of its row, which stays positive in the polar rows.
+    double cell_solid_angle;
+    if (mapping == EnvironmentMapping::EqualAreaOctahedral)
+      cell_solid_angle = 4 * pi / (double(w) * h);
     else
-      pixel_solid_angle = 4 * pi / (double(w) * h);
+      cell_solid_angle = 2 * pi / w * (std::cos(pi * y / cells_y) - std::cos(pi * (y + 1) / cells_y));
     for (int x = 0; x < w; ++x) {
       double lum = 0;
-      for (int j = -1; j <= 1; ++j)
-        for (int i = -1; i <= 1; ++i) lum += k[i + 1] * k[j + 1] * d->texel(x + i, y + j).luminance();
-      integral += lum * pixel_solid_angle;
-      // For equirectangular maps the density over (u, v) should follow L sin(theta): use the exact
-      // solid angle of the pixel's row, which stays positive in the polar rows.
-      weights[size_t(y) * size_t(w) + size_t(x)] = float(lum * pixel_solid_angle);
+      if (d->pole_rows()) {
+        lum = 0.25 * (double(d->texel(x, y).luminance()) + d->texel(x + 1, y).luminance() +
+                      d->texel(x, y + 1).luminance() + d->texel(x + 1, y + 1).luminance());
+      } else {
+        for (int j = -1; j <= 1; ++j)
+          for (int i = -1; i <= 1; ++i) lum += k[i + 1] * k[j + 1] * d->texel(x + i, y + j).luminance();
+      }
+      integral += lum * cell_solid_angle;
+      weights[size_t(y) * size_t(w) + size_t(x)] = float(lum * cell_solid_angle);
     }
   }
   // A floor under every pixel that has any radiance, so that in a map with a very bright sun the
@@ -155,7 +188,7 @@ EnvironmentLight::EnvironmentLight(const Image& image, EnvironmentMapping mappin
   mean_weight /= double(weights.size());
   for (float& wt : weights)
     if (wt > 0) wt = std::max(wt, float(1e-3 * mean_weight));
-  d->distribution = Distribution2D(weights, w, h);
+  d->distribution = Distribution2D(weights, w, cells_y);
   d->average_luminance = float(integral / (4 * pi));
   data_ = std::move(d);
 }
@@ -180,16 +213,17 @@ RGB EnvironmentLight::radiance(const Vec3& world_dir) const {
 
 LightSample EnvironmentLight::sample_li(const LightSampleContext& ctx, Vec2 u) const {
   const Data& d = *data_;
-  // Pick a pixel by the 2D distribution and a point uniformly inside it, then map it to the sphere.
+  // Pick a cell by the 2D distribution and a point uniformly inside it, then map it to the sphere.
   Distribution2DSample s = d.distribution.sample(u);
   if (!(s.pdf > 0)) return {};
-  Vec3 local = d.uv_to_direction(s.point);
+  const Vec2 uv = d.cell_to_image(s.point);
+  Vec3 local = d.uv_to_direction(uv);
   // Convert the density over the image to one over solid angle.
   float pdf = d.solid_angle_pdf(s.pdf, local);
   if (!(pdf > 0) || !std::isfinite(pdf)) return {};
   Vec3 wi = to_world(local);
   LightSample ls;
-  ls.radiance = d.bilinear(s.point);
+  ls.radiance = d.bilinear(uv);
   ls.wi = wi;
   ls.distance = std::numeric_limits<float>::infinity();
   ls.pdf = pdf;
@@ -202,7 +236,7 @@ float EnvironmentLight::pdf_li(const LightSampleContext&, const Vec3& wi, const 
   const Data& d = *data_;
   Vec3 local = to_local(wi);
   if (!is_finite(local)) return 0;
-  return d.solid_angle_pdf(d.distribution.pdf(d.direction_to_uv(local)), local);
+  return d.solid_angle_pdf(d.distribution.pdf(d.image_to_cell(d.direction_to_uv(local))), local);
 }
 
 LightEmission EnvironmentLight::sample_le(Vec2 u_pos, Vec2 u_dir, const SceneSphere& s) const {

@@ -407,9 +407,14 @@ struct SkyLight {
 
 // How an environment image covers the sphere of directions, in the light's local frame.
 enum class EnvironmentMapping {
-  // Latitude-longitude with +y up (Mitsuba's envmap): pixel (u, v) in [0,1]^2, v = 0 the top row,
-  // is the direction (sin(theta) sin(phi), cos(theta), -sin(theta) cos(phi)), phi = 2 pi u, theta = pi v.
+  // Latitude-longitude with +y up (Mitsuba's orientation): image position (u, v) in [0,1]^2, v = 0 at
+  // the top, is the direction (sin(theta) sin(phi), cos(theta), -sin(theta) cos(phi)), phi = 2 pi u,
+  // theta = pi v. Texel (x, y) sits at ((x + 1/2) / width, (y + 1/2) / height), as most lat-long images
+  // are made.
   Equirectangular,
+  // The same directions with Mitsuba's envmap texel placement: texel (x, y) at ((x + 1/2) / width,
+  // y / (height - 1)), so the first and last rows are the poles themselves.
+  EquirectangularPoleRows,
   // Clarberg's equal-area octahedral square with +z up (pbrt-v4's "infinite" light with a filename).
   EqualAreaOctahedral
 };
