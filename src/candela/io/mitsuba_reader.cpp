@@ -657,6 +657,10 @@ bool is_unbounded_name(std::string_view name) {
   return name == "eta" || name == "k" || name == "int_ior" || name == "ext_ior";
 }
 
+// How Mitsuba looks a texture up: for a colour (eval, eval_3) or for a float parameter (eval_1).
+// The two differ for the checkerboard, so a texture object becomes one candela texture per lookup.
+enum class TextureLookup { Color, Scalar };
+
 class Converter {
  public:
   Converter(XmlParser& parser, std::vector<std::string>& warnings) : parser_(parser), warnings_(warnings) {}
@@ -853,7 +857,8 @@ class Converter {
     return ms::spectrum_list_to_srgb(p.wavelengths, v, bounded);
   }
 
-  std::optional<ColorInput> color_input(const Object& o, std::string_view name, bool within_emitter = false) {
+  std::optional<ColorInput> color_input(const Object& o, std::string_view name, bool within_emitter = false,
+                                        TextureLookup lookup = TextureLookup::Color) {
     const Property* p = find(o, name);
     if (!p) return std::nullopt;
     switch (p->kind) {
@@ -868,7 +873,7 @@ class Converter {
                                                   o.describe(), name, t.tag);
         if (t.type == "blackbody") return ColorInput(blackbody(t));  // a constant: no texture lookups
         ColorInput c;
-        c.texture = texture(t);
+        c.texture = texture(t, lookup);
         return c;
       }
       default: wrong_kind(o, *p, "a colour (rgb, spectrum, float or texture)");
@@ -896,7 +901,7 @@ class Converter {
         if (t.tag != "texture") throw_scene_error(p->where.loc(), "{}: \"{}\" must be a texture, not a <{}>",
                                                   o.describe(), name, t.tag);
         FloatInput f;
-        f.texture = texture(t);
+        f.texture = texture(t, TextureLookup::Scalar);
         return f;
       }
       default: break;
@@ -934,8 +939,8 @@ class Converter {
     return m;
   }
 
-  int texture(const Object& t) {
-    if (auto it = texture_memo_.find(&t); it != texture_memo_.end()) return it->second;
+  int texture(const Object& t, TextureLookup lookup = TextureLookup::Color) {
+    if (auto it = texture_memo_.find({&t, lookup}); it != texture_memo_.end()) return it->second;
     int index = -1;
     if (t.type == "bitmap") {
       ImageTexture img;
@@ -962,9 +967,12 @@ class Converter {
       index = add_texture(img);
     } else if (t.type == "checkerboard") {
       CheckerboardTexture c;
-      c.tex1 = color(t, "color0", RGB(0.4f));
-      c.tex2 = color(t, "color1", RGB(0.2f));
+      c.tex1 = color_input(t, "color0", false, lookup).value_or(ColorInput(RGB(0.4f)));
+      c.tex2 = color_input(t, "color1", false, lookup).value_or(ColorInput(RGB(0.2f)));
       // Mitsuba: color0 where (u mod 1 < 0.5) == (v mod 1 < 0.5), i.e. where floor(2u) + floor(2v) is even.
+      // Its scalar lookup (eval_1: roughness, metallic, blend weights, ...) keeps a legacy convention
+      // with the colours the other way round.
+      if (lookup == TextureLookup::Scalar) std::swap(c.tex1, c.tex2);
       UVMapping m = to_uv(t);
       c.mapping = {2 * m.su, 2 * m.sv, 2 * m.du, 2 * m.dv, 2 * m.s_from_v, 2 * m.t_from_u};
       index = add_texture(c);
@@ -996,7 +1004,7 @@ class Converter {
                         t.type);
     }
     check_all_used(t);
-    texture_memo_[&t] = index;
+    texture_memo_[{&t, lookup}] = index;
     return index;
   }
 
@@ -1634,7 +1642,8 @@ class Converter {
   XmlParser& parser_;
   std::vector<std::string>& warnings_;
   SceneDesc desc_;
-  std::map<const Object*, int> texture_memo_;
+  // A texture once per way it is looked up (see TextureLookup).
+  std::map<std::pair<const Object*, TextureLookup>, int> texture_memo_;
   std::map<std::pair<const Object*, bool>, int> bsdf_memo_;
   std::map<const Object*, int> group_memo_;
   int default_material_ = -1;
