@@ -118,11 +118,11 @@ TEST_P(MitsubaConformance, PassesMitsubasRenderTest) {
 // The 26 scenes. Expectations are what this checkout achieves; docs/conformance.md explains each.
 const ConformanceCase kCases[] = {
     {"bsdf_spheres", "test_arealight_path", Expect::PassWithNegativeVarianceReplaced},
-    {"bsdf_spheres", "test_bumpmap_path", Expect::KnownFailure},
+    {"bsdf_spheres", "test_bumpmap_path", Expect::Pass},
     {"bsdf_spheres", "test_constant_path", Expect::Pass},
     {"bsdf_spheres", "test_envmap_path", Expect::KnownFailure},
     {"bsdf_spheres", "test_normalmap_identity_roughconductor_path", Expect::KnownFailure},
-    {"bsdf_spheres", "test_normalmap_path", Expect::KnownFailure},
+    {"bsdf_spheres", "test_normalmap_path", Expect::Pass},
     {"bsdf_spheres", "test_normalmap_roughconductor_path", Expect::KnownFailure},
     {"bsdf_spheres", "test_pointlight_path", Expect::Pass},
     {"bsdf_spheres", "test_roughdielectric_path", Expect::KnownFailure},

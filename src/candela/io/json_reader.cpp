@@ -1072,12 +1072,14 @@ class JsonSceneReader {
       NormalMapMaterial map;
       map.normal_map = texture_reference(m, "normal_map");
       map.material = wrapped_material(m, "material");
+      map.options = read_perturbed_normal_options(m);
       material = map;
     } else if (type == "bump_map") {
       BumpMapMaterial map;
       map.height = texture_reference(m, "height");
       map.scale = m.number_or("scale", map.scale);
       map.material = wrapped_material(m, "material");
+      map.options = read_perturbed_normal_options(m);
       material = map;
     } else
       report_.fail(m.pointer_of("type"),
@@ -1275,6 +1277,13 @@ class JsonSceneReader {
     unit("diff_trans", p.diff_trans);
     unit("flatness", p.flatness);
     return p;
+  }
+
+  static PerturbedNormalOptions read_perturbed_normal_options(CheckedObject& m) {
+    PerturbedNormalOptions o;
+    o.flip_invalid_normals = m.boolean_or("flip_invalid_normals", o.flip_invalid_normals);
+    o.shadowing_function = m.boolean_or("shadowing_function", o.shadowing_function);
+    return o;
   }
 
   BlendMaterial read_blend(CheckedObject& m) {

@@ -96,6 +96,12 @@ void write_roughness(const Roughness& r, Json& j) {
   if (r.distribution == MicrofacetDistribution::Beckmann) j["distribution"] = "beckmann";
 }
 
+Json with_options(Json j, const PerturbedNormalOptions& o) {
+  if (o.flip_invalid_normals) j["flip_invalid_normals"] = true;
+  if (o.shadowing_function) j["shadowing_function"] = true;
+  return j;
+}
+
 Json material_json(const MaterialDesc& desc) {
   return std::visit(
       Overloaded{
@@ -178,15 +184,17 @@ Json material_json(const MaterialDesc& desc) {
                         {"materials", Json::array({material_name(m.material0), material_name(m.material1)})}};
           },
           [](const NormalMapMaterial& m) {
-            return Json{{"type", "normal_map"},
-                        {"normal_map", texture_name(m.normal_map)},
-                        {"material", material_name(m.material)}};
+            return with_options(Json{{"type", "normal_map"},
+                                     {"normal_map", texture_name(m.normal_map)},
+                                     {"material", material_name(m.material)}},
+                                m.options);
           },
           [](const BumpMapMaterial& m) {
-            return Json{{"type", "bump_map"},
-                        {"height", texture_name(m.height)},
-                        {"scale", m.scale},
-                        {"material", material_name(m.material)}};
+            return with_options(Json{{"type", "bump_map"},
+                                     {"height", texture_name(m.height)},
+                                     {"scale", m.scale},
+                                     {"material", material_name(m.material)}},
+                                m.options);
           },
       },
       desc);

@@ -1010,6 +1010,11 @@ class Converter {
 
   // ------------------------------------------------ materials
 
+  // bumpmap's and normalmap's two switches, on by default since Mitsuba 3.7.1.
+  PerturbedNormalOptions perturbed_normal_options(const Object& b) {
+    return {get_bool(b, "flip_invalid_normals", true), get_bool(b, "use_shadowing_function", true)};
+  }
+
   int add_material(MaterialDesc m) {
     desc_.materials.push_back(std::move(m));
     return int(desc_.materials.size()) - 1;
@@ -1150,14 +1155,16 @@ class Converter {
       if (auto* img = std::get_if<ImageTexture>(&desc_.textures[n.normal_map]); img)
         img->encoding = ColorEncoding::Linear;  // Mitsuba reads normal maps raw
       n.material = single_nested_bsdf(b, two_sided);
+      n.options = perturbed_normal_options(b);
       index = add_material(n);
     } else if (type == "bumpmap") {
       BumpMapMaterial m;
       auto textures = nested(b, "texture");
       if (textures.size() != 1) throw_scene_error(b.where.loc(), "bumpmap needs exactly one nested texture");
-      m.height = texture(*textures[0].second);
+      m.height = texture(*textures[0].second, TextureLookup::Scalar);  // Mitsuba's eval_1_grad
       m.scale = get_float(b, "scale", 1.0f);
       m.material = single_nested_bsdf(b, two_sided);
+      m.options = perturbed_normal_options(b);
       index = add_material(m);
     } else if (type == "blendbsdf") {
       BlendMaterial m;

@@ -164,22 +164,32 @@ Shading MaterialTable::shading(uint32_t material, const TextureEvalContext& ctx,
   const Entry& e = entries_[material];
   if (e.perturbations.empty()) return s;
   const Normal3 original = s.frame.n;
-  for (int map : e.perturbations) perturb(map, ctx, hit, s.frame);
+  bool shadowing = false;
+  for (int map : e.perturbations) shadowing |= perturb(map, ctx, hit, wo, s.frame);
   s.bsdf.check_side = true;
   s.bsdf.original_normal = s.frame.to_local(original);
+  if (shadowing) {
+    // The tilt's tan^2 (Mitsuba's tan_theta_2 of the perturbed normal in the original frame).
+    float cos2 = sqr(s.bsdf.original_normal.z), sin2 = std::max(0.0f, 1 - cos2);
+    s.bsdf.terminator_alpha2 = cos2 > 0 ? std::min(0.125f * sin2 / cos2, 1.0f) : 1.0f;
+  }
   return s;
 }
 
-void MaterialTable::perturb(int map, const TextureEvalContext& ctx, const SurfaceHit& hit, Frame& frame) const {
+bool MaterialTable::perturb(int map, const TextureEvalContext& ctx, const SurfaceHit& hit, const Vec3& wo,
+                            Frame& frame) const {
   const TextureSet& tex = *textures_;
   Vec3 n_local;
+  PerturbedNormalOptions options;
   if (const auto* nm = std::get_if<NormalMapMaterial>(&entries_[size_t(map)].desc)) {
+    options = nm->options;
     ColorInput in;
     in.texture = nm->normal_map;
     RGB c = tex.eval(in, ctx);
     n_local = Vec3(2 * c.r - 1, 2 * c.g - 1, 2 * c.b - 1);
   } else {
     const auto& bm = std::get<BumpMapMaterial>(entries_[size_t(map)].desc);
+    options = bm.options;
     FloatInput height;
     height.texture = bm.height;
     // The height's gradient in (u, v) by central differences a hundredth of a texel wide (within a
@@ -204,9 +214,17 @@ void MaterialTable::perturb(int map, const TextureEvalContext& ctx, const Surfac
     n_local = frame.to_local(c);
   }
   float len = length(n_local);
-  if (!(len > 0) || !std::isfinite(len)) return;
-  Vec3 n = normalize(frame.to_world(n_local / len));
+  if (!(len > 0) || !std::isfinite(len)) return false;
+  n_local = n_local / len;
+  if (options.flip_invalid_normals) {
+    // Keep the tilted normal on wo's side of the surface (Mitsuba after Schuessler et al. 2017):
+    // mirror it about the original normal where wo would be below it.
+    Vec3 wo_local = frame.to_local(wo);
+    if (wo_local.z * dot(wo_local, n_local) <= 0) n_local = Vec3(-n_local.x, -n_local.y, n_local.z);
+  }
+  Vec3 n = normalize(frame.to_world(n_local));
   frame = Frame::from_normal_tangent(n, frame.s);
+  return options.shadowing_function;
 }
 
 Bsdf MaterialTable::build(const Entry& entry, const TextureEvalContext& ctx) const {

@@ -74,7 +74,9 @@ class MaterialTable {
   SurfaceBsdf resolve(uint32_t material, const TextureEvalContext& ctx) const;
   void collect(int material, float weight, bool one_sided, const TextureEvalContext& ctx, SurfaceBsdf& out) const;
   // Tilts `frame` by the normal or bump map material `map`.
-  void perturb(int map, const TextureEvalContext& ctx, const SurfaceHit& hit, Frame& frame) const;
+  // Tilts `frame` by one normal or bump map as seen from wo; says whether the map asks for the
+  // terminator shadowing (surface_bsdf.h).
+  bool perturb(int map, const TextureEvalContext& ctx, const SurfaceHit& hit, const Vec3& wo, Frame& frame) const;
 
   const TextureSet* textures_ = nullptr;
   std::vector<Entry> entries_;

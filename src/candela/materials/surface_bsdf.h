@@ -66,6 +66,11 @@ struct SurfaceBsdf {
   // Normal or bump mapped: the original shading normal in the (tilted) local frame.
   bool check_side = false;
   Vec3 original_normal{0, 0, 1};
+  // Mitsuba's shadowing of the tilt (Conty Estevez et al., "A Microfacet-Based Shadowing Function to
+  // Solve the Bump Terminator Problem", 2019), on when > 0: alpha^2 = min(tan^2(tilt) / 8, 1), and f
+  // is scaled by G(wi) = 2 / (1 + sqrt(1 + alpha^2 tan^2 theta)), theta wi's angle to the original
+  // normal. (Only wi, the sampled side, as Mitsuba's bumpmap/normalmap do; densities are unchanged.)
+  float terminator_alpha2 = 0;
 
   SurfaceBsdf() = default;
   SurfaceBsdf(const Bsdf& b) : count(1) { components[0] = {b, 1, false}; }  // NOLINT: a plain BSDF converts implicitly
@@ -75,6 +80,7 @@ struct SurfaceBsdf {
     null_weight = o.null_weight;
     check_side = o.check_side;
     original_normal = o.original_normal;
+    terminator_alpha2 = o.terminator_alpha2;
     for (int k = 0; k < count; ++k) components[size_t(k)] = o.components[size_t(k)];
     return *this;
   }
@@ -96,7 +102,7 @@ struct SurfaceBsdf {
       const Component& c = components[size_t(k)];
       if (c.weight > 0 && faces(c, wo, wi)) f += bsdf_eval(c.bsdf, wo, wi) * c.weight;
     }
-    return f;
+    return f * terminator(wi);
   }
 
   // The adjoint f*(wo, wi) (paths carrying importance; bsdf.h's bsdf_adjoint_scale per component).
@@ -109,7 +115,7 @@ struct SurfaceBsdf {
       if (c.weight > 0 && faces(c, wo, wi))
         f += bsdf_eval(c.bsdf, wo, wi) * (c.weight * bsdf_adjoint_scale(c.bsdf, wo, wi));
     }
-    return f;
+    return f * terminator(wi);
   }
 
   float pdf(const Vec3& wo, const Vec3& wi) const {
@@ -186,6 +192,12 @@ struct SurfaceBsdf {
     return !c.one_sided || (wo.z > 0 && wi.z > 0);
   }
   bool side_ok(const Vec3& wi) const { return !check_side || dot(wi, original_normal) * wi.z > 0; }
+  float terminator(const Vec3& wi) const {
+    if (!(terminator_alpha2 > 0)) return 1;
+    float cos2 = sqr(dot(wi, original_normal)), sin2 = std::max(0.0f, 1 - cos2);
+    if (!(cos2 > 0)) return 0;
+    return 2 / (1 + std::sqrt(1 + terminator_alpha2 * sin2 / cos2));
+  }
   // A one-sided component seen from the back scatters nothing: all of it counts as its
   // (empty) non-delta part.
   static float component_non_delta(const Component& c, const Vec3& wo) {
@@ -202,6 +214,7 @@ struct SurfaceBsdf {
     if (bs->is_delta || count == 1) {
       // The component's weight stands: its share of f and of the probability is the same w_k / t.
       bs->pdf *= c.weight / t;
+      bs->weight *= terminator(bs->wi);
       return bs;
     }
     // A non-delta direction: the mixture's weight and density (all non-delta parts could have made it).

@@ -235,11 +235,23 @@ struct BlendMaterial {
   int material0 = -1, material1 = -1;
 };
 
+// What Mitsuba 3 (since 3.7.1) adds to a tilted shading normal, both off by default here (pbrt-v4
+// and glTF have neither) and on in Mitsuba scenes (its defaults):
+//   flip_invalid_normals  where the direction towards the previous vertex, wo, lies below the tilted
+//                         normal, the normal is mirrored about the original one (Schuessler et al. 2017)
+//   shadowing_function    the BSDF is scaled by a microfacet shadowing term of the sampled direction
+//                         (Conty Estevez et al. 2019) that softens the terminator of a strong tilt
+struct PerturbedNormalOptions {
+  bool flip_invalid_normals = false;
+  bool shadowing_function = false;
+};
+
 // Shading normals from a tangent-space normal map (Mitsuba's "normalmap"): the texture's RGB in
 // [0, 1], read without any colour decoding, is n = 2 rgb - 1 in the frame (dp/du, dp/dv, n).
 struct NormalMapMaterial {
   int normal_map = -1;  // index into SceneDesc::textures
   int material = -1;
+  PerturbedNormalOptions options;
 };
 
 // Shading normals from a height field (Mitsuba's "bumpmap"): the surface displaced by
@@ -249,6 +261,7 @@ struct BumpMapMaterial {
   int height = -1;  // index into SceneDesc::textures (its channel average is the height)
   float scale = 1;
   int material = -1;
+  PerturbedNormalOptions options;
 };
 
 using MaterialDesc = std::variant<DiffuseMaterial, PhongMaterial, MirrorMaterial, DielectricMaterial, BlackMaterial,
