@@ -1133,7 +1133,9 @@ class JsonSceneReader {
     if (const Json* distribution = m.find("distribution"))
       roughness.distribution = read_name<MicrofacetDistribution>(
           report_, *distribution, m.pointer_of("distribution"), "microfacet distribution",
-          {{"ggx", MicrofacetDistribution::GGX}, {"beckmann", MicrofacetDistribution::Beckmann}});
+          {{"ggx", MicrofacetDistribution::GGX},
+           {"ggx_separable", MicrofacetDistribution::GGXSeparable},
+           {"beckmann", MicrofacetDistribution::Beckmann}});
     return roughness;
   }
 

@@ -94,6 +94,7 @@ void write_roughness(const Roughness& r, Json& j) {
     j["alpha_v"] = number(r.v);
   }
   if (r.distribution == MicrofacetDistribution::Beckmann) j["distribution"] = "beckmann";
+  if (r.distribution == MicrofacetDistribution::GGXSeparable) j["distribution"] = "ggx_separable";
 }
 
 Json with_options(Json j, const PerturbedNormalOptions& o) {

@@ -1053,7 +1053,7 @@ class Converter {
     Roughness r;
     std::string dist = get_string(o, "distribution", "beckmann");
     if (dist == "beckmann") r.distribution = MicrofacetDistribution::Beckmann;
-    else if (dist == "ggx") r.distribution = MicrofacetDistribution::GGX;
+    else if (dist == "ggx") r.distribution = MicrofacetDistribution::GGXSeparable;
     else throw_scene_error(o.where.loc(), "{}: distribution \"{}\" (use beckmann or ggx)", o.describe(), dist);
     bool has_alpha = find(o, "alpha") != nullptr;
     if (has_alpha) {

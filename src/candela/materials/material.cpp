@@ -62,8 +62,12 @@ Microfacet microfacet(const Roughness& r, const TextureSet& tex, const TextureEv
     u = TrowbridgeReitz::roughness_to_alpha(u);
     v = TrowbridgeReitz::roughness_to_alpha(v);
   }
-  return r.distribution == MicrofacetDistribution::Beckmann ? Microfacet(Beckmann(u, v))
-                                                            : Microfacet(TrowbridgeReitz(u, v));
+  switch (r.distribution) {
+    case MicrofacetDistribution::Beckmann: return Beckmann(u, v);
+    case MicrofacetDistribution::GGXSeparable: return TrowbridgeReitz(u, v, MaskingShadowing::Separable);
+    case MicrofacetDistribution::GGX: break;
+  }
+  return TrowbridgeReitz(u, v);
 }
 
 }  // namespace

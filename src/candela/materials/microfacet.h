@@ -53,12 +53,17 @@ inline bool refract_about(const Vec3& w, Vec3 n, float eta, Vec3& wt, float& eta
   return true;
 }
 
+// How masking and shadowing combine: pbrt-v4's height-correlated form or Mitsuba's product of the two.
+enum class MaskingShadowing { HeightCorrelated, Separable };
+
 // The anisotropic Trowbridge-Reitz (GGX) microfacet distribution.
 struct TrowbridgeReitz {
   float alpha_x = 0, alpha_y = 0;
+  MaskingShadowing masking = MaskingShadowing::HeightCorrelated;
 
   TrowbridgeReitz() = default;
-  TrowbridgeReitz(float ax, float ay) : alpha_x(ax), alpha_y(ay) {
+  TrowbridgeReitz(float ax, float ay, MaskingShadowing m = MaskingShadowing::HeightCorrelated)
+      : alpha_x(ax), alpha_y(ay), masking(m) {
     // A rough surface must be a little rough along both axes: D divides by each alpha (pbrt-v4).
     if (!effectively_smooth()) {
       alpha_x = std::max(alpha_x, 1e-4f);
@@ -97,8 +102,11 @@ struct TrowbridgeReitz {
   // Masking: the fraction of microfacets visible from w.
   float G1(const Vec3& w) const { return 1 / (1 + Lambda(w)); }
 
-  // Height-correlated masking-shadowing: microfacets visible from both wo and wi.
-  float G(const Vec3& wo, const Vec3& wi) const { return 1 / (1 + Lambda(wo) + Lambda(wi)); }
+  // Masking-shadowing: the fraction of microfacets visible from both wo and wi.
+  float G(const Vec3& wo, const Vec3& wi) const {
+    if (masking == MaskingShadowing::Separable) return G1(wo) * G1(wi);
+    return 1 / (1 + Lambda(wo) + Lambda(wi));
+  }
 
   // Distribution of normals visible from w: D_w(wm) = G1(w) / |cos theta_w| D(wm) |w . wm|.
   float D(const Vec3& w, const Vec3& wm) const {

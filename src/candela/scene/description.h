@@ -114,7 +114,10 @@ struct MirrorMaterial {
 
 // The microfacet normal distribution: Trowbridge-Reitz (GGX, the default) or Beckmann (Mitsuba's
 // "beckmann"); alpha has the usual meaning for each (Beckmann: the RMS slope).
-enum class MicrofacetDistribution { GGX, Beckmann };
+// GGX with pbrt-v4's height-correlated masking-shadowing 1 / (1 + Lambda(wo) + Lambda(wi)), or with
+// Mitsuba's separable G1(wo) G1(wi) (GGXSeparable: what Mitsuba's rough BSDFs use); Beckmann (always
+// separable, as Mitsuba's).
+enum class MicrofacetDistribution { GGX, GGXSeparable, Beckmann };
 
 // Microfacet roughness: the Trowbridge-Reitz (GGX) alpha along the shading frame's u and v axes.
 // alpha < 1e-3 on both axes is treated as perfectly smooth (a delta BSDF), as pbrt-v4 does.
