@@ -8,6 +8,7 @@
 #include <string>
 #include <variant>
 
+#include "candela/film/image_io.h"
 #include "candela/io/error.h"
 #include "candela/io/named_spectra.h"
 #include "candela/lights/light.h"
@@ -128,7 +129,7 @@ TEST(MitsubaReader, Bsdfs) {
   EXPECT_NEAR(d.ior, 2.419f / 1.000277f, 1e-5);
   const auto& c = std::get<ConductorMaterial>(
       s.materials[std::get<OneSidedMaterial>(s.materials[s.shapes[1].material]).material]);
-  EXPECT_EQ(c.roughness.distribution, MicrofacetDistribution::GGX);
+  EXPECT_EQ(c.roughness.distribution, MicrofacetDistribution::GGXSeparable);  // Mitsuba's G1(wo) G1(wi)
   EXPECT_FLOAT_EQ(c.roughness.u.value, 0.25f);
   EXPECT_FLOAT_EQ(c.roughness.v.value, 0.05f);
   EXPECT_NEAR(c.eta.value.r, 1.6575f, 1e-3);
@@ -161,6 +162,49 @@ TEST(MitsubaReader, CheckerboardMapsToCandelasSquares) {
   EXPECT_FLOAT_EQ(c.tex2.value.r, 0.1f);
   EXPECT_FLOAT_EQ(c.mapping.su, 10);
   EXPECT_FLOAT_EQ(c.mapping.sv, 6);
+}
+
+TEST(MitsubaReader, CheckerboardLookedUpAsAFloatSwapsItsColours) {
+  // Mitsuba's checkerboard gives color0 where (u mod 1 < 0.5) == (v mod 1 < 0.5) to colour lookups
+  // (eval, eval_3) but color1 there to float lookups (eval_1: roughness and other float parameters).
+  SceneDesc s = read_text(R"(<texture type="checkerboard" id="check"><float name="color0" value="0.05"/>
+      <float name="color1" value="0.3"/></texture>
+    <shape type="sphere"><bsdf type="roughconductor"><string name="distribution" value="ggx"/>
+      <ref name="alpha" id="check"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="diffuse"><ref name="reflectance" id="check"/></bsdf></shape>)");
+  ASSERT_EQ(s.textures.size(), 2u);
+  const auto& conductor = std::get<ConductorMaterial>(
+      s.materials[std::get<OneSidedMaterial>(s.materials[s.shapes[0].material]).material]);
+  const auto& diffuse = std::get<DiffuseMaterial>(
+      s.materials[std::get<OneSidedMaterial>(s.materials[s.shapes[1].material]).material]);
+  const auto& as_float = std::get<CheckerboardTexture>(s.textures[size_t(conductor.roughness.u.texture)]);
+  const auto& as_colour = std::get<CheckerboardTexture>(s.textures[size_t(diffuse.reflectance.texture)]);
+  EXPECT_FLOAT_EQ(as_colour.tex1.value.r, 0.05f);  // candela's tex1: where floor(2u) + floor(2v) is even
+  EXPECT_FLOAT_EQ(as_colour.tex2.value.r, 0.3f);
+  EXPECT_FLOAT_EQ(as_float.tex1.value.r, 0.3f);
+  EXPECT_FLOAT_EQ(as_float.tex2.value.r, 0.05f);
+  EXPECT_EQ(conductor.roughness.u.texture, conductor.roughness.v.texture);  // one texture per lookup kind
+}
+
+TEST(MitsubaReader, NormalAndBumpMapsTakeMitsubasFlipAndShadowingDefaults) {
+  SceneDesc s = read_text(R"(
+    <shape type="sphere"><bsdf type="normalmap"><texture name="normalmap" type="rawconstant">
+      <vector name="value" value="0.5, 0.5, 1"/></texture><bsdf type="diffuse"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="normalmap"><boolean name="flip_invalid_normals" value="false"/>
+      <boolean name="use_shadowing_function" value="false"/><texture name="normalmap" type="rawconstant">
+      <vector name="value" value="0.5, 0.5, 1"/></texture><bsdf type="diffuse"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="bumpmap"><texture type="checkerboard"/><bsdf type="diffuse"/></bsdf></shape>)");
+  auto options = [&](int shape) {
+    const MaterialDesc& m = s.materials[s.shapes[size_t(shape)].material];
+    if (const auto* n = std::get_if<NormalMapMaterial>(&m)) return n->options;
+    return std::get<BumpMapMaterial>(m).options;
+  };
+  EXPECT_TRUE(options(0).flip_invalid_normals);
+  EXPECT_TRUE(options(0).shadowing_function);
+  EXPECT_FALSE(options(1).flip_invalid_normals);
+  EXPECT_FALSE(options(1).shadowing_function);
+  EXPECT_TRUE(options(2).flip_invalid_normals);
+  EXPECT_TRUE(options(2).shadowing_function);
 }
 
 TEST(MitsubaReader, RotatedToUvOfABitmap) {
@@ -284,6 +328,17 @@ TEST(MitsubaReader, Emitters) {
   EXPECT_FLOAT_EQ(spot.cone_delta, 30 - 22.5f);  // beam_width defaults to 3/4 of the cutoff
   EXPECT_NEAR(spot.direction.y, -1, 1e-5);
   EXPECT_NEAR(spot.up.z, 1, 1e-5);
+}
+
+TEST(MitsubaReader, EnvmapUsesMitsubasTexelPlacement) {
+  write_image(temp_dir() / "envmap-test.exr", Image(8, 4));
+  SceneDesc s = read_text(R"(<emitter type="envmap"><string name="filename" value="envmap-test.exr"/>
+      <float name="scale" value="2"/><transform name="to_world"><rotate y="1" angle="90"/></transform></emitter>)");
+  ASSERT_EQ(s.lights.size(), 1u);
+  const auto& map = std::get<EnvironmentMap>(s.lights[0]);
+  EXPECT_EQ(map.mapping, EnvironmentMapping::EquirectangularPoleRows);
+  EXPECT_FLOAT_EQ(map.scale.g, 2);
+  EXPECT_NEAR(map.to_world.vector({1, 0, 0}).z, -1, 1e-5f);
 }
 
 TEST(MitsubaReader, TexturedAreaEmittersOnAnalyticShapes) {

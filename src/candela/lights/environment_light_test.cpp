@@ -81,9 +81,20 @@ EnvironmentLight test_light(EnvironmentMapping mapping) {
 }
 
 constexpr EnvironmentMapping kMappings[] = {EnvironmentMapping::Equirectangular,
+                                            EnvironmentMapping::EquirectangularPoleRows,
                                             EnvironmentMapping::EqualAreaOctahedral};
 const char* name(EnvironmentMapping m) {
-  return m == EnvironmentMapping::Equirectangular ? "equirectangular" : "equal-area octahedral";
+  switch (m) {
+    case EnvironmentMapping::Equirectangular: return "equirectangular";
+    case EnvironmentMapping::EquirectangularPoleRows: return "equirectangular, pole rows";
+    case EnvironmentMapping::EqualAreaOctahedral: return "equal-area octahedral";
+  }
+  return "?";
+}
+// Where texel (x, y) sits in the image's (u, v).
+Vec2 texel_centre(EnvironmentMapping m, int x, int y, const Image& img) {
+  if (m == EnvironmentMapping::EquirectangularPoleRows) return {(x + 0.5f) / img.width, float(y) / (img.height - 1)};
+  return {(x + 0.5f) / img.width, (y + 0.5f) / img.height};
 }
 
 TEST(EnvironmentLight, EquirectangularFollowsMitsubasConvention) {
@@ -110,7 +121,7 @@ TEST(EnvironmentLight, RadianceIsTheScaledImageAtPixelCentresUnderTheRotation) {
     Image img = testing::environment_test_map(m);
     EnvironmentLight light = test_light(m);
     for (auto [x, y] : {std::pair{3, 2}, std::pair{img.width / 2 + 3, img.height / 4}, std::pair{10, 7}}) {
-      Vec2 uv{(x + 0.5f) / img.width, (y + 0.5f) / img.height};
+      Vec2 uv = texel_centre(m, x, y, img);
       Vec3 world = test_rotation().vector(light.uv_to_direction(uv));
       RGB expected = img.at(x, y) * RGB(1.5f, 1.0f, 0.5f);
       RGB got = light.radiance(world * 2.0f);  // need not be normalised
@@ -119,18 +130,87 @@ TEST(EnvironmentLight, RadianceIsTheScaledImageAtPixelCentresUnderTheRotation) {
   }
 }
 
+// Mitsuba 3's envmap lookup (emitters/envmap.cpp, eval_spectrum), transcribed independently of
+// environment_light.cpp: the image gets a copy of its first column appended (width + 1 columns),
+// then uv.x -= 1 / (2 width), uv -= floor(uv), uv *= (width, height - 1), and the texels at
+// min(floor(uv), (width - 1, height - 2)) and their +1 neighbours are blended bilinearly.
+RGB mitsuba_envmap_eval(const Image& img, Vec2 uv) {
+  const int w = img.width + 1, h = img.height;
+  auto texel = [&](int x, int y) { return img.at(x % img.width, y); };
+  double u = uv.x - 0.5 / (w - 1), v = uv.y;
+  u -= std::floor(u);
+  v -= std::floor(v);
+  u *= w - 1;
+  v *= h - 1;
+  int x = std::min(int(u), w - 2), y = std::min(int(v), h - 2);
+  float fx = float(u - x), fy = float(v - y);
+  RGB top = texel(x, y) * (1 - fx) + texel(x + 1, y) * fx;
+  RGB bottom = texel(x, y + 1) * (1 - fx) + texel(x + 1, y + 1) * fx;
+  return top * (1 - fy) + bottom * fy;
+}
+
+TEST(EnvironmentLight, PoleRowsLookUpAsMitsubasEnvmap) {
+  const EnvironmentMapping m = EnvironmentMapping::EquirectangularPoleRows;
+  Image img = testing::environment_test_map(m);
+  EnvironmentLight light(img, m, RGB(2.0f), test_rotation(), 1);
+  Rng rng(7, 1);
+  for (int i = 0; i < 20000; ++i) {
+    Vec3 world = square_to_uniform_sphere({rng.next_float(), rng.next_float()});
+    // Mitsuba's direction_to_uv of the direction in the emitter's frame.
+    Vec3 d = normalize(test_rotation().inverse().vector(world));
+    Vec2 uv{std::atan2(d.x, -d.z) * kInv2Pi, std::acos(std::clamp(d.y, -1.0f, 1.0f)) * kInvPi};
+    RGB expected = mitsuba_envmap_eval(img, uv) * 2.0f, got = light.radiance(world);
+    for (int c = 0; c < 3; ++c) ASSERT_NEAR(got[c], expected[c], 2e-4f * (1 + expected[c])) << uv.x << " " << uv.y;
+  }
+}
+
+TEST(EnvironmentLight, PoleRowsDensityIsLuminanceTimesSolidAngleOfEachPatch) {
+  // Mitsuba samples its envmap in proportion to luminance times sin(theta), interpolated between
+  // texel centres. Here each patch between four texel centres has the density of its mean corner
+  // luminance times its solid angle, uniform over the patch in (u, v): so pdf_li times the patch's
+  // row Jacobian 2 pi^2 sin(theta) is the same at every point of a patch, and, divided by the mean
+  // corner luminance and the row's solid angle per patch area, the same for every patch.
+  const EnvironmentMapping m = EnvironmentMapping::EquirectangularPoleRows;
+  Image img = testing::environment_test_map(m);
+  EnvironmentLight light(img, m, RGB(1.0f), Transform(), 1);
+  const int w = img.width, rows = img.height - 1;
+  double ratio0 = 0;
+  for (int j = 0; j < rows; ++j)
+    for (int i = 0; i < w; ++i) {
+      float lum = 0.25f * (img.at(i, j).luminance() + img.at((i + 1) % w, j).luminance() +
+                           img.at(i, j + 1).luminance() + img.at((i + 1) % w, j + 1).luminance());
+      if (!(lum > 0.05f)) continue;  // below the floor every pixel with radiance gets
+      double row_solid_angle = 2 * std::numbers::pi / w *
+                               (std::cos(std::numbers::pi * j / rows) - std::cos(std::numbers::pi * (j + 1) / rows));
+      double patch_area = 1.0 / (double(w) * rows);
+      for (Vec2 f : {Vec2(0.3f, 0.4f), Vec2(0.8f, 0.6f)}) {
+        Vec2 uv{float((i + 0.5 + f.x) / w), float((j + f.y) / rows)};
+        if (uv.x >= 1) uv.x -= 1;
+        Vec3 dir = light.uv_to_direction(uv);
+        double sin_theta = std::sqrt(dir.x * dir.x + dir.z * dir.z);
+        double density_uv = light.pdf_li({}, dir, {}, {}) * 2 * sqr(std::numbers::pi) * sin_theta;
+        double ratio = density_uv / (lum * row_solid_angle / patch_area);
+        if (ratio0 == 0) ratio0 = ratio;
+        ASSERT_NEAR(ratio / ratio0, 1, 2e-3) << "patch " << i << ", " << j;
+      }
+    }
+  EXPECT_GT(ratio0, 0);
+}
+
 TEST(EnvironmentLight, RadianceIsContinuousAcrossTheImageEdges) {
   // Points just either side of where the image's edges meet on the sphere see the same radiance:
   // the equirectangular seam u = 0 ~ 1, and the octahedral square's folded edges, (eps, t) ~ (eps, 1 - t)
   // and (t, eps) ~ (1 - t, eps). The interpolation must wrap to the right neighbours for this.
   const float eps = 1e-6f;
   EnvironmentLight equirect = test_light(EnvironmentMapping::Equirectangular);
+  EnvironmentLight pole_rows = test_light(EnvironmentMapping::EquirectangularPoleRows);
   EnvironmentLight octahedral = test_light(EnvironmentMapping::EqualAreaOctahedral);
   auto expect_close = [](const RGB& a, const RGB& b, const char* what, float t) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 2e-4f * (1 + a[c])) << what << " t = " << t;
   };
   for (float t : {0.05f, 0.2f, 0.33f, 0.47f, 0.6f, 0.9f}) {
     expect_close(equirect.lookup({eps, t}), equirect.lookup({1 - eps, t}), "seam", t);
+    expect_close(pole_rows.lookup({eps, t}), pole_rows.lookup({1 - eps, t}), "seam (pole rows)", t);
     expect_close(octahedral.lookup({eps, t}), octahedral.lookup({eps, 1 - t}), "left edge", t);
     expect_close(octahedral.lookup({1 - eps, t}), octahedral.lookup({1 - eps, 1 - t}), "right edge", t);
     expect_close(octahedral.lookup({t, eps}), octahedral.lookup({1 - t, eps}), "top edge", t);

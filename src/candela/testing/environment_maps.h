@@ -7,7 +7,7 @@
 namespace candela::testing {
 
 inline Image environment_test_map(EnvironmentMapping mapping) {
-  const bool equirect = mapping == EnvironmentMapping::Equirectangular;
+  const bool equirect = mapping != EnvironmentMapping::EqualAreaOctahedral;
   const int w = equirect ? 32 : 24, h = equirect ? 16 : 24;  // the octahedral mapping needs a square
   Image img(w, h);
   for (int y = 0; y < h; ++y)
