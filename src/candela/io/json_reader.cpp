@@ -1779,6 +1779,7 @@ class JsonSceneReader {
                                          {"equirectangular_pole_rows", EnvironmentMapping::EquirectangularPoleRows},
                                          {"equal_area", EnvironmentMapping::EqualAreaOctahedral}});
     environment.scale = light.rgb_or("scale", ColorKind::Emission, environment.scale);
+    environment.mis_compensation = light.boolean_or("mis_compensation", environment.mis_compensation);
     environment.to_world = read_environment_orientation(light, environment.mapping);
     return environment;
   }

@@ -295,6 +295,7 @@ Json light_json(const LightDesc& light) {
                    {"mapping", environment_mapping_name(l.mapping)},
                    {"scale", rgb(l.scale)}};
             if (!l.to_world.is_identity()) j["transform"] = matrix(l.to_world);
+            if (l.mis_compensation) j["mis_compensation"] = true;
             return j;
           },
           [](const ProjectorLight& l) {

@@ -1387,6 +1387,7 @@ class Converter {
       l.scale = RGB(get_float(e, "scale", 1.0f));
       l.to_world = get_transform(e, "to_world");
       l.mapping = EnvironmentMapping::EquirectangularPoleRows;
+      l.mis_compensation = get_bool(e, "mis_compensation", false);
       ignore(e, "filter_type");
       desc_.lights.push_back(l);
     } else if (type == "directional") {

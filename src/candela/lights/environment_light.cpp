@@ -124,7 +124,7 @@ struct EnvironmentLight::Data {
 };
 
 EnvironmentLight::EnvironmentLight(const Image& image, EnvironmentMapping mapping, const RGB& scale,
-                                   const Transform& world_from_light, float scene_radius) {
+                                   const Transform& world_from_light, float scene_radius, bool mis_compensation) {
   if (image.width <= 0 || image.height <= 0 || image.rgb.size() < size_t(image.width) * size_t(image.height) * 3)
     throw SceneError("environment map: the image is empty");
   if (mapping == EnvironmentMapping::EqualAreaOctahedral && image.width != image.height)
@@ -156,7 +156,21 @@ EnvironmentLight::EnvironmentLight(const Image& image, EnvironmentMapping mappin
   // separable [1 6 1] / 8 filter of the texels (a neighbour's tent reaches halfway into the pixel with
   // 1/8 of its area); over a patch between texel centres it is the mean of its four corners.
   const int cells_y = d->cells_y();
+  // MIS compensation subtracts the mean texel luminance (unless the map is nearly constant, where it
+  // would leave nothing), as Mitsuba's envmap does.
+  float offset = 0;
+  if (mis_compensation) {
+    double sum = 0;
+    float least = std::numeric_limits<float>::infinity();
+    for (const RGB& t : d->texels) {
+      sum += t.luminance();
+      least = std::min(least, t.luminance());
+    }
+    offset = float(sum / double(d->texels.size()));
+    if (offset - least <= 0.01f * offset) offset = 0;
+  }
   std::vector<float> weights(size_t(w) * size_t(cells_y));
+  std::vector<char> radiant(weights.size(), 0);
   const float k[3] = {0.125f, 0.75f, 0.125f};
   constexpr double pi = std::numbers::pi;
   double integral = 0;  // of the luminance over solid angle
@@ -178,7 +192,9 @@ EnvironmentLight::EnvironmentLight(const Image& image, EnvironmentMapping mappin
           for (int i = -1; i <= 1; ++i) lum += k[i + 1] * k[j + 1] * d->texel(x + i, y + j).luminance();
       }
       integral += lum * cell_solid_angle;
-      weights[size_t(y) * size_t(w) + size_t(x)] = float(lum * cell_solid_angle);
+      const size_t i = size_t(y) * size_t(w) + size_t(x);
+      weights[i] = float(std::max(lum - offset, 0.0) * cell_solid_angle);
+      radiant[i] = lum > 0;
     }
   }
   // A floor under every pixel that has any radiance, so that in a map with a very bright sun the
@@ -186,8 +202,8 @@ EnvironmentLight::EnvironmentLight(const Image& image, EnvironmentMapping mappin
   double mean_weight = 0;
   for (float wt : weights) mean_weight += wt;
   mean_weight /= double(weights.size());
-  for (float& wt : weights)
-    if (wt > 0) wt = std::max(wt, float(1e-3 * mean_weight));
+  for (size_t i = 0; i < weights.size(); ++i)
+    if (radiant[i]) weights[i] = std::max(weights[i], float(1e-3 * mean_weight));
   d->distribution = Distribution2D(weights, w, cells_y);
   d->average_luminance = float(integral / (4 * pi));
   data_ = std::move(d);
@@ -266,7 +282,7 @@ EnvironmentLight make_environment_light(const EnvironmentMap& desc, float scene_
     throw SceneError(fmt::format("environment map: {}", e.what()));
   }
   try {
-    return EnvironmentLight(image, desc.mapping, desc.scale, desc.to_world, scene_radius);
+    return EnvironmentLight(image, desc.mapping, desc.scale, desc.to_world, scene_radius, desc.mis_compensation);
   } catch (const SceneError& e) {
     throw SceneError(fmt::format("{}: {}", desc.filename, e.what()));
   }

@@ -10,10 +10,10 @@
 // bilinearly between them (wrapping around in phi for equirectangular maps, clamped at the poles;
 // across the folded edges for the octahedral square).
 //
-// Directions are sampled from a piecewise-constant density over the pixels proportional to the
-// luminance the bilinear radiance has on average over each pixel, times the pixel's solid angle,
-// then uniformly within the pixel in (u, v); pdf_li reports exactly that density, converted to
-// solid angle.
+// Directions are sampled from a piecewise-constant density over the pixels (for pole rows, over the
+// patches between texel centres) proportional to the luminance the bilinear radiance has on average
+// over each, times its solid angle, then uniformly within it in (u, v); pdf_li reports exactly that
+// density, converted to solid angle.
 #include <filesystem>
 #include <memory>
 
@@ -29,8 +29,11 @@ class EnvironmentLight {
   // `image` is linear RGB radiance (negative and NaN values count as zero) and is multiplied by
   // `scale`; world_from_light orients the map (a rotation; directions are normalised after it).
   // Throws SceneError for an empty image, or a non-square one with the octahedral mapping.
+  // mis_compensation: sample in proportion to max(luminance - its mean, 0) instead (Mitsuba's
+  // envmap option, after Karlik et al. 2019), leaving the directions that BSDF sampling finds well
+  // to it under MIS; every direction with radiance keeps a small density.
   EnvironmentLight(const Image& image, EnvironmentMapping mapping, const RGB& scale,
-                   const Transform& world_from_light, float scene_radius);
+                   const Transform& world_from_light, float scene_radius, bool mis_compensation = false);
 
   // Radiance arriving along -world_dir, i.e. seen looking in direction world_dir (for rays that
   // escape the scene). world_dir need not be normalised.

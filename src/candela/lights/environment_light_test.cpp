@@ -299,6 +299,32 @@ TEST(EnvironmentLight, RadianceOverPdfEstimatesTheIntegralOfTheMap) {
   }
 }
 
+TEST(EnvironmentLight, MisCompensationSamplesLuminanceAboveTheMeanAndStaysUnbiased) {
+  // Mitsuba's mis_compensation: the density follows max(luminance - mean, 0); directions darker than
+  // the mean keep only the small floor, and radiance / pdf still integrates the map.
+  const EnvironmentMapping m = EnvironmentMapping::EquirectangularPoleRows;
+  Image img = testing::environment_test_map(m);
+  EnvironmentLight plain(img, m, RGB(1.0f), Transform(), 1), compensated(img, m, RGB(1.0f), Transform(), 1, true);
+  const Vec3 bright = plain.uv_to_direction({(img.width / 2 + 4) / float(img.width), (img.height / 4 + 0.5f) / (img.height - 1)});
+  const Vec3 dim = plain.uv_to_direction({0.1f, 0.8f});
+  EXPECT_GT(compensated.pdf_li({}, bright, {}, {}), plain.pdf_li({}, bright, {}, {}));
+  EXPECT_LT(compensated.pdf_li({}, dim, {}, {}), 0.1f * plain.pdf_li({}, dim, {}, {}));
+  EXPECT_GT(compensated.pdf_li({}, dim, {}, {}), 0);
+  RGB reference = sphere_integral([&](const Vec3& w) { return plain.radiance(w); }, 600, 1200);
+  Rng rng(5, 6);
+  double sum = 0, sum_sq = 0;
+  const int n = kSamples;
+  for (int i = 0; i < n; ++i) {
+    LightSample s = compensated.sample_li({}, {rng.next_float(), rng.next_float()});
+    if (s.pdf == 0) continue;
+    double v = s.radiance.g / s.pdf;
+    sum += v;
+    sum_sq += v * v;
+  }
+  double mean = sum / n, se = std::sqrt(std::max(0.0, sum_sq / n - mean * mean) / n);
+  EXPECT_NEAR(mean, reference.g, 4 * se + 1e-3 * reference.g);
+}
+
 TEST(EnvironmentLight, ConstantMapIsSampledUniformly) {
   Image img(8, 8);
   for (int y = 0; y < 8; ++y)

@@ -441,6 +441,7 @@ struct EnvironmentMap {
   EnvironmentMapping mapping = EnvironmentMapping::Equirectangular;
   RGB scale{1.0f};
   Transform to_world;  // from the map's local frame to the world (rotations only are meaningful)
+  bool mis_compensation = false;  // sample by luminance minus its mean (environment_light.h)
 };
 
 using LightDesc = std::variant<PointLight, SkyLight, SpotLight, DistantLight, EnvironmentMap, ProjectorLight>;
