@@ -142,7 +142,7 @@ const ConformanceCase kCases[] = {
     {"projector", "test_projector_textured_direct", Expect::Pass},
     {"spot_light", "test_spot_direct", Expect::PassWithNegativeVarianceReplaced},
     {"various_emitters", "test_various_emitters_ptracer", Expect::PassWithNegativeVarianceReplaced},
-    {"various_shapes", "test_various_shapes_path", Expect::KnownFailure},
+    {"various_shapes", "test_various_shapes_path", Expect::Pass},
 };
 
 INSTANTIATE_TEST_SUITE_P(Scenes, MitsubaConformance, ::testing::ValuesIn(kCases),
