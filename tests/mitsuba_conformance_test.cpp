@@ -126,7 +126,6 @@ TEST_P(MitsubaConformance, PassesMitsubasRenderTest) {
   }
 }
 
-// The 26 scenes. Expectations are what this checkout achieves; docs/conformance.md explains each.
 // The 26 scenes, with what each sampler achieves in this checkout; docs/conformance.md explains each.
 const ConformanceCase kCases[] = {
     {"bsdf_spheres", "test_arealight_path", Expect::PassWithNegativeVarianceReplaced, Expect::PassWithNegativeVarianceReplaced},
@@ -154,7 +153,7 @@ const ConformanceCase kCases[] = {
     {"projector", "test_projector_textured_direct", Expect::Pass, Expect::PassWithNegativeVarianceReplaced},
     {"spot_light", "test_spot_direct", Expect::PassWithNegativeVarianceReplaced, Expect::PassWithNegativeVarianceReplaced},
     {"various_emitters", "test_various_emitters_ptracer", Expect::PassWithNegativeVarianceReplaced, Expect::PassWithNegativeVarianceReplaced},
-    {"various_shapes", "test_various_shapes_path", Expect::KnownFailure, Expect::KnownFailure},
+    {"various_shapes", "test_various_shapes_path", Expect::Pass, Expect::Pass},
 };
 
 INSTANTIATE_TEST_SUITE_P(Scenes, MitsubaConformance,

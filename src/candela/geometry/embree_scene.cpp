@@ -6,23 +6,14 @@
 #include <stdexcept>
 #include <string>
 
+#include "candela/math/vec3d.h"
+
 namespace candela {
 namespace {
 
 void report_embree_error(void*, RTCError code, const char* message) {
   // Errors from Embree are programming or resource errors, not user input errors.
   throw std::runtime_error("Embree error " + std::to_string(int(code)) + ": " + (message ? message : ""));
-}
-
-struct Vec3d {
-  double x, y, z;
-};
-double dot(const Vec3d& a, const Vec3d& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-
-Vec3d apply(const Matrix4& m, double x, double y, double z, double w) {
-  return {m.m[0][0] * x + m.m[0][1] * y + m.m[0][2] * z + m.m[0][3] * w,
-          m.m[1][0] * x + m.m[1][1] * y + m.m[1][2] * z + m.m[1][3] * w,
-          m.m[2][0] * x + m.m[2][1] * y + m.m[2][2] * z + m.m[2][3] * w};
 }
 
 // A ray as a user-geometry callback sees it; time is Embree's, in [0,1].
@@ -36,8 +27,8 @@ struct UserRay {
 // `inv`, the world-to-object matrix) in double precision with the cancellation-free quadratic formula.
 bool intersect_sphere_in_object_space(const SphereGeometry& s, const Matrix4& inv, const UserRay& ray, double& t_hit) {
   const double t_near = ray.t_near, t_far = ray.t_far;
-  Vec3d o = apply(inv, ray.o.x, ray.o.y, ray.o.z, 1);
-  Vec3d d = apply(inv, ray.d.x, ray.d.y, ray.d.z, 0);
+  Vec3d o = apply(inv, ray.o, 1);
+  Vec3d d = apply(inv, ray.d, 0);
   Vec3d f{o.x - s.center.x, o.y - s.center.y, o.z - s.center.z};
   double a = dot(d, d);
   double b_half = dot(f, d);
@@ -119,8 +110,8 @@ bool intersect_quadric(const QuadricGeometry& q, const UserRay& ray, double& t_h
     if (!at_time) return false;
     inv = &at_time->inverse_matrix();
   }
-  Vec3d o = apply(*inv, ray.o.x, ray.o.y, ray.o.z, 1);
-  Vec3d d = apply(*inv, ray.d.x, ray.d.y, ray.d.z, 0);
+  Vec3d o = apply(*inv, ray.o, 1);
+  Vec3d d = apply(*inv, ray.d, 0);
   return intersect_unit_quadric_d(q.kind, o, d, ray.t_near, ray.t_far, t_hit);
 }
 
@@ -137,6 +128,24 @@ bool intersect_plane(const PlaneGeometry& pl, float extent, const UserRay& ray, 
   double px = o.x + t * d.x - pl.point.x, py = o.y + t * d.y - pl.point.y, pz = o.z + t * d.z - pl.point.z;
   if (std::abs(px) > extent || std::abs(py) > extent || std::abs(pz) > extent) return false;
   t_hit = t;
+  return true;
+}
+
+// The first crossing of the surface of an SDF grid's voxel, found in the grid's index space (where
+// t is unchanged: the direction is transformed, not normalised).
+bool intersect_sdf_voxel(const SdfGridGeometry& sdf, const Matrix4& static_world_to_index, uint32_t voxel,
+                         const UserRay& ray, double& t_hit) {
+  const Matrix4* to_index = &static_world_to_index;
+  std::optional<Transform> at_time;
+  if (sdf.to_world_end) {
+    at_time = sdf.index_to_world(ray.time);
+    if (!at_time) return false;
+    to_index = &at_time->inverse_matrix();
+  }
+  std::optional<double> t =
+      sdf.grid->intersect_voxel(voxel, apply(*to_index, ray.o, 1), apply(*to_index, ray.d, 0), ray.t_near, ray.t_far);
+  if (!t) return false;
+  t_hit = *t;
   return true;
 }
 
@@ -207,6 +216,30 @@ Bounds3 quadric_world_bounds(const QuadricGeometry& q, const Transform& to_world
     b.extend(to_world.point(corner));
   }
   return b;
+}
+
+Bounds3 sdf_voxel_world_bounds(const SdfGrid& grid, uint32_t voxel, const Transform& to_world) {
+  // The voxel's cube grown by a thousandth of a voxel, so that no rounding in Embree's box tests
+  // loses a hit on a face; intersect_voxel clips to the exact cube itself.
+  const Transform index_to_world = to_world * grid.index_to_object();
+  const std::array<int, 3> corner = grid.voxel_corner(voxel);
+  Bounds3 b;
+  for (int i = 0; i < 8; ++i) {
+    Vec3 p;
+    for (int a = 0; a < 3; ++a) p[a] = float(corner[size_t(a)]) + ((i >> a & 1) ? 1.001f : -0.001f);
+    b.extend(index_to_world.point(p));
+  }
+  return b;
+}
+
+std::optional<Transform> SdfGridGeometry::to_world_at(float time) const {
+  return to_world_end ? interpolate_transform(to_world, *to_world_end, time) : to_world;
+}
+
+std::optional<Transform> SdfGridGeometry::index_to_world(float time) const {
+  std::optional<Transform> object_to_world = to_world_at(time);
+  if (!object_to_world) return std::nullopt;
+  return *object_to_world * grid->index_to_object();
 }
 
 bool intersect_unit_quadric(QuadricGeometry::Kind kind, const Point3& o, const Vec3& d, double t_near, double t_far,
@@ -330,47 +363,45 @@ void EmbreeScene::add_moving_triangles(uint32_t id, const std::vector<Point3>& p
   attach(geom, id);
 }
 
+void EmbreeScene::attach_user_geometry(uint32_t id, void* data, unsigned primitives, bool moving,
+                                       RTCBoundsFunction bounds, RTCIntersectFunctionN intersect,
+                                       RTCOccludedFunctionN occluded, int object) {
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(geom, primitives);
+  rtcSetGeometryUserData(geom, data);
+  rtcSetGeometryBoundsFunction(geom, bounds, nullptr);
+  // Moving: Embree interpolates the two time steps' boxes linearly; they contain the shape at every
+  // time in between because each point of it moves linearly.
+  if (moving) rtcSetGeometryTimeStepCount(geom, 2);
+  rtcSetGeometryIntersectFunction(geom, intersect);
+  rtcSetGeometryOccludedFunction(geom, occluded);
+  attach(geom, id, object);
+}
+
 void EmbreeScene::add_sphere(uint32_t id, const SphereGeometry& sphere, int object) {
   spheres_.push_back(std::make_unique<SphereGeometry>(sphere));
-  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
-  rtcSetGeometryUserPrimitiveCount(geom, 1);
-  rtcSetGeometryUserData(geom, spheres_.back().get());
-  rtcSetGeometryBoundsFunction(geom, sphere_bounds, nullptr);
-  if (sphere.to_world_end) {
-    // Embree interpolates the two time steps' boxes linearly; they contain the sphere at every time
-    // in between because each point of it moves linearly.
-    rtcSetGeometryTimeStepCount(geom, 2);
-    rtcSetGeometryIntersectFunction(geom, moving_sphere_intersect);
-    rtcSetGeometryOccludedFunction(geom, moving_sphere_occluded);
-  } else {
-    rtcSetGeometryIntersectFunction(geom, sphere_intersect);
-    rtcSetGeometryOccludedFunction(geom, sphere_occluded);
-  }
-  attach(geom, id, object);
+  const bool moving = sphere.to_world_end.has_value();
+  attach_user_geometry(id, spheres_.back().get(), 1, moving, sphere_bounds,
+                       moving ? moving_sphere_intersect : sphere_intersect,
+                       moving ? moving_sphere_occluded : sphere_occluded, object);
 }
 
 void EmbreeScene::add_quadric(uint32_t id, const QuadricGeometry& q, int object) {
   quadrics_.push_back(std::make_unique<QuadricGeometry>(q));
-  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
-  rtcSetGeometryUserPrimitiveCount(geom, 1);
-  rtcSetGeometryUserData(geom, quadrics_.back().get());
-  rtcSetGeometryBoundsFunction(geom, quadric_bounds, nullptr);
-  // Moving: two time steps whose boxes Embree interpolates (every point moves linearly).
-  if (q.to_world_end) rtcSetGeometryTimeStepCount(geom, 2);
-  rtcSetGeometryIntersectFunction(geom, quadric_intersect);
-  rtcSetGeometryOccludedFunction(geom, quadric_occluded);
-  attach(geom, id, object);
+  attach_user_geometry(id, quadrics_.back().get(), 1, q.to_world_end.has_value(), quadric_bounds, quadric_intersect,
+                       quadric_occluded, object);
+}
+
+void EmbreeScene::add_sdf_grid(uint32_t id, const SdfGridGeometry& sdf, int object) {
+  sdf_grids_.push_back(std::make_unique<SdfGridRecord>(
+      SdfGridRecord{sdf, (sdf.to_world * sdf.grid->index_to_object()).inverse_matrix()}));
+  attach_user_geometry(id, sdf_grids_.back().get(), sdf.grid->voxel_count(), sdf.to_world_end.has_value(), sdf_bounds,
+                       sdf_intersect, sdf_occluded, object);
 }
 
 void EmbreeScene::add_plane(uint32_t id, const PlaneGeometry& plane, float extent) {
   planes_.push_back(std::make_unique<PlaneRecord>(PlaneRecord{plane, extent}));
-  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
-  rtcSetGeometryUserPrimitiveCount(geom, 1);
-  rtcSetGeometryUserData(geom, planes_.back().get());
-  rtcSetGeometryBoundsFunction(geom, plane_bounds, nullptr);
-  rtcSetGeometryIntersectFunction(geom, plane_intersect);
-  rtcSetGeometryOccludedFunction(geom, plane_occluded);
-  attach(geom, id);
+  attach_user_geometry(id, planes_.back().get(), 1, false, plane_bounds, plane_intersect, plane_occluded);
 }
 
 void EmbreeScene::commit() { rtcCommitScene(scene_); }
@@ -481,6 +512,26 @@ void EmbreeScene::quadric_intersect(const RTCIntersectFunctionNArguments* args) 
 
 void EmbreeScene::quadric_occluded(const RTCOccludedFunctionNArguments* args) {
   user_occluded(args, *static_cast<const QuadricGeometry*>(args->geometryUserPtr), intersect_quadric);
+}
+
+void EmbreeScene::sdf_bounds(const RTCBoundsFunctionArguments* args) {
+  const SdfGridGeometry& sdf = static_cast<const SdfGridRecord*>(args->geometryUserPtr)->sdf;
+  Bounds3 b = sdf_voxel_world_bounds(*sdf.grid, args->primID, args->timeStep == 0 ? sdf.to_world : *sdf.to_world_end);
+  write_padded_bounds(b, *args->bounds_o);
+}
+
+void EmbreeScene::sdf_intersect(const RTCIntersectFunctionNArguments* args) {
+  user_intersect(args, *static_cast<const SdfGridRecord*>(args->geometryUserPtr),
+                 [voxel = args->primID](const SdfGridRecord& r, const UserRay& ray, double& t) {
+                   return intersect_sdf_voxel(r.sdf, r.world_to_index, voxel, ray, t);
+                 });
+}
+
+void EmbreeScene::sdf_occluded(const RTCOccludedFunctionNArguments* args) {
+  user_occluded(args, *static_cast<const SdfGridRecord*>(args->geometryUserPtr),
+                [voxel = args->primID](const SdfGridRecord& r, const UserRay& ray, double& t) {
+                  return intersect_sdf_voxel(r.sdf, r.world_to_index, voxel, ray, t);
+                });
 }
 
 void EmbreeScene::plane_bounds(const RTCBoundsFunctionArguments* args) {

@@ -2,7 +2,8 @@
 // The acceleration structure: every intersection and occlusion query goes through Embree.
 // Triangle meshes are Embree quad geometry, their triangles paired across shared edges
 // (triangle_pairs.h; hits are reported per triangle), or with the compact layout Embree triangles; spheres, disks, open cylinders and infinite planes
-// are Embree user geometry intersected analytically in double precision (exact, not tessellated).
+// are Embree user geometry intersected analytically in double precision (exact, not tessellated), and
+// so are SDF grids, one primitive per voxel that holds surface.
 // Moving shapes (motion blur, the paper's sec. 4.2) have two Embree time steps: their transform is
 // interpolated linearly between the start and end transforms, as Embree interpolates vertices.
 #include <embree3/rtcore.h>
@@ -14,6 +15,7 @@
 
 #include "candela/geometry/ray.h"
 #include "candela/geometry/ray_log.h"
+#include "candela/geometry/sdf_grid.h"
 #include "candela/geometry/triangle_pairs.h"
 #include "candela/math/transform.h"
 
@@ -48,6 +50,17 @@ struct QuadricGeometry {
   Transform to_world;
   std::optional<Transform> to_world_end;  // moving: the transform at Embree time 1
 };
+// An SDF grid (sdf_grid.h) placed by `to_world` (any invertible affine map); each voxel the surface
+// passes through is one Embree primitive, intersected in double precision.
+struct SdfGridGeometry {
+  std::shared_ptr<const SdfGrid> grid;
+  Transform to_world;  // object space ([0,1]^3) to world
+  std::optional<Transform> to_world_end;  // moving: the transform at Embree time 1
+  // Object space to world at Embree time `time`, and index space (sample (i, j, k) at (i, j, k)) to
+  // world; nullopt where the interpolated transform is singular.
+  std::optional<Transform> to_world_at(float time) const;
+  std::optional<Transform> index_to_world(float time) const;
+};
 struct PlaneGeometry {
   Point3 point;
   Normal3 normal;  // unit length, world space
@@ -57,6 +70,8 @@ struct PlaneGeometry {
 Bounds3 sphere_world_bounds(const SphereGeometry& sphere, const Transform& to_world);
 // Bounds of a disk or cylinder under `to_world`: the transformed corners of its object-space box.
 Bounds3 quadric_world_bounds(const QuadricGeometry& q, const Transform& to_world);
+// Bounds of voxel `voxel` of an SDF grid under `to_world` (the grid's object-to-world transform).
+Bounds3 sdf_voxel_world_bounds(const SdfGrid& grid, uint32_t voxel, const Transform& to_world);
 // The nearest intersection of (o + t d) with the unit disk or cylinder in its own space, t in
 // (t_near, t_far); exposed for tests.
 bool intersect_unit_quadric(QuadricGeometry::Kind kind, const Point3& o, const Vec3& d, double t_near, double t_far,
@@ -89,6 +104,7 @@ class EmbreeScene {
                             const std::vector<uint32_t>& indices);
   void add_sphere(uint32_t id, const SphereGeometry& sphere, int object = -1);  // moving when sphere.to_world_end is set
   void add_quadric(uint32_t id, const QuadricGeometry& q, int object = -1);  // moving when q.to_world_end is set
+  void add_sdf_grid(uint32_t id, const SdfGridGeometry& sdf, int object = -1);  // moving when sdf.to_world_end is set
   void add_plane(uint32_t id, const PlaneGeometry& plane, float extent);
   // Objects for instancing: a separate acceleration structure, built once, placed by instances.
   int add_object();
@@ -120,6 +136,9 @@ class EmbreeScene {
   static void quadric_bounds(const RTCBoundsFunctionArguments* args);
   static void quadric_intersect(const RTCIntersectFunctionNArguments* args);
   static void quadric_occluded(const RTCOccludedFunctionNArguments* args);
+  static void sdf_bounds(const RTCBoundsFunctionArguments* args);
+  static void sdf_intersect(const RTCIntersectFunctionNArguments* args);
+  static void sdf_occluded(const RTCOccludedFunctionNArguments* args);
   static void plane_bounds(const RTCBoundsFunctionArguments* args);
   static void plane_intersect(const RTCIntersectFunctionNArguments* args);
   static void plane_occluded(const RTCOccludedFunctionNArguments* args);
@@ -128,8 +147,16 @@ class EmbreeScene {
     PlaneGeometry plane;
     float extent;
   };
+  struct SdfGridRecord {
+    SdfGridGeometry sdf;
+    Matrix4 world_to_index;  // a static grid's, computed once rather than per ray and voxel
+  };
 
   void attach(RTCGeometry geom, uint32_t id, int object = -1);
+  // A user geometry of `primitives` primitives on `data` (kept alive by the caller), with two time
+  // steps when `moving`.
+  void attach_user_geometry(uint32_t id, void* data, unsigned primitives, bool moving, RTCBoundsFunction bounds,
+                            RTCIntersectFunctionN intersect, RTCOccludedFunctionN occluded, int object = -1);
   // The Embree geometry for the triangles `indices` (vertices still to be set): quads of paired
   // triangles, the pairing kept under `id` for intersect(); with the compact layout, the triangles
   // themselves (reading `indices` in place when `shared`, else copying them).
@@ -146,6 +173,7 @@ class EmbreeScene {
   // Stable storage for user-geometry data (Embree keeps raw pointers to it).
   std::vector<std::unique_ptr<SphereGeometry>> spheres_;
   std::vector<std::unique_ptr<QuadricGeometry>> quadrics_;
+  std::vector<std::unique_ptr<SdfGridRecord>> sdf_grids_;
   std::vector<std::unique_ptr<PlaneRecord>> planes_;
   // By geometry id: the triangle pairs of a mesh (Embree reads their quads in place), or null.
   std::vector<std::unique_ptr<TrianglePairs>> triangle_pairs_;

@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "candela/geometry/sdf_grid.h"
 #include "candela/io/error.h"
 #include "candela/io/mesh_io.h"
 #include "candela/io/named_spectra.h"
@@ -1330,6 +1331,8 @@ class JsonSceneReader {
     shape.geometry = read_geometry(s);
     shape.material = read_shape_material(s);
     if (const Json* emission = s.find("emission")) shape.emission = read_emission(*emission, s.pointer_of("emission"));
+    if (shape.emission && std::holds_alternative<SdfGridShape>(shape.geometry))
+      report_.fail(s.pointer_of("emission"), "an sdfgrid cannot emit light (as in Mitsuba: it has no area to sample)");
     shape.to_world = read_transform_key(s);
     if (const Json* end = s.find("transform_end")) shape.to_world_end = read_moving_transform(*end, s, shape);
     shape.name = s.string_or("name", "");
@@ -1351,10 +1354,49 @@ class JsonSceneReader {
       if (length_squared(c.p1 - c.p0) == 0) report_.fail(s.pointer_of("p1"), "p1 must differ from p0 (the axis)");
       return c;
     }
+    if (type == "sdfgrid") return read_sdf_grid(s);
     report_.fail(s.pointer_of("type"),
                  "unknown shape type \"{}\"; expected one of: sphere, plane, box, rectangle, mesh, disk, cylinder, "
-                 "instance",
+                 "sdfgrid, instance",
                  type);
+  }
+
+  // A Mitsuba .vol file, or the samples inline (as `candela convert` writes a grid made in memory).
+  SdfGridShape read_sdf_grid(CheckedObject& s) const {
+    const std::string normals = s.string_or("normals", "smooth");
+    if (normals != "smooth" && normals != "analytic")
+      report_.fail(s.pointer_of("normals"), "expected \"smooth\" or \"analytic\", got \"{}\"", normals);
+    const SdfNormals mode = normals == "smooth" ? SdfNormals::Smooth : SdfNormals::Analytic;
+    const bool from_file = s.has("filename"), inline_data = s.has("values") || s.has("resolution");
+    if (from_file == inline_data)
+      report_.fail(s.pointer(), "an sdfgrid takes either \"filename\" or inline \"resolution\" and \"values\", {}",
+                   from_file ? "not both" : "and has neither");
+    if (from_file)
+      return read_sdf_grid_file(existing_file(s, "filename", "SDF grid"), report_.location(s.pointer_of("filename")),
+                                mode);
+    SdfGridShape grid;
+    grid.normals = mode;
+    const Json& resolution = s.require("resolution");
+    const std::string resolution_pointer = s.pointer_of("resolution");
+    if (!resolution.is_array() || resolution.size() != 3)
+      report_.fail(resolution_pointer, "expected an array of 3 integers, got {}", describe(resolution));
+    for (size_t i = 0; i < 3; ++i) {
+      const int64_t n = read_int64(report_, resolution[i], child_pointer(resolution_pointer, i));
+      if (n < 2 || n > std::numeric_limits<int>::max())
+        report_.fail(child_pointer(resolution_pointer, i), "expected an integer >= 2 (a voxel needs 2 samples), got {}", n);
+      grid.resolution[i] = int(n);
+    }
+    const Json& values = s.require("values");
+    const std::string values_pointer = s.pointer_of("values");
+    check_is_array(report_, values, values_pointer, "SDF values");
+    const double expected = double(grid.resolution[0]) * grid.resolution[1] * grid.resolution[2];
+    if (double(values.size()) != expected)
+      report_.fail(values_pointer, "expected {} values (x fastest, then y, then z), got {}", expected, values.size());
+    std::vector<float> samples(values.size());
+    for (size_t k = 0; k < values.size(); ++k) samples[k] = read_float_element(report_, values, k, values_pointer);
+    grid.values = std::make_shared<const std::vector<float>>(std::move(samples));
+    if (std::string problem = sdf_grid_problem(grid); !problem.empty()) report_.fail(s.pointer(), "{}", problem);
+    return grid;
   }
 
   static SphereShape read_sphere(CheckedObject& s) { return {s.vec3("center"), s.number("radius", Bound::Positive)}; }

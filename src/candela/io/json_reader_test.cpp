@@ -714,7 +714,7 @@ TEST(JsonReader, UnknownTypesAreErrors) {
       error_of(with_shape(R"({"type": "torus"})"))
           .find(
               "at /shapes/0/type: unknown shape type \"torus\"; expected one of: sphere, plane, box, rectangle, mesh, "
-              "disk, cylinder, instance"),
+              "disk, cylinder, sdfgrid, instance"),
       std::string::npos);
   EXPECT_NE(
       error_of(with_material(R"({"type": "velvet"})")).find("at /materials/m/type: unknown material type \"velvet\""),

@@ -242,6 +242,17 @@ Json geometry_json(const ShapeGeometry& geometry) {
           [](const CylinderShape& c) {
             return Json{{"type", "cylinder"}, {"p0", vec3(c.p0)}, {"p1", vec3(c.p1)}, {"radius", c.radius}};
           },
+          [](const SdfGridShape& g) {
+            Json j{{"type", "sdfgrid"}};
+            if (!g.filename.empty()) {
+              j["filename"] = absolute(g.filename);
+            } else {  // made in memory: the samples inline
+              j["resolution"] = g.resolution;
+              j["values"] = g.values ? *g.values : std::vector<float>{};
+            }
+            if (g.normals == SdfNormals::Analytic) j["normals"] = "analytic";
+            return j;
+          },
       },
       geometry);
 }

@@ -61,6 +61,7 @@ INSTANTIATE_TEST_SUITE_P(Scenes, ConvertRoundTrip,
                                            "scenes/mitsuba-tests/tests/scenes/bsdf_spheres/test_constant_path.xml",
                                            "scenes/mitsuba-tests/tests/scenes/bsdf_spheres/test_pointlight_path.xml",
                                            "scenes/mitsuba-tests/tests/scenes/spot_light/test_spot_direct.xml",
+                                           "scenes/mitsuba-tests/tests/scenes/various_shapes/test_various_shapes_path.xml",
                                            "meshes/gltf-sample-assets/BoxTextured/glTF/BoxTextured.gltf",
                                            "meshes/cornell-box/CornellBox-Glossy.obj"),
                          [](const ::testing::TestParamInfo<const char*>& info) {

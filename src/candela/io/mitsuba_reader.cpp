@@ -31,6 +31,7 @@
 #include <utility>
 #include <vector>
 
+#include "candela/geometry/sdf_grid.h"
 #include "candela/io/error.h"
 #include "candela/io/mesh_io.h"
 #include "candela/io/named_spectra.h"
@@ -1268,6 +1269,18 @@ class Converter {
     return mesh;
   }
 
+  // Mitsuba's sdfgrid: a one-channel .vol file; any to_world is accepted (Mitsuba warns about
+  // rotations, which its own intersection handles too).
+  SdfGridShape sdf_grid(const Object& s) {
+    const std::string normals = get_string(s, "normals", "smooth");
+    if (normals != "smooth" && normals != "analytic")
+      throw_scene_error(find(s, "normals")->where.loc(), "sdfgrid: normals \"{}\" must be \"smooth\" or \"analytic\"",
+                        normals);
+    const fs::path file = resolve_file(s, "filename");
+    return read_sdf_grid_file(file, find(s, "filename")->where.loc(),
+                              normals == "smooth" ? SdfNormals::Smooth : SdfNormals::Analytic);
+  }
+
   void shape(const Object& s, ObjectDesc* group) {
     ShapeDesc out;
     out.name = s.id.empty() ? s.type : s.id;
@@ -1295,6 +1308,8 @@ class Converter {
       if (!(c.radius > 0) || length(c.p1 - c.p0) == 0)
         throw_scene_error(s.where.loc(), "cylinder: needs a positive radius and p0 != p1");
       out.geometry = c;
+    } else if (type == "sdfgrid") {
+      out.geometry = sdf_grid(s);
     } else if (type == "instance") {
       if (group) throw_scene_error(s.where.loc(), "an instance cannot be inside a shapegroup");
       auto groups = nested(s, "shape");
@@ -1309,8 +1324,8 @@ class Converter {
     } else if (type == "shapegroup") {
       throw_scene_error(s.where.loc(), "a shapegroup cannot be nested in another shape");
     } else {
-      throw_scene_error(s.where.loc(), "unknown shape type \"{}\" (supported: obj, ply, sphere, rectangle, cube, disk, "
-                                       "cylinder, shapegroup, instance)",
+      throw_scene_error(s.where.loc(), "unknown shape type \"{}\" (supported: obj, ply, serialized, sphere, rectangle, "
+                                       "cube, disk, cylinder, sdfgrid, shapegroup, instance)",
                         type);
     }
     out.reverse_orientation = get_bool(s, "flip_normals", false);
@@ -1323,6 +1338,8 @@ class Converter {
       const Object& e = *emitters[0].second;
       if (e.type != "area")
         throw_scene_error(e.where.loc(), "emitter \"{}\" cannot be attached to a shape (only \"area\" can)", e.type);
+      if (type == "sdfgrid")
+        throw_scene_error(e.where.loc(), "an sdfgrid cannot be an area emitter (nor can it in Mitsuba)");
       if (group) throw_scene_error(e.where.loc(), "emitters inside a shapegroup are not supported");
       AreaEmission em;
       ColorInput radiance = color(e, "radiance", RGB(1.0f), true);

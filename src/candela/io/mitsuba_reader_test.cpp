@@ -401,31 +401,26 @@ TEST(MitsubaReader, RenderTestScenes) {
   if (!fs::exists(root)) GTEST_SKIP() << "no shared Mitsuba test scenes";
   // Every scene of the suite reads, except the participating-media ones (media are not supported:
   // each is refused with a message that says so; test_surf_area_light of that folder has no medium
-  // and reads) and test_various_shapes, whose sdfgrid shape is not supported yet.
+  // and reads).
   int read = 0, refused = 0;
   for (const auto& dir : fs::directory_iterator(root))
     for (const auto& entry : fs::directory_iterator(dir.path())) {
       if (entry.path().extension() != ".xml") continue;
       const bool media = dir.path().filename() == "participating_media" &&
                          entry.path().filename() != "test_surf_area_light_volpath.xml";
-      const bool sdf = entry.path().filename() == "test_various_shapes_path.xml";
       std::vector<std::string> warnings;
       try {
         SceneDesc s = read_mitsuba_scene(entry.path(), warnings);
         EXPECT_FALSE(s.shapes.empty() && s.instances.empty()) << entry.path();
-        EXPECT_FALSE(media || sdf) << entry.path() << ": read, but it needs what is not supported";
+        EXPECT_FALSE(media) << entry.path() << ": read, but it needs what is not supported";
         ++read;
       } catch (const SceneError& e) {
-        std::string what = e.what();
-        EXPECT_TRUE(media || sdf) << entry.path() << ": " << what;
-        if (sdf) {
-          EXPECT_NE(what.find("sdfgrid"), std::string::npos) << what;
-        }
+        EXPECT_TRUE(media) << entry.path() << ": " << e.what();
         ++refused;
       }
     }
   EXPECT_EQ(read + refused, 33);
-  EXPECT_EQ(read, 26);
+  EXPECT_EQ(read, 27);
 }
 
 }  // namespace

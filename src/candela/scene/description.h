@@ -3,9 +3,11 @@
 // later Mitsuba and glTF) fills in and that scene/build turns into a render scene. Nothing after this
 // point knows which file format a scene came from. Units are whatever the scene uses; colours are linear RGB.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <variant>
@@ -329,7 +331,27 @@ struct CylinderShape {
   float radius = 1;
 };
 
-using ShapeGeometry = std::variant<SphereShape, PlaneShape, BoxShape, RectangleShape, MeshShape, DiskShape, CylinderShape>;
+// How an SDF grid's shading normal is found (Mitsuba's sdfgrid "normals").
+enum class SdfNormals {
+  Smooth,   // Hansson-Söderlund et al.'s blend of the gradients of the voxels around the hit, continuous
+            // across voxel faces (Mitsuba's default)
+  Analytic  // the gradient of the hit voxel's trilinear interpolant, as the geometric normal
+};
+
+// A signed distance function sampled on a grid (Mitsuba's "sdfgrid"): the surface is the zero level
+// set of the trilinear interpolation of the samples, positive outside; normals point outwards. The
+// grid spans [0,1]^3 in object space, sample (i, j, k) at (i / (nx - 1), j / (ny - 1), k / (nz - 1)).
+// It has no (u, v) (they are 0) and cannot emit light.
+struct SdfGridShape {
+  std::array<int, 3> resolution{2, 2, 2};  // samples along x, y and z, each >= 2
+  // nx * ny * nz distances, x fastest, then y, then z; shared, so that copies of a SceneDesc are cheap.
+  std::shared_ptr<const std::vector<float>> values;
+  SdfNormals normals = SdfNormals::Smooth;
+  std::string filename;  // the Mitsuba .vol file it was read from (empty: made in memory)
+};
+
+using ShapeGeometry =
+    std::variant<SphereShape, PlaneShape, BoxShape, RectangleShape, MeshShape, DiskShape, CylinderShape, SdfGridShape>;
 
 // Diffuse emission attached to a shape (an area light). One-sided: emits on the side the surface
 // normal points to, unless two_sided.

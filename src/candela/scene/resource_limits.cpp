@@ -15,6 +15,7 @@
 #include <variant>
 
 #include "candela/film/film.h"
+#include "candela/geometry/sdf_grid.h"
 #include "candela/io/error.h"
 #include "candela/lights/light.h"
 
@@ -75,7 +76,14 @@ ShapeCost shape_cost(const ShapeDesc& shape) {
   }
   if (std::holds_alternative<BoxShape>(shape.geometry)) return triangle_cost(24, 12, true, true, moving, emissive);
   if (std::holds_alternative<RectangleShape>(shape.geometry)) return triangle_cost(4, 2, true, true, moving, emissive);
-  return {kBytesPerSimpleShape, 0};  // spheres and planes
+  if (const auto* sdf = std::get_if<SdfGridShape>(&shape.geometry)) {
+    // The grid's values are the SceneDesc's own (shared); each voxel holding surface adds its index
+    // and a BVH leaf, as a triangle would.
+    const uint64_t voxels = count_surface_voxels(*sdf);
+    return {add(mul(voxels, sizeof(uint32_t) + (moving ? 2 : 1) * kEmbreeBvhBytesPerTriangle), kBytesPerSimpleShape),
+            0};
+  }
+  return {kBytesPerSimpleShape, 0};  // spheres, planes, disks and cylinders
 }
 
 // ---------------------------------------------------------------- images

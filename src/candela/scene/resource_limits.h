@@ -12,7 +12,8 @@
 //            shape moves), Embree's vertex and index buffers (12 bytes per vertex and per triangle per
 //            time step) and Embree's high-quality BVH, kEmbreeBvhBytesPerTriangle (twice that for
 //            motion blur); emissive meshes add one Light and 8 bytes of light distribution per
-//            triangle. Objects (instancing) count once, each instance kBytesPerInstance.
+//            triangle; an SDF grid, per voxel holding surface, its index and a BVH leaf as a triangle's.
+//            Objects (instancing) count once, each instance kBytesPerInstance.
 //   textures: image textures and environment maps, read from their headers only: 12 bytes per texel
 //            for the float RGB image plus the file's own pixels while it is converted (channels x
 //            bytes per channel); environment maps add 8 bytes per texel of sampling distribution.

@@ -4,7 +4,9 @@
 
 #include "candela/film/image_io.h"
 #include "candela/geometry/quadric_uv.h"
+#include "candela/geometry/sdf_grid.h"
 #include "candela/io/error.h"
+#include "candela/math/frame.h"
 
 namespace candela {
 namespace {
@@ -246,6 +248,13 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int object, TriangleM
                 object);
     return;
   }
+  if (const auto* g = std::get_if<SdfGridShape>(&desc.geometry)) {
+    if (desc.emission)
+      throw SceneError(fmt::format("{}: {}: an SDF grid cannot emit light (as in Mitsuba: it has no area to sample)",
+                                   source_file_, rec.name));
+    add_sdf_grid(std::move(rec), *g, T, T_end, object);
+    return;
+  }
   TriangleMesh mesh;
   if (const auto* b = std::get_if<BoxShape>(&desc.geometry)) mesh = box_mesh(*b);
   else if (const auto* r = std::get_if<RectangleShape>(&desc.geometry)) mesh = rectangle_mesh(*r);
@@ -318,6 +327,23 @@ void Scene::add_quadric(ShapeRecord rec, QuadricGeometry::Kind kind, const Trans
     }
   }
   embree_.add_quadric(uint32_t(shapes_.size()), rec.quadric, object);
+  shapes_.push_back(std::move(rec));
+}
+
+void Scene::add_sdf_grid(ShapeRecord rec, const SdfGridShape& grid, const Transform& T, const Transform* T_end,
+                         int object) {
+  if (std::string problem = sdf_grid_problem(grid); !problem.empty())
+    throw SceneError(fmt::format("{}: {}: SDF grid: {}", source_file_, rec.name, problem));
+  if (!Transform::from_matrix(T.matrix()) || (T_end && !Transform::from_matrix(T_end->matrix())))
+    throw SceneError(fmt::format("{}: {}: the transform is singular", source_file_, rec.name));
+  rec.kind = ShapeRecord::Kind::SdfGrid;
+  rec.sdf = SdfGridGeometry{std::make_shared<const SdfGrid>(grid), T, T_end ? std::optional<Transform>(*T_end) : std::nullopt};
+  rec.sdf_normals = grid.normals;
+  // The whole grid's box: the surface is somewhere inside [0,1]^3.
+  for (const Transform* X : {&T, T_end})
+    if (X)
+      for (int c = 0; c < 8; ++c) bounds_.extend(X->point({float(c & 1), float(c >> 1 & 1), float(c >> 2)}));
+  embree_.add_sdf_grid(uint32_t(shapes_.size()), rec.sdf, object);
   shapes_.push_back(std::move(rec));
 }
 
@@ -445,6 +471,9 @@ bool Scene::intersect(const Ray& world_ray, SurfaceHit& hit) const {
     case ShapeRecord::Kind::Cylinder:
       reconstruct_quadric_hit(rec, ray, eh.t, hit);
       break;
+    case ShapeRecord::Kind::SdfGrid:
+      reconstruct_sdf_hit(rec, ray, eh.t, eh.primitive, hit);
+      break;
     case ShapeRecord::Kind::Plane: {
       hit.p = ray.at(eh.t);
       hit.ng = rec.flip_normal ? -rec.plane.normal : rec.plane.normal;
@@ -568,6 +597,38 @@ void Scene::reconstruct_quadric_hit(const ShapeRecord& rec, const Ray& ray, floa
   hit.p = M->point(local);
   if (rec.flip_normal) hit.ng = -hit.ng;
   hit.ns = hit.ng;
+}
+
+void Scene::reconstruct_sdf_hit(const ShapeRecord& rec, const Ray& ray, float t, uint32_t voxel, SurfaceHit& hit) const {
+  const SdfGridGeometry& sdf = rec.sdf;
+  const SdfGrid& grid = *sdf.grid;
+  // A moving grid is where Embree found it: under its transform at the ray's time (invertible
+  // there, or it would not have been hit).
+  const Transform to_world = sdf.to_world_at(embree_.normalized_time(ray.time)).value_or(sdf.to_world);
+  const Transform index_to_world = to_world * grid.index_to_object();
+  // The hit point in the grid's index space, in double, moved onto the surface of the voxel found.
+  const Matrix4& to_index = index_to_world.inverse_matrix();
+  Vec3d p = apply(to_index, Vec3d::from(ray.origin), 1) + apply(to_index, Vec3d::from(ray.direction), 0) * double(t);
+  p = grid.project_to_surface(voxel, p);
+  hit.p = apply(index_to_world.matrix(), p, 1).to_float();
+  // Distances grow outwards, so the gradient is the outward normal.
+  Normal3 ng = to_world.normal(grid.gradient(voxel, p).to_float());
+  hit.ng = length_squared(ng) > 0 ? normalize(ng) : -normalize(ray.direction);
+  hit.ns = hit.ng;
+  if (rec.sdf_normals == SdfNormals::Smooth) {
+    // Kept only where it leans to the same side as the geometric normal (as SurfaceHit promises).
+    Normal3 ns = to_world.normal(grid.smooth_normal(p).to_float());
+    if (length_squared(ns) > 0 && dot(ns, hit.ng) > 0) hit.ns = normalize(ns);
+  }
+  if (rec.flip_normal) {
+    hit.ng = -hit.ng;
+    hit.ns = -hit.ns;
+  }
+  // No (u, v) parameterisation (as in Mitsuba): u = v = 0, and the tangents of the shading frame.
+  hit.uv = {0, 0};
+  const Frame frame(hit.ns);
+  hit.dpdu = frame.s;
+  hit.dpdv = frame.t;
 }
 
 TextureEvalContext Scene::texture_context(const SurfaceHit& hit) const {

@@ -17,7 +17,7 @@
 namespace candela {
 
 struct ShapeRecord {
-  enum class Kind : uint8_t { Triangles, Sphere, Plane, Disk, Cylinder };
+  enum class Kind : uint8_t { Triangles, Sphere, Plane, Disk, Cylinder, SdfGrid };
   Kind kind = Kind::Triangles;
   uint32_t material = 0;
   int first_light = -1;  // index of the light of primitive 0 when emissive
@@ -25,7 +25,7 @@ struct ShapeRecord {
   RGB radiance;          // emitted radiance when emissive
   bool two_sided_emission = false;
   int emission_texture = -1;  // textured emitters: index into the scene's textures
-  bool flip_normal = false;  // spheres, planes, disks and cylinders: reverse orientation
+  bool flip_normal = false;  // spheres, planes, disks, cylinders and SDF grids: reverse orientation
   bool winding_swapped = false;  // triangles: indices 1 and 2 swapped to orient the normal
   // Triangles, in world space, winding baked so cross(p1-p0, p2-p0) is the oriented normal.
   std::vector<Point3> positions;
@@ -39,12 +39,15 @@ struct ShapeRecord {
   SphereGeometry sphere;
   PlaneGeometry plane;
   QuadricGeometry quadric;  // disks and cylinders
+  SdfGridGeometry sdf;
+  SdfNormals sdf_normals = SdfNormals::Smooth;
   // Triangles: the mesh's named attributes (mesh_attribute textures), shared; null when none.
   std::shared_ptr<const std::vector<TriangleMesh::Attribute>> attributes;
   std::string name;
   bool is_emissive() const { return first_light >= 0; }
   bool is_moving() const {
-    return !positions_end.empty() || sphere.to_world_end.has_value() || quadric.to_world_end.has_value();
+    return !positions_end.empty() || sphere.to_world_end.has_value() || quadric.to_world_end.has_value() ||
+           sdf.to_world_end.has_value();
   }
 };
 
@@ -119,7 +122,10 @@ class Scene {
                   int object);
   void add_quadric(ShapeRecord rec, QuadricGeometry::Kind kind, const Transform& unit_to_world,
                    const Transform* unit_to_world_end, const std::optional<AreaEmission>& emission, int object);
+  void add_sdf_grid(ShapeRecord rec, const SdfGridShape& grid, const Transform& to_world,
+                    const Transform* to_world_end, int object);
   void reconstruct_quadric_hit(const ShapeRecord& rec, const Ray& ray, float t, SurfaceHit& hit) const;
+  void reconstruct_sdf_hit(const ShapeRecord& rec, const Ray& ray, float t, uint32_t voxel, SurfaceHit& hit) const;
   void reconstruct_triangle_hit(const ShapeRecord& rec, const EmbreeHit& eh, float time, SurfaceHit& hit) const;
   void reconstruct_sphere_hit(const ShapeRecord& rec, const Ray& ray, float t, SurfaceHit& hit) const;
 
