@@ -263,3 +263,28 @@ TEST_F(InterruptResume, PixelRendersOnePixelAsInTheFullImage) {
 
 }  // namespace
 }  // namespace candela
+
+namespace candela {
+namespace {
+
+class MltInterrupt : public InterruptResume {};
+
+TEST_F(MltInterrupt, SigtermDuringTheBootstrapOfADeepRenderIsAnsweredWithinASecond) {
+  // MLT's bootstrap and normalisation take one batch of paths per depth: at max depth 400 they run
+  // for many seconds before the first chain. A signal must still stop the render within a second,
+  // writing the image so far (the directly seen emission).
+  std::string out = path("mlt.exr");
+  pid_t pid = start({"render", kScene, "-o", out, "--integrator", "mlt", "--max-depth", "400", "--resolution",
+                     "32x32", "--spp", "64", "-q"});
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // the scene is read, the bootstrap runs
+  const auto sent = std::chrono::steady_clock::now();
+  kill(pid, SIGTERM);
+  const int code = wait_exit(pid);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+  ASSERT_EQ(code, 3) << log();
+  EXPECT_LT(seconds, 1.0) << log();
+  EXPECT_EQ(read_image_metadata(out)["candela:interrupted"], "true");
+}
+
+}  // namespace
+}  // namespace candela

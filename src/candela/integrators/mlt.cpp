@@ -1,5 +1,6 @@
 #include "candela/integrators/mlt.h"
 
+#include <fmt/format.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -7,6 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <functional>
 #include <limits>
 
 #include "candela/film/filter.h"
@@ -94,9 +96,10 @@ struct Normalization {
   double value = 0, relative_error = 0;
 };
 
+// Stops early (its result then unused) once `cancelled` says so.
 Normalization estimate_normalization(const Scene& scene, const BdptIntegrator& bdpt, const RenderSettings& settings,
                                      tbb::task_arena& arena, tbb::enumerable_thread_specific<RayCounts>& ray_counts,
-                                     uint64_t samples, uint64_t batch = 0) {
+                                     uint64_t samples, const std::function<bool()>& cancelled, uint64_t batch = 0) {
   const PerspectiveCamera& camera = scene.camera();
   const Vec2 margin = camera.margin();
   const float width = float(camera.width()) + 2 * margin.x, height = float(camera.height()) + 2 * margin.y;
@@ -107,7 +110,8 @@ Normalization estimate_normalization(const Scene& scene, const BdptIntegrator& b
   const size_t depths = size_t(max_depth) + 1;
   std::vector<double> luminance(n * depths);
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<uint64_t>(0, n, 256), [&](const auto& range) {
+    tbb::parallel_for(tbb::blocked_range<uint64_t>(0, n, 64), [&](const auto& range) {
+      if (cancelled()) return;  // a deep max_depth makes each sample long: answer a signal promptly
       thread_local std::vector<BdptVertex> camera_path, light_path;
       thread_local std::vector<RGB> crossed;
       camera_path.resize(size_t(max_depth) + 2);
@@ -195,17 +199,29 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   const int depths = settings.max_depth + 1;
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   tbb::enumerable_thread_specific<RayCounts> ray_counts;
-  auto cancelled = [&] { return options.cancel && options.cancel->load(std::memory_order_relaxed); };
+  const std::function<bool()> cancelled = [&] {
+    return options.cancel && options.cancel->load(std::memory_order_relaxed);
+  };
+  // Interrupted before the chains: the image is the depth-0 pass alone.
+  auto stop_cancelled = [&](ProgressBar& progress) {
+    progress.finish();
+    stats.cancelled = true;
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+    return stats;
+  };
 
   const uint64_t pixels = uint64_t(film.width()) * uint64_t(film.height());
   const uint64_t total_mutations = uint64_t(settings.spp) * pixels;
   const uint64_t bootstrap_count = uint64_t(settings.mlt_bootstrap) * uint64_t(depths);
   ProgressBar progress(bootstrap_count + total_mutations, options.progress);
+  // The bootstrap grows with max_depth (one per depth): the bar says which phase it is in.
+  progress.set_label(fmt::format("MLT bootstrap ({} depths x {})", depths, settings.mlt_bootstrap));
 
   // Bootstrap: the luminance of independent states, depth by depth in turn.
   std::vector<float> weights(bootstrap_count);
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<uint64_t>(0, bootstrap_count, 1024), [&](const auto& range) {
+    tbb::parallel_for(tbb::blocked_range<uint64_t>(0, bootstrap_count, 64), [&](const auto& range) {
+      if (cancelled()) return;
       RayCounts& counts = ray_counts.local();
       for (uint64_t i = range.begin(); i < range.end(); ++i) {
         int depth = int(i % uint64_t(depths));
@@ -216,6 +232,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
       progress.advance(range.size());
     });
   });
+  if (cancelled()) return stop_cancelled(progress);
   double sum = 0;
   for (float w : weights) sum += w;
   // The chains' deposits are scaled by b, the image's mean luminance, from its own estimator (the
@@ -230,8 +247,10 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   const uint64_t normalization_samples = std::max<uint64_t>(
       uint64_t(settings.mlt_bootstrap), options.time_limit_seconds > 0 ? 0 : total_mutations / 8);
   const auto normalization_start = std::chrono::steady_clock::now();
-  Normalization normalization =
-      estimate_normalization(scene, bdpt_with_roulette, settings, arena, ray_counts, normalization_samples);
+  progress.set_label(fmt::format("MLT normalisation ({} paths)", normalization_samples));
+  Normalization normalization = estimate_normalization(scene, bdpt_with_roulette, settings, arena, ray_counts,
+                                                       normalization_samples, cancelled);
+  if (cancelled()) return stop_cancelled(progress);
   // Under a time limit the number of mutations is not known: further independent batches of
   // mlt_bootstrap samples, averaged, until the normalisation has taken about a ninth of the time
   // (1 sample per 8 mutations costs about that much).
@@ -243,7 +262,8 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
     };
     while (elapsed() < options.time_limit_seconds / 9 && !cancelled()) {
       Normalization more = estimate_normalization(scene, bdpt_with_roulette, settings, arena, ray_counts,
-                                                  normalization_samples, batches);
+                                                  normalization_samples, cancelled, batches);
+      if (cancelled()) return stop_cancelled(progress);
       double k = double(batches);
       for (size_t d = 0; d < normalization.per_depth.size(); ++d)
         normalization.per_depth[d] = (normalization.per_depth[d] * k + more.per_depth[d]) / (k + 1);
@@ -267,6 +287,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
     return stats;
   }
 
+  progress.set_label("MLT chains");
   // The chains: each depth gets a share of them proportional to its brightness, and at least one if
   // it has any light (so no depth's light is lost to chance), starting from its bootstrap paths
   // chosen proportionally to their luminance, stratified over its chains. Each depth's deposits are

@@ -909,6 +909,7 @@ class JsonSceneReader {
                                        {{"bilinear", true}, {"nearest", false}});
     image.scale = t.number_or("scale", image.scale, Bound::NonNegative);
     image.invert = t.boolean_or("invert", image.invert);
+    image.luminance = t.boolean_or("luminance", image.luminance);
     image.mapping = read_uv_mapping(t);
     return image;
   }

@@ -64,6 +64,7 @@ Json texture_json(const TextureDesc& desc) {
             j["filter"] = t.bilinear ? "bilinear" : "nearest";
             if (t.scale != 1) j["scale"] = t.scale;
             if (t.invert) j["invert"] = true;
+            if (t.luminance) j["luminance"] = true;
             write_mapping(t.mapping, j);
             return j;
           },

@@ -963,6 +963,8 @@ class Converter {
       img.mapping.t_from_u = -m.t_from_u;
       img.mapping.sv = -m.sv;
       img.mapping.dv = 1 - m.dv;
+      // A float parameter reads an RGB image's luminance (Mitsuba's eval_1 and eval_1_grad).
+      img.luminance = lookup == TextureLookup::Scalar;
       ignore(t, "format");  // "variant" / "rgb": the channels are read as RGB either way
       ignore(t, "accel");
       index = add_texture(img);

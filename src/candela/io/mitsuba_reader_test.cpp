@@ -186,6 +186,20 @@ TEST(MitsubaReader, CheckerboardLookedUpAsAFloatSwapsItsColours) {
   EXPECT_EQ(conductor.roughness.u.texture, conductor.roughness.v.texture);  // one texture per lookup kind
 }
 
+TEST(MitsubaReader, BitmapLookedUpAsAFloatIsItsLuminance) {
+  write_image(temp_dir() / "roughness-test.exr", Image(4, 4));
+  SceneDesc s = read_text(R"(<texture type="bitmap" id="map"><string name="filename" value="roughness-test.exr"/></texture>
+    <shape type="sphere"><bsdf type="roughconductor"><ref name="alpha" id="map"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="diffuse"><ref name="reflectance" id="map"/></bsdf></shape>)");
+  ASSERT_EQ(s.textures.size(), 2u);
+  const auto& conductor = std::get<ConductorMaterial>(
+      s.materials[std::get<OneSidedMaterial>(s.materials[s.shapes[0].material]).material]);
+  const auto& diffuse = std::get<DiffuseMaterial>(
+      s.materials[std::get<OneSidedMaterial>(s.materials[s.shapes[1].material]).material]);
+  EXPECT_TRUE(std::get<ImageTexture>(s.textures[size_t(conductor.roughness.u.texture)]).luminance);
+  EXPECT_FALSE(std::get<ImageTexture>(s.textures[size_t(diffuse.reflectance.texture)]).luminance);
+}
+
 TEST(MitsubaReader, NormalAndBumpMapsTakeMitsubasFlipAndShadowingDefaults) {
   SceneDesc s = read_text(R"(
     <shape type="sphere"><bsdf type="normalmap"><texture name="normalmap" type="rawconstant">

@@ -31,6 +31,12 @@ void ProgressBar::advance(uint64_t work) {
   draw(done, false);
 }
 
+void ProgressBar::set_label(std::string label) {
+  std::lock_guard lock(draw_mutex_);
+  label_ = std::move(label);
+  if (enabled_) draw(done_.load(), false);
+}
+
 void ProgressBar::finish() {
   if (!enabled_) return;
   std::lock_guard lock(draw_mutex_);
@@ -46,8 +52,8 @@ void ProgressBar::draw(uint64_t done, bool final) {
   std::string bar(size_t(filled), '=');
   if (filled < kWidth) bar += '>' + std::string(size_t(kWidth - filled - 1), ' ');
   std::string eta = fraction > 0 && !final ? format_duration(elapsed * (1 - fraction) / fraction) : "00:00";
-  std::fprintf(stderr, "\r[%s] %5.1f%%  elapsed %s  ETA %s ", bar.c_str(), 100 * fraction,
-               format_duration(elapsed).c_str(), eta.c_str());
+  std::fprintf(stderr, "\r%s%s[%s] %5.1f%%  elapsed %s  ETA %s \033[K", label_.c_str(), label_.empty() ? "" : " ",
+               bar.c_str(), 100 * fraction, format_duration(elapsed).c_str(), eta.c_str());
   std::fflush(stderr);
 }
 

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdint>
 #include <mutex>
+#include <string>
 
 namespace candela {
 
@@ -13,10 +14,13 @@ class ProgressBar {
   ProgressBar(uint64_t total_work, bool enabled);
   void advance(uint64_t work);  // thread-safe
   void finish();
+  // A word on the phase under way, drawn before the bar (thread-safe).
+  void set_label(std::string label);
 
  private:
   void draw(uint64_t done, bool final);
 
+  std::string label_;
   uint64_t total_;
   bool enabled_;
   std::atomic<uint64_t> done_{0};

@@ -59,6 +59,7 @@ struct ImageTexture {
   bool bilinear = true;
   float scale = 1;      // texel values are multiplied by this...
   bool invert = false;  // ...and then replaced by 1 - value when set (pbrt's "invert")
+  bool luminance = false;  // each texel read as its luminance, grey (Mitsuba's float lookup of an RGB image)
   UVMapping mapping;
 };
 

@@ -161,7 +161,7 @@ TextureSet::TextureSet(const std::vector<TextureDesc>& descs) {
           throw SceneError(fmt::format("texture {}: {}", i, e.what()));
         }
       }
-      textures_.emplace_back(ImageLookup{image, desc->wrap, desc->bilinear, desc->scale, desc->invert, desc->mapping});
+      textures_.emplace_back(ImageLookup{image, desc->wrap, desc->bilinear, desc->scale, desc->invert, desc->luminance, desc->mapping});
     } else {
       std::visit(
           [&](const auto& d) {
@@ -176,6 +176,7 @@ RGB TextureSet::eval_texture(int index, const TextureEvalContext& ctx) const {
   const Texture& texture = textures_[size_t(index)];
   if (const auto* t = std::get_if<ImageLookup>(&texture)) {
     RGB v = t->scale * lookup(*t->image, t->wrap, t->bilinear, apply_mapping(t->mapping, ctx.uv));
+    if (t->luminance) v = RGB(v.luminance());
     return clamp_zero(t->invert ? RGB(1.0f) - v : v);  // pbrt-v4 clamps negative results too
   }
   if (const auto* t = std::get_if<CheckerboardTexture>(&texture)) {

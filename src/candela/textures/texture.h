@@ -64,6 +64,7 @@ class TextureSet {
     bool bilinear = true;
     float scale = 1;
     bool invert = false;
+    bool luminance = false;
     UVMapping mapping;
   };
   // The other kinds need nothing beyond their descriptions.

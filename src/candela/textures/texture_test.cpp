@@ -136,6 +136,21 @@ TEST_F(TextureTest, FloatExrIsLinear) {
   for (int i = 0; i < 3; ++i) EXPECT_EQ(at(set, i, 0.5f, 0.5f), RGB(0.5f, 2.0f, 0.25f));
 }
 
+TEST_F(TextureTest, LuminanceReadsEachColourAsItsGreyLuminance) {
+  Image image(1, 1);
+  image.set(0, 0, RGB(0.5f, 2.0f, 0.25f));
+  fs::path exr = dir_ / "colour.exr";
+  write_image(exr, image);
+  ImageTexture grey = image_desc(exr);
+  grey.luminance = true;
+  TextureSet set({image_desc(exr), grey});
+  const float y = RGB(0.5f, 2.0f, 0.25f).luminance();
+  expect_rgb_near(at(set, 1, 0.5f, 0.5f), RGB(y), 1e-6f);
+  FloatInput as_float;
+  as_float.texture = 1;
+  EXPECT_NEAR(set.eval(as_float, TextureEvalContext{{0, 0, 0}, {0.5f, 0.5f}, {}}), y, 1e-6f);
+}
+
 TEST_F(TextureTest, GreyscaleIsReplicatedToRgb) {
   fs::path grey = write_u8("grey.png", 1, 1, 1, {200});
   fs::path grey_alpha = write_u8("grey_alpha.png", 1, 1, 2, {200, 0});
