@@ -111,7 +111,6 @@ Normalization estimate_normalization(const Scene& scene, const BdptIntegrator& b
   std::vector<double> luminance(n * depths);
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<uint64_t>(0, n, 64), [&](const auto& range) {
-      if (cancelled()) return;  // a deep max_depth makes each sample long: answer a signal promptly
       thread_local std::vector<BdptVertex> camera_path, light_path;
       thread_local std::vector<RGB> crossed;
       camera_path.resize(size_t(max_depth) + 2);
@@ -120,6 +119,7 @@ Normalization estimate_normalization(const Scene& scene, const BdptIntegrator& b
       IndependentSampler sampler(batch == 0 ? hash_values(settings.seed, 0x6e6f726d)
                                             : hash_values(settings.seed, 0x6e6f726d, batch));
       for (uint64_t i = range.begin(); i < range.end(); ++i) {
+        if (cancelled()) return;  // a deep max_depth makes each sample long: answer a signal promptly
         int cx = int(i % uint64_t(gx)), cy = int(i / uint64_t(gx));
         sampler.start_pixel_sample(cx, cy, 0);
         Vec2 u = sampler.get_2d();
@@ -221,9 +221,9 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   std::vector<float> weights(bootstrap_count);
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<uint64_t>(0, bootstrap_count, 64), [&](const auto& range) {
-      if (cancelled()) return;
       RayCounts& counts = ray_counts.local();
       for (uint64_t i = range.begin(); i < range.end(); ++i) {
+        if (cancelled()) return;
         int depth = int(i % uint64_t(depths));
         if (depth == 0) continue;  // rendered directly above
         MltSampler sampler(settings.seed, i, settings.mlt_sigma);
