@@ -477,7 +477,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "candela " CANDELA_VERSION);
   RenderCommand cmd;
   CLI::App* render_cmd = app.add_subcommand("render", "Render a scene file to an image");
-  render_cmd->add_option("scene", cmd.scene_file, "Scene file: .json (candela's format) or .pbrt (pbrt-v4)")
+  render_cmd->add_option("scene", cmd.scene_file, "Scene file: .json (candela's format), .pbrt (pbrt-v4), .xml (Mitsuba 3), .gltf/.glb, .obj")
       ->required();
   render_cmd->add_option("-o,--output", cmd.output,
                          "Output image; the extension picks the format: .exr (linear HDR, with metadata), "

@@ -9,8 +9,9 @@
 
 namespace candela {
 
-// Chooses the reader by extension: .json, .pbrt. Throws SceneError for a missing file or an
-// unknown extension.
+// Chooses the reader by extension: .json (candela's format), .pbrt (pbrt-v4), .xml (Mitsuba 3),
+// .gltf / .glb (glTF 2.0), .obj (with its MTL). Throws SceneError for a missing file or an unknown
+// extension.
 SceneDesc read_scene_file(const std::filesystem::path& file);
 
 // The native JSON format (docs/scene-format.md). `file_name` is used in messages; relative mesh

@@ -1,6 +1,6 @@
 #pragma once
 // The format-neutral scene description: plain structs with defaults that every reader (JSON, pbrt-v4,
-// later Mitsuba and glTF) fills in and that scene/build turns into a render scene. Nothing after this
+// Mitsuba 3, glTF, OBJ) fills in and that scene/build turns into a render scene. Nothing after this
 // point knows which file format a scene came from. Units are whatever the scene uses; colours are linear RGB.
 #include <algorithm>
 #include <array>
