@@ -18,17 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// What is wrong with a .vol file; the public readers prefix the place and the file's name.
-class VolumeFileProblem : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-template <typename... Args>
-[[noreturn]] void fail(fmt::format_string<Args...> format, Args&&... args) {
-  throw VolumeFileProblem(fmt::format(format, std::forward<Args>(args)...));
-}
-
 constexpr size_t kVolumeHeaderBytes = 48;
 
 uint32_t little_endian_u32(const unsigned char* bytes) {
@@ -44,34 +33,34 @@ void put_u32(std::string& out, uint32_t v) {
 VolumeGrid parse_volume_file(const fs::path& file) {
   std::error_code ec;
   const fs::file_status status = fs::status(file, ec);
-  if (status.type() == fs::file_type::not_found) fail("no such file");
-  if (status.type() == fs::file_type::directory) fail("it is a directory, not a file");
+  if (status.type() == fs::file_type::not_found) fail_file_content("no such file");
+  if (status.type() == fs::file_type::directory) fail_file_content("it is a directory, not a file");
   std::ifstream in(file, std::ios::binary);
-  if (!in) fail("cannot open it: {}", std::strerror(errno));
+  if (!in) fail_file_content("cannot open it: {}", std::strerror(errno));
 
   unsigned char header[kVolumeHeaderBytes];
   in.read(reinterpret_cast<char*>(header), kVolumeHeaderBytes);
   const size_t got = size_t(in.gcount());
-  if (got >= 3 && std::memcmp(header, "VOL", 3) != 0) fail("not a Mitsuba volume file (it does not start with \"VOL\")");
-  if (got < kVolumeHeaderBytes) fail("truncated: {} bytes, but the header alone takes {}", got, kVolumeHeaderBytes);
-  if (header[3] != 3) fail("version {}; only version 3 is supported", int(header[3]));
+  if (got >= 3 && std::memcmp(header, "VOL", 3) != 0) fail_file_content("not a Mitsuba volume file (it does not start with \"VOL\")");
+  if (got < kVolumeHeaderBytes) fail_file_content("truncated: {} bytes, but the header alone takes {}", got, kVolumeHeaderBytes);
+  if (header[3] != 3) fail_file_content("version {}; only version 3 is supported", int(header[3]));
   const int32_t encoding = little_endian_i32(header + 4);
-  if (encoding != 1) fail("data encoding {}; only 1 (float32) is supported", encoding);
+  if (encoding != 1) fail_file_content("data encoding {}; only 1 (float32) is supported", encoding);
 
   VolumeGrid grid;
   uint64_t count = 1;
   for (int axis = 0; axis < 3; ++axis) {
     const int32_t n = little_endian_i32(header + 8 + 4 * axis);
     grid.resolution[size_t(axis)] = n;
-    if (n < 1) fail("the resolution along {} is {}", "xyz"[axis], n);
+    if (n < 1) fail_file_content("the resolution along {} is {}", "xyz"[axis], n);
     // Saturated above the limit: both factors stay below 2^32, so the product cannot overflow.
     count = std::min(count * uint64_t(n), kMaxVolumeGridValues + 1);
   }
   grid.channels = little_endian_i32(header + 20);
-  if (grid.channels < 1) fail("{} channels", grid.channels);
+  if (grid.channels < 1) fail_file_content("{} channels", grid.channels);
   const auto& n = grid.resolution;
   if (count > kMaxVolumeGridValues || count * uint64_t(grid.channels) > kMaxVolumeGridValues)
-    fail("{} x {} x {} samples of {} channels is more than the {} values supported", n[0], n[1], n[2], grid.channels,
+    fail_file_content("{} x {} x {} samples of {} channels is more than the {} values supported", n[0], n[1], n[2], grid.channels,
          kMaxVolumeGridValues);
   count *= uint64_t(grid.channels);
   for (size_t i = 0; i < 6; ++i) grid.bounds[i] = little_endian_f32(header + 24 + 4 * i);
@@ -80,12 +69,12 @@ VolumeGrid parse_volume_file(const fs::path& file) {
   const uintmax_t size = fs::file_size(file, ec);
   const uint64_t needed = count * sizeof(float);
   if (!ec && size - kVolumeHeaderBytes < needed)
-    fail("truncated: {} x {} x {} samples of {} channels need {} bytes of values, but the file has {} after its header",
+    fail_file_content("truncated: {} x {} x {} samples of {} channels need {} bytes of values, but the file has {} after its header",
          n[0], n[1], n[2], grid.channels, needed, size - kVolumeHeaderBytes);
   grid.values.resize(count);
   in.read(reinterpret_cast<char*>(grid.values.data()), std::streamsize(needed));
   if (uint64_t(in.gcount()) != needed)
-    fail("truncated: {} bytes of values expected after the header, {} read", needed, in.gcount());
+    fail_file_content("truncated: {} bytes of values expected after the header, {} read", needed, in.gcount());
   if constexpr (std::endian::native == std::endian::big)
     for (float& v : grid.values) v = little_endian_f32(reinterpret_cast<const unsigned char*>(&v));
   return grid;
@@ -128,7 +117,7 @@ void for_each_surface_voxel(const std::array<int, 3>& n, const std::vector<float
 VolumeGrid read_volume_grid(const fs::path& file, const SourceLocation& referenced_from) {
   try {
     return parse_volume_file(file);
-  } catch (const VolumeFileProblem& problem) {
+  } catch (const FileContentError& problem) {
     throw_scene_error(referenced_from, "cannot read volume grid '{}': {}", file.string(), problem.what());
   } catch (const std::bad_alloc&) {
     throw_scene_error(referenced_from, "cannot read volume grid '{}': out of memory", file.string());

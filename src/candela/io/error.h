@@ -35,4 +35,17 @@ template <typename... Args>
   throw SceneError(where.to_string() + ": " + fmt::format(format, std::forward<Args>(args)...));
 }
 
+// A problem found inside a data file (a mesh, a volume grid) by a reader that does not know which
+// scene entry referenced the file: the caller adds that place and the file's name and throws a
+// SceneError, so every failure reaches the user as one message.
+class FileContentError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+template <typename... Args>
+[[noreturn]] void fail_file_content(fmt::format_string<Args...> format, Args&&... args) {
+  throw FileContentError(fmt::format(format, std::forward<Args>(args)...));
+}
+
 }  // namespace candela

@@ -34,18 +34,6 @@
 namespace candela {
 namespace {
 
-// What went wrong with the mesh file itself; load_mesh_file prefixes the place that referenced the
-// file and the file's name, so every failure reaches the user as one SceneError.
-class MeshFileProblem : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-template <typename... Args>
-[[noreturn]] void fail(fmt::format_string<Args...> format, Args&&... args) {
-  throw MeshFileProblem(fmt::format(format, std::forward<Args>(args)...));
-}
-
 // ---------------------------------------------------------------- file access
 
 enum class MeshFormat { Obj, Ply, MitsubaSerialized };
@@ -57,28 +45,28 @@ MeshFormat mesh_format_of(const std::filesystem::path& file) {
   if (extension == ".obj") return MeshFormat::Obj;
   if (extension == ".ply") return MeshFormat::Ply;
   if (extension == ".serialized") return MeshFormat::MitsubaSerialized;
-  if (extension.empty()) fail("the file name has no extension; supported mesh formats are .obj, .ply and .serialized");
-  fail("unsupported mesh format '{}'; supported mesh formats are .obj, .ply and .serialized", file.extension().string());
+  if (extension.empty()) fail_file_content("the file name has no extension; supported mesh formats are .obj, .ply and .serialized");
+  fail_file_content("unsupported mesh format '{}'; supported mesh formats are .obj, .ply and .serialized", file.extension().string());
 }
 
 std::string read_whole_file(const std::filesystem::path& file) {
   std::error_code ec;
   const auto status = std::filesystem::status(file, ec);
-  if (status.type() == std::filesystem::file_type::not_found) fail("no such file");
-  if (status.type() == std::filesystem::file_type::directory) fail("it is a directory, not a file");
+  if (status.type() == std::filesystem::file_type::not_found) fail_file_content("no such file");
+  if (status.type() == std::filesystem::file_type::directory) fail_file_content("it is a directory, not a file");
 
   struct FileCloser {
     void operator()(std::FILE* f) const { std::fclose(f); }
   };
   std::unique_ptr<std::FILE, FileCloser> handle(std::fopen(file.c_str(), "rb"));
-  if (!handle) fail("cannot open it: {}", std::strerror(errno));
+  if (!handle) fail_file_content("cannot open it: {}", std::strerror(errno));
 
   // Read in chunks rather than trusting a size from stat: works for pipes and files that change.
   std::string bytes;
   char chunk[1 << 16];
   size_t got = 0;
   while ((got = std::fread(chunk, 1, sizeof chunk, handle.get())) > 0) bytes.append(chunk, got);
-  if (std::ferror(handle.get())) fail("read error: {}", std::strerror(errno));
+  if (std::ferror(handle.get())) fail_file_content("read error: {}", std::strerror(errno));
   return bytes;
 }
 
@@ -119,7 +107,7 @@ std::string first_line(std::string_view text) {
 
 void check_obj_index(int index, size_t count, const char* what, size_t face) {
   if (index < 0 || static_cast<size_t>(index) >= count)
-    fail("malformed OBJ: face {} refers to {} {} but the file has {} of them", face + 1, what,
+    fail_file_content("malformed OBJ: face {} refers to {} {} but the file has {} of them", face + 1, what,
          index < 0 ? fmt::format("{} (before the first one)", index) : std::to_string(index + 1), count);
 }
 
@@ -149,7 +137,7 @@ void fail_on_dropped_obj_faces(const std::string& warnings) {
     const size_t at = warnings.find(dropped);
     if (at == std::string::npos) continue;
     const size_t line_start = warnings.rfind('\n', at);
-    fail("malformed OBJ: {}", first_line(std::string_view(warnings).substr(line_start == std::string::npos ? 0 : line_start)));
+    fail_file_content("malformed OBJ: {}", first_line(std::string_view(warnings).substr(line_start == std::string::npos ? 0 : line_start)));
   }
 }
 
@@ -178,11 +166,11 @@ std::string printable(std::string_view text, size_t limit = 40) {
 void check_obj_vertex_line(const std::vector<std::string_view>& words, size_t line_number) {
   const size_t needed = words[0] == "vt" ? 1 : 3;
   if (words.size() - 1 < needed)
-    fail("malformed OBJ: line {}: a '{}' line needs {} numbers, it has {}", line_number, words[0], needed,
+    fail_file_content("malformed OBJ: line {}: a '{}' line needs {} numbers, it has {}", line_number, words[0], needed,
          words.size() - 1);
   for (size_t k = 1; k < words.size(); ++k)
     if (!is_plain_number(words[k]))
-      fail("malformed OBJ: line {}: '{}' is not a finite number", line_number, printable(words[k]));
+      fail_file_content("malformed OBJ: line {}: '{}' is not a finite number", line_number, printable(words[k]));
 }
 
 void check_obj_vertex_lines(std::string_view text) {
@@ -230,7 +218,7 @@ class ObjMeshBuilder {
     const auto [slot, inserted] = vertex_of_corner_.try_emplace(key, 0);
     if (!inserted) return slot->second;
     if (mesh_.positions.size() >= std::numeric_limits<uint32_t>::max())
-      fail("too many distinct vertices for 32-bit indices");
+      fail_file_content("too many distinct vertices for 32-bit indices");
     slot->second = static_cast<uint32_t>(mesh_.positions.size());
     const float* p = &attrib_.vertices[3 * static_cast<size_t>(key.position)];
     mesh_.positions.push_back({p[0], p[1], p[2]});
@@ -261,12 +249,12 @@ tinyobj::ObjReader parse_obj(const std::string& text, const std::string& mtl_tex
   // Parsing from strings makes tinyobjloader ignore `mtllib`: the caller reads the library (or not),
   // so a missing or misplaced .mtl file cannot fail the load of the geometry.
   if (!reader.ParseFromString(text, mtl_text, config))
-    fail("malformed OBJ: {}", printable(first_line(reader.Error()), 200));
+    fail_file_content("malformed OBJ: {}", printable(first_line(reader.Error()), 200));
   check_obj_corners(reader.GetAttrib(), reader.GetShapes());
   fail_on_dropped_obj_faces(reader.Warning());
   size_t corner_count = 0;
   for (const tinyobj::shape_t& shape : reader.GetShapes()) corner_count += shape.mesh.indices.size();
-  if (corner_count == 0) fail("the OBJ file contains no triangles (no 'f' faces)");
+  if (corner_count == 0) fail_file_content("the OBJ file contains no triangles (no 'f' faces)");
   return reader;
 }
 
@@ -356,45 +344,45 @@ std::string line_of(const std::vector<std::string_view>& words) {
 
 PlyScalarType ply_scalar_type_or_fail(std::string_view name) {
   const std::optional<PlyScalarType> type = ply_scalar_type(name);
-  if (!type) fail("malformed PLY: unknown property type '{}' in the header", printable(name));
+  if (!type) fail_file_content("malformed PLY: unknown property type '{}' in the header", printable(name));
   return *type;
 }
 
 void read_ply_format(const std::vector<std::string_view>& words, PlyHeader& header) {
   // Assimp keeps the first format line and would read the data the wrong way (and leak on failing).
-  if (header.encoding) fail("malformed PLY: the header has more than one format line");
+  if (header.encoding) fail_file_content("malformed PLY: the header has more than one format line");
   if (words.size() == 3 && words[1] == "ascii") header.encoding = PlyEncoding::Ascii;
   else if (words.size() == 3 && words[1] == "binary_little_endian") header.encoding = PlyEncoding::BinaryLittleEndian;
   else if (words.size() == 3 && words[1] == "binary_big_endian") header.encoding = PlyEncoding::BinaryBigEndian;
-  else fail("malformed PLY: unknown format line '{}'", printable(line_of(words)));
+  else fail_file_content("malformed PLY: unknown format line '{}'", printable(line_of(words)));
 }
 
 void read_ply_element(const std::vector<std::string_view>& words, PlyHeader& header) {
-  if (words.size() != 3) fail("malformed PLY: bad element line '{}'", printable(line_of(words)));
+  if (words.size() != 3) fail_file_content("malformed PLY: bad element line '{}'", printable(line_of(words)));
   // Assimp misreads a long name of digits as a count and allocates for it (tens of gigabytes).
   if (!(std::isalpha(static_cast<unsigned char>(words[1][0])) || words[1][0] == '_'))
-    fail("malformed PLY: element name '{}' does not start with a letter", printable(words[1]));
+    fail_file_content("malformed PLY: element name '{}' does not start with a letter", printable(words[1]));
   PlyElement element;
   element.name = printable(words[1]);  // kept for messages only
   const char* end = words[2].data() + words[2].size();
   const auto [stop, error] = std::from_chars(words[2].data(), end, element.count);
   if (error != std::errc() || stop != end)
-    fail("malformed PLY: element '{}' has an invalid count '{}'", element.name, printable(words[2]));
+    fail_file_content("malformed PLY: element '{}' has an invalid count '{}'", element.name, printable(words[2]));
   // Assimp reads a second element of a name over the first (and leaks the first one's data).
   for (const PlyElement& earlier : header.elements)
-    if (earlier.name == element.name) fail("malformed PLY: element '{}' is declared twice", element.name);
+    if (earlier.name == element.name) fail_file_content("malformed PLY: element '{}' is declared twice", element.name);
   header.elements.push_back(element);
 }
 
 void read_ply_property(const std::vector<std::string_view>& words, PlyHeader& header) {
-  if (header.elements.empty()) fail("malformed PLY: a property comes before any element");
+  if (header.elements.empty()) fail_file_content("malformed PLY: a property comes before any element");
   const bool list = words.size() >= 2 && words[1] == "list";
-  if (words.size() != (list ? 5u : 3u)) fail("malformed PLY: bad property line '{}'", printable(line_of(words)));
+  if (words.size() != (list ? 5u : 3u)) fail_file_content("malformed PLY: bad property line '{}'", printable(line_of(words)));
   PlyProperty property;
   property.name = words.back();
   if (list) {
     property.list_length = ply_scalar_type_or_fail(words[2]);
-    if (!property.list_length->is_integer) fail("malformed PLY: list length type '{}' is not an integer", printable(words[2]));
+    if (!property.list_length->is_integer) fail_file_content("malformed PLY: list length type '{}' is not an integer", printable(words[2]));
     property.value = ply_scalar_type_or_fail(words[3]);
   } else {
     property.value = ply_scalar_type_or_fail(words[1]);
@@ -403,22 +391,22 @@ void read_ply_property(const std::vector<std::string_view>& words, PlyHeader& he
 }
 
 void check_ply_header_complete(const PlyHeader& header) {
-  if (!header.encoding) fail("malformed PLY: the header has no format line");
+  if (!header.encoding) fail_file_content("malformed PLY: the header has no format line");
   for (const PlyElement& element : header.elements) {
     if (element.count > 0 && element.properties.empty())
-      fail("malformed PLY: element '{}' has no properties", element.name);
+      fail_file_content("malformed PLY: element '{}' has no properties", element.name);
     // Assimp would read vertices without coordinates as all zero.
     if (element.name == "vertex" && !(element.has_scalar("x") && element.has_scalar("y") && element.has_scalar("z")))
-      fail("malformed PLY: the 'vertex' element lacks an x, y or z property");
+      fail_file_content("malformed PLY: the 'vertex' element lacks an x, y or z property");
     // Assimp 5.2 turns a strip into the wrong triangles: strips become faces first (strips_as_faces).
     if (element.name == "tristrips" && element.count > 0 &&
         !(element.properties.size() == 1 && element.properties[0].list_length && element.properties[0].value.is_integer))
-      fail("unsupported PLY: a 'tristrips' element must hold one list of vertex indices");
+      fail_file_content("unsupported PLY: a 'tristrips' element must hold one list of vertex indices");
   }
   // Without a vertex element Assimp guesses which element holds the vertices and misreads the data.
   if (std::none_of(header.elements.begin(), header.elements.end(),
                    [](const PlyElement& e) { return e.name == "vertex"; }))
-    fail("malformed PLY: the header declares no 'vertex' element");
+    fail_file_content("malformed PLY: the header declares no 'vertex' element");
 }
 
 PlyHeader read_ply_header(std::string_view bytes) {
@@ -435,9 +423,9 @@ PlyHeader read_ply_header(std::string_view bytes) {
     for (size_t k = 0; k < text.size(); ++k) {
       const auto c = static_cast<unsigned char>(text[k]);
       if (c == '\r' && k + 1 != text.size())
-        fail("malformed PLY: header line {} has a carriage return inside it", header.line_count + 1);
+        fail_file_content("malformed PLY: header line {} has a carriage return inside it", header.line_count + 1);
       if ((c < 0x20 && c != '\t' && c != '\r') || c == 0x7f)
-        fail("malformed PLY: header line {} has a control byte (0x{:02x}) in it", header.line_count + 1, c);
+        fail_file_content("malformed PLY: header line {} has a control byte (0x{:02x}) in it", header.line_count + 1, c);
     }
     const std::vector<std::string_view> words = split_words(text);
     line_start = newline + 1;
@@ -461,19 +449,19 @@ PlyHeader read_ply_header(std::string_view bytes) {
       // after it, so the two readers would disagree on the record size (the data would then be
       // misread, in one fuzzed file into an 8.5 GB allocation). Before the first element such a line
       // is harmless (Blender 2.4 broke its "Created by" comment over two lines) and is skipped.
-      fail("malformed PLY: unrecognised header line '{}' after element '{}'", printable(line_of(words)),
+      fail_file_content("malformed PLY: unrecognised header line '{}' after element '{}'", printable(line_of(words)),
            header.elements.back().name);
     }
   }
-  fail("{}", seen_magic ? "truncated PLY: the header has no 'end_header' line"
+  fail_file_content("{}", seen_magic ? "truncated PLY: the header has no 'end_header' line"
                         : "malformed PLY: the file does not start with 'ply'");
 }
 
 [[noreturn]] void fail_ply_data_short(const PlyElement& element, uint64_t complete, size_t data_size) {
   if (element.count > data_size)
-    fail("corrupt PLY header: it declares {} '{}' elements but only {} bytes of data follow it", element.count,
+    fail_file_content("corrupt PLY header: it declares {} '{}' elements but only {} bytes of data follow it", element.count,
          element.name, data_size);
-  fail("truncated PLY: the data ends after {} of the {} '{}' elements the header declares", complete, element.count,
+  fail_file_content("truncated PLY: the data ends after {} of the {} '{}' elements the header declares", complete, element.count,
        element.name);
 }
 
@@ -488,7 +476,7 @@ uint64_t read_binary_bits(std::string_view data, uint64_t at, unsigned size, boo
 
 uint64_t read_binary_list_length(std::string_view data, uint64_t at, PlyScalarType type, bool big_endian) {
   const uint64_t bits = read_binary_bits(data, at, type.size, big_endian);
-  if (type.is_signed && (bits >> (8 * type.size - 1)) != 0) fail("malformed PLY: negative list length");
+  if (type.is_signed && (bits >> (8 * type.size - 1)) != 0) fail_file_content("malformed PLY: negative list length");
   return bits;
 }
 
@@ -516,7 +504,7 @@ void check_ply_counts_fit_data(const PlyHeader& header, std::string_view data) {
     // A binary file that holds some of the elements is more likely cut short: the scan below says
     // exactly where its data ends ("truncated PLY").
     if (!ascii && element.count <= data.size()) return;
-    fail("corrupt PLY header: it declares {} '{}' elements (at least {} bytes each in a{} file) but only {} bytes of "
+    fail_file_content("corrupt PLY header: it declares {} '{}' elements (at least {} bytes each in a{} file) but only {} bytes of "
          "data follow it",
          element.count, element.name, element_bytes, ascii ? "n ASCII" : " binary", data.size());
   }
@@ -558,12 +546,12 @@ bool ascii_ply_line_holds(const PlyElement& element, std::string_view line, size
   // read different records (a fuzzed file made Assimp take a 30-digit number for a list length
   // and allocate 14 GB). A carriage return is allowed only right before the newline.
   if (const size_t cr = line.find('\r'); cr != std::string_view::npos && cr + 1 != line.size())
-    fail("malformed PLY: line {} has a carriage return inside it", line_number);
+    fail_file_content("malformed PLY: line {} has a carriage return inside it", line_number);
   const std::vector<std::string_view> values = split_words(line);
   // Assimp would stop at a word that is no number with a message quoting raw bytes (and leak).
   for (const std::string_view value : values)
     if (!is_plain_number(value))
-      fail("malformed PLY: line {}: '{}' is not a finite number", line_number, printable(value));
+      fail_file_content("malformed PLY: line {}: '{}' is not a finite number", line_number, printable(value));
   size_t next = 0;
   for (const PlyProperty& property : element.properties) {
     if (next >= values.size()) return false;
@@ -572,7 +560,7 @@ bool ascii_ply_line_holds(const PlyElement& element, std::string_view line, size
     uint64_t length = 0;
     const auto [stop, error] = std::from_chars(value.data(), value.data() + value.size(), length);
     if (error != std::errc() || stop != value.data() + value.size())
-      fail("malformed PLY: line {}: '{}' is not a list length", line_number, printable(value));
+      fail_file_content("malformed PLY: line {}: '{}' is not a list length", line_number, printable(value));
     if (length > values.size() - next) return false;
     next += length;
   }
@@ -597,7 +585,7 @@ void check_ascii_ply_data(const PlyHeader& header, std::string_view data) {
       const std::optional<std::string_view> line = next_line();
       if (!line) fail_ply_data_short(element, i, data.size());
       if (!ascii_ply_line_holds(element, *line, line_number))
-        fail("malformed PLY: line {} has fewer values than the header declares for a '{}' element", line_number,
+        fail_file_content("malformed PLY: line {} has fewer values than the header declares for a '{}' element", line_number,
              element.name);
     }
   }
@@ -618,10 +606,10 @@ void check_assimp_face_indices(const aiScene& scene) {
     const aiMesh& mesh = *scene.mMeshes[m];
     for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
       const aiFace& face = mesh.mFaces[f];
-      if (face.mNumIndices == 0) fail("malformed PLY: face {} has no vertices", f);
+      if (face.mNumIndices == 0) fail_file_content("malformed PLY: face {} has no vertices", f);
       for (unsigned k = 0; k < face.mNumIndices; ++k)
         if (face.mIndices[k] >= mesh.mNumVertices)
-          fail("malformed PLY: face {} refers to vertex {} but there are {} vertices", f, face.mIndices[k],
+          fail_file_content("malformed PLY: face {} refers to vertex {} but there are {} vertices", f, face.mIndices[k],
                mesh.mNumVertices);
     }
   }
@@ -630,7 +618,7 @@ void check_assimp_face_indices(const aiScene& scene) {
 void append_assimp_mesh(const aiMesh& source, bool with_normals, bool with_uvs, TriangleMesh& mesh) {
   const uint64_t base = mesh.positions.size();
   if (base + source.mNumVertices > std::numeric_limits<uint32_t>::max())
-    fail("too many vertices for 32-bit indices");
+    fail_file_content("too many vertices for 32-bit indices");
   for (unsigned i = 0; i < source.mNumVertices; ++i) {
     const aiVector3D& p = source.mVertices[i];
     mesh.positions.push_back({p.x, p.y, p.z});
@@ -841,13 +829,13 @@ class PlyNumbers {
       if (data_.substr(at_, line_end_ - at_).find_first_not_of(" \t\r") != std::string_view::npos) return;
       at_ = line_end_ + 1;
     }
-    fail("truncated PLY: the data ends early");
+    fail_file_content("truncated PLY: the data ends early");
   }
   double next(PlyScalarType type) {
     if (header_.encoding == PlyEncoding::Ascii) {
       const std::string_view line = data_.substr(0, line_end_);
       const size_t start = line.find_first_not_of(" \t\r", at_);
-      if (start == std::string_view::npos) fail("malformed PLY: a line has fewer values than the header declares");
+      if (start == std::string_view::npos) fail_file_content("malformed PLY: a line has fewer values than the header declares");
       size_t end = line.find_first_of(" \t\r", start);
       if (end == std::string_view::npos) end = line.size();
       at_ = end;
@@ -855,7 +843,7 @@ class PlyNumbers {
       std::from_chars(data_.data() + start, data_.data() + end, v);
       return v;
     }
-    if (!fits(at_, type.size, data_.size())) fail("truncated PLY: the data ends early");
+    if (!fits(at_, type.size, data_.size())) fail_file_content("truncated PLY: the data ends early");
     const uint64_t bits = read_binary_bits(data_, at_, type.size, header_.encoding == PlyEncoding::BinaryBigEndian);
     at_ += type.size;
     if (!type.is_integer) return type.size == 4 ? double(std::bit_cast<float>(uint32_t(bits))) : std::bit_cast<double>(bits);
@@ -901,7 +889,7 @@ TriangleMesh load_ply_with_attributes(std::string_view bytes, const PlyHeader& h
         for (uint64_t j = 0; j < n; ++j) {
           const double index = numbers.next(p.value);
           if (!(index >= 0 && index <= double(std::numeric_limits<uint32_t>::max())))
-            fail("malformed PLY: face {} has a vertex index {}", r, index);
+            fail_file_content("malformed PLY: face {} has a vertex index {}", r, index);
           if (keep) face_indices.push_back(uint32_t(index));
         }
         has_indices = has_indices || keep;
@@ -941,7 +929,7 @@ TriangleMesh load_ply_with_attributes(std::string_view bytes, const PlyHeader& h
       face_of_triangle.push_back(f);
     }
   }
-  if (mesh.indices.empty()) fail("the PLY file contains no triangles{}", describe_elements(header));
+  if (mesh.indices.empty()) fail_file_content("the PLY file contains no triangles{}", describe_elements(header));
   for (const PropertyGroup& g : attribute_groups(*vertex)) {
     TriangleMesh::Attribute a{g.name, false, int(g.columns.size()), {}};
     for (size_t row = 0; row < vertex_count; ++row)
@@ -975,11 +963,11 @@ TriangleMesh load_ply(const std::string& original) {
 
   Assimp::Importer importer;
   if (!importer.ReadFileFromMemory(bytes.data(), bytes.size(), 0, "ply"))
-    fail("malformed PLY: {}", printable(importer.GetErrorString(), 200));
+    fail_file_content("malformed PLY: {}", printable(importer.GetErrorString(), 200));
   check_assimp_face_indices(*importer.GetScene());
   // No normal generation and no vertex joining: the mesh is exactly what the file holds.
   const aiScene* scene = importer.ApplyPostProcessing(aiProcess_Triangulate);
-  if (!scene) fail("malformed PLY: {}", printable(importer.GetErrorString(), 200));
+  if (!scene) fail_file_content("malformed PLY: {}", printable(importer.GetErrorString(), 200));
 
   bool with_normals = true, with_uvs = true, any_triangles = false;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
@@ -989,7 +977,7 @@ TriangleMesh load_ply(const std::string& original) {
     with_normals = with_normals && source.HasNormals();
     with_uvs = with_uvs && source.HasTextureCoords(0);
   }
-  if (!any_triangles) fail("the PLY file contains no triangles{}", describe_elements(header));
+  if (!any_triangles) fail_file_content("the PLY file contains no triangles{}", describe_elements(header));
 
   TriangleMesh mesh;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m)
@@ -1034,7 +1022,7 @@ class SerializedInflater {
   SerializedInflater(std::string_view bytes, size_t at) {
     stream_.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(bytes.data() + at));
     stream_.avail_in = uInt(std::min<size_t>(bytes.size() - at, std::numeric_limits<uInt>::max()));
-    if (inflateInit(&stream_) != Z_OK) fail("zlib cannot start inflating");
+    if (inflateInit(&stream_) != Z_OK) fail_file_content("zlib cannot start inflating");
   }
   ~SerializedInflater() { inflateEnd(&stream_); }
   SerializedInflater(const SerializedInflater&) = delete;
@@ -1051,7 +1039,7 @@ class SerializedInflater {
       out_.resize(have + step - stream_.avail_out);
       if (status == Z_STREAM_END) ended_ = true;
       else if (status == Z_BUF_ERROR && stream_.avail_in == 0) ended_ = true;  // cut short
-      else if (status != Z_OK) fail("corrupt .serialized file: zlib: {}", stream_.msg ? stream_.msg : "inflate failed");
+      else if (status != Z_OK) fail_file_content("corrupt .serialized file: zlib: {}", stream_.msg ? stream_.msg : "inflate failed");
     }
     return out_.size() >= want;
   }
@@ -1065,25 +1053,25 @@ class SerializedInflater {
 
 TriangleMesh load_serialized(std::string_view bytes, int shape_index) {
   if (bytes.size() >= 2 && little_endian<uint16_t>(bytes.data()) != kSerializedMagic)
-    fail("not a Mitsuba .serialized file (it does not start with 0x041C)");
-  if (bytes.size() < 8) fail("truncated .serialized file: {} bytes", bytes.size());
+    fail_file_content("not a Mitsuba .serialized file (it does not start with 0x041C)");
+  if (bytes.size() < 8) fail_file_content("truncated .serialized file: {} bytes", bytes.size());
   const uint16_t version = little_endian<uint16_t>(bytes.data() + 2);
-  if (version != 3 && version != 4) fail("unsupported .serialized version {} (3 and 4 are)", version);
+  if (version != 3 && version != 4) fail_file_content("unsupported .serialized version {} (3 and 4 are)", version);
   // The table of mesh offsets at the end of the file.
   const uint32_t count = little_endian<uint32_t>(bytes.data() + bytes.size() - 4);
   const size_t offset_size = version == 3 ? 4 : 8;
   if (count == 0 || uint64_t(count) * offset_size > bytes.size() - 4)
-    fail("corrupt or truncated .serialized file: the table of meshes at its end (count {}) does not fit in its {} bytes",
+    fail_file_content("corrupt or truncated .serialized file: the table of meshes at its end (count {}) does not fit in its {} bytes",
          count, bytes.size());
   if (shape_index < 0 || uint32_t(shape_index) >= count)
-    fail("shape_index {} is out of range: the file holds {} mesh{}", shape_index, count, count == 1 ? "" : "es");
+    fail_file_content("shape_index {} is out of range: the file holds {} mesh{}", shape_index, count, count == 1 ? "" : "es");
   const char* entry = bytes.data() + bytes.size() - 4 - size_t(count - shape_index) * offset_size;
   const uint64_t at = version == 3 ? little_endian<uint32_t>(entry) : little_endian<uint64_t>(entry);
   if (at >= bytes.size() || bytes.size() - at <= 4 || little_endian<uint16_t>(bytes.data() + at) != kSerializedMagic)
-    fail("corrupt .serialized file: mesh {} does not start where the table says (byte {})", shape_index, at);
+    fail_file_content("corrupt .serialized file: mesh {} does not start where the table says (byte {})", shape_index, at);
 
   SerializedInflater in(bytes, size_t(at) + 4);
-  const auto truncated = [&] { fail("truncated .serialized file: mesh {} ends early", shape_index); };
+  const auto truncated = [&] { fail_file_content("truncated .serialized file: mesh {} ends early", shape_index); };
   if (!in.fill(4)) truncated();
   const uint32_t flags = little_endian<uint32_t>(in.data().data());
   size_t header = 4;
@@ -1091,7 +1079,7 @@ TriangleMesh load_serialized(std::string_view bytes, int shape_index) {
     while (true) {
       if (!in.fill(header + 1)) truncated();
       if (in.data()[header++] == '\0') break;
-      if (header > 4096) fail("corrupt .serialized file: mesh {} has no end to its name", shape_index);
+      if (header > 4096) fail_file_content("corrupt .serialized file: mesh {} has no end to its name", shape_index);
     }
   }
   if (!in.fill(header + 16)) truncated();
@@ -1101,7 +1089,7 @@ TriangleMesh load_serialized(std::string_view bytes, int shape_index) {
   const bool doubles = (flags & kDoublePrecision) != 0;
   // Indices are uint64 only beyond 2^32 vertices, which candela's uint32 indices cannot hold anyway.
   if (vertices > std::numeric_limits<uint32_t>::max())
-    fail("mesh {} has {} vertices; candela indexes at most 2^32", shape_index, vertices);
+    fail_file_content("mesh {} has {} vertices; candela indexes at most 2^32", shape_index, vertices);
   const uint64_t real = doubles ? 8 : 4, index = 4;
   const uint64_t per_vertex =
       real * (3 + ((flags & kHasNormals) ? 3 : 0) + ((flags & kHasUvs) ? 2 : 0) + ((flags & kHasColors) ? 3 : 0));
@@ -1109,7 +1097,7 @@ TriangleMesh load_serialized(std::string_view bytes, int shape_index) {
   if (__builtin_mul_overflow(vertices, per_vertex, &vertex_bytes) ||
       __builtin_mul_overflow(triangles, 3 * index, &index_bytes) ||
       __builtin_add_overflow(vertex_bytes, index_bytes, &total) || total > available_memory_bytes())
-    fail("mesh {} declares {} vertices and {} triangles: more than this machine's memory", shape_index, vertices,
+    fail_file_content("mesh {} declares {} vertices and {} triangles: more than this machine's memory", shape_index, vertices,
          triangles);
   if (!in.fill(header + size_t(total))) truncated();
 
@@ -1147,23 +1135,23 @@ TriangleMesh load_serialized(std::string_view bytes, int shape_index) {
 }
 
 void validate_mesh(const TriangleMesh& mesh) {
-  if (mesh.indices.empty()) fail("the file contains no triangles");
-  if (mesh.indices.size() % 3 != 0) fail("internal error: {} indices is not whole triangles", mesh.indices.size());
+  if (mesh.indices.empty()) fail_file_content("the file contains no triangles");
+  if (mesh.indices.size() % 3 != 0) fail_file_content("internal error: {} indices is not whole triangles", mesh.indices.size());
   if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
-    fail("internal error: {} normals for {} vertices", mesh.normals.size(), mesh.positions.size());
+    fail_file_content("internal error: {} normals for {} vertices", mesh.normals.size(), mesh.positions.size());
   if (!mesh.uvs.empty() && mesh.uvs.size() != mesh.positions.size())
-    fail("internal error: {} uvs for {} vertices", mesh.uvs.size(), mesh.positions.size());
+    fail_file_content("internal error: {} uvs for {} vertices", mesh.uvs.size(), mesh.positions.size());
   for (size_t i = 0; i < mesh.indices.size(); ++i)
     if (mesh.indices[i] >= mesh.positions.size())
-      fail("triangle {} refers to vertex {} but there are {} vertices", i / 3, mesh.indices[i], mesh.positions.size());
+      fail_file_content("triangle {} refers to vertex {} but there are {} vertices", i / 3, mesh.indices[i], mesh.positions.size());
   for (size_t i = 0; i < mesh.positions.size(); ++i) {
     const Point3& p = mesh.positions[i];
-    if (!is_finite(p)) fail("vertex {} has a non-finite position ({}, {}, {})", i, p.x, p.y, p.z);
+    if (!is_finite(p)) fail_file_content("vertex {} has a non-finite position ({}, {}, {})", i, p.x, p.y, p.z);
     if (!mesh.normals.empty() && !is_finite(mesh.normals[i]))
-      fail("vertex {} has a non-finite normal ({}, {}, {})", i, mesh.normals[i].x, mesh.normals[i].y,
+      fail_file_content("vertex {} has a non-finite normal ({}, {}, {})", i, mesh.normals[i].x, mesh.normals[i].y,
            mesh.normals[i].z);
     if (!mesh.uvs.empty() && !is_finite_uv(mesh.uvs[i]))
-      fail("vertex {} has a non-finite texture coordinate ({}, {})", i, mesh.uvs[i].x, mesh.uvs[i].y);
+      fail_file_content("vertex {} has a non-finite texture coordinate ({}, {})", i, mesh.uvs[i].x, mesh.uvs[i].y);
   }
 }
 
@@ -1193,7 +1181,7 @@ ObjModel load_obj_model(const std::filesystem::path& file, const SourceLocation&
       const std::filesystem::path library = file.parent_path() / name;
       try {
         mtl_text += read_whole_file(library) + "\n";
-      } catch (const MeshFileProblem& problem) {
+      } catch (const FileContentError& problem) {
         model.warnings.push_back(fmt::format("material library '{}': {}; its materials are diffuse grey",
                                              library.string(), problem.what()));
       }
@@ -1220,15 +1208,15 @@ ObjModel load_obj_model(const std::filesystem::path& file, const SourceLocation&
         if (std::find(used.begin(), used.end(), id) == used.end()) used.push_back(id);
     std::sort(used.begin(), used.end());
     for (int id : used) {
-      if (id >= int(model.materials.size())) fail("internal error: material {} of {}", id, model.materials.size());
+      if (id >= int(model.materials.size())) fail_file_content("internal error: material {} of {}", id, model.materials.size());
       TriangleMesh mesh = obj_faces(reader, id);
       if (mesh.indices.empty()) continue;
       validate_mesh(mesh);
       model.parts.push_back({id, std::move(mesh)});
     }
-    if (model.parts.empty()) fail("the OBJ file contains no triangles");
+    if (model.parts.empty()) fail_file_content("the OBJ file contains no triangles");
     return model;
-  } catch (const MeshFileProblem& problem) {
+  } catch (const FileContentError& problem) {
     throw_scene_error(referenced_from, "cannot read mesh '{}': {}", file.string(), problem.what());
   } catch (const std::bad_alloc&) {
     throw_scene_error(referenced_from, "cannot read mesh '{}': out of memory", file.string());
@@ -1240,14 +1228,14 @@ TriangleMesh load_mesh_file(const std::filesystem::path& file, const SourceLocat
   try {
     const MeshFormat format = mesh_format_of(file);
     if (shape_index != 0 && format != MeshFormat::MitsubaSerialized)
-      fail("a shape index ({}) is only meaningful for a .serialized file", shape_index);
+      fail_file_content("a shape index ({}) is only meaningful for a .serialized file", shape_index);
     const std::string bytes = read_whole_file(file);
     TriangleMesh mesh = format == MeshFormat::Obj   ? load_obj(bytes)
                         : format == MeshFormat::Ply ? load_ply(bytes)
                                                     : load_serialized(bytes, shape_index);
     validate_mesh(mesh);
     return mesh;
-  } catch (const MeshFileProblem& problem) {
+  } catch (const FileContentError& problem) {
     throw_scene_error(referenced_from, "cannot read mesh '{}': {}", file.string(), problem.what());
   } catch (const std::bad_alloc&) {
     throw_scene_error(referenced_from, "cannot read mesh '{}': out of memory", file.string());
