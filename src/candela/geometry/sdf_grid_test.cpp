@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -20,8 +22,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// One folder per test process (ctest runs tests in parallel processes).
 fs::path temp_file(const std::string& name) {
-  fs::path dir = fs::temp_directory_path() / "candela_sdf_grid_test";
+  fs::path dir = fs::temp_directory_path() / ("candela_sdf_grid_test_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   return dir / name;
 }

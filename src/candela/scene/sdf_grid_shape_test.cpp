@@ -15,6 +15,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -55,8 +57,10 @@ Tolerances tolerances(int n, double radius) {
   return t;
 }
 
+// One folder per test process: ctest runs these tests in parallel processes, which would otherwise
+// write and read the same files at once.
 fs::path temp_dir() {
-  fs::path dir = fs::temp_directory_path() / "candela_sdf_shape_test";
+  fs::path dir = fs::temp_directory_path() / ("candela_sdf_shape_test_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   return dir;
 }
