@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/scene_reader.h"
 #include "fuzz_common.h"
 

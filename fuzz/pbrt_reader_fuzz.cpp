@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/pbrt_reader.h"
 #include "fuzz_common.h"
 

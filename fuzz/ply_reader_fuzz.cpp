@@ -1,7 +1,7 @@
 // libFuzzer target: load_mesh_file on a .ply file.
 #include <cstdint>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/mesh_io.h"
 #include "fuzz_common.h"
 

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <string>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/mesh_io.h"
 #include "fuzz_common.h"
 

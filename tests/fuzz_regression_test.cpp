@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/mesh_io.h"
 #include "candela/io/pbrt_reader.h"
 #include "candela/io/scene_reader.h"

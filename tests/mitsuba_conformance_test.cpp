@@ -15,7 +15,7 @@
 #include <tuple>
 
 #include "candela/film/image_io.h"
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/scene_reader.h"
 #include "candela/testing/mitsuba_z_test.h"
 #include "candela/testing/render_helpers.h"

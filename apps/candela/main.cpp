@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "candela/film/image_io.h"
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/json_writer.h"
 #include "candela/io/scene_reader.h"
 #include "candela/render/checkpoint.h"

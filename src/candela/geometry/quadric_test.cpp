@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "candela/geometry/embree_scene.h"
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/math/frame.h"
 #include "candela/sampling/rng.h"
 #include "candela/scene/scene.h"

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/math/transform.h"
 #include "candela/math/vec3d.h"
 #include "candela/scene/description.h"

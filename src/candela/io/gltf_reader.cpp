@@ -48,7 +48,7 @@
 #include <utility>
 #include <vector>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/pbrt_reader.h"  // print_pbrt_warnings: the same one-line warnings
 
 namespace candela {

@@ -21,7 +21,7 @@
 #include <variant>
 #include <vector>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/gltf_reader.h"
 #include "candela/io/scene_reader.h"
 #include "candela/scene/description.h"

@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "candela/geometry/sdf_grid.h"
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/mesh_io.h"
 #include "candela/io/named_spectra.h"
 #include "candela/io/scene_reader.h"

@@ -7,7 +7,7 @@
 #include <variant>
 #include <vector>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/json_writer.h"
 #include "candela/io/scene_reader.h"
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/scene/description.h"
 
 namespace candela {

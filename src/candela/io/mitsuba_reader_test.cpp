@@ -9,7 +9,7 @@
 #include <variant>
 
 #include "candela/film/image_io.h"
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/named_spectra.h"
 #include "candela/lights/light.h"
 #include "candela/scene/scene.h"

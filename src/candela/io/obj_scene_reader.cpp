@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/mesh_io.h"
 
 namespace candela {

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <string>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/scene_reader.h"
 #include "candela/testing/render_helpers.h"
 

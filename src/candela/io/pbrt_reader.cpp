@@ -32,7 +32,7 @@
 #include <utility>
 #include <vector>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/mesh_io.h"
 #include "candela/io/named_spectra.h"
 #include "candela/io/scene_reader.h"

@@ -14,7 +14,7 @@
 #include <variant>
 #include <vector>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/named_spectra.h"
 #include "candela/io/pbrt_reader.h"
 #include "candela/io/scene_reader.h"

@@ -10,7 +10,7 @@
 #include <string>
 #include <system_error>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/gltf_reader.h"
 #include "candela/io/mitsuba_reader.h"
 #include "candela/io/obj_scene_reader.h"

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/lights/light_sample.h"
 #include "candela/scene/description.h"
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "candela/film/image_io.h"
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/sampling/distribution2d.h"
 #include "candela/sampling/warp.h"
 

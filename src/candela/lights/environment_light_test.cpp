@@ -13,7 +13,7 @@
 #include <unistd.h>
 
 #include "candela/film/image_io.h"
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/sampling/rng.h"
 #include "candela/sampling/warp.h"
 #include "candela/testing/environment_maps.h"

@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 
 #include "candela/sampling/rng.h"
 #include "candela/testing/statistics.h"

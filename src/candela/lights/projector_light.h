@@ -13,7 +13,7 @@
 #include <memory>
 #include <vector>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/lights/light_sample.h"
 #include "candela/math/transform.h"
 #include "candela/sampling/distribution2d.h"

@@ -8,7 +8,7 @@
 // frame (s, t, n) = (x, y, axis), uv = (1/2 + x / (2 z tan(cutoff)), 1/2 + y / (2 z tan(cutoff))).
 #include <cmath>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/lights/light_sample.h"
 #include "candela/math/frame.h"
 #include "candela/scene/description.h"

@@ -1,6 +1,6 @@
 #include "candela/materials/material.h"
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 
 namespace candela {
 namespace {

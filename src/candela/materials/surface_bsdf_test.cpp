@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/materials/material.h"
 #include "candela/sampling/rng.h"
 #include "candela/sampling/warp.h"

@@ -13,6 +13,7 @@
 #include <variant>
 #include <vector>
 
+#include "candela/base/error.h"
 #include "candela/math/color.h"
 #include "candela/math/transform.h"
 #include "candela/math/vec.h"
@@ -376,7 +377,8 @@ struct ShapeDesc {
   // Independently of this, a to_world that swaps handedness keeps normals equal to the object-space
   // normals transformed as normals (pbrt-v4's convention).
   bool reverse_orientation = false;
-  std::string name;  // for messages
+  std::string name;      // for messages
+  SourceLocation where;  // where the scene file declares it (file empty = unknown), for messages
 };
 
 // A group of shapes defined once and placed many times (pbrt's ObjectBegin/ObjectInstance): Embree
@@ -385,12 +387,14 @@ struct ShapeDesc {
 struct ObjectDesc {
   std::vector<ShapeDesc> shapes;  // in the object's own space; their to_world is object-relative
   std::string name;
+  SourceLocation where;
 };
 
 struct InstanceDesc {
   int object = 0;  // index into SceneDesc::objects
   Transform to_world;
   std::optional<Transform> to_world_end;  // moving instance, as ShapeDesc::to_world_end
+  SourceLocation where;
 };
 
 // ---------------------------------------------------------------- lights (those that are not shapes)
@@ -631,6 +635,12 @@ struct SceneDesc {
   // The times at which ShapeDesc::to_world and to_world_end hold (pbrt's TransformTimes).
   float transform_start_time = 0, transform_end_time = 1;
   std::string source_file;  // the file it was read from, for messages and image metadata
+  // Where the scene file declares each texture, material and light (parallel to those vectors;
+  // shorter, or an empty file, where a reader does not know): errors found while building the
+  // render scene name that place.
+  struct Places {
+    std::vector<SourceLocation> textures, materials, lights;
+  } places;
 };
 
 }  // namespace candela

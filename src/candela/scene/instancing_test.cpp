@@ -3,7 +3,7 @@
 // non-uniform scales, mirroring transforms, spheres inside objects, textures and a moving instance.
 #include <gtest/gtest.h>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/testing/render_helpers.h"
 
 namespace candela {

@@ -9,7 +9,7 @@
 #include <functional>
 #include <limits>
 
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/testing/render_helpers.h"
 
 namespace candela {

@@ -16,7 +16,7 @@
 
 #include "candela/film/film.h"
 #include "candela/geometry/sdf_grid.h"
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/lights/light.h"
 
 namespace candela {

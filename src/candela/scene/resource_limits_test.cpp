@@ -10,7 +10,7 @@
 
 #include "candela/film/image.h"
 #include "candela/film/image_io.h"
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 
 namespace candela {
 namespace {

@@ -5,7 +5,7 @@
 #include "candela/film/image_io.h"
 #include "candela/geometry/quadric_uv.h"
 #include "candela/geometry/sdf_grid.h"
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/math/frame.h"
 
 namespace candela {

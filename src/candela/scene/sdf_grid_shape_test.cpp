@@ -25,7 +25,7 @@
 #include <string>
 
 #include "candela/geometry/sdf_grid.h"
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 #include "candela/io/json_writer.h"
 #include "candela/io/mitsuba_reader.h"
 #include "candela/io/scene_reader.h"

@@ -14,7 +14,7 @@
 #include <variant>
 
 #include "candela/film/image_io.h"
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 
 namespace candela {
 namespace {

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "candela/film/image_io.h"
-#include "candela/io/error.h"
+#include "candela/base/error.h"
 
 namespace candela {
 namespace {

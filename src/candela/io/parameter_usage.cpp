@@ -1,0 +1,40 @@
+#include "candela/io/parameter_usage.h"
+
+#include <algorithm>
+
+namespace candela {
+
+void ParameterUsage::give(std::string name, SourceLocation where) {
+  given_.push_back({std::move(name), std::move(where), false});
+}
+
+bool ParameterUsage::ask(std::string_view name) {
+  if (std::find(asked_.begin(), asked_.end(), name) == asked_.end()) asked_.emplace_back(name);
+  bool found = false;
+  for (Parameter& p : given_)
+    if (p.name == name) p.used = found = true;
+  return found;
+}
+
+void ParameterUsage::mark_used(std::string_view name) {
+  for (Parameter& p : given_)
+    if (p.name == name) p.used = true;
+}
+
+bool ParameterUsage::was_given(std::string_view name) const {
+  return std::any_of(given_.begin(), given_.end(), [&](const Parameter& p) { return p.name == name; });
+}
+
+std::string ParameterUsage::asked_list() const {
+  std::string list;
+  for (const std::string& name : asked_) list += (list.empty() ? "" : ", ") + name;
+  return list;
+}
+
+const ParameterUsage::Parameter* ParameterUsage::first_unused() const {
+  for (const Parameter& p : given_)
+    if (!p.used) return &p;
+  return nullptr;
+}
+
+}  // namespace candela
