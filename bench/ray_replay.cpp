@@ -36,7 +36,7 @@
 #include "candela/film/film.h"
 #include "candela/io/scene_reader.h"
 #include "candela/math/frame.h"
-#include "candela/render/renderer.h"
+#include "candela/integrators/integrator.h"
 #include "candela/sampling/rng.h"
 #include "candela/sampling/warp.h"
 #include "candela/scene/scene.h"

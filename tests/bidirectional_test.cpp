@@ -18,6 +18,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "candela/integrators/bdpt.h"
 #include "candela/film/image_io.h"
 #include "candela/io/scene_reader.h"
 #include "candela/testing/render_helpers.h"
@@ -230,8 +231,8 @@ void expect_metropolis_closed_sphere(bool spectral, double floor) {
   d.shapes[0].emission = AreaEmission{RGB(Le), true};
   d.settings.spectral = spectral;
   d.settings.max_depth = 30;  // what is left beyond depth 30 is 0.6^31 of the light
-  d.settings.mlt_bootstrap = 4000;
-  d.settings.mlt_chains = 64;
+  d.settings.mlt.bootstrap = 4000;
+  d.settings.mlt.chains = 64;
   std::vector<double> means;
   for (uint64_t seed = 1; seed <= 4; ++seed) means.push_back(image_mean(render_image(d, "mlt", 64, seed)));
   double m = 0, v = 0;
@@ -253,8 +254,8 @@ TEST(BidirectionalFurnace, MetropolisClosedSphereUnderATimeLimit) {
   d.shapes[0].emission = AreaEmission{RGB(Le), true};
   d.settings.integrator = "mlt";
   d.settings.max_depth = 30;
-  d.settings.mlt_bootstrap = 4000;
-  d.settings.mlt_chains = 64;
+  d.settings.mlt.bootstrap = 4000;
+  d.settings.mlt.chains = 64;
   d.settings.spp = 1 << 20;  // more than fits in the time
   const Scene scene(d);
   RenderOptions options;
@@ -272,7 +273,7 @@ TEST(BidirectionalFurnace, MetropolisClosedSphereUnderATimeLimit) {
     options.time_limit_seconds = 0;
     EXPECT_TRUE(limited.time_limited);
     EXPECT_GE(limited.mlt_normalization_seconds, 1.5 / 9);
-    ASSERT_EQ(single.mlt_normalization_samples, uint64_t(d.settings.mlt_bootstrap));
+    ASSERT_EQ(single.mlt_normalization_samples, uint64_t(d.settings.mlt.bootstrap));
     ASSERT_EQ(limited.mlt_normalization_samples % single.mlt_normalization_samples, 0u);
     const double batches = double(limited.mlt_normalization_samples / single.mlt_normalization_samples);
     EXPECT_NEAR(limited.mlt_normalization_relative_error * std::sqrt(batches),
@@ -294,8 +295,8 @@ TEST(BidirectionalFurnace, MetropolisGlassSphereInWhiteFurnace) {
   // Light paths from the sky through glass, in Metropolis chains; judged over seeds as above.
   SceneDesc d = sphere_under_sky(DielectricMaterial{1.5f, RGB(1.0f), RGB(1.0f)});
   d.settings.max_depth = 12;  // the glass passes almost everything on: depths beyond 12 hold < 1e-3
-  d.settings.mlt_bootstrap = 10000;
-  d.settings.mlt_chains = 64;
+  d.settings.mlt.bootstrap = 10000;
+  d.settings.mlt.chains = 64;
   std::vector<double> means;
   for (uint64_t seed = 1; seed <= 4; ++seed) {
     Image img = render_image(d, "mlt", 64, seed);
@@ -389,8 +390,8 @@ TEST(BidirectionalStrategies, LightTracingAloneReproducesThePathTracer) {
 
 TEST(BidirectionalAgreement, CornellBox) {
   SceneDesc d = scene_at(kScenes + "cornell-box.json", 48, 48);
-  d.settings.mlt_bootstrap = 20000;
-  d.settings.mlt_chains = 256;
+  d.settings.mlt.bootstrap = 20000;
+  d.settings.mlt.chains = 256;
   expect_integrators_agree(d, {{"path", 256}, {"bdpt", 64}, {"mlt", 256}}, 0.005, "cornell-box");
 }
 
@@ -434,8 +435,8 @@ void expect_metropolis_agrees(const SceneDesc& d, int mutations, int bdpt_spp, c
 TEST(BidirectionalAgreement, VeachMis) {
   SceneDesc d = scene_at(kShared + "/scenes/bitterli/veach-mis/scene-v4.pbrt", 64, 36);
   expect_integrators_agree(d, {{"path", 256}, {"bdpt", 64}}, 0.005, "veach-mis");
-  d.settings.mlt_bootstrap = 20000;
-  d.settings.mlt_chains = 256;
+  d.settings.mlt.bootstrap = 20000;
+  d.settings.mlt.chains = 256;
   expect_metropolis_agrees(d, 256, 256, "veach-mis");
 }
 
@@ -443,10 +444,10 @@ TEST(BidirectionalAgreement, MetropolisWithLensAndCausticPerturbations) {
   // The perturbations, and the small steps that stand in for them where they would move nothing
   // (accepted with Hastings' ratio, MltSampler::small_step_probability), keep the chains' target.
   SceneDesc d = scene_at(kScenes + "cornell-box.json", 48, 48);
-  d.settings.mlt_bootstrap = 20000;
-  d.settings.mlt_chains = 256;
-  d.settings.mlt_lens = 0.3f;
-  d.settings.mlt_caustic = 0.2f;
+  d.settings.mlt.bootstrap = 20000;
+  d.settings.mlt.chains = 256;
+  d.settings.mlt.lens = 0.3f;
+  d.settings.mlt.caustic = 0.2f;
   expect_metropolis_agrees(d, 256, 256, "cornell-box with perturbations");
 }
 
@@ -458,15 +459,15 @@ TEST(BidirectionalAgreement, GlassSphereCaustic) {
   // The caustic's focus is a narrow peak of the Metropolis target: at this budget the chains share
   // their deposits between it and the rest unevenly (4-5 standard errors by region, in both
   // directions, docs/bidirectional.md), so only the whole image is judged here.
-  d.settings.mlt_bootstrap = 20000;
-  d.settings.mlt_chains = 64;
+  d.settings.mlt.bootstrap = 20000;
+  d.settings.mlt.chains = 64;
   expect_metropolis_agrees(d, 512, 2048, "caustic", false);
 }
 
 TEST(BidirectionalAgreement, PaperRoom) {
   SceneDesc d = scene_at(kScenes + "room.json", 48, 36);
-  d.settings.mlt_bootstrap = 20000;
-  d.settings.mlt_chains = 256;
+  d.settings.mlt.bootstrap = 20000;
+  d.settings.mlt.chains = 256;
   expect_integrators_agree(d, {{"path", 256}, {"bdpt", 64}, {"mlt", 256}}, 0.005, "room");
 }
 
@@ -569,16 +570,16 @@ TEST(BidirectionalAgreement, SpectralCornellBox) {
   // Spectral transport with saturated walls: the path tracer, BDPT and MLT sample the same spectra.
   SceneDesc d = scene_at(kScenes + "cornell-box.json", 32, 32);
   d.settings.spectral = true;
-  d.settings.mlt_bootstrap = 20000;
-  d.settings.mlt_chains = 256;
+  d.settings.mlt.bootstrap = 20000;
+  d.settings.mlt.chains = 256;
   expect_integrators_agree(d, {{"path", 256}, {"bdpt", 64}, {"mlt", 256}}, 0.005, "spectral cornell-box");
 }
 
 TEST(SpectralTransport, OneAndTwoThreadsGiveBitwiseIdenticalImages) {
   SceneDesc d = scene_at(kScenes + "cornell-box.json", 24, 16);
   d.settings.spectral = true;
-  d.settings.mlt_bootstrap = 2000;
-  d.settings.mlt_chains = 16;
+  d.settings.mlt.bootstrap = 2000;
+  d.settings.mlt.chains = 16;
   for (const char* integrator : {"path", "bdpt", "mlt"}) {
     Image one = render_image(d, integrator, 8, 7, 1), two = render_image(d, integrator, 8, 7, 2);
     EXPECT_TRUE(std::memcmp(one.rgb.data(), two.rgb.data(), one.rgb.size() * sizeof(float)) == 0) << integrator;
@@ -593,8 +594,8 @@ bool bitwise_equal(const Image& a, const Image& b) {
 
 TEST(BidirectionalDeterminism, OneAndTwoThreadsGiveBitwiseIdenticalImages) {
   SceneDesc d = scene_at(kScenes + "cornell-box.json", 40, 24);
-  d.settings.mlt_bootstrap = 2000;
-  d.settings.mlt_chains = 16;
+  d.settings.mlt.bootstrap = 2000;
+  d.settings.mlt.chains = 16;
   for (const char* integrator : {"bdpt", "mlt"}) {
     Image one = render_image(d, integrator, 8, 7, 1), two = render_image(d, integrator, 8, 7, 2);
     EXPECT_TRUE(bitwise_equal(one, two)) << integrator;

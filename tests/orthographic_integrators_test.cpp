@@ -83,8 +83,8 @@ Image render_image(SceneDesc d, const std::string& integrator, int spp, uint64_t
   d.settings.integrator = integrator;
   d.settings.spp = spp;
   d.settings.seed = seed;
-  d.settings.mlt_bootstrap = 20000;
-  d.settings.mlt_chains = 128;
+  d.settings.mlt.bootstrap = 20000;
+  d.settings.mlt.chains = 128;
   return testing::render_description(d).mean_image();
 }
 

@@ -22,7 +22,8 @@
 #include "candela/io/json_writer.h"
 #include "candela/io/scene_reader.h"
 #include "candela/render/checkpoint.h"
-#include "candela/render/renderer.h"
+#include "candela/integrators/bdpt.h"
+#include "candela/integrators/integrator.h"
 #include "candela/scene/resource_limits.h"
 #include "candela/scene/scene.h"
 
@@ -94,6 +95,44 @@ Enum parse_choice(const std::string& option, const std::string& value,
   throw UsageError(fmt::format("{}: unknown value '{}' (expected one of: {})", option, value, names));
 }
 
+// The chosen integrator must read every selective setting the command line gives
+// (integrators/integrator.h); what the scene file sets for another integrator gets a note.
+void check_integrator_flags(const RenderCommand& cmd, const SceneDesc& scene) {
+  const IntegratorEntry* integrator = find_integrator(scene.settings.integrator);
+  if (!integrator)
+    throw UsageError(fmt::format("unknown integrator '{}' (known: {})", scene.settings.integrator, integrator_names()));
+  struct SelectiveFlag {
+    const char* flag;
+    std::string_view key;
+    bool given;
+  };
+  const SelectiveFlag flags[] = {
+      {"--direction-sampling", "direction_sampling", !cmd.direction_sampling.empty()},
+      {"--no-mis", "mis", cmd.no_mis},
+      {"--shadow-rays", "shadow_rays", cmd.shadow_rays.has_value()},
+      {"--light-selection paper", "light_selection=paper", cmd.light_selection == "paper"},
+      {"--adaptive-threshold", "adaptive", cmd.adaptive_threshold.has_value()},
+      {"--adaptive-spp", "adaptive", cmd.adaptive_spp.has_value()},
+      {"--adaptive-batch", "adaptive", cmd.adaptive_batch.has_value()},
+      {"--max-spp", "adaptive", cmd.max_spp.has_value()},
+      {"--mlt-bootstrap", "mlt", cmd.mlt_bootstrap.has_value()},
+      {"--mlt-chains", "mlt", cmd.mlt_chains.has_value()},
+      {"--mlt-sigma", "mlt", cmd.mlt_sigma.has_value()},
+      {"--mlt-large-step", "mlt", cmd.mlt_large_step.has_value()},
+      {"--mlt-lens", "mlt", cmd.mlt_lens.has_value()},
+      {"--mlt-caustic", "mlt", cmd.mlt_caustic.has_value()},
+  };
+  for (const SelectiveFlag& f : flags)
+    if (f.given && !integrator->reads_setting(f.key))
+      throw UsageError(fmt::format("{}: {}", f.flag, unread_setting_message(*integrator, f.key)));
+  if (!cmd.bdpt_strategies.empty() && !integrator->strategy_images)
+    throw UsageError(fmt::format("--bdpt-strategies: the {} integrator writes no strategy images (bdpt does)",
+                                 integrator->name));
+  if (!cmd.integrator.empty() && !cmd.quiet)
+    for (std::string_view key : set_but_unread(*integrator, scene.settings))
+      fmt::print(stderr, "note: the scene sets {}, which --integrator {} does not read\n", key, integrator->name);
+}
+
 void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
   if (cmd.spp) scene.settings.spp = *cmd.spp;
   if (cmd.max_depth) scene.settings.max_depth = *cmd.max_depth;
@@ -113,7 +152,7 @@ void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
         {{"box", FilterType::Box}, {"tent", FilterType::Tent}, {"gaussian", FilterType::Gaussian},
          {"mitchell", FilterType::Mitchell}}));
   if (!cmd.direction_sampling.empty())
-    rs.direction_sampling = parse_choice<DirectionSampling>(
+    rs.path.direction_sampling = parse_choice<DirectionSampling>(
         "--direction-sampling", cmd.direction_sampling,
         {{"bsdf", DirectionSampling::Bsdf}, {"cosine", DirectionSampling::Cosine},
          {"uniform", DirectionSampling::Uniform}});
@@ -124,19 +163,18 @@ void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
                                                       {{"power", LightSelection::Power},
                                                        {"paper", LightSelection::Paper},
                                                        {"uniform", LightSelection::Uniform}});
-  if (cmd.no_mis) rs.mis = false;
+  if (cmd.no_mis) rs.path.mis = false;
   if (!cmd.transport.empty())
     rs.spectral = parse_choice<bool>("--transport", cmd.transport, {{"rgb", false}, {"spectral", true}});
-  if (cmd.mlt_bootstrap) rs.mlt_bootstrap = *cmd.mlt_bootstrap;
-  if (cmd.mlt_chains) rs.mlt_chains = *cmd.mlt_chains;
-  if (cmd.mlt_sigma) rs.mlt_sigma = *cmd.mlt_sigma;
-  if (cmd.mlt_large_step) rs.mlt_large_step = *cmd.mlt_large_step;
-  if (cmd.mlt_lens) rs.mlt_lens = *cmd.mlt_lens;
-  if (cmd.mlt_caustic) rs.mlt_caustic = *cmd.mlt_caustic;
-  if (rs.mlt_large_step + rs.mlt_lens + rs.mlt_caustic > 1)
-    throw UsageError(fmt::format("--mlt-large-step + --mlt-lens + --mlt-caustic must be at most 1, got {}",
-                                 rs.mlt_large_step + rs.mlt_lens + rs.mlt_caustic));
-  if (cmd.shadow_rays) rs.shadow_rays = *cmd.shadow_rays;
+  if (cmd.mlt_bootstrap) rs.mlt.bootstrap = *cmd.mlt_bootstrap;
+  if (cmd.mlt_chains) rs.mlt.chains = *cmd.mlt_chains;
+  if (cmd.mlt_sigma) rs.mlt.sigma = *cmd.mlt_sigma;
+  if (cmd.mlt_large_step) rs.mlt.large_step = *cmd.mlt_large_step;
+  if (cmd.mlt_lens) rs.mlt.lens = *cmd.mlt_lens;
+  if (cmd.mlt_caustic) rs.mlt.caustic = *cmd.mlt_caustic;
+  if (std::string problem = rs.mlt.problem(); !problem.empty())
+    throw UsageError("--mlt-large-step, --mlt-lens, --mlt-caustic: " + problem);
+  if (cmd.shadow_rays) rs.path.shadow_rays = *cmd.shadow_rays;
   if (cmd.adaptive_threshold) rs.adaptive_threshold = *cmd.adaptive_threshold;
   if (cmd.adaptive_spp) rs.adaptive_spp = *cmd.adaptive_spp;
   if (cmd.adaptive_batch) rs.adaptive_batch = *cmd.adaptive_batch;
@@ -164,12 +202,7 @@ void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
       (long long)f.width * f.height > kMaxPixels)
     throw UsageError(fmt::format("resolution {}x{} is out of range (each side 1..{}, at most {} pixels)", f.width,
                                  f.height, kMaxResolution, kMaxPixels));
-  if (!is_known_integrator(scene.settings.integrator))
-    throw UsageError(fmt::format("unknown integrator '{}' (known: {})", scene.settings.integrator, known_integrators()));
-  if (scene.settings.integrator == "mlt" && scene.settings.adaptive())
-    throw UsageError("adaptive sampling (--adaptive-threshold, --adaptive-spp) does not apply to the mlt integrator (its mutations go where the light is)");
-  if (!cmd.bdpt_strategies.empty() && scene.settings.integrator != "bdpt")
-    throw UsageError("--bdpt-strategies needs --integrator bdpt");
+  check_integrator_flags(cmd, scene);
   if (cmd.bdpt_unweighted && cmd.bdpt_strategies.empty()) throw UsageError("--bdpt-unweighted needs --bdpt-strategies DIR");
 }
 
@@ -235,19 +268,16 @@ RenderFingerprint make_fingerprint(const std::string& scene_bytes, const SceneDe
       {"max-depth", std::to_string(rs.max_depth)},
       {"integrator", rs.integrator},
       {"rr-start-depth", std::to_string(rs.rr_start_depth)},
-      {"direction-sampling", std::to_string(int(rs.direction_sampling))},
-      {"mis", rs.mis ? "on" : "off"},
+      {"direction-sampling", std::to_string(int(rs.path.direction_sampling))},
+      {"mis", rs.path.mis ? "on" : "off"},
       {"transport", rs.spectral ? "spectral" : "rgb"},
       {"light-selection", std::to_string(int(rs.light_selection))},
-      {"shadow-rays", std::to_string(rs.shadow_rays)},
+      {"shadow-rays", std::to_string(rs.path.shadow_rays)},
       {"adaptive-threshold", fmt::format("{}", rs.adaptive_threshold)},
       {"adaptive-spp", std::to_string(rs.adaptive_spp)},
       {"clamp", clamp > 0 ? fmt::format("{}", clamp) : "off"},
   };
-  if (rs.integrator == "mlt")
-    fp.settings.push_back({"mlt", fmt::format("bootstrap {} chains {} sigma {} large-step {} lens {} caustic {}",
-                                              rs.mlt_bootstrap, rs.mlt_chains, rs.mlt_sigma, rs.mlt_large_step,
-                                              rs.mlt_lens, rs.mlt_caustic)});
+  if (find_integrator(rs.integrator)->reads_setting("mlt")) fp.settings.push_back({"mlt", rs.mlt.describe()});
   return fp;
 }
 
@@ -268,10 +298,11 @@ int run_render(const RenderCommand& cmd) {
     throw UsageError("--checkpoint and --resume are not supported with adaptive sampling (--adaptive-threshold, --adaptive-spp)");
   if (pixel_mode && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
     throw UsageError("--pixel cannot be combined with --checkpoint or --resume");
-  const bool mlt = desc.settings.integrator == "mlt";
-  if (mlt && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
-    throw UsageError("--checkpoint and --resume are not supported with the mlt integrator (its chains are not saved)");
-  if (mlt && pixel_mode) throw UsageError("--pixel cannot be used with the mlt integrator (its chains roam the whole film)");
+  const IntegratorEntry& integrator = *find_integrator(desc.settings.integrator);
+  if (!integrator.resumable && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
+    throw UsageError(fmt::format("--checkpoint and --resume are not supported with the {} integrator (it cannot continue a partly rendered film)", integrator.name));
+  if (!integrator.single_pixel && pixel_mode)
+    throw UsageError(fmt::format("--pixel cannot be used with the {} integrator (it cannot render one pixel alone)", integrator.name));
   if (!cmd.bdpt_strategies.empty() && !fs::is_directory(cmd.bdpt_strategies))
     throw UsageError(fmt::format("--bdpt-strategies '{}': not a directory", cmd.bdpt_strategies));
   int px = -1, py = -1;
@@ -397,7 +428,7 @@ int run_render(const RenderCommand& cmd) {
   const double mean_spp = double(film.total_samples()) / pixels;
   std::string spp_text;
   const char* spp_unit = " spp";  // appended in messages where spp_text is a bare count
-  if (mlt) {
+  if (integrator.samples_are_mutations) {
     spp_text = fmt::format("{:.2f} mutations per pixel", double(stats.samples) / pixels);
     spp_unit = "";
   } else if (adaptive && !stopped) {
@@ -422,10 +453,7 @@ int run_render(const RenderCommand& cmd) {
   if (stats.time_limited) metadata["candela:time-limited"] = "true";
   if (clamp > 0) metadata["candela:clamp"] = fmt::format("{}", clamp);
   if (non_finite > 0) metadata["candela:non_finite_samples"] = std::to_string(non_finite);
-  if (mlt) metadata["candela:mlt"] = fmt::format(
-      "bootstrap {} chains {} sigma {} large-step {} lens {} caustic {}", desc.settings.mlt_bootstrap,
-      desc.settings.mlt_chains, desc.settings.mlt_sigma, desc.settings.mlt_large_step, desc.settings.mlt_lens,
-      desc.settings.mlt_caustic);
+  if (integrator.reads_setting("mlt")) metadata["candela:mlt"] = desc.settings.mlt.describe();
   Image image = film.mean_image();
   for (const auto& f : outputs) write_image(f, image, metadata);
   // One image per strategy: bdpt_d<depth>_s<s>_t<t>.exr, scaled like the light image.
@@ -488,9 +516,10 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--max-depth", cmd.max_depth, "Maximum number of bounces; 1 = direct light only")
       ->check(CLI::Range(1, 100000));
   render_cmd->add_option("--resolution", cmd.resolution, "Image size WIDTHxHEIGHT (overrides the scene)");
-  render_cmd->add_option("--integrator", cmd.integrator,
-                         "Integrator: path (path tracing), bdpt (bidirectional path tracing), mlt (Metropolis "
-                         "light transport over bidirectional paths; --spp is then mutations per pixel)");
+  std::string integrator_help = "Integrator:";
+  for (const IntegratorEntry& entry : integrators())
+    integrator_help += fmt::format(" {} ({}){}", entry.name, entry.description, &entry == &integrators().back() ? "" : ";");
+  render_cmd->add_option("--integrator", cmd.integrator, integrator_help);
   render_cmd->add_option("--bdpt-strategies", cmd.bdpt_strategies,
                          "bdpt: also write each strategy's contribution (depth <= 5) to "
                          "DIR/bdpt_d<depth>_s<s>_t<t>.exr");

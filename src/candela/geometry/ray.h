@@ -1,9 +1,22 @@
 #pragma once
+#include <cstdint>
 #include <limits>
 
 #include "candela/math/vec.h"
 
 namespace candela {
+
+// Rays traced, by kind, for the statistics line.
+struct RayCounts {
+  uint64_t camera = 0, bounce = 0, shadow = 0;
+  uint64_t total() const { return camera + bounce + shadow; }
+  RayCounts& operator+=(const RayCounts& o) {
+    camera += o.camera;
+    bounce += o.bounce;
+    shadow += o.shadow;
+    return *this;
+  }
+};
 
 struct Ray {
   Point3 origin;

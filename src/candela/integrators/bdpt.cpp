@@ -2,6 +2,7 @@
 
 #include "candela/integrators/mlt_sampler.h"
 #include "candela/materials/spectral_bsdf.h"
+#include "candela/render/camera_sample_tiles.h"
 #include "candela/sampling/samplers.h"
 
 namespace candela {
@@ -530,6 +531,23 @@ RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts
       }
     }
   return L;
+}
+
+RenderStats render_bdpt(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options) {
+  if (!film.has_splats()) film.enable_splats();
+  const BdptIntegrator bdpt(scene, settings);
+  const Filter filter(settings.filter);
+  const BdptTarget target{&film, &filter, options.bdpt_strategies, options.bdpt_unweighted};
+  CameraSampleTiles tiles([&](const Ray& ray, auto& sampler, RayCounts& counts, const PixelSample& pixel,
+                              const Wavelengths* wl) {
+    return bdpt.radiance(ray, sampler, counts, target, pixel.x, pixel.y, pixel.filter_weight, wl);
+  });
+  RenderStats stats = render_tiles(scene, settings, film, options, tiles);
+  // One light path was traced per camera sample: the light image is the splats times the
+  // importance film's area over their number.
+  uint64_t light_paths = film.total_samples();
+  film.set_splat_scale(light_paths > 0 ? double(scene.camera().importance_film_pixels()) / double(light_paths) : 0);
+  return stats;
 }
 
 // One instantiation per pixel sampler, and one for Metropolis light transport's sampler.

@@ -138,4 +138,9 @@ class BdptIntegrator {
   bool hide_emitters_;  // no depth-0 strategies: emitters seen directly are not shown
 };
 
+// Integrator "bdpt": renders `film` through the shared tile loop, one light subpath per camera
+// sample; light tracing lands in the film's splats, scaled by the importance film's area over the
+// number of light paths.
+RenderStats render_bdpt(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options);
+
 }  // namespace candela

@@ -14,6 +14,7 @@
 #include "candela/film/filter.h"
 #include "candela/integrators/bdpt.h"
 #include "candela/integrators/mlt_sampler.h"
+#include "candela/integrators/path_integrator.h"
 #include "candela/render/progress.h"
 #include "candela/sampling/distribution1d.h"
 #include "candela/sampling/sampler.h"
@@ -173,7 +174,6 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   // sums, and the chains' splats of the depths >= 1 are added to it. Left to chains, the share of
   // the film covered by small visible lights is estimated far more noisily.
   RenderSettings emission = settings;
-  emission.integrator = "path";
   emission.max_depth = 0;
   emission.spp = std::clamp(settings.spp / 16, 16, 256);
   emission.adaptive_threshold = 0;
@@ -182,7 +182,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   emission_options.after_pass = nullptr;
   emission_options.time_limit_seconds = 0;
   emission_options.bdpt_strategies = nullptr;
-  RenderStats stats = render(scene, emission, film, emission_options);
+  RenderStats stats = render_path(scene, emission, film, emission_options);
   stats.samples = 0;
   film.enable_splats();
   film.set_splat_scale(0);
@@ -212,10 +212,10 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
 
   const uint64_t pixels = uint64_t(film.width()) * uint64_t(film.height());
   const uint64_t total_mutations = uint64_t(settings.spp) * pixels;
-  const uint64_t bootstrap_count = uint64_t(settings.mlt_bootstrap) * uint64_t(depths);
+  const uint64_t bootstrap_count = uint64_t(settings.mlt.bootstrap) * uint64_t(depths);
   ProgressBar progress(bootstrap_count + total_mutations, options.progress);
   // The bootstrap grows with max_depth (one per depth): the bar says which phase it is in.
-  progress.set_label(fmt::format("MLT bootstrap ({} depths x {})", depths, settings.mlt_bootstrap));
+  progress.set_label(fmt::format("MLT bootstrap ({} depths x {})", depths, settings.mlt.bootstrap));
 
   // Bootstrap: the luminance of independent states, depth by depth in turn.
   std::vector<float> weights(bootstrap_count);
@@ -226,7 +226,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
         if (cancelled()) return;
         int depth = int(i % uint64_t(depths));
         if (depth == 0) continue;  // rendered directly above
-        MltSampler sampler(settings.seed, i, settings.mlt_sigma);
+        MltSampler sampler(settings.seed, i, settings.mlt.sigma);
         weights[i] = paths.sample(sampler, depth, counts).luminance();
       }
       progress.advance(range.size());
@@ -245,7 +245,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   // evaluates every strategy of paths up to 16 bounces).
   const BdptIntegrator bdpt_with_roulette(scene, settings);
   const uint64_t normalization_samples = std::max<uint64_t>(
-      uint64_t(settings.mlt_bootstrap), options.time_limit_seconds > 0 ? 0 : total_mutations / 8);
+      uint64_t(settings.mlt.bootstrap), options.time_limit_seconds > 0 ? 0 : total_mutations / 8);
   const auto normalization_start = std::chrono::steady_clock::now();
   progress.set_label(fmt::format("MLT normalisation ({} paths)", normalization_samples));
   Normalization normalization = estimate_normalization(scene, bdpt_with_roulette, settings, arena, ray_counts,
@@ -297,12 +297,12 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   depth_bootstrap.resize(size_t(depths));
   std::vector<bool> depth_found(size_t(depths), false);
   for (size_t d = 0; d < size_t(depths); ++d) {
-    std::vector<float> w(size_t(settings.mlt_bootstrap));
+    std::vector<float> w(size_t(settings.mlt.bootstrap));
     for (size_t k = 0; k < w.size(); ++k) w[k] = weights[k * size_t(depths) + d];
     depth_found[d] = std::any_of(w.begin(), w.end(), [](float x) { return x > 0; });
     depth_bootstrap[d] = Distribution1D(w);
   }
-  const uint64_t wanted = std::max<uint64_t>(1, std::min<uint64_t>(uint64_t(settings.mlt_chains), total_mutations));
+  const uint64_t wanted = std::max<uint64_t>(1, std::min<uint64_t>(uint64_t(settings.mlt.chains), total_mutations));
   double b_chains = 0;  // the brightness the chains render: every depth but 0
   for (size_t d = 1; d < size_t(depths); ++d) b_chains += normalization.per_depth[d];
   for (size_t d = 0; d < size_t(depths); ++d)
@@ -325,7 +325,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
     float scale = 0;
     float brightness = 0;  // the depth's mean luminance b_d
   };
-  const MltMutationProbabilities mutations{settings.mlt_large_step, settings.mlt_lens, settings.mlt_caustic};
+  const MltMutationProbabilities mutations{settings.mlt.large_step, settings.mlt.lens, settings.mlt.caustic};
   const PerspectiveCamera& camera = scene.camera();
   const MltPerturbedNumbers perturbed{MltPathSampler::kFilmNumber, MltPathSampler::kLightDirectionNumber,
                                       {float(camera.width()) + 2 * camera.margin().x,
@@ -338,7 +338,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
       Rng pick(c, hash_values(settings.seed, 0x7374617274));
       float u = std::min((float(k) + pick.next_float()) / float(depth_chains[d]), 0x1.fffffep-1f);
       size_t index = depth_bootstrap[d].sample(u) * size_t(depths) + d;
-      chain_states.push_back(Chain{MltSampler(settings.seed, index, settings.mlt_sigma, mutations, perturbed),
+      chain_states.push_back(Chain{MltSampler(settings.seed, index, settings.mlt.sigma, mutations, perturbed),
                                    Rng(c, hash_values(settings.seed, 0x636861696e)), PathState{}, int(d), 0});
     }
   // Deposits are kept near 1 (relative to the largest depth scale) for the fixed-point splat sums.
@@ -389,7 +389,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
           // the two estimators are combined by their densities (p_large against f / b), so dim
           // regions that chains seldom visit are estimated by the large steps instead.
           float large = c.sampler.large_step() ? 1.0f : 0.0f;
-          float floor_density = settings.mlt_large_step * c.brightness;
+          float floor_density = settings.mlt.large_step * c.brightness;
           if (y_proposed > 0 && accept + large > 0 &&
               !film.splats().add(proposed.raster,
                                  proposed.L * ((accept + large) * c.scale / (y_proposed + floor_density)), filter))

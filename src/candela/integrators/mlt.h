@@ -26,12 +26,13 @@
 // Chains are independent and their deposits are summed in fixed point, so the image is the same
 // for any number of threads.
 #include "candela/film/film.h"
-#include "candela/render/renderer.h"
+#include "candela/render/render_loop.h"
 #include "candela/scene/scene.h"
 
 namespace candela {
 
-// Renders settings.spp mutations per pixel into film's splats (and sets its splat scale).
+// Integrator "mlt": renders settings.spp mutations per pixel into film's splats (and sets its
+// splat scale), on top of depth 0 rendered by the path tracer into its pixel sums.
 RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options);
 
 }  // namespace candela

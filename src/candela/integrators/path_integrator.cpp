@@ -1,6 +1,7 @@
 #include "candela/integrators/path_integrator.h"
 
 #include "candela/materials/spectral_bsdf.h"
+#include "candela/render/camera_sample_tiles.h"
 #include "candela/sampling/samplers.h"
 #include "candela/sampling/warp.h"
 
@@ -20,11 +21,11 @@ PathIntegrator::PathIntegrator(const Scene& scene, const RenderSettings& setting
     : scene_(scene),
       max_depth_(settings.max_depth),
       rr_start_depth_(settings.rr_start_depth),
-      direction_sampling_(settings.direction_sampling),
-      mis_(settings.mis),
+      direction_sampling_(settings.path.direction_sampling),
+      mis_(settings.path.mis),
       hide_emitters_(settings.hide_emitters),
       light_selection_(settings.light_selection),
-      shadow_rays_(std::max(1, settings.shadow_rays)) {}
+      shadow_rays_(std::max(1, settings.path.shadow_rays)) {}
 
 template <typename Sampler>
 RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, const Wavelengths* wl) const {
@@ -246,6 +247,13 @@ RGB PathIntegrator::shadow_ray_estimate(const Vertex& v, size_t li, const Vec2& 
   if (ls.is_delta || !mis_) return f * Le / light_pdf;
   float w = power_heuristic(light_pdf, direction_pdf(v.bsdf, v.wo_local, wi_local));
   return f * Le * (w / light_pdf);
+}
+
+RenderStats render_path(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options) {
+  const PathIntegrator path(scene, settings);
+  CameraSampleTiles tiles([&path](const Ray& ray, auto& sampler, RayCounts& counts, const PixelSample&,
+                                  const Wavelengths* wl) { return path.radiance(ray, sampler, counts, wl); });
+  return render_tiles(scene, settings, film, options, tiles);
 }
 
 // One instantiation per sampler type of the variant.

@@ -11,21 +11,11 @@
 
 #include "candela/geometry/ray.h"
 #include "candela/math/color.h"
+#include "candela/render/render_loop.h"
 #include "candela/scene/scene.h"
 #include "candela/spectral/wavelengths.h"
 
 namespace candela {
-
-struct RayCounts {
-  uint64_t camera = 0, bounce = 0, shadow = 0;
-  uint64_t total() const { return camera + bounce + shadow; }
-  RayCounts& operator+=(const RayCounts& o) {
-    camera += o.camera;
-    bounce += o.bounce;
-    shadow += o.shadow;
-    return *this;
-  }
-};
 
 class PathIntegrator {
  public:
@@ -64,6 +54,9 @@ class PathIntegrator {
   LightSelection light_selection_;
   int shadow_rays_;
 };
+
+// Integrator "path": renders `film` with the path tracer through the shared tile loop.
+RenderStats render_path(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options);
 
 inline float power_heuristic(float pdf_a, float pdf_b) {
   float a = pdf_a * pdf_a, b = pdf_b * pdf_b;

@@ -78,28 +78,28 @@ void expect_same_image(const SceneDesc& a, const SceneDesc& b, const char* what)
 
 TEST(PathIntegratorStrategies, DirectionSamplingDoesNotChangeTheImage) {
   SceneDesc bsdf = soft_shadow_scene(256), cosine = bsdf, uniform = bsdf;
-  cosine.settings.direction_sampling = DirectionSampling::Cosine;
-  uniform.settings.direction_sampling = DirectionSampling::Uniform;
+  cosine.settings.path.direction_sampling = DirectionSampling::Cosine;
+  uniform.settings.path.direction_sampling = DirectionSampling::Uniform;
   expect_same_image(bsdf, cosine, "bsdf vs cosine");
   expect_same_image(bsdf, uniform, "bsdf vs uniform");
 }
 
 TEST(PathIntegratorStrategies, MisOnAndOffAgree) {
   SceneDesc mis = soft_shadow_scene(256), no_mis = mis;
-  no_mis.settings.mis = false;
+  no_mis.settings.path.mis = false;
   expect_same_image(mis, no_mis, "MIS vs no MIS");
-  no_mis.settings.direction_sampling = DirectionSampling::Uniform;
+  no_mis.settings.path.direction_sampling = DirectionSampling::Uniform;
   expect_same_image(mis, no_mis, "MIS vs the paper's uniform sampling without MIS");
 }
 
 TEST(PathIntegratorStrategies, ShadowRayCountAndLightSelectionAgree) {
   SceneDesc one = soft_shadow_scene(256), four = one, paper = one;
-  four.settings.shadow_rays = 4;
+  four.settings.path.shadow_rays = 4;
   paper.settings.light_selection = LightSelection::Paper;
-  paper.settings.shadow_rays = 4;
+  paper.settings.path.shadow_rays = 4;
   expect_same_image(one, four, "1 vs 4 shadow rays");
   expect_same_image(one, paper, "power vs paper's rule");
-  paper.settings.mis = false;
+  paper.settings.path.mis = false;
   expect_same_image(one, paper, "paper's rule without MIS");
 }
 
@@ -116,8 +116,8 @@ TEST(PathIntegratorStrategies, MoreShadowRaysLowerTheNoise) {
   // Direct light only, without MIS: the noise left is that of the shadow rays and the pixel jitter.
   SceneDesc one = soft_shadow_scene(16), eight = one;
   one.settings.max_depth = eight.settings.max_depth = 1;
-  one.settings.mis = eight.settings.mis = false;
-  eight.settings.shadow_rays = 8;
+  one.settings.path.mis = eight.settings.path.mis = false;
+  eight.settings.path.shadow_rays = 8;
   auto noise = [](const Film& f) {
     double v = 0;
     for (float x : f.variance_of_mean_image().rgb) v += x;

@@ -680,16 +680,16 @@ class JsonSceneReader {
   void read_mlt(const Json& value, const std::string& pointer, RenderSettings& settings) const {
     CheckedObject object(report_, value, pointer);
     constexpr int64_t kIntMax = std::numeric_limits<int>::max();
-    settings.mlt_bootstrap = object.integer_or("bootstrap", settings.mlt_bootstrap, 1, kIntMax);
-    settings.mlt_chains = object.integer_or("chains", settings.mlt_chains, 1, kIntMax);
-    settings.mlt_sigma = object.number_or("sigma", settings.mlt_sigma, Bound::Positive);
-    if (settings.mlt_sigma > 1) report_.fail(object.pointer_of("sigma"), "sigma must be at most 1, got {}", settings.mlt_sigma);
-    settings.mlt_large_step = object.number_or("large_step", settings.mlt_large_step, Bound::UnitInterval);
-    settings.mlt_lens = object.number_or("lens", settings.mlt_lens, Bound::UnitInterval);
-    settings.mlt_caustic = object.number_or("caustic", settings.mlt_caustic, Bound::UnitInterval);
-    if (settings.mlt_large_step + settings.mlt_lens + settings.mlt_caustic > 1)
+    settings.mlt.bootstrap = object.integer_or("bootstrap", settings.mlt.bootstrap, 1, kIntMax);
+    settings.mlt.chains = object.integer_or("chains", settings.mlt.chains, 1, kIntMax);
+    settings.mlt.sigma = object.number_or("sigma", settings.mlt.sigma, Bound::Positive);
+    if (settings.mlt.sigma > 1) report_.fail(object.pointer_of("sigma"), "sigma must be at most 1, got {}", settings.mlt.sigma);
+    settings.mlt.large_step = object.number_or("large_step", settings.mlt.large_step, Bound::UnitInterval);
+    settings.mlt.lens = object.number_or("lens", settings.mlt.lens, Bound::UnitInterval);
+    settings.mlt.caustic = object.number_or("caustic", settings.mlt.caustic, Bound::UnitInterval);
+    if (settings.mlt.large_step + settings.mlt.lens + settings.mlt.caustic > 1)
       report_.fail(pointer, "large_step + lens + caustic must be at most 1, got {}",
-                   settings.mlt_large_step + settings.mlt_lens + settings.mlt_caustic);
+                   settings.mlt.large_step + settings.mlt.lens + settings.mlt.caustic);
     object.finish();
   }
 
@@ -748,18 +748,18 @@ class JsonSceneReader {
 
   void read_integrator_strategies(CheckedObject& render, RenderSettings& settings) const {
     if (const Json* value = render.find("direction_sampling"))
-      settings.direction_sampling = read_name<DirectionSampling>(
+      settings.path.direction_sampling = read_name<DirectionSampling>(
           report_, *value, render.pointer_of("direction_sampling"), "direction sampling",
           {{"bsdf", DirectionSampling::Bsdf}, {"cosine", DirectionSampling::Cosine},
            {"uniform", DirectionSampling::Uniform}});
-    settings.mis = render.boolean_or("mis", settings.mis);
+    settings.path.mis = render.boolean_or("mis", settings.path.mis);
     settings.hide_emitters = render.boolean_or("hide_emitters", settings.hide_emitters);
     settings.spectral = render.boolean_or("spectral", settings.spectral);
     if (const Json* value = render.find("light_selection"))
       settings.light_selection =
           read_name<LightSelection>(report_, *value, render.pointer_of("light_selection"), "light selection",
                                     {{"power", LightSelection::Power}, {"paper", LightSelection::Paper}, {"uniform", LightSelection::Uniform}});
-    settings.shadow_rays = render.integer_or("shadow_rays", settings.shadow_rays, 1, std::numeric_limits<int>::max());
+    settings.path.shadow_rays = render.integer_or("shadow_rays", settings.path.shadow_rays, 1, std::numeric_limits<int>::max());
     if (const Json* value = render.find("bvh"))
       settings.bvh = read_name<BvhLayout>(report_, *value, render.pointer_of("bvh"), "BVH layout",
                                           {{"fast", BvhLayout::Fast}, {"compact", BvhLayout::Compact}});

@@ -103,10 +103,10 @@ TEST(JsonReader, EmptySceneGetsDefaults) {
   EXPECT_EQ(scene.settings.sampler.type, SamplerType::ZSobol);  // the default for scenes that name none
   EXPECT_EQ(scene.settings.filter.type, FilterType::Box);
   EXPECT_FLOAT_EQ(scene.settings.filter.radius.x, 0.5f);
-  EXPECT_EQ(scene.settings.direction_sampling, DirectionSampling::Bsdf);
-  EXPECT_TRUE(scene.settings.mis);
+  EXPECT_EQ(scene.settings.path.direction_sampling, DirectionSampling::Bsdf);
+  EXPECT_TRUE(scene.settings.path.mis);
   EXPECT_EQ(scene.settings.light_selection, LightSelection::Power);
-  EXPECT_EQ(scene.settings.shadow_rays, 1);
+  EXPECT_EQ(scene.settings.path.shadow_rays, 1);
   EXPECT_EQ(scene.settings.adaptive_threshold, 0);  // off
   EXPECT_FLOAT_EQ(scene.transform_start_time, 0);
   EXPECT_FLOAT_EQ(scene.transform_end_time, 1);
@@ -142,16 +142,16 @@ TEST(JsonReader, ReadsMetropolisSettings) {
   SceneDesc scene = read(R"({"render": {"integrator": "mlt", "spp": 64,
     "mlt": {"bootstrap": 5000, "chains": 32, "sigma": 0.02, "large_step": 0.5, "lens": 0.25, "caustic": 0.125}}})");
   EXPECT_EQ(scene.settings.integrator, "mlt");
-  EXPECT_EQ(scene.settings.mlt_bootstrap, 5000);
-  EXPECT_EQ(scene.settings.mlt_chains, 32);
-  EXPECT_FLOAT_EQ(scene.settings.mlt_sigma, 0.02f);
-  EXPECT_FLOAT_EQ(scene.settings.mlt_large_step, 0.5f);
-  EXPECT_FLOAT_EQ(scene.settings.mlt_lens, 0.25f);
-  EXPECT_FLOAT_EQ(scene.settings.mlt_caustic, 0.125f);
+  EXPECT_EQ(scene.settings.mlt.bootstrap, 5000);
+  EXPECT_EQ(scene.settings.mlt.chains, 32);
+  EXPECT_FLOAT_EQ(scene.settings.mlt.sigma, 0.02f);
+  EXPECT_FLOAT_EQ(scene.settings.mlt.large_step, 0.5f);
+  EXPECT_FLOAT_EQ(scene.settings.mlt.lens, 0.25f);
+  EXPECT_FLOAT_EQ(scene.settings.mlt.caustic, 0.125f);
   SceneDesc defaults = read(R"({"render": {"integrator": "bdpt"}})");
   EXPECT_EQ(defaults.settings.integrator, "bdpt");
-  EXPECT_EQ(defaults.settings.mlt_bootstrap, 100000);
-  EXPECT_FLOAT_EQ(defaults.settings.mlt_large_step, 0.3f);
+  EXPECT_EQ(defaults.settings.mlt.bootstrap, 100000);
+  EXPECT_FLOAT_EQ(defaults.settings.mlt.large_step, 0.3f);
   EXPECT_NE(error_of(R"({"render": {"mlt": {"chains": 0}}})").find("/render/mlt/chains"), std::string::npos);
   EXPECT_NE(error_of(R"({"render": {"mlt": {"sigma": 2}}})").find("sigma must be at most 1"), std::string::npos);
   EXPECT_NE(error_of(R"({"render": {"mlt": {"large_step": 1.5}}})").find("/render/mlt/large_step"), std::string::npos);
@@ -220,16 +220,16 @@ TEST(JsonReader, ReadsIntegratorStrategiesAndAdaptiveSampling) {
   SceneDesc scene = read(R"({"render": {"direction_sampling": "uniform", "mis": false, "light_selection": "paper",
                                          "shadow_rays": 4,
                                          "adaptive": {"threshold": 0.02, "batch": 8, "max_spp": 512}}})");
-  EXPECT_EQ(scene.settings.direction_sampling, DirectionSampling::Uniform);
-  EXPECT_FALSE(scene.settings.mis);
+  EXPECT_EQ(scene.settings.path.direction_sampling, DirectionSampling::Uniform);
+  EXPECT_FALSE(scene.settings.path.mis);
   EXPECT_EQ(scene.settings.light_selection, LightSelection::Paper);
-  EXPECT_EQ(scene.settings.shadow_rays, 4);
+  EXPECT_EQ(scene.settings.path.shadow_rays, 4);
   EXPECT_FLOAT_EQ(scene.settings.adaptive_threshold, 0.02f);
   EXPECT_EQ(scene.settings.adaptive_batch, 8);
   EXPECT_EQ(scene.settings.adaptive_max_spp, 512);
-  EXPECT_EQ(read(R"({"render": {"direction_sampling": "cosine"}})").settings.direction_sampling,
+  EXPECT_EQ(read(R"({"render": {"direction_sampling": "cosine"}})").settings.path.direction_sampling,
             DirectionSampling::Cosine);
-  EXPECT_EQ(read(R"({"render": {"direction_sampling": "bsdf"}})").settings.direction_sampling, DirectionSampling::Bsdf);
+  EXPECT_EQ(read(R"({"render": {"direction_sampling": "bsdf"}})").settings.path.direction_sampling, DirectionSampling::Bsdf);
   EXPECT_EQ(read(R"({"render": {"light_selection": "power"}})").settings.light_selection, LightSelection::Power);
   EXPECT_EQ(read(R"({"render": {"bvh": "compact"}})").settings.bvh, BvhLayout::Compact);
   EXPECT_EQ(read(R"({"render": {}})").settings.bvh, BvhLayout::Fast);

@@ -356,13 +356,13 @@ Json render_json(const SceneDesc& scene) {
   }
   j["filter"] = std::move(filter);
   static const char* kDirections[] = {"bsdf", "cosine", "uniform"};
-  j["direction_sampling"] = kDirections[int(s.direction_sampling)];
-  j["mis"] = s.mis;
+  j["direction_sampling"] = kDirections[int(s.path.direction_sampling)];
+  j["mis"] = s.path.mis;
   if (s.hide_emitters) j["hide_emitters"] = true;
   if (s.spectral) j["spectral"] = true;
   static const char* kSelection[] = {"power", "paper", "uniform"};
   j["light_selection"] = kSelection[int(s.light_selection)];
-  j["shadow_rays"] = s.shadow_rays;
+  j["shadow_rays"] = s.path.shadow_rays;
   j["bvh"] = s.bvh == BvhLayout::Compact ? "compact" : "fast";
   if (s.adaptive()) {
     Json adaptive;
@@ -372,8 +372,8 @@ Json render_json(const SceneDesc& scene) {
     if (s.adaptive_max_spp > 0) adaptive["max_spp"] = s.adaptive_max_spp;
     j["adaptive"] = std::move(adaptive);
   }
-  j["mlt"] = Json{{"bootstrap", s.mlt_bootstrap}, {"chains", s.mlt_chains},   {"sigma", s.mlt_sigma},
-                  {"large_step", s.mlt_large_step}, {"lens", s.mlt_lens}, {"caustic", s.mlt_caustic}};
+  j["mlt"] = Json{{"bootstrap", s.mlt.bootstrap}, {"chains", s.mlt.chains},   {"sigma", s.mlt.sigma},
+                  {"large_step", s.mlt.large_step}, {"lens", s.mlt.lens}, {"caustic", s.mlt.caustic}};
   return j;
 }
 

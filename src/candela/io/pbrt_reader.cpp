@@ -1316,10 +1316,10 @@ void PbrtParser::integrator(const Token& d) {
     float sigma = params.get_float("sigma", 0.01f);
     if (!(sigma > 0 && sigma <= 1)) params.fail("sigma", "must be in (0, 1], got {}", sigma);
     rs.spp = mutations;
-    rs.mlt_bootstrap = bootstrap;
-    rs.mlt_chains = chains;
-    rs.mlt_large_step = large_step;
-    rs.mlt_sigma = sigma;
+    rs.mlt.bootstrap = bootstrap;
+    rs.mlt.chains = chains;
+    rs.mlt.large_step = large_step;
+    rs.mlt.sigma = sigma;
   } else {
     for (std::string_view name : known->second)
       ignore_param(params, name, "candela's path integrator has no such setting");

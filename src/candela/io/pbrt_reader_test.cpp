@@ -1136,10 +1136,10 @@ TEST(PbrtReader, BdptAndMltAreCandelasOwn) {
     EXPECT_EQ(mlt.settings.integrator, "mlt");
     EXPECT_EQ(mlt.settings.max_depth, 4);
     EXPECT_EQ(mlt.settings.spp, 40);
-    EXPECT_EQ(mlt.settings.mlt_bootstrap, 500);
-    EXPECT_EQ(mlt.settings.mlt_chains, 20);
-    EXPECT_FLOAT_EQ(mlt.settings.mlt_large_step, 0.25f);
-    EXPECT_FLOAT_EQ(mlt.settings.mlt_sigma, 0.02f);
+    EXPECT_EQ(mlt.settings.mlt.bootstrap, 500);
+    EXPECT_EQ(mlt.settings.mlt.chains, 20);
+    EXPECT_FLOAT_EQ(mlt.settings.mlt.large_step, 0.25f);
+    EXPECT_FLOAT_EQ(mlt.settings.mlt.sigma, 0.02f);
   }
   EXPECT_EQ(read_lines({"Integrator \"mlt\"", "WorldBegin"}).settings.spp, 100);  // pbrt's default
   EXPECT_THROW(read_lines({"Integrator \"mlt\" \"float sigma\" 0", "WorldBegin"}), SceneError);

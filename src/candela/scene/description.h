@@ -577,30 +577,63 @@ enum class LightSelection {
            // misjudges, as for a small spot beside a large sky
 };
 
+// Settings only the path tracer reads (integrator "path"; docs/cli.md lists the flags).
+struct PathSettings {
+  DirectionSampling direction_sampling = DirectionSampling::Bsdf;
+  bool mis = true;  // false: light sampling for direct light, emission found by bounces ignored
+  int shadow_rays = 1;  // per path vertex
+};
+
+// Metropolis light transport's settings (integrator "mlt"; RenderSettings::spp is then the number
+// of mutations per pixel): bootstrap states per depth, independent chains, the deviation of small
+// steps in primary sample space and the probability of a large step (pbrt's defaults), and the
+// probabilities of a lens and of a caustic perturbation (mlt_sampler.h); the rest are small steps.
+struct MltSettings {
+  int bootstrap = 100000;
+  int chains = 1000;
+  float sigma = 0.01f;
+  float large_step = 0.3f;
+  float lens = 0;
+  float caustic = 0;
+  // Why these are not a valid set (the mutation probabilities sum past 1), or empty: the one
+  // check behind the command line's and the readers' messages.
+  std::string problem() const {
+    float sum = large_step + lens + caustic;
+    return sum > 1 ? fmt::format("large_step + lens + caustic must be at most 1, got {}", sum) : std::string();
+  }
+  // For image metadata and checkpoint fingerprints.
+  std::string describe() const {
+    return fmt::format("bootstrap {} chains {} sigma {} large-step {} lens {} caustic {}", bootstrap, chains, sigma,
+                       large_step, lens, caustic);
+  }
+};
+
+// What a render does. The fields outside `path` and `mlt` are read by more than one integrator;
+// integrators/integrator.h's registry says which integrator reads which, and the readers and the
+// command line reject a setting the chosen integrator does not read.
 struct RenderSettings {
   int spp = 16;
   int max_depth = 16;  // maximum number of scattering events; 1 = direct lighting only
   uint64_t seed = 0;
   std::string integrator = "path";
-  int rr_start_depth = 3;  // Russian roulette on throughput starts after this many bounces
+  int rr_start_depth = 3;  // Russian roulette on throughput starts after this many bounces (path, bdpt)
   SamplerDesc sampler;
   FilterDesc filter;
-  DirectionSampling direction_sampling = DirectionSampling::Bsdf;
-  bool mis = true;  // false: light sampling for direct light, emission found by bounces ignored
   bool hide_emitters = false;  // emitters seen directly by the camera (depth 0) are not shown (Mitsuba's)
   // Spectral transport (spectral/wavelengths.h): each sample carries three wavelengths and RGB
   // parameters become smooth spectra, as in pbrt-v4; off = RGB transport.
   bool spectral = false;
+  // Power and uniform shape the scene's light distribution, which every integrator samples; the
+  // paper's rule is the path tracer's alone.
   LightSelection light_selection = LightSelection::Power;
-  int shadow_rays = 1;
   BvhLayout bvh = BvhLayout::Fast;
-  // Adaptive sampling (sec. 4.3), on when a threshold or a budget is set (then `spp` is unused).
-  // Every pixel first gets `adaptive_batch` samples (a power of two). With a threshold, pixels
-  // whose relative standard error falls below it get no more. With a budget of `adaptive_spp`
-  // samples per pixel on average, the rest of the budget goes, in rounds, to each pixel in
-  // proportion to its estimated relative deviation (the allocation that minimises the image's
-  // relMSE); without a budget every pixel above the threshold gets another batch per round. No
-  // pixel gets more than `adaptive_max_spp` (0: 1024, or 8 x adaptive_spp with a budget).
+  // Adaptive sampling (sec. 4.3; path and bdpt), on when a threshold or a budget is set (then `spp`
+  // is unused). Every pixel first gets `adaptive_batch` samples (a power of two). With a threshold,
+  // pixels whose relative standard error falls below it get no more. With a budget of
+  // `adaptive_spp` samples per pixel on average, the rest of the budget goes, in rounds, to each
+  // pixel in proportion to its estimated relative deviation (the allocation that minimises the
+  // image's relMSE); without a budget every pixel above the threshold gets another batch per
+  // round. No pixel gets more than `adaptive_max_spp` (0: 1024, or 8 x adaptive_spp with a budget).
   float adaptive_threshold = 0;
   int adaptive_spp = 0;
   int adaptive_batch = 16;
@@ -610,16 +643,8 @@ struct RenderSettings {
     if (adaptive_max_spp > 0) return adaptive_max_spp;
     return adaptive_spp > 0 ? int(std::min<int64_t>(8 * int64_t(adaptive_spp), std::numeric_limits<int>::max())) : 1024;
   }
-  // Metropolis light transport (integrator "mlt"; spp is then the number of mutations per pixel):
-  // bootstrap states per depth, independent chains, the deviation of small steps in primary sample
-  // space and the probability of a large step (pbrt's defaults), and the probabilities of a lens
-  // and of a caustic perturbation (mlt_sampler.h); the rest are small steps.
-  int mlt_bootstrap = 100000;
-  int mlt_chains = 1000;
-  float mlt_sigma = 0.01f;
-  float mlt_large_step = 0.3f;
-  float mlt_lens = 0;
-  float mlt_caustic = 0;
+  PathSettings path;
+  MltSettings mlt;
 };
 
 struct SceneDesc {

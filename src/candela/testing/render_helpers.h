@@ -5,7 +5,7 @@
 #include <functional>
 
 #include "candela/film/film.h"
-#include "candela/render/renderer.h"
+#include "candela/integrators/integrator.h"
 #include "candela/scene/description.h"
 #include "candela/scene/scene.h"
 

@@ -1,23 +1,28 @@
 #pragma once
-// The render loop: the image is cut into tiles, the samples into passes; each pass renders every
-// tile in parallel with oneTBB. Every pixel sample draws its random numbers as a function of
-// (pixel, sample index, seed) and each pixel accumulates its samples in sample order, so the image
-// is bitwise identical for any thread count.
+// The render loop that the integrators tracing camera samples share (pbrt-v4's ImageTileIntegrator):
+// the image is cut into tiles, the samples into passes; each pass renders every tile in parallel
+// with oneTBB. Every pixel sample draws its random numbers as a function of (pixel, sample index,
+// seed) and each pixel accumulates its samples in sample order, so the image is bitwise identical
+// for any thread count.
 //
 // Adaptive sampling (Häkkinen 2002, sec. 4.3): all pixels first get one batch of F samples (F a
 // power of two, so stratification holds within the batch); then, round by round, pixels whose
 // relative standard error still exceeds the threshold get another batch, up to the maximum spp, or,
 // with a budget of samples, each pixel gets a share proportional to its estimated relative
 // deviation (RenderSettings::adaptive_spp).
+//
+// An integrator gives the loop a TileIntegrator (usually CameraSampleTiles, render/camera_sample_tiles.h,
+// around its radiance function); integrators/integrator.h chooses the integrator.
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <mutex>
 #include <string>
 #include <vector>
 
 #include "candela/film/film.h"
-#include "candela/integrators/bdpt.h"
-#include "candela/integrators/path_integrator.h"
+#include "candela/film/filter.h"
+#include "candela/sampling/samplers.h"
 #include "candela/scene/scene.h"
 
 namespace candela {
@@ -67,22 +72,62 @@ struct RenderStats {
   double mlt_normalization_seconds = 0;
 };
 
-// Names of the integrators, for messages: "path, bdpt, mlt".
-std::string known_integrators();
-
-// Names accepted by RenderSettings::integrator.
-bool is_known_integrator(const std::string& name);
-
 // The relative error adaptive sampling compares with its threshold: the largest over the channels
 // of standard error / sqrt(mean^2 + 0.01), the per-pixel form of relMSE with epsilon 0.01.
 float relative_error(const PixelSums& pixel);
 
-// Renders into `film` (sized to the camera's resolution) with settings.integrator: "path" (the path
-// tracer), "bdpt" (bidirectional path tracing; light tracing lands in the film's splats) or "mlt"
-// (Metropolis light transport: settings.spp mutations per pixel, all in the splats).
-// settings.spp samples per pixel, or adaptively when settings.adaptive() (path, bdpt). Without adaptive sampling the film may already
-// hold samples (a resumed checkpoint): each pixel continues from its own sample count, so the result
-// is bitwise the same as one uninterrupted render.
-RenderStats render(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options);
+// The non-finite samples to report: the `limit` smallest by (sample, y, x), so the list does not
+// depend on thread timing.
+class NonFiniteLog {
+ public:
+  explicit NonFiniteLog(int limit);
+  void add(int x, int y, uint64_t sample);
+  std::vector<NonFiniteSample> samples() const { return samples_; }
+
+ private:
+  size_t limit_;
+  std::mutex mutex_;
+  std::vector<NonFiniteSample> samples_;
+};
+
+struct Tile {
+  int x0, y0, x1, y1;
+};
+
+// Which samples a pixel gets in a pass: [first, first + count); count <= 0 skips the pixel.
+struct SampleRange {
+  int64_t first;
+  int count;
+};
+using SampleRanges = std::function<SampleRange(int x, int y)>;
+
+// What every tile of a render shares.
+struct TileContext {
+  const Scene& scene;
+  const Filter& filter;
+  const Sampler& prototype;  // copied per tile: samplers carry per-sample state
+  Film& film;
+  std::atomic<uint64_t>& non_finite;
+  NonFiniteLog& non_finite_log;
+  float clamp;
+  bool spectral;
+};
+
+// An integrator as the loop sees it: renders the samples `range` names for every pixel of a tile,
+// adding them to context.film, and returns how many it rendered. Called concurrently for different
+// tiles (never for two tiles that share a pixel).
+class TileIntegrator {
+ public:
+  virtual ~TileIntegrator() = default;
+  virtual uint64_t render_tile(const Tile& tile, const SampleRanges& range, const TileContext& context,
+                               RayCounts& counts) const = 0;
+};
+
+// Renders settings.spp samples per pixel into `film` (sized to the camera's resolution) with
+// `integrator`, or adaptively when settings.adaptive(). Without adaptive sampling the film may
+// already hold samples (a resumed checkpoint): each pixel continues from its own sample count, so
+// the result is bitwise the same as one uninterrupted render.
+RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options,
+                         const TileIntegrator& integrator);
 
 }  // namespace candela

@@ -1,4 +1,4 @@
-#include "candela/render/renderer.h"
+#include "candela/render/render_loop.h"
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -14,10 +14,7 @@
 #include <stdexcept>
 #include <tuple>
 
-#include "candela/film/filter.h"
-#include "candela/integrators/mlt.h"
 #include "candela/render/progress.h"
-#include "candela/sampling/samplers.h"
 
 namespace candela {
 namespace {
@@ -25,10 +22,6 @@ namespace {
 constexpr int kTileSize = 16;
 constexpr int kPassSpp = 16;  // samples per pixel per pass in plain renders: a responsive progress bar, and
                                // runs of one pixel's samples long enough for samplers to reuse per-pixel work
-
-struct Tile {
-  int x0, y0, x1, y1;
-};
 
 std::vector<Tile> make_tiles(int width, int height) {
   std::vector<Tile> tiles;
@@ -38,113 +31,24 @@ std::vector<Tile> make_tiles(int width, int height) {
   return tiles;
 }
 
-// The non-finite samples to report: the `limit` smallest by (sample, y, x), so the list does not
-// depend on thread timing.
-class NonFiniteLog {
- public:
-  explicit NonFiniteLog(int limit) : limit_(size_t(std::max(limit, 0))) {}
-  void add(int x, int y, uint64_t s) {
-    std::lock_guard lock(mutex_);
-    NonFiniteSample n{x, y, s};
-    auto less = [](const NonFiniteSample& a, const NonFiniteSample& b) {
-      return std::tie(a.sample, a.y, a.x) < std::tie(b.sample, b.y, b.x);
-    };
-    if (samples_.size() == limit_ && (limit_ == 0 || !less(n, samples_.back()))) return;
-    samples_.insert(std::upper_bound(samples_.begin(), samples_.end(), n, less), n);
-    if (samples_.size() > limit_) samples_.pop_back();
-  }
-  std::vector<NonFiniteSample> samples() const { return samples_; }
-
- private:
-  size_t limit_;
-  std::mutex mutex_;
-  std::vector<NonFiniteSample> samples_;
-};
-
 // Everything one pass needs, shared by all tiles.
 struct PassContext {
-  const Scene& scene;
-  const PathIntegrator* path;  // one of the two
-  const BdptIntegrator* bdpt;
-  BdptTarget bdpt_target;
-  const Filter& filter;
-  const Sampler& prototype;  // copied per tile: samplers carry per-sample state
-  Film& film;
+  const TileIntegrator& integrator;
+  TileContext tile;
   tbb::enumerable_thread_specific<RayCounts>& ray_counts;
-  std::atomic<uint64_t>& non_finite;
-  NonFiniteLog& non_finite_log;
-  float clamp;
   const std::atomic<bool>* cancel;
-  bool spectral;
 };
 
 bool cancelled(const PassContext& pc) { return pc.cancel && pc.cancel->load(std::memory_order_relaxed); }
 
-// Renders samples [first, first + count) of pixel (x, y).
-template <typename S>
-void render_pixel(const PassContext& pc, S& sampler, int x, int y, uint64_t first, int count, RayCounts& counts) {
-  const PerspectiveCamera& camera = pc.scene.camera();
-  for (uint64_t s = first; s < first + uint64_t(count); ++s) {
-    sampler.start_pixel_sample(x, y, s);
-    // Place the sample in the pixel by importance-sampling the reconstruction filter (eq. 9 with a
-    // filter); the sample counts for this pixel only, with the filter's weight.
-    Filter::Sample fs = pc.filter.sample(sampler.get_pixel_2d());
-    // Only effects that exist take sampler dimensions: a pinhole needs no lens sample, a scene where
-    // nothing moves no time (the path's first vertices then get the better-stratified dimensions).
-    Vec2 lens = camera.has_lens() ? sampler.get_2d() : Vec2(0.5f, 0.5f);
-    // Pick the path's time in the shutter interval (sec. 4.2); every object is seen at it.
-    float time = pc.scene.has_motion() ? lerp(sampler.get_1d(), camera.shutter_open(), camera.shutter_close())
-                                       : camera.shutter_open();
-    Ray ray = camera.generate_ray({float(x) + 0.5f + fs.offset.x, float(y) + 0.5f + fs.offset.y}, lens, time);
-    // A spectral render draws the path's wavelengths next; its radiance comes back as their values.
-    Wavelengths storage;
-    const Wavelengths* wl = sample_wavelengths_if(pc.spectral, sampler, storage);
-    RGB L = wavelengths_to_rgb(pc.bdpt ? pc.bdpt->radiance(ray, sampler, counts, pc.bdpt_target, x, y, fs.weight, wl)
-                                       : pc.path->radiance(ray, sampler, counts, wl),
-                               wl);
-    if (!L.is_finite()) {
-      // Never reaches the film: counted, the first few logged, and the sample counts as black.
-      pc.non_finite.fetch_add(1, std::memory_order_relaxed);
-      pc.non_finite_log.add(x, y, s);
-      L = RGB(0.0f);
-    } else if (pc.clamp > 0) {
-      float m = L.max_component();
-      if (m > pc.clamp) L *= pc.clamp / m;
-    }
-    pc.film.add_sample(x, y, L, fs.weight);
-  }
-}
-
-// Which samples a pixel gets in a pass: [first, first + count); count <= 0 skips the pixel.
-struct SampleRange {
-  int64_t first;
-  int count;
-};
-
 // One pass over the tiles: pixel (x, y) gets the samples range(x, y) names. Tiles not yet started
 // when the cancel flag is set are skipped.
-template <typename Range>
-void run_pass(const PassContext& pc, const std::vector<Tile>& tiles, tbb::task_arena& arena, Range range,
+void run_pass(const PassContext& pc, const std::vector<Tile>& tiles, tbb::task_arena& arena, const SampleRanges& range,
               ProgressBar& progress) {
   arena.execute([&] {
     tbb::parallel_for(size_t(0), tiles.size(), [&](size_t t) {
       if (cancelled(pc)) return;
-      const Tile& tile = tiles[t];
-      RayCounts& counts = pc.ray_counts.local();
-      uint64_t done = 0;
-      std::visit(
-          [&](const auto& prototype) {
-            auto sampler = prototype;
-            for (int y = tile.y0; y < tile.y1; ++y)
-              for (int x = tile.x0; x < tile.x1; ++x) {
-                SampleRange r = range(x, y);
-                if (r.count <= 0) continue;
-                render_pixel(pc, sampler, x, y, uint64_t(r.first), r.count, counts);
-                done += uint64_t(r.count);
-              }
-          },
-          pc.prototype);
-      progress.advance(done);
+      progress.advance(pc.integrator.render_tile(tiles[t], range, pc.tile, pc.ray_counts.local()));
     });
   });
 }
@@ -251,7 +155,7 @@ template <typename StopAfterPass>
 void render_adaptive(const PassContext& pc, const std::vector<Tile>& tiles, tbb::task_arena& arena,
                      ProgressBar& progress, const RenderSettings& settings, const RenderOptions& options,
                      StopAfterPass stop_after_pass) {
-  Film& film = pc.film;
+  Film& film = pc.tile.film;
   const int w = film.width(), h = film.height();
   const size_t pixels = size_t(w) * h;
   const int batch = settings.adaptive_batch, cap = std::max(settings.adaptive_spp_limit(), batch);
@@ -333,9 +237,18 @@ void render_adaptive(const PassContext& pc, const std::vector<Tile>& tiles, tbb:
 
 }  // namespace
 
-bool is_known_integrator(const std::string& name) { return name == "path" || name == "bdpt" || name == "mlt"; }
+NonFiniteLog::NonFiniteLog(int limit) : limit_(size_t(std::max(limit, 0))) {}
 
-std::string known_integrators() { return "path, bdpt, mlt"; }
+void NonFiniteLog::add(int x, int y, uint64_t s) {
+  std::lock_guard lock(mutex_);
+  NonFiniteSample n{x, y, s};
+  auto less = [](const NonFiniteSample& a, const NonFiniteSample& b) {
+    return std::tie(a.sample, a.y, a.x) < std::tie(b.sample, b.y, b.x);
+  };
+  if (samples_.size() == limit_ && (limit_ == 0 || !less(n, samples_.back()))) return;
+  samples_.insert(std::upper_bound(samples_.begin(), samples_.end(), n, less), n);
+  if (samples_.size() > limit_) samples_.pop_back();
+}
 
 float relative_error(const PixelSums& pixel) {
   RGB mean = pixel.mean(), se = pixel.standard_error();
@@ -344,30 +257,15 @@ float relative_error(const PixelSums& pixel) {
   return worst;
 }
 
-RenderStats render(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options) {
-  if (!is_known_integrator(settings.integrator))
-    throw std::invalid_argument("unknown integrator '" + settings.integrator + "' (known: " + known_integrators() + ")");
+RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options,
+                         const TileIntegrator& integrator) {
   if (options.only_x >= film.width() || options.only_y >= film.height() || (options.only_x >= 0) != (options.only_y >= 0))
     throw std::invalid_argument("pixel to render is outside the image");
-  if (settings.integrator == "mlt") {
-    if (settings.adaptive()) throw std::invalid_argument("adaptive sampling does not apply to the mlt integrator");
-    if (options.only_x >= 0) throw std::invalid_argument("the mlt integrator cannot render a single pixel");
-    if (film.total_samples() > 0 || (film.has_splats() && film.splats().sums() != std::vector<int64_t>(film.splats().sums().size(), 0)))
-      throw std::invalid_argument("the mlt integrator cannot continue a partly rendered film");
-    return render_mlt(scene, settings, film, options);
-  }
-  const bool bidirectional = settings.integrator == "bdpt";
-  if (bidirectional && !film.has_splats()) film.enable_splats();
   auto start = std::chrono::steady_clock::now();
   const bool adaptive = settings.adaptive();
   const int max_spp = adaptive ? std::max(settings.adaptive_spp_limit(), settings.adaptive_batch) : settings.spp;
 
   const Filter filter(settings.filter);
-  std::optional<PathIntegrator> path;
-  std::optional<BdptIntegrator> bdpt;
-  if (bidirectional) bdpt.emplace(scene, settings);
-  else path.emplace(scene, settings);
-  BdptTarget bdpt_target{&film, &filter, options.bdpt_strategies, options.bdpt_unweighted};
   const Sampler prototype = make_sampler(settings.sampler, adaptive ? adaptive_set_size(settings) : settings.spp,
                                          settings.seed, film.width(), film.height());
   std::vector<Tile> tiles = options.only_x >= 0 ? std::vector<Tile>{{options.only_x, options.only_y,
@@ -377,8 +275,10 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
   tbb::enumerable_thread_specific<RayCounts> ray_counts;
   std::atomic<uint64_t> non_finite{0};
   NonFiniteLog non_finite_log(options.max_reported_non_finite);
-  PassContext pc{scene,      path ? &*path : nullptr, bdpt ? &*bdpt : nullptr, bdpt_target, filter, prototype, film,
-                 ray_counts, non_finite,            non_finite_log,          options.clamp, options.cancel, settings.spectral};
+  PassContext pc{integrator,
+                 {scene, filter, prototype, film, non_finite, non_finite_log, options.clamp, settings.spectral},
+                 ray_counts,
+                 options.cancel};
   const uint64_t samples_before = film.total_samples();
   const uint64_t expected_spp = adaptive && settings.adaptive_spp > 0 ? uint64_t(settings.adaptive_spp) : uint64_t(max_spp);
   ProgressBar progress(pixel_count * expected_spp, options.progress);
@@ -423,12 +323,6 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
   }
   progress.finish();
 
-  // One light path was traced per camera sample: the light image is the splats times the
-  // importance film's area over their number.
-  if (bidirectional) {
-    uint64_t light_paths = film.total_samples();
-    film.set_splat_scale(light_paths > 0 ? double(scene.camera().importance_film_pixels()) / double(light_paths) : 0);
-  }
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   stats.samples = film.total_samples() - samples_before;
   stats.non_finite_samples = non_finite.load();

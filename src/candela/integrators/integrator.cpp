@@ -1,0 +1,96 @@
+#include "candela/integrators/integrator.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "candela/integrators/bdpt.h"
+#include "candela/integrators/mlt.h"
+#include "candela/integrators/path_integrator.h"
+
+namespace candela {
+
+const std::vector<IntegratorEntry>& integrators() {
+  static const std::vector<IntegratorEntry> table = {
+      {"path", "path tracing (Häkkinen 2002): next-event estimation, MIS, Russian roulette",
+       {"direction_sampling", "mis", "shadow_rays", "light_selection=paper", "rr_start_depth", "adaptive"},
+       /*resumable=*/true, /*single_pixel=*/true, /*strategy_images=*/false, /*samples_are_mutations=*/false,
+       render_path},
+      {"bdpt", "bidirectional path tracing: every connection strategy, MIS, light tracing splatted",
+       {"rr_start_depth", "adaptive"},
+       /*resumable=*/true, /*single_pixel=*/true, /*strategy_images=*/true, /*samples_are_mutations=*/false,
+       render_bdpt},
+      {"mlt", "Metropolis light transport over bidirectional paths (--spp is then mutations per pixel)",
+       {"mlt"},
+       /*resumable=*/false, /*single_pixel=*/false, /*strategy_images=*/false, /*samples_are_mutations=*/true,
+       render_mlt},
+  };
+  return table;
+}
+
+bool IntegratorEntry::reads_setting(std::string_view key) const {
+  return std::find(reads.begin(), reads.end(), key) != reads.end();
+}
+
+const IntegratorEntry* find_integrator(std::string_view name) {
+  for (const IntegratorEntry& entry : integrators())
+    if (entry.name == name) return &entry;
+  return nullptr;
+}
+
+std::string integrator_names() {
+  std::string names;
+  for (const IntegratorEntry& entry : integrators()) names += (names.empty() ? "" : ", ") + std::string(entry.name);
+  return names;
+}
+
+std::string unread_setting_message(const IntegratorEntry& integrator, std::string_view key) {
+  std::string readers;
+  for (const IntegratorEntry& entry : integrators())
+    if (entry.reads_setting(key)) readers += (readers.empty() ? "" : ", ") + std::string(entry.name);
+  std::string_view what;
+  for (const SelectiveSetting& s : kSelectiveSettings)
+    if (s.key == key) what = s.what;
+  return fmt::format("the {} integrator does not read {} ({}; read by: {})", integrator.name, key, what, readers);
+}
+
+std::vector<std::string_view> set_but_unread(const IntegratorEntry& integrator, const RenderSettings& settings) {
+  const RenderSettings defaults;
+  const PathSettings& p = settings.path;
+  const MltSettings& m = settings.mlt;
+  auto set = [&](std::string_view key) {
+    if (key == "direction_sampling") return p.direction_sampling != defaults.path.direction_sampling;
+    if (key == "mis") return p.mis != defaults.path.mis;
+    if (key == "shadow_rays") return p.shadow_rays != defaults.path.shadow_rays;
+    if (key == "light_selection=paper") return settings.light_selection == LightSelection::Paper;
+    if (key == "rr_start_depth") return settings.rr_start_depth != defaults.rr_start_depth;
+    if (key == "adaptive") return settings.adaptive();
+    if (key == "mlt")
+      return m.bootstrap != defaults.mlt.bootstrap || m.chains != defaults.mlt.chains || m.sigma != defaults.mlt.sigma ||
+             m.large_step != defaults.mlt.large_step || m.lens != defaults.mlt.lens || m.caustic != defaults.mlt.caustic;
+    throw std::logic_error(fmt::format("set_but_unread: no check for the setting {}", key));
+  };
+  std::vector<std::string_view> unread;
+  for (const SelectiveSetting& s : kSelectiveSettings)
+    if (!integrator.reads_setting(s.key) && set(s.key)) unread.push_back(s.key);
+  return unread;
+}
+
+RenderStats render(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options) {
+  const IntegratorEntry* integrator = find_integrator(settings.integrator);
+  if (!integrator)
+    throw std::invalid_argument(fmt::format("unknown integrator '{}' (known: {})", settings.integrator, integrator_names()));
+  if (settings.adaptive() && !integrator->reads_setting("adaptive"))
+    throw std::invalid_argument(fmt::format("adaptive sampling does not apply to the {} integrator", integrator->name));
+  if (options.only_x >= 0 && !integrator->single_pixel)
+    throw std::invalid_argument(fmt::format("the {} integrator cannot render a single pixel", integrator->name));
+  const bool started = film.total_samples() > 0 ||
+                       (film.has_splats() && std::any_of(film.splats().sums().begin(), film.splats().sums().end(),
+                                                         [](int64_t v) { return v != 0; }));
+  if (started && !integrator->resumable)
+    throw std::invalid_argument(fmt::format("the {} integrator cannot continue a partly rendered film", integrator->name));
+  return integrator->render(scene, settings, film, options);
+}
+
+}  // namespace candela

@@ -1,0 +1,84 @@
+#pragma once
+// The tile body of integrators that trace one camera ray per pixel sample (path tracing, BDPT):
+// for each sample, place it in the pixel by importance-sampling the reconstruction filter, pick the
+// lens point and the time, trace the ray with the integrator's radiance function, and add the
+// result to the pixel with the filter's weight. A template over the radiance function so that the
+// sampler and the integrator are dispatched once per tile, not per sample.
+#include <utility>
+#include <variant>
+
+#include "candela/render/render_loop.h"
+#include "candela/spectral/wavelengths.h"
+
+namespace candela {
+
+// Where a camera sample lies: its pixel and its reconstruction filter weight.
+struct PixelSample {
+  int x = 0, y = 0;
+  float filter_weight = 1;
+};
+
+// Radiance: a callable (const Ray&, auto& sampler, RayCounts&, const PixelSample&, const Wavelengths*)
+// returning the radiance along the camera ray (at the wavelengths, when given).
+template <typename Radiance>
+class CameraSampleTiles final : public TileIntegrator {
+ public:
+  explicit CameraSampleTiles(Radiance radiance) : radiance_(std::move(radiance)) {}
+
+  uint64_t render_tile(const Tile& tile, const SampleRanges& range, const TileContext& context,
+                       RayCounts& counts) const override {
+    uint64_t done = 0;
+    std::visit(
+        [&](const auto& prototype) {
+          auto sampler = prototype;
+          for (int y = tile.y0; y < tile.y1; ++y)
+            for (int x = tile.x0; x < tile.x1; ++x) {
+              SampleRange r = range(x, y);
+              if (r.count <= 0) continue;
+              render_pixel(context, sampler, x, y, uint64_t(r.first), r.count, counts);
+              done += uint64_t(r.count);
+            }
+        },
+        context.prototype);
+    return done;
+  }
+
+ private:
+  // Renders samples [first, first + count) of pixel (x, y).
+  template <typename S>
+  void render_pixel(const TileContext& context, S& sampler, int x, int y, uint64_t first, int count,
+                    RayCounts& counts) const {
+    const PerspectiveCamera& camera = context.scene.camera();
+    for (uint64_t s = first; s < first + uint64_t(count); ++s) {
+      sampler.start_pixel_sample(x, y, s);
+      // Place the sample in the pixel by importance-sampling the reconstruction filter (eq. 9 with a
+      // filter); the sample counts for this pixel only, with the filter's weight.
+      Filter::Sample fs = context.filter.sample(sampler.get_pixel_2d());
+      // Only effects that exist take sampler dimensions: a pinhole needs no lens sample, a scene where
+      // nothing moves no time (the path's first vertices then get the better-stratified dimensions).
+      Vec2 lens = camera.has_lens() ? sampler.get_2d() : Vec2(0.5f, 0.5f);
+      // Pick the path's time in the shutter interval (sec. 4.2); every object is seen at it.
+      float time = context.scene.has_motion() ? lerp(sampler.get_1d(), camera.shutter_open(), camera.shutter_close())
+                                              : camera.shutter_open();
+      Ray ray = camera.generate_ray({float(x) + 0.5f + fs.offset.x, float(y) + 0.5f + fs.offset.y}, lens, time);
+      // A spectral render draws the path's wavelengths next; its radiance comes back as their values.
+      Wavelengths storage;
+      const Wavelengths* wl = sample_wavelengths_if(context.spectral, sampler, storage);
+      RGB L = wavelengths_to_rgb(radiance_(ray, sampler, counts, PixelSample{x, y, fs.weight}, wl), wl);
+      if (!L.is_finite()) {
+        // Never reaches the film: counted, the first few logged, and the sample counts as black.
+        context.non_finite.fetch_add(1, std::memory_order_relaxed);
+        context.non_finite_log.add(x, y, s);
+        L = RGB(0.0f);
+      } else if (context.clamp > 0) {
+        float m = L.max_component();
+        if (m > context.clamp) L *= context.clamp / m;
+      }
+      context.film.add_sample(x, y, L, fs.weight);
+    }
+  }
+
+  Radiance radiance_;
+};
+
+}  // namespace candela
