@@ -124,7 +124,7 @@ std::string error_reading(const fs::path& file) {
   return error_of([&](std::vector<std::string>& warnings) { read_pbrt_scene(file, warnings); });
 }
 
-std::string error_reading(const std::vector<std::string>& lines) {
+std::string error_reading_text(const std::vector<std::string>& lines) {
   return error_of(
       [&](std::vector<std::string>& warnings) { read_pbrt_string(joined(lines), kSceneName, scratch_dir(), warnings); });
 }
@@ -134,7 +134,7 @@ std::string error_reading(const std::vector<std::string>& lines) {
 void expect_error(const std::vector<std::string>& lines, int line, std::string_view marker, std::string_view fragment) {
   size_t column = lines.at(line - 1).find(marker);
   ASSERT_NE(column, std::string::npos) << "marker " << marker << " is not in line " << line;
-  std::string message = error_reading(lines);
+  std::string message = error_reading_text(lines);
   std::string place = fmt::format("{}:{}:{}: ", kSceneName, line, column + 1);
   EXPECT_TRUE(message.starts_with(place)) << "expected the error at " << place << "\ngot: " << message;
   EXPECT_NE(message.find(fragment), std::string::npos) << "expected \"" << fragment << "\" in: " << message;
@@ -1027,7 +1027,7 @@ TEST(PbrtReader, DirectivesInTheWrongSection) {
 
 TEST(PbrtReader, SceneMustReachWorldBegin) {
   // The error is at the end of the text: line 3, after the last newline.
-  EXPECT_EQ(error_reading({"Film \"rgb\"", "# no world"}),
+  EXPECT_EQ(error_reading_text({"Film \"rgb\"", "# no world"}),
             kSceneName + ":3:1: the scene ends before WorldBegin; the shapes and lights must follow a WorldBegin");
 }
 
