@@ -125,8 +125,9 @@ std::string error_reading(const fs::path& file) {
 }
 
 std::string error_reading_text(const std::vector<std::string>& lines) {
-  return error_of(
-      [&](std::vector<std::string>& warnings) { read_pbrt_string(joined(lines), kSceneName, scratch_dir(), warnings); });
+  return error_of([&](std::vector<std::string>& warnings) {
+    read_pbrt_string(joined(lines), kSceneName, scratch_dir(), warnings);
+  });
 }
 
 // Expects the scene to fail with a message that starts "<file>:<line>:<column>: ", where the column

@@ -18,6 +18,12 @@ RGB SceneParser::read_light_scale(ParamList& params, RGB emitted) {
   return emitted * scale;
 }
 
+// Lights are placed once: an animated CTM (ActiveTransform) cannot move them.
+void SceneParser::require_static_light(const Token& directive, const Token& type) const {
+  if (state_.ctm.is_animated())
+    throw_scene_error(at(directive), "LightSource \"{}\": lights must not move (the CTM is animated)", type.text);
+}
+
 void SceneParser::light_source(const Token& d) {
   require_world(d);
   Token type = expect_string(d, "the light type");
@@ -32,8 +38,7 @@ void SceneParser::light_source(const Token& d) {
     if (power > 0) intensity *= power / (4 * kPi);  // pbrt-v4: the power of an isotropic source
     Point3 from = params.get_point3("from", Point3(0.0f));
     params.reject_unused();
-    if (state_.ctm.is_animated())
-      throw_scene_error(at(d), "LightSource \"point\": lights must not move (the CTM is animated)");
+    require_static_light(d, type);
     add_light(PointLight{ctm.point(from), intensity}, at(d));
   } else if (type.text == "spot") {
     RGB intensity = read_light_scale(params, read_emission(params, "I").value_or(RGB(1.0f)));
@@ -52,8 +57,7 @@ void SceneParser::light_source(const Token& d) {
     Point3 to = params.get_point3("to", Point3(0, 0, 1));
     if (from == to) params.fail("to", "must differ from \"from\" (the spot light points from \"from\" to \"to\")");
     params.reject_unused();
-    if (state_.ctm.is_animated())
-      throw_scene_error(at(d), "LightSource \"spot\": lights must not move (the CTM is animated)");
+    require_static_light(d, type);
     add_light(
         SpotLight{ctm.point(from), normalize(ctm.vector(to - from)), intensity, cone_angle, cone_delta}, at(d));
   } else if (type.text == "distant") {
@@ -64,8 +68,7 @@ void SceneParser::light_source(const Token& d) {
     Point3 to = params.get_point3("to", Point3(0, 0, 1));
     if (from == to) params.fail("to", "must differ from \"from\" (the light travels from \"from\" to \"to\")");
     params.reject_unused();
-    if (state_.ctm.is_animated())
-      throw_scene_error(at(d), "LightSource \"distant\": lights must not move (the CTM is animated)");
+    require_static_light(d, type);
     add_light(DistantLight{normalize(ctm.vector(to - from)), radiance}, at(d));
   } else if (type.text == "infinite") {
     if (params.has("L") && params.has("filename"))
@@ -89,8 +92,7 @@ void SceneParser::light_source(const Token& d) {
       std::string name = params.get_string("filename", "");
       fs::path file = resolve_path(name, params.where("filename"), fmt::format("{}: \"filename\"", params.owner()));
       params.reject_unused();
-      if (state_.ctm.is_animated())
-        throw_scene_error(at(d), "LightSource \"infinite\": lights must not move (the CTM is animated)");
+      require_static_light(d, type);
       EnvironmentMap map;
       map.filename = file.string();
       map.mapping = EnvironmentMapping::EqualAreaOctahedral;

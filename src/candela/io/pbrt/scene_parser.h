@@ -206,6 +206,7 @@ class SceneParser {
   BuiltGeometry make_disk(ParamList& params);
   BuiltGeometry make_bilinear_mesh(ParamList& params);
   RGB read_light_scale(ParamList& params, RGB emitted);
+  void require_static_light(const Token& directive, const Token& type) const;
   void add_emissive_shape(ShapeDesc shape, const BuiltGeometry& built, const Token& directive);
   void add_shape(ShapeDesc shape, const Token& directive);
 

@@ -38,7 +38,8 @@ bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' |
 
 }  // namespace
 
-Tokenizer::Tokenizer(std::string text, std::string file_name) : text_(std::move(text)), file_name_(std::move(file_name)) {
+Tokenizer::Tokenizer(std::string text, std::string file_name)
+    : text_(std::move(text)), file_name_(std::move(file_name)) {
   if (text_.starts_with("\xEF\xBB\xBF")) pos_ = 3;  // a UTF-8 byte-order mark some editors write
 }
 
@@ -138,24 +139,31 @@ char Tokenizer::decode_escape(char c, const SourceLocation& where) {
   throw_scene_error(where, "unknown escape sequence '\\{}' in a string", c);
 }
 
-std::optional<double> parse_number(std::string_view text) {
+namespace {
+
+// All of `text` read as one T (a leading '+' allowed, as pbrt's own parser does), or nothing.
+template <typename T>
+std::optional<T> read_whole(std::string_view text) {
   if (text.starts_with('+')) text.remove_prefix(1);
   if (text.empty() || text[0] == '+') return std::nullopt;
-  double value = 0;
+  T value = 0;
   auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
   if (error != std::errc() || end != text.data() + text.size()) return std::nullopt;
-  if (!std::isfinite(value) || std::abs(value) > FLT_MAX) return std::nullopt;
+  return value;
+}
+
+}  // namespace
+
+std::optional<double> parse_number(std::string_view text) {
+  std::optional<double> value = read_whole<double>(text);
+  if (!value || !std::isfinite(*value) || std::abs(*value) > FLT_MAX) return std::nullopt;
   return value;
 }
 
 std::optional<int> parse_integer(std::string_view text) {
-  if (text.starts_with('+')) text.remove_prefix(1);
-  if (text.empty() || text[0] == '+') return std::nullopt;
-  int64_t value = 0;
-  auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (error != std::errc() || end != text.data() + text.size()) return std::nullopt;
-  if (value < INT_MIN || value > INT_MAX) return std::nullopt;
-  return static_cast<int>(value);
+  std::optional<int64_t> value = read_whole<int64_t>(text);
+  if (!value || *value < INT_MIN || *value > INT_MAX) return std::nullopt;
+  return static_cast<int>(*value);
 }
 
 }  // namespace candela::pbrt
