@@ -9,6 +9,7 @@
 #include <numbers>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -33,8 +34,9 @@ const fs::path kTestData = fs::path(CANDELA_SOURCE_DIR) / "tests/data/pbrt";
 // The directory of the scratch scenes and files of this test process.
 fs::path scratch_dir() { return fs::temp_directory_path() / fmt::format("candela_pbrt_reader_{}", getpid()); }
 
-// A scene written to its own file, named after the test so that tests can run in parallel
-// processes; the file is removed again when the object goes out of scope.
+// A scene written to its own file, for the tests whose point is reading files; named after the test
+// so that tests can run in parallel processes; the file is removed again when the object goes out of
+// scope.
 class ScratchScene {
  public:
   explicit ScratchScene(const std::vector<std::string>& lines) {
@@ -80,9 +82,19 @@ class ScratchFile {
   fs::path path_;
 };
 
+std::string joined(const std::vector<std::string>& lines) {
+  std::string text;
+  for (const std::string& line : lines) text += line + "\n";
+  return text;
+}
+
+// The scenes of most tests are text, read with read_pbrt_string: this is their name in messages,
+// and the files they name (ScratchFile) are looked up in scratch_dir().
+const std::string kSceneName = "scene.pbrt";
+
 SceneDesc read_lines(const std::vector<std::string>& lines) {
   std::vector<std::string> warnings;
-  return read_pbrt_scene(ScratchScene(lines).path(), warnings);
+  return read_pbrt_string(joined(lines), kSceneName, scratch_dir(), warnings);
 }
 
 struct Warned {
@@ -91,37 +103,40 @@ struct Warned {
 };
 
 Warned read_warned(const std::vector<std::string>& lines) {
-  ScratchScene file(lines);
   Warned result;
-  result.scene = read_pbrt_scene(file.path(), result.warnings);
+  result.scene = read_pbrt_string(joined(lines), kSceneName, scratch_dir(), result.warnings);
   return result;
 }
 
-std::string joined(const std::vector<std::string>& lines) {
-  std::string text;
-  for (const std::string& line : lines) text += line + "\n";
-  return text;
-}
-
-// The message of the error reading `file` gives, or "" when it reads without one.
-std::string error_reading(const fs::path& file) {
+// The message of the error `read` throws, or "" when it reads without one.
+template <typename Read>
+std::string error_of(Read read) {
   try {
     std::vector<std::string> warnings;
-    read_pbrt_scene(file, warnings);
+    read(warnings);
   } catch (const SceneError& error) {
     return error.what();
   }
   return "";
 }
 
+std::string error_reading(const fs::path& file) {
+  return error_of([&](std::vector<std::string>& warnings) { read_pbrt_scene(file, warnings); });
+}
+
+std::string error_reading_text(const std::vector<std::string>& lines) {
+  return error_of([&](std::vector<std::string>& warnings) {
+    read_pbrt_string(joined(lines), kSceneName, scratch_dir(), warnings);
+  });
+}
+
 // Expects the scene to fail with a message that starts "<file>:<line>:<column>: ", where the column
 // is that of `marker` in the line, and that contains `fragment`.
 void expect_error(const std::vector<std::string>& lines, int line, std::string_view marker, std::string_view fragment) {
-  ScratchScene scene(lines);
   size_t column = lines.at(line - 1).find(marker);
   ASSERT_NE(column, std::string::npos) << "marker " << marker << " is not in line " << line;
-  std::string message = error_reading(scene.path());
-  std::string place = fmt::format("{}:{}:{}: ", scene.path().string(), line, column + 1);
+  std::string message = error_reading_text(lines);
+  std::string place = fmt::format("{}:{}:{}: ", kSceneName, line, column + 1);
   EXPECT_TRUE(message.starts_with(place)) << "expected the error at " << place << "\ngot: " << message;
   EXPECT_NE(message.find(fragment), std::string::npos) << "expected \"" << fragment << "\" in: " << message;
 }
@@ -130,13 +145,11 @@ void expect_error(const std::vector<std::string>& lines, int line, std::string_v
 // the column is that of `marker` in the line, containing `fragment`.
 void expect_warning(const std::vector<std::string>& lines, int line, std::string_view marker,
                     std::string_view fragment) {
-  ScratchScene scene(lines);
   size_t column = lines.at(line - 1).find(marker);
   ASSERT_NE(column, std::string::npos) << "marker " << marker << " is not in line " << line;
-  std::vector<std::string> warnings;
-  read_pbrt_scene(scene.path(), warnings);
+  std::vector<std::string> warnings = read_warned(lines).warnings;
   ASSERT_EQ(warnings.size(), 1u) << joined(warnings);
-  std::string place = fmt::format("{}:{}:{}: warning: ", scene.path().string(), line, column + 1);
+  std::string place = fmt::format("{}:{}:{}: warning: ", kSceneName, line, column + 1);
   EXPECT_TRUE(warnings[0].starts_with(place)) << "expected the warning at " << place << "\ngot: " << warnings[0];
   EXPECT_NE(warnings[0].find(fragment), std::string::npos) << "expected \"" << fragment << "\" in: " << warnings[0];
 }
@@ -674,6 +687,8 @@ TEST(PbrtReader, IncludeResolvesNamesBesideTheNamingFile) {
   // The same .ply named relative to the including file and relative to the top-level file.
   EXPECT_EQ(mesh_of(scene.shapes[1]).triangle_count(), 1u);
   EXPECT_EQ(mesh_of(scene.shapes[2]).positions, mesh_of(scene.shapes[1]).positions);
+  // A shape declared in an included file is placed in that file.
+  EXPECT_EQ(scene.shapes[0].where.to_string(), (kTestData / "include/parts/spheres.pbrt").string() + ":3:5");
 }
 
 TEST(PbrtReader, ErrorInAnIncludedFileNamesThatFileAndLine) {
@@ -700,14 +715,83 @@ TEST(PbrtReader, ImportedGraphicsStateDoesNotLeak) {
   EXPECT_EQ(reflectance_of(scene, scene.shapes[1]), RGB(0.5f));
 }
 
+// ---------------------------------------------------------------- text not read from a file
+
+TEST(PbrtReader, TextReadsAsItsFileWouldWithNamesResolvedInTheBaseDirectory) {
+  const fs::path file = kTestData / "include/main.pbrt";
+  std::ifstream in(file);
+  std::ostringstream text;
+  text << in.rdbuf();
+  SceneDesc from_file = read_pbrt_scene(file);
+  SceneDesc from_text = read_pbrt_string(text.str(), "main (as text)", file.parent_path());
+  EXPECT_EQ(from_text.source_file, "main (as text)");
+  EXPECT_EQ(from_text.film.width, from_file.film.width);
+  ASSERT_EQ(from_text.shapes.size(), 3u);
+  ASSERT_EQ(from_text.shapes.size(), from_file.shapes.size());
+  for (size_t i = 0; i < from_file.shapes.size(); ++i) {
+    EXPECT_EQ(from_text.shapes[i].to_world, from_file.shapes[i].to_world);
+    EXPECT_EQ(from_text.shapes[i].where.to_string(), from_file.shapes[i].where.to_string());
+    EXPECT_EQ(reflectance_of(from_text, from_text.shapes[i]), reflectance_of(from_file, from_file.shapes[i]));
+  }
+  EXPECT_EQ(mesh_of(from_text.shapes[1]).positions, mesh_of(from_file.shapes[1]).positions);
+
+  // Messages name the text by the name given, and the files it includes by their paths.
+  std::string message = error_of([&](std::vector<std::string>& warnings) {
+    read_pbrt_string("WorldBegin\nInclude \"parts/bad.pbrt\"\n", "inline", kTestData / "include", warnings);
+  });
+  EXPECT_TRUE(message.starts_with((kTestData / "include/parts/bad.pbrt").string() + ":3:1: unknown directive"))
+      << message;
+  EXPECT_NE(message.find("(in the file included at inline:2:9)"), std::string::npos) << message;
+}
+
+TEST(PbrtReader, RecordsWhereEachEntityIsDeclared) {
+  ScratchFile png("wood.png");
+  SceneDesc scene = read_lines({
+      "WorldBegin",
+      "Texture \"wood\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\"",
+      "MakeNamedMaterial \"m\" \"string type\" \"diffuse\" \"texture reflectance\" \"wood\"",
+      // "scale" makes a scale texture of "wood", which this directive declares
+      "  Material \"diffusetransmission\" \"texture transmittance\" \"wood\" \"float scale\" 0.5",
+      "LightSource \"point\"",
+      "  Shape \"sphere\"",
+      "ObjectBegin \"pair\"",
+      "Shape \"sphere\"",
+      "ObjectEnd",
+      "  ObjectInstance \"pair\"",
+  });
+  auto places = [](const std::vector<SourceLocation>& where) {
+    std::vector<std::string> text;
+    for (const SourceLocation& w : where) text.push_back(w.to_string());
+    return text;
+  };
+  ASSERT_EQ(scene.textures.size(), 2u);
+  EXPECT_EQ(places(scene.places.textures), (std::vector<std::string>{"scene.pbrt:2:1", "scene.pbrt:4:3"}));
+  ASSERT_EQ(scene.materials.size(), 2u);
+  EXPECT_EQ(places(scene.places.materials), (std::vector<std::string>{"scene.pbrt:3:1", "scene.pbrt:4:3"}));
+  ASSERT_EQ(scene.lights.size(), 1u);
+  EXPECT_EQ(places(scene.places.lights), (std::vector<std::string>{"scene.pbrt:5:1"}));
+  ASSERT_EQ(scene.shapes.size(), 1u);
+  EXPECT_EQ(scene.shapes[0].where.to_string(), "scene.pbrt:6:3");
+  ASSERT_EQ(scene.objects.size(), 1u);
+  EXPECT_EQ(scene.objects[0].where.to_string(), "scene.pbrt:7:1");
+  EXPECT_EQ(scene.objects[0].shapes.at(0).where.to_string(), "scene.pbrt:8:1");
+  ASSERT_EQ(scene.instances.size(), 1u);
+  EXPECT_EQ(scene.instances[0].where.to_string(), "scene.pbrt:10:3");
+}
+
 TEST(PbrtReader, MissingIncludeFile) {
-  expect_error({"WorldBegin", "Include \"no/such/file.pbrt\""}, 2, "\"no/such",
-               "Include: cannot find \"no/such/file.pbrt\"");
+  ScratchScene scene({"WorldBegin", "Include \"no/such/file.pbrt\""});
+  std::string message = error_reading(scene.path());
+  EXPECT_TRUE(message.starts_with(scene.path().string() + ":2:9: Include: cannot find \"no/such/file.pbrt\""))
+      << message;
 }
 
 TEST(PbrtReader, MissingPlyFile) {
-  expect_error({"WorldBegin", "Shape \"plymesh\" \"string filename\" \"missing.ply\""}, 2, "\"string filename\"",
-               "cannot find \"missing.ply\"");
+  ScratchScene scene({"WorldBegin", "Shape \"plymesh\" \"string filename\" \"missing.ply\""});
+  std::string message = error_reading(scene.path());
+  EXPECT_TRUE(message.starts_with(scene.path().string() + ":2:17: Shape \"plymesh\": \"filename\": cannot find "
+                                  "\"missing.ply\""))
+      << message;
 }
 
 TEST(PbrtReader, MissingSceneFile) {
@@ -943,11 +1027,9 @@ TEST(PbrtReader, DirectivesInTheWrongSection) {
 }
 
 TEST(PbrtReader, SceneMustReachWorldBegin) {
-  ScratchScene scene({"Film \"rgb\"", "# no world"});
-  // The error is at the end of the file: line 3, after the last newline.
-  EXPECT_EQ(error_reading(scene.path()), scene.path().string() +
-                                             ":3:1: the scene ends before WorldBegin; the shapes and lights must "
-                                             "follow a WorldBegin");
+  // The error is at the end of the text: line 3, after the last newline.
+  EXPECT_EQ(error_reading_text({"Film \"rgb\"", "# no world"}),
+            kSceneName + ":3:1: the scene ends before WorldBegin; the shapes and lights must follow a WorldBegin");
 }
 
 TEST(PbrtReader, ObjectInstancingErrors) {

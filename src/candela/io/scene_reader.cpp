@@ -14,6 +14,7 @@
 #include "candela/io/gltf_reader.h"
 #include "candela/io/mitsuba_reader.h"
 #include "candela/io/obj_scene_reader.h"
+#include "candela/io/pbrt_reader.h"
 
 namespace candela {
 namespace {

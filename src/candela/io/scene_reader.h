@@ -19,9 +19,6 @@ SceneDesc read_scene_file(const std::filesystem::path& file);
 SceneDesc read_json_scene(std::string_view text, const std::string& file_name,
                           const std::filesystem::path& base_dir);
 
-// pbrt-v4's scene format (the subset in docs/pbrt-format.md).
-SceneDesc read_pbrt_scene(const std::filesystem::path& file);
-
 // scenes/cornell-box.json, compiled into the program.
 std::string_view builtin_scene_json();
 

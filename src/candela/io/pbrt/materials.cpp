@@ -1,0 +1,179 @@
+// The material directives: Material, MakeNamedMaterial and NamedMaterial.
+#include <algorithm>
+
+#include "candela/io/pbrt/scene_parser.h"
+
+namespace candela::pbrt {
+
+using pbrt_spectra::Role;
+
+// c * scale, with a ScaleTexture when c is a texture (declared by the directive at `where`).
+ColorInput SceneParser::scaled(ColorInput c, float scale, const SourceLocation& where) {
+  if (scale == 1) return c;
+  if (c.is_constant()) return ColorInput(c.value * scale);
+  ScaleTexture t;
+  t.tex = c;
+  t.scale = FloatInput(scale);
+  ColorInput result;
+  result.texture = add_texture(t, where);
+  return result;
+}
+
+int SceneParser::add_material(MaterialDesc material, const SourceLocation& where) {
+  scene_.materials.push_back(std::move(material));
+  scene_.places.materials.push_back(where);
+  return static_cast<int>(scene_.materials.size()) - 1;
+}
+
+MaterialDesc SceneParser::make_material(const std::string& type, const SourceLocation& type_where,
+                                       ParamList& params) {
+  if (type == "diffuse") {
+    DiffuseMaterial m;
+    m.reflectance = read_color(params, "reflectance", Role::Reflectance).value_or(ColorInput(RGB(0.5f)));
+    ignore_shading_params(params);
+    return m;
+  }
+  if (type == "conductor") {
+    ConductorMaterial m;  // pbrt-v4's default is copper, as ConductorMaterial's
+    std::optional<ColorInput> eta = read_color(params, "eta", Role::Unbounded);
+    std::optional<ColorInput> k = read_color(params, "k", Role::Unbounded);
+    std::optional<ColorInput> reflectance = read_color(params, "reflectance", Role::Reflectance);
+    if (reflectance && (eta || k))
+      params.fail("reflectance", "cannot be given together with \"{}\" (as in pbrt-v4: the normal-incidence "
+                  "reflectance replaces the optical constants)", eta ? "eta" : "k");
+    if (eta) m.eta = *eta;
+    if (k) m.k = *k;
+    m.reflectance = reflectance;
+    m.roughness = read_roughness(params);
+    ignore_shading_params(params);
+    return m;
+  }
+  if (type == "dielectric") {
+    DielectricMaterial m;
+    m.ior = read_ior(params, "eta").value_or(1.5f);
+    m.roughness = read_roughness(params);
+    ignore_shading_params(params);
+    return m;
+  }
+  if (type == "coateddiffuse") {
+    CoatedDiffuseMaterial m;
+    m.reflectance = read_color(params, "reflectance", Role::Reflectance).value_or(ColorInput(RGB(0.5f)));
+    m.roughness = read_roughness(params);
+    m.ior = read_ior(params, "eta").value_or(1.5f);
+    // candela's coat is the closed form of Mitsuba's plastic: an interface over a Lambertian base
+    // with every internal bounce summed, no layer in between. pbrt-v4 simulates the layer.
+    bool own_thickness = params.has_own("thickness");
+    if (std::optional<FloatInput> thickness = read_float_texture(params, "thickness"); thickness && own_thickness)
+      warn(params.where("thickness"),
+           "{}: \"thickness\" is ignored: candela's coated diffuse has no layer between coat and base (the "
+           "closed-form Mitsuba plastic model)",
+           params.owner());
+    std::optional<ColorInput> albedo = read_color(params, "albedo", Role::Reflectance);
+    if (albedo && !(albedo->is_constant() && albedo->value.is_black()))
+      warn(params.where("albedo"),
+           "{}: \"albedo\" is ignored: candela's coated diffuse has no scattering medium between coat and base "
+           "(the closed-form Mitsuba plastic model); the layer is rendered as if empty",
+           params.owner());
+    read_float_texture(params, "g");                  // only matters with an albedo
+    int max_depth = params.get_int("maxdepth", 10);   // pbrt's random walk through the layer: candela
+    int samples = params.get_int("nsamples", 1);      // sums the whole series in closed form
+    if (max_depth < 1) params.fail("maxdepth", "must be positive, got {}", max_depth);
+    if (samples < 1) params.fail("nsamples", "must be positive, got {}", samples);
+    ignore_shading_params(params);
+    return m;
+  }
+  if (type == "diffusetransmission") {
+    DiffuseTransmissionMaterial m;
+    ColorInput reflectance = read_color(params, "reflectance", Role::Reflectance).value_or(ColorInput(RGB(0.25f)));
+    ColorInput transmittance = read_color(params, "transmittance", Role::Reflectance).value_or(ColorInput(RGB(0.25f)));
+    float scale = params.get_float("scale", 1);
+    if (scale < 0) params.fail("scale", "must not be negative, got {}", scale);
+    // pbrt-v4 clamps scale * value to [0, 1].
+    auto clamp01 = [](ColorInput c) {
+      if (c.is_constant())
+        for (int i = 0; i < 3; ++i) c.value[i] = std::clamp(c.value[i], 0.0f, 1.0f);
+      return c;
+    };
+    m.reflectance = clamp01(scaled(reflectance, scale, params.directive()));
+    m.transmittance = clamp01(scaled(transmittance, scale, params.directive()));
+    ignore_shading_params(params);
+    return m;
+  }
+  if (type == "interface" || type == "none" || type.empty()) return InterfaceMaterial{};
+  if (type == "mix") {
+    std::vector<std::string> names = params.get_strings("materials");
+    if (names.size() != 2)
+      params.fail("materials", "must name exactly two materials (made with MakeNamedMaterial), got {}", names.size());
+    FloatInput amount = read_float_texture(params, "amount").value_or(FloatInput(0.5f));
+    int chosen[2];
+    for (int i = 0; i < 2; ++i) {
+      if (names[i].empty() || names[i] == "none" || names[i] == "interface") {
+        chosen[i] = -2;  // pbrt's "no material": an interface
+        continue;
+      }
+      auto named = named_materials_.find(names[i]);
+      if (named == named_materials_.end())
+        params.fail("materials", "names \"{}\", which no MakeNamedMaterial before it defines", names[i]);
+      chosen[i] = named->second.first;
+    }
+    // pbrt-v4 takes the first material where amount <= 0 and the second where amount >= 1.
+    int pick = -1;
+    if (chosen[0] == chosen[1])
+      pick = 0;
+    else if (amount.is_constant() && amount.value <= 0)
+      pick = 0;
+    else if (amount.is_constant() && amount.value >= 1)
+      pick = 1;
+    if (pick < 0)
+      throw_scene_error(type_where,
+                        "material type \"mix\" is not supported: candela cannot blend two materials (only a constant "
+                        "\"amount\" of 0 or 1, which selects one of them, is read)");
+    if (chosen[pick] == -2) return InterfaceMaterial{};
+    return scene_.materials.at(chosen[pick]);
+  }
+  if (type == "thindielectric")
+    throw_scene_error(type_where,
+                      "material type \"thindielectric\" is not supported: candela has no thin-sheet BSDF, and a "
+                      "\"dielectric\" in its place would bend the light that a thin sheet lets straight through");
+  reject_type(type_where, "material", type,
+              {"diffuse", "conductor", "dielectric", "coateddiffuse", "diffusetransmission", "interface", "mix"},
+              {"coatedconductor", "hair", "measured", "subsurface"}, "candela has no BSDF for it");
+}
+
+void SceneParser::material(const Token& d) {
+  require_world(d);
+  Token type = expect_string(d, "the material type");
+  ParamList params = read_params(d, fmt::format("Material \"{}\"", type.text), kMaterialAttributes);
+  MaterialDesc desc = make_material(type.text, at(type), params);
+  params.reject_unused();
+  state_.material = add_material(std::move(desc), at(d));
+}
+
+void SceneParser::make_named_material(const Token& d) {
+  require_world(d);
+  Token name = expect_string(d, "the material name");
+  if (auto earlier = named_materials_.find(name.text); earlier != named_materials_.end())
+    throw_scene_error(at(name), "MakeNamedMaterial: \"{}\" is already defined at {}", name.text,
+                      earlier->second.second.to_string());
+  ParamList params = read_params(d, fmt::format("MakeNamedMaterial \"{}\"", name.text), kMaterialAttributes);
+  if (!params.has("type"))
+    throw_scene_error(at(d), "MakeNamedMaterial \"{}\": missing the \"string type\" parameter", name.text);
+  std::string type = params.get_string("type", "");
+  MaterialDesc desc = make_material(type, params.where("type"), params);
+  params.reject_unused();
+  named_materials_[name.text] = {add_material(std::move(desc), at(d)), at(name)};
+}
+
+void SceneParser::named_material(const Token& d) {
+  require_world(d);
+  Token name = expect_string(d, "the material name");
+  auto named = named_materials_.find(name.text);
+  if (named == named_materials_.end())
+    throw_scene_error(at(name),
+                      "NamedMaterial: no material named \"{}\" is defined (MakeNamedMaterial must come first)",
+                      name.text);
+  state_.material = named->second.first;
+}
+
+
+}  // namespace candela::pbrt

@@ -1,0 +1,285 @@
+// The rendering-option directives (before WorldBegin): Camera, Film, Sampler, Integrator,
+// PixelFilter, Accelerator, Option and ColorSpace.
+#include <climits>
+#include <cstdint>
+
+#include "candela/io/pbrt/scene_parser.h"
+
+namespace candela::pbrt {
+
+namespace {
+
+// pbrt's limits on what a scene may ask for, beyond which the request is surely a mistake.
+constexpr int kMaxResolutionPerSide = 65536;
+constexpr int64_t kMaxPixels = int64_t{1} << 28;
+constexpr float kMaxFilterRadius = 64;  // pixels; the filter is tabulated per unit of radius
+
+}  // namespace
+
+void SceneParser::camera(const Token& d) {
+  require_options(d);
+  Token type = expect_string(d, "the camera type");
+  if (type.text != "perspective")
+    reject_type(at(type), "camera", type.text, {"perspective"}, {"orthographic", "realistic", "spherical"});
+  ParamList params = read_params(d, "Camera \"perspective\"");
+  float fov = params.get_float("fov", 90);
+  if (!(fov > 0 && fov < 180)) params.fail("fov", "must be between 0 and 180 degrees, got {}", fov);
+  float lens_radius = params.get_float("lensradius", 0);
+  if (lens_radius < 0) params.fail("lensradius", "must not be negative, got {}", lens_radius);
+  float focus_distance = params.get_float("focaldistance", 1e6f);
+  if (!(focus_distance > 0)) params.fail("focaldistance", "must be positive, got {}", focus_distance);
+  float shutter_open = params.get_float("shutteropen", 0);
+  float shutter_close = params.get_float("shutterclose", 1);
+  // pbrt swaps the two with a warning; candela has no warnings, so this is an error.
+  if (shutter_close < shutter_open)
+    params.fail("shutterclose", "must not be less than \"shutteropen\" ({}), got {}", shutter_open, shutter_close);
+  params.reject_unused();
+  if (state_.ctm.is_animated())
+    throw_scene_error(at(d),
+                      "Camera: the camera transform is animated (ActiveTransform made the start and end CTMs "
+                      "differ); a moving camera is not supported");
+
+  // The CTM maps world space to camera space here; pbrt names the inverse "camera".
+  CameraDesc& camera = scene_.camera;
+  camera.world_from_camera = state_.ctm.start.inverse();
+  camera.fov_degrees = fov;
+  camera.fov_axis = FovAxis::Smaller;
+  camera.lens_radius = lens_radius;
+  camera.focus_distance = focus_distance;
+  camera.shutter_open = shutter_open;
+  camera.shutter_close = shutter_close;
+  coordinate_systems_["camera"] = {camera.world_from_camera, camera.world_from_camera};
+}
+
+void SceneParser::film(const Token& d) {
+  require_options(d);
+  Token type = expect_string(d, "the film type");
+  if (type.text != "rgb") reject_type(at(type), "film", type.text, {"rgb"}, {"gbuffer", "spectral"});
+  ParamList params = read_params(d, "Film \"rgb\"");
+  int width = params.get_int("xresolution", 1280);
+  int height = params.get_int("yresolution", 720);
+  if (width < 1 || width > kMaxResolutionPerSide)
+    params.fail("xresolution", "must be between 1 and {}, got {}", kMaxResolutionPerSide, width);
+  if (height < 1 || height > kMaxResolutionPerSide)
+    params.fail("yresolution", "must be between 1 and {}, got {}", kMaxResolutionPerSide, height);
+  if (int64_t{width} * height > kMaxPixels)
+    throw_scene_error(params.where(params.has("yresolution") ? "yresolution" : "xresolution"),
+                      "Film \"rgb\": {} x {} is too many pixels (at most 2^28 = {})", width, height, kMaxPixels);
+  std::string filename = params.get_string("filename", "");
+  params.get_bool("savefp16", true);  // the precision of the output file only
+  ignore_param(params, "maxcomponentvalue", "candela does not clamp sample values (pbrt would, trading energy "
+               "for fewer fireflies)");
+  params.reject_unused();
+  scene_.film.width = width;
+  scene_.film.height = height;
+  scene_.film.filename = filename;
+}
+
+void SceneParser::sampler(const Token& d) {
+  require_options(d);
+  Token type = expect_string(d, "the sampler type");
+  const std::string& name = type.text;
+  // pbrt-v4's other low-discrepancy samplers become candela's zsobol with the same sample count.
+  bool replaced = name == "sobol" || name == "halton" || name == "pmj02bn" || name == "paddedsobol";
+  if (name != "independent" && name != "stratified" && name != "zsobol" && !replaced)
+    reject_type(at(type), "sampler", name,
+                {"independent", "stratified", "zsobol", "sobol", "halton", "paddedsobol", "pmj02bn"}, {});
+  ParamList params = read_params(d, fmt::format("Sampler \"{}\"", name));
+  SamplerDesc sampler;
+  int64_t spp = 0;
+  if (name == "independent") {
+    sampler.type = SamplerType::Independent;
+    spp = params.get_int("pixelsamples", 4);
+  } else if (name == "stratified") {
+    // The stratified sampler takes a grid of xsamples x ysamples per pixel instead of pixelsamples.
+    sampler.type = SamplerType::Stratified;
+    int x = params.get_int("xsamples", 4), y = params.get_int("ysamples", 4);
+    if (x < 1) params.fail("xsamples", "must be positive, got {}", x);
+    if (y < 1) params.fail("ysamples", "must be positive, got {}", y);
+    sampler.jitter = params.get_bool("jitter", true);
+    spp = int64_t{x} * y;
+    if (spp > INT_MAX) params.fail("ysamples", "makes {} samples per pixel, too many", spp);
+  } else {
+    sampler.type = SamplerType::ZSobol;
+    spp = params.get_int("pixelsamples", 16);
+    // candela's ZSobol is always Owen-scrambled; the other choices only change the sample pattern.
+    if (name != "pmj02bn") {
+      std::string randomization = params.get_string("randomization", "fastowen");
+      if (randomization != "none" && randomization != "permutedigits" && randomization != "fastowen" &&
+          randomization != "owen")
+        params.fail("randomization", "must be \"none\", \"permutedigits\", \"fastowen\" or \"owen\", got \"{}\"",
+                    randomization);
+    }
+  }
+  if (spp < 1) params.fail("pixelsamples", "must be positive, got {}", spp);
+  int seed = params.get_int("seed", 0);
+  if (seed < 0) params.fail("seed", "must not be negative, got {}", seed);
+  params.reject_unused();
+  if (name == "sobol")
+    warn(at(type), "sobol: using candela's zsobol sampler (same Owen-scrambled Sobol' points, Morton-ordered)");
+  else if (replaced)
+    warn(at(type), "{}: using candela's zsobol sampler (Owen-scrambled Sobol' points, Morton-ordered; the same "
+         "number of samples, a different pattern)", name);
+  options_.sampler = sampler;
+  // Metropolis light transport counts mutations per pixel (its own parameter), not pixel samples.
+  if (options_.integrator != "mlt") options_.spp = static_cast<int>(spp);
+  if (params.has("seed")) options_.seed = static_cast<uint64_t>(seed);
+}
+
+// Every pbrt-v4 integrator is rendered with candela's path tracer at the scene's "maxdepth"; the
+// parameters the others have are accepted with a warning that they are ignored.
+void SceneParser::integrator(const Token& d) {
+  require_options(d);
+  Token type = expect_string(d, "the integrator type");
+  static const std::map<std::string, std::vector<std::string_view>, std::less<>> kOwnParameters = {
+      {"path", {}},
+      {"volpath", {}},
+      {"bdpt", {"visualizestrategies", "visualizeweights"}},
+      {"mlt", {"bootstrapsamples", "chains", "mutationsperpixel", "largestepprobability", "sigma"}},
+      {"sppm", {"photonsperiteration", "radius", "seed"}},
+      {"lightpath", {}},
+      {"randomwalk", {}},
+      {"simplepath", {"samplelights", "samplebsdf"}},
+      {"simplevolpath", {}},
+  };
+  // Ambient occlusion is a different image altogether, not another way to the same one.
+  if (type.text == "ambientocclusion")
+    throw_scene_error(at(type), "Integrator \"ambientocclusion\" is not supported: candela renders global "
+                      "illumination, which would be a different image (use \"path\")");
+  auto known = kOwnParameters.find(type.text);
+  if (known == kOwnParameters.end())
+    reject_type(at(type), "integrator", type.text,
+                {"path", "volpath", "bdpt", "mlt", "sppm", "lightpath", "randomwalk",
+                 "simplepath", "simplevolpath"},
+                {});
+  ParamList params = read_params(d, fmt::format("Integrator \"{}\"", type.text));
+  int max_depth = params.get_int("maxdepth", 5);
+  if (max_depth < 0) params.fail("maxdepth", "must not be negative, got {}", max_depth);
+  if (type.text == "path" || type.text == "volpath" || type.text == "bdpt") read_light_sampler(params);
+  if (type.text == "path" || type.text == "volpath" || type.text == "bdpt" || type.text == "mlt") {
+    if (params.get_bool("regularize", false))
+      warn(params.where("regularize"), "Integrator \"{}\": \"regularize\" is ignored: candela does not roughen "
+           "near-specular surfaces (the image keeps the caustics pbrt would blur)", type.text);
+  }
+  std::string integrator = "path";
+  if (type.text == "bdpt") {
+    integrator = "bdpt";
+    for (std::string_view name : known->second)
+      ignore_param(params, name, "use candela's --bdpt-strategies DIR (and --bdpt-unweighted) instead");
+  } else if (type.text == "mlt") {
+    integrator = "mlt";
+    int mutations = params.get_int("mutationsperpixel", 100);
+    if (mutations < 1) params.fail("mutationsperpixel", "must be positive, got {}", mutations);
+    int bootstrap = params.get_int("bootstrapsamples", 100000);
+    if (bootstrap < 1) params.fail("bootstrapsamples", "must be positive, got {}", bootstrap);
+    int chains = params.get_int("chains", 1000);
+    if (chains < 1) params.fail("chains", "must be positive, got {}", chains);
+    float large_step = params.get_float("largestepprobability", 0.3f);
+    if (!(large_step >= 0 && large_step <= 1))
+      params.fail("largestepprobability", "must be in [0, 1], got {}", large_step);
+    float sigma = params.get_float("sigma", 0.01f);
+    if (!(sigma > 0 && sigma <= 1)) params.fail("sigma", "must be in (0, 1], got {}", sigma);
+    options_.spp = mutations;
+    options_.mlt = RenderOptions::Metropolis{bootstrap, chains, large_step, sigma};
+  } else {
+    for (std::string_view name : known->second)
+      ignore_param(params, name, "candela's path integrator has no such setting");
+  }
+  params.reject_unused();
+  if (type.text == "volpath")
+    warn(at(type), "Integrator \"volpath\": using candela's path integrator; without participating media (which "
+         "candela does not render) it is the same integrator");
+  else if (integrator == "path" && type.text != "path")
+    warn(at(type), "Integrator \"{}\": using candela's path integrator with maxdepth {} (it converges to the "
+         "same image, with different noise)", type.text, max_depth);
+  options_.integrator = integrator;
+  options_.max_depth = max_depth;
+}
+
+// pbrt's "power" chooses lights by power, as candela does. Its default "bvh" also weighs each light
+// by its distance and orientation from the shading point; candela has no light BVH and uses "power"
+// for it too, which changes only the noise.
+void SceneParser::read_light_sampler(ParamList& params) {
+  std::string light_sampler = params.get_string("lightsampler", "bvh");
+  if (light_sampler == "uniform" || light_sampler == "exhaustive")
+    params.fail("lightsampler", "\"{}\" is not supported yet (supported: \"power\", \"bvh\")", light_sampler);
+  if (light_sampler != "bvh" && light_sampler != "power")
+    params.fail("lightsampler", "must be \"bvh\", \"power\", \"uniform\" or \"exhaustive\", got \"{}\"",
+                light_sampler);
+  options_.light_sampler_given = true;
+}
+
+void SceneParser::pixel_filter(const Token& d) {
+  require_options(d);
+  Token type = expect_string(d, "the filter type");
+  FilterDesc filter;
+  if (type.text == "box")
+    filter = default_filter(FilterType::Box);
+  else if (type.text == "triangle")
+    filter = default_filter(FilterType::Tent);
+  else if (type.text == "gaussian")
+    filter = default_filter(FilterType::Gaussian);
+  else if (type.text == "mitchell")
+    filter = default_filter(FilterType::Mitchell);
+  else
+    reject_type(at(type), "pixel filter", type.text, {"box", "triangle", "gaussian", "mitchell"}, {"sinc"});
+  ParamList params = read_params(d, fmt::format("PixelFilter \"{}\"", type.text));
+  filter.radius = {params.get_float("xradius", filter.radius.x), params.get_float("yradius", filter.radius.y)};
+  for (auto [name, radius] : {std::pair{"xradius", filter.radius.x}, std::pair{"yradius", filter.radius.y}})
+    if (!(radius > 0 && radius <= kMaxFilterRadius))
+      params.fail(name, "must be in (0, {}] pixels, got {}", kMaxFilterRadius, radius);
+  if (filter.type == FilterType::Gaussian) {
+    filter.gaussian_sigma = params.get_float("sigma", filter.gaussian_sigma);
+    if (!(filter.gaussian_sigma > 0)) params.fail("sigma", "must be positive, got {}", filter.gaussian_sigma);
+  }
+  if (filter.type == FilterType::Mitchell) {
+    filter.mitchell_b = params.get_float("B", filter.mitchell_b);
+    filter.mitchell_c = params.get_float("C", filter.mitchell_c);
+  }
+  params.reject_unused();
+  options_.filter = filter;
+}
+
+void SceneParser::option(const Token& d) {
+  expect_string(d, "the option name");
+  Token value = tokens_->next();
+  if (value.kind != TokenKind::Word && value.kind != TokenKind::String)
+    throw_scene_error(at(value), "Option: expected a value, got {}", describe(value));
+}
+
+void SceneParser::color_space(const Token& d) {
+  Token name = expect_string(d, "the colour space name");
+  if (name.text != "srgb")
+    warn(at(name), "ColorSpace \"{}\" is ignored: candela reads every colour as linear sRGB (Rec. 709 primaries)",
+         name.text);
+}
+
+// The acceleration structure is Embree's whatever pbrt's choice; the image does not depend on it.
+void SceneParser::accelerator(const Token& d) {
+  require_options(d);
+  Token type = expect_string(d, "the accelerator type");
+  if (type.text != "bvh" && type.text != "kdtree")
+    reject_type(at(type), "accelerator", type.text, {"bvh", "kdtree"}, {});
+  read_params(d, fmt::format("Accelerator \"{}\"", type.text));  // its parameters only tune the structure
+}
+
+
+// The one place that writes RenderSettings: what the directives above chose, or pbrt-v4's defaults.
+void SceneParser::write_render_settings(RenderSettings& settings) const {
+  settings.spp = options_.spp;
+  settings.sampler = options_.sampler;
+  if (options_.seed) settings.seed = *options_.seed;
+  settings.filter = options_.filter;
+  settings.max_depth = options_.max_depth;
+  settings.integrator = options_.integrator;
+  settings.spectral = true;  // pbrt-v4 renders spectrally; RGB parameters become spectra as there
+  if (options_.light_sampler_given) settings.light_selection = LightSelection::Power;
+  if (options_.mlt) {
+    settings.mlt.bootstrap = options_.mlt->bootstrap;
+    settings.mlt.chains = options_.mlt->chains;
+    settings.mlt.large_step = options_.mlt->large_step;
+    settings.mlt.sigma = options_.mlt->sigma;
+  }
+}
+
+}  // namespace candela::pbrt

@@ -1,0 +1,234 @@
+#pragma once
+// The third layer of the pbrt-v4 reader (docs/pbrt-format.md): the directives, read in order with
+// pbrt's graphics state (graphics_state.h), build a SceneDesc. One class, its members defined by
+// subject in several files:
+//   scene_parser.cpp    files, Include/Import, the directive table, transforms, attribute blocks
+//   render_options.cpp  Camera, Film, Sampler, Integrator, PixelFilter and the other options
+//   textures.cpp        spectra, textured parameters and Texture
+//   materials.cpp       Material, MakeNamedMaterial, NamedMaterial
+//   lights.cpp          LightSource, AreaLightSource
+//   shapes.cpp          Shape and object instancing
+// Every problem is one SceneError naming file:line:column. What candela reads but cannot reproduce
+// exactly (a sampler or integrator it replaces, a parameter it ignores) is a warning naming
+// file:line:column; what would change the image materially is an error.
+#include <fmt/format.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "candela/io/named_spectra.h"
+#include "candela/io/pbrt/graphics_state.h"
+#include "candela/io/pbrt/parameters.h"
+#include "candela/io/pbrt/tokenizer.h"
+#include "candela/scene/description.h"
+
+namespace candela::pbrt {
+
+namespace fs = std::filesystem;
+constexpr float kPi = std::numbers::pi_v<float>;
+
+struct ObjectDefinition {
+  std::string name;
+  SourceLocation where;
+  std::vector<ShapeDesc> shapes;
+  int index = -1;  // into SceneDesc::objects, once it is first instanced
+};
+
+// A shape's geometry with what "power" needs to know about its area: pbrt-v4 makes one area light
+// per primitive (each triangle of a mesh, each patch of a bilinear mesh, the whole sphere or disk)
+// and gives each the radiance that makes *that primitive* emit "power".
+struct BuiltGeometry {
+  ShapeGeometry geometry;
+  // Meshes: the pbrt primitive each triangle belongs to (empty: each triangle is its own).
+  std::vector<uint32_t> primitive_of_triangle;
+  // Spheres and disks: pbrt's object-space area (pbrt ignores the CTM's scale here).
+  float object_area = 0;
+};
+
+struct NamedTexture {
+  int index = -1;  // into SceneDesc::textures; -1 for a "constant" texture
+  ColorInput color;
+  FloatInput value;
+  SourceLocation where;
+};
+
+// What the Sampler, Integrator and PixelFilter directives chose, starting from pbrt-v4's defaults
+// for a scene that leaves them out. write_render_settings copies it into SceneDesc::settings: the
+// one place that writes RenderSettings.
+struct RenderOptions {
+  SamplerDesc sampler{SamplerType::ZSobol};
+  int spp = 16;  // pixel samples, or an "mlt" integrator's mutations per pixel
+  std::optional<uint64_t> seed;
+  std::string integrator = "path";
+  int max_depth = 5;
+  FilterDesc filter = default_filter(FilterType::Gaussian);
+  bool light_sampler_given = false;  // an integrator that reads "lightsampler" was named
+  struct Metropolis {
+    int bootstrap = 0, chains = 0;
+    float large_step = 0, sigma = 0;
+  };
+  std::optional<Metropolis> mlt;
+};
+
+enum class Section { Options, World };
+
+class SceneParser {
+ public:
+  explicit SceneParser(std::vector<std::string>& warnings) : warnings_(warnings) {}
+  SceneDesc parse(const fs::path& file);
+  // pbrt text not read from a file: `name` stands for the file in messages, and relative file
+  // names (Include, Import, meshes, images) are looked up in `base_dir`.
+  SceneDesc parse(std::string text, const std::string& name, const fs::path& base_dir);
+
+ private:
+  using Handler = void (SceneParser::*)(const Token&);
+  static const std::unordered_map<std::string_view, Handler>& handlers();
+
+  template <typename... Args>
+  void warn(const SourceLocation& where, fmt::format_string<Args...> format, Args&&... args) {
+    warnings_.push_back(
+        fmt::format("{}: warning: {}", where.to_string(), fmt::format(format, std::forward<Args>(args)...)));
+  }
+  // Accepts the parameter `name` if given and warns that it is ignored (silently for one an
+  // Attribute set, which applies to many directives).
+  void ignore_param(ParamList& params, std::string_view name, std::string_view why);
+
+  // files
+  void start(const std::string& source, const fs::path& top_directory);
+  SceneDesc finish(const SourceLocation& end);
+  SourceLocation parse_file(const fs::path& file, const SourceLocation* included_from);
+  SourceLocation parse_tokens(Tokenizer& tokens, const fs::path& directory, const fs::path& canonical_file,
+                              const SourceLocation* included_from);
+  void parse_directives();
+  fs::path resolve_path(const std::string& name, const SourceLocation& where, std::string_view what) const;
+  void check_end_of_scene(const SourceLocation& end) const;
+
+  // reading arguments
+  Token expect_string(const Token& directive, std::string_view what);
+  double expect_number(const Token& directive, int index, int count);
+  Vec3 read_vec3(const Token& directive, int first_index = 0, int count = 3);
+  Matrix4 read_bracketed_matrix(const Token& directive);
+  ParamList read_params(const Token& directive, std::string owner, AttributeTarget target = kAttributeTargets);
+
+  // state checks
+  void require_world(const Token& directive) const;
+  void require_options(const Token& directive) const;
+  void push_block(const Token& directive, BlockKind kind);
+  void pop_block(const Token& directive, BlockKind kind);
+
+  // the CTMs that ActiveTransform selects become f(CTM)
+  template <typename F>
+  void update_active_ctms(F f) {
+    if (state_.active_transforms & kStartTransform) state_.ctm.start = f(state_.ctm.start);
+    if (state_.active_transforms & kEndTransform) state_.ctm.end = f(state_.ctm.end);
+  }
+  void post_multiply_ctm(const Transform& t) {
+    update_active_ctms([&](const Transform& ctm) { return ctm * t; });
+  }
+
+  // directives
+  void identity(const Token&) {
+    update_active_ctms([](const Transform&) { return Transform(); });
+  }
+  void translate(const Token& d) { post_multiply_ctm(Transform::translate(read_vec3(d))); }
+  void scale(const Token& d);
+  void rotate(const Token& d);
+  void look_at(const Token& d);
+  void transform(const Token& d);
+  void concat_transform(const Token& d);
+  void coordinate_system(const Token& d);
+  void coord_sys_transform(const Token& d);
+  void active_transform(const Token& d);
+  void transform_times(const Token& d);
+  void attribute_begin(const Token& d);
+  void attribute_end(const Token& d);
+  void attribute(const Token& d);
+  void reverse_orientation(const Token& d);
+  void camera(const Token& d);
+  void film(const Token& d);
+  void sampler(const Token& d);
+  void integrator(const Token& d);
+  void pixel_filter(const Token& d);
+  void accelerator(const Token& d);
+  void read_light_sampler(ParamList& params);
+  void option(const Token& d);
+  void color_space(const Token& d);
+  void world_begin(const Token& d);
+  void texture(const Token& d);
+  void material(const Token& d);
+  void make_named_material(const Token& d);
+  void named_material(const Token& d);
+  void light_source(const Token& d);
+  void area_light_source(const Token& d);
+  void shape(const Token& d);
+  void object_begin(const Token& d);
+  void object_end(const Token& d);
+  void object_instance(const Token& d);
+  void make_named_medium(const Token& d);
+  void medium_interface(const Token& d);
+  void include(const Token& d);
+  void import(const Token& d);
+  void world_end(const Token& d);
+
+  // the rendering options, once read
+  void write_render_settings(RenderSettings& settings) const;
+
+  // spectra and textured parameters
+  std::optional<ColorInput> read_color(ParamList& params, std::string_view name, pbrt_spectra::Role role);
+  std::optional<FloatInput> read_float_texture(ParamList& params, std::string_view name);
+  std::optional<RGB> read_emission(ParamList& params, std::string_view name);
+  std::optional<float> read_ior(ParamList& params, std::string_view name);
+  Roughness read_roughness(ParamList& params);
+  void ignore_shading_params(ParamList& params);
+  int add_texture(TextureDesc texture, const SourceLocation& where);
+
+  // textures
+  UVMapping read_uv_mapping(ParamList& params);
+  ImageTexture make_image_texture(ParamList& params);
+  ColorInput read_texture_input(ParamList& params, std::string_view name, bool is_float, RGB fallback);
+
+  // scene objects from parameter lists
+  MaterialDesc make_material(const std::string& type, const SourceLocation& type_where, ParamList& params);
+  ColorInput scaled(ColorInput c, float scale, const SourceLocation& where);
+  int add_material(MaterialDesc material, const SourceLocation& where);
+  void add_light(LightDesc light, const SourceLocation& where);
+  BuiltGeometry make_sphere(ParamList& params);
+  BuiltGeometry make_triangle_mesh(ParamList& params);
+  BuiltGeometry make_ply_mesh(ParamList& params);
+  BuiltGeometry make_disk(ParamList& params);
+  BuiltGeometry make_bilinear_mesh(ParamList& params);
+  RGB read_light_scale(ParamList& params, RGB emitted);
+  void require_static_light(const Token& directive, const Token& type) const;
+  void add_emissive_shape(ShapeDesc shape, const BuiltGeometry& built, const Token& directive);
+  void add_shape(ShapeDesc shape, const Token& directive);
+
+  std::vector<std::string>& warnings_;
+  SceneDesc scene_;
+  RenderOptions options_;
+  GraphicsState state_;
+  Section section_ = Section::Options;
+  SourceLocation world_begin_;
+  std::vector<OpenBlock> blocks_;
+  size_t block_floor_ = 0;  // blocks below this belong to the file that Imported the current one
+  std::map<std::string, TransformSet> coordinate_systems_;
+  std::map<std::string, std::pair<int, SourceLocation>> named_materials_;
+  std::map<std::string, NamedTexture> spectrum_textures_, float_textures_;
+  std::optional<ObjectDefinition> open_object_;
+  std::map<std::string, ObjectDefinition> objects_;
+  Tokenizer* tokens_ = nullptr;
+  fs::path directory_;  // of the file being read: relative names are looked up there first
+  // Canonical paths of the files being read, to catch include cycles (empty for text not read from
+  // a file).
+  std::vector<fs::path> open_files_;
+  fs::path top_directory_;
+};
+
+}  // namespace candela::pbrt

@@ -1,0 +1,400 @@
+// The Shape directive (each shape type built into candela's geometry, area lights spread over its
+// primitives) and object instancing: ObjectBegin, ObjectEnd, ObjectInstance.
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "candela/io/mesh_io.h"
+#include "candela/io/pbrt/scene_parser.h"
+
+namespace candela::pbrt {
+
+namespace {
+
+// Tessellation of the shapes candela has no primitive for.
+constexpr int kDiskSegmentsPerTurn = 128;  // with the rings scaled to keep the area exact
+constexpr int kBilinearPatchTessellation = 16;  // a non-planar bilinear patch becomes 16 x 16 quads
+
+}  // namespace
+
+// pbrt clamps zmin/zmax to the radius and phimax to 360; anything less than the whole sphere is
+// a partial sphere, which candela cannot represent.
+BuiltGeometry SceneParser::make_sphere(ParamList& params) {
+  float radius = params.get_float("radius", 1);
+  if (!(radius > 0)) params.fail("radius", "must be positive, got {}", radius);
+  float z_min = params.get_float("zmin", -radius);
+  float z_max = params.get_float("zmax", radius);
+  float phi_max = params.get_float("phimax", 360);
+  if (std::min(z_min, z_max) > -radius) params.fail("zmin", "cuts the sphere: partial spheres are not supported yet");
+  if (std::max(z_min, z_max) < radius) params.fail("zmax", "cuts the sphere: partial spheres are not supported yet");
+  if (phi_max < 360) params.fail("phimax", "cuts the sphere: partial spheres are not supported yet");
+  BuiltGeometry built;
+  built.geometry = SphereShape{Point3(0.0f), radius};
+  built.object_area = 4 * kPi * radius * radius;
+  return built;
+}
+
+BuiltGeometry SceneParser::make_triangle_mesh(ParamList& params) {
+  TriangleMesh mesh;
+  mesh.positions = params.get_vec3_array("P", "point3");
+  std::vector<int> indices = params.get_int_array("indices");
+  mesh.normals = params.get_vec3_array("N", "normal");
+  mesh.uvs = params.get_point2_array("uv");
+  size_t n = mesh.positions.size();
+  if (n == 0) params.fail("P", "is required: give the vertex positions as \"point3 P\"");
+  if (indices.empty()) {
+    if (n != 3) params.fail("indices", "is required unless \"P\" has exactly 3 points (it has {})", n);
+    indices = {0, 1, 2};
+  }
+  if (indices.size() % 3 != 0)
+    params.fail("indices", "has {} values, which is not a multiple of 3 (three per triangle)", indices.size());
+  for (size_t i = 0; i < indices.size(); ++i)
+    if (indices[i] < 0 || static_cast<size_t>(indices[i]) >= n)
+      params.fail("indices", "value {} (number {}) is out of range: \"P\" has {} points", indices[i], i + 1, n);
+  if (!mesh.normals.empty() && mesh.normals.size() != n)
+    params.fail("N", "has {} normals but \"P\" has {} points; give one normal per point", mesh.normals.size(), n);
+  if (!mesh.uvs.empty() && mesh.uvs.size() != n)
+    params.fail("uv", "has {} coordinates but \"P\" has {} points; give one per point", mesh.uvs.size(), n);
+  ignore_param(params, "S", "candela derives the shading tangents itself");
+  params.take_any("faceIndices");  // only for ptex textures
+  mesh.indices.assign(indices.begin(), indices.end());
+  return BuiltGeometry{MeshShape{std::move(mesh)}, {}, 0};
+}
+
+BuiltGeometry SceneParser::make_ply_mesh(ParamList& params) {
+  if (!params.has("filename")) params.fail("filename", "is required: name the .ply file");
+  std::string name = params.get_string("filename", "");
+  SourceLocation where = params.where("filename");
+  fs::path file = resolve_path(name, where, fmt::format("{}: \"filename\"", params.owner()));
+  ignore_param(params, "displacement", "displacement mapping is not supported");
+  params.take_any("edgelength");  // the displacement's tessellation
+  return BuiltGeometry{MeshShape{load_mesh_file(file, where)}, {}, 0};
+}
+
+// pbrt-v4's disk: radius, innerradius and phimax at z = height, facing +z; u = phi / phimax and
+// v = (radius - r) / (radius - innerradius). Triangulated with kDiskSegmentsPerTurn segments per
+// full turn, the rings pushed out by sqrt(dphi / sin dphi) so the polygon has exactly the disk's
+// area (the outline then deviates from the circle by at most 0.02% of the radius).
+BuiltGeometry SceneParser::make_disk(ParamList& params) {
+  float height = params.get_float("height", 0);
+  float radius = params.get_float("radius", 1);
+  float inner = params.get_float("innerradius", 0);
+  float phi_max_degrees = params.get_float("phimax", 360);
+  if (!(radius > 0)) params.fail("radius", "must be positive, got {}", radius);
+  if (!(inner >= 0 && inner < radius))
+    params.fail("innerradius", "must be in [0, \"radius\" = {}), got {}", radius, inner);
+  if (!(phi_max_degrees > 0)) params.fail("phimax", "must be positive, got {}", phi_max_degrees);
+  double phi_max = std::min(phi_max_degrees, 360.0f) * std::numbers::pi / 180;
+  int segments = std::max(3, static_cast<int>(std::ceil(kDiskSegmentsPerTurn * phi_max / (2 * std::numbers::pi))));
+  double dphi = phi_max / segments;
+  double stretch = std::sqrt(dphi / std::sin(dphi));
+
+  TriangleMesh mesh;
+  auto add_vertex = [&](double r, double phi, float u, float v) {
+    mesh.positions.emplace_back(static_cast<float>(stretch * r * std::cos(phi)),
+                                static_cast<float>(stretch * r * std::sin(phi)), height);
+    mesh.normals.emplace_back(0, 0, 1);
+    mesh.uvs.emplace_back(u, v);
+    return static_cast<uint32_t>(mesh.positions.size() - 1);
+  };
+  std::vector<uint32_t> outer_ring, inner_ring;
+  for (int i = 0; i <= segments; ++i)
+    outer_ring.push_back(add_vertex(radius, i * dphi, static_cast<float>(i) / segments, 0));
+  if (inner > 0) {
+    for (int i = 0; i <= segments; ++i)
+      inner_ring.push_back(add_vertex(inner, i * dphi, static_cast<float>(i) / segments, 1));
+    for (int i = 0; i < segments; ++i)
+      mesh.indices.insert(mesh.indices.end(), {outer_ring[i], outer_ring[i + 1], inner_ring[i + 1], outer_ring[i],
+                                               inner_ring[i + 1], inner_ring[i]});
+  } else {
+    for (int i = 0; i < segments; ++i) {
+      uint32_t centre = add_vertex(0, 0, (i + 0.5f) / segments, 1);
+      mesh.indices.insert(mesh.indices.end(), {centre, outer_ring[i], outer_ring[i + 1]});
+    }
+  }
+  BuiltGeometry built{MeshShape{std::move(mesh)}, {}, 0};
+  built.object_area = static_cast<float>(0.5 * phi_max * (double(radius) * radius - double(inner) * inner));
+  return built;
+}
+
+// pbrt-v4's bilinear patches: four vertices (p00, p10, p01, p11) each, p(u, v) the bilinear
+// interpolation. A planar patch becomes two triangles; any other is tessellated into
+// kBilinearPatchTessellation^2 quads with bilinear positions, uvs and normals.
+BuiltGeometry SceneParser::make_bilinear_mesh(ParamList& params) {
+  std::vector<Vec3> p = params.get_vec3_array("P", "point3");
+  std::vector<int> indices = params.get_int_array("indices");
+  std::vector<Vec3> normals = params.get_vec3_array("N", "normal");
+  std::vector<Vec2> uvs = params.get_point2_array("uv");
+  size_t n = p.size();
+  if (n == 0) params.fail("P", "is required: give the vertex positions as \"point3 P\"");
+  if (indices.empty()) {
+    if (n != 4) params.fail("indices", "is required unless \"P\" has exactly 4 points (it has {})", n);
+    indices = {0, 1, 2, 3};
+  }
+  if (indices.size() % 4 != 0)
+    params.fail("indices", "has {} values, which is not a multiple of 4 (four per patch)", indices.size());
+  for (size_t i = 0; i < indices.size(); ++i)
+    if (indices[i] < 0 || static_cast<size_t>(indices[i]) >= n)
+      params.fail("indices", "value {} (number {}) is out of range: \"P\" has {} points", indices[i], i + 1, n);
+  if (!normals.empty() && normals.size() != n)
+    params.fail("N", "has {} normals but \"P\" has {} points; give one normal per point", normals.size(), n);
+  if (!uvs.empty() && uvs.size() != n)
+    params.fail("uv", "has {} coordinates but \"P\" has {} points; give one per point", uvs.size(), n);
+  ignore_param(params, "emissionfilename", "textured area lights are not supported");
+
+  size_t patches = indices.size() / 4;
+  auto corner = [&](size_t patch, int c) { return static_cast<size_t>(indices[4 * patch + c]); };
+  auto is_planar = [&](size_t patch) {
+    Vec3 p00 = p[corner(patch, 0)], p10 = p[corner(patch, 1)], p01 = p[corner(patch, 2)], p11 = p[corner(patch, 3)];
+    Vec3 normal = cross(p10 - p00, p01 - p00);
+    float size = length(p10 - p00) + length(p01 - p00) + length(p11 - p00);
+    if (!(length(normal) > 0)) return false;
+    return std::abs(dot(p11 - p00, normalize(normal))) <= 1e-5f * size;
+  };
+  std::vector<bool> planar(patches);
+  bool all_planar = true;
+  for (size_t i = 0; i < patches; ++i) {
+    planar[i] = is_planar(i);
+    all_planar = all_planar && planar[i];
+  }
+
+  BuiltGeometry built;
+  TriangleMesh mesh;
+  const Vec2 default_uv[4] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}};
+  for (size_t patch = 0; patch < patches; ++patch) {
+    Vec3 q[4], nq[4];
+    Vec2 t[4];
+    for (int c = 0; c < 4; ++c) {
+      q[c] = p[corner(patch, c)];
+      t[c] = uvs.empty() ? default_uv[c] : uvs[corner(patch, c)];
+      if (!normals.empty()) nq[c] = normals[corner(patch, c)];
+    }
+    auto lerp3 = [](float s, Vec3 a, Vec3 b) { return a * (1 - s) + b * s; };
+    auto add_vertex = [&](float u, float v) {
+      mesh.positions.push_back(lerp3(v, lerp3(u, q[0], q[1]), lerp3(u, q[2], q[3])));
+      mesh.uvs.emplace_back((1 - v) * ((1 - u) * t[0].x + u * t[1].x) + v * ((1 - u) * t[2].x + u * t[3].x),
+                            (1 - v) * ((1 - u) * t[0].y + u * t[1].y) + v * ((1 - u) * t[2].y + u * t[3].y));
+      if (!normals.empty()) {
+        mesh.normals.push_back(normalize(lerp3(v, lerp3(u, nq[0], nq[1]), lerp3(u, nq[2], nq[3]))));
+      } else if (!all_planar) {
+        Vec3 dpdu = lerp3(v, q[1] - q[0], q[3] - q[2]), dpdv = lerp3(u, q[2] - q[0], q[3] - q[1]);
+        Vec3 normal = cross(dpdu, dpdv);
+        mesh.normals.push_back(length(normal) > 0 ? normalize(normal) : Vec3(0, 0, 1));
+      }
+      return static_cast<uint32_t>(mesh.positions.size() - 1);
+    };
+    int steps = planar[patch] ? 1 : kBilinearPatchTessellation;
+    uint32_t first = static_cast<uint32_t>(mesh.positions.size());
+    for (int j = 0; j <= steps; ++j)
+      for (int i = 0; i <= steps; ++i) add_vertex(static_cast<float>(i) / steps, static_cast<float>(j) / steps);
+    auto vertex = [&](int i, int j) { return first + static_cast<uint32_t>(j * (steps + 1) + i); };
+    for (int j = 0; j < steps; ++j)
+      for (int i = 0; i < steps; ++i) {
+        // (u, v) -> (u+1, v) -> (u+1, v+1) faces along dp/du x dp/dv, pbrt's patch normal.
+        mesh.indices.insert(mesh.indices.end(), {vertex(i, j), vertex(i + 1, j), vertex(i + 1, j + 1), vertex(i, j),
+                                                 vertex(i + 1, j + 1), vertex(i, j + 1)});
+        built.primitive_of_triangle.insert(built.primitive_of_triangle.end(), 2, static_cast<uint32_t>(patch));
+      }
+  }
+  built.geometry = MeshShape{std::move(mesh)};
+  return built;
+}
+
+namespace {
+
+// The triangles `triangles` of `mesh` as a mesh of their own.
+TriangleMesh submesh(const TriangleMesh& mesh, const std::vector<uint32_t>& triangles) {
+  TriangleMesh out;
+  std::vector<int64_t> remap(mesh.positions.size(), -1);
+  for (uint32_t t : triangles)
+    for (int c = 0; c < 3; ++c) {
+      uint32_t v = mesh.indices[3 * t + c];
+      if (remap[v] < 0) {
+        remap[v] = static_cast<int64_t>(out.positions.size());
+        out.positions.push_back(mesh.positions[v]);
+        if (!mesh.normals.empty()) out.normals.push_back(mesh.normals[v]);
+        if (!mesh.uvs.empty()) out.uvs.push_back(mesh.uvs[v]);
+      }
+      out.indices.push_back(static_cast<uint32_t>(remap[v]));
+    }
+  return out;
+}
+
+}  // namespace
+
+// An area light with "power": pbrt-v4 gives every primitive (a triangle, a bilinear patch, a sphere,
+// a disk) the radiance L * scale * power / (pi * (twosided ? 2 : 1) * its area), so each primitive
+// emits "power" (the RGB L is not normalised). Triangles whose primitives have the same area share
+// a shape; others become shapes of their own.
+void SceneParser::add_emissive_shape(ShapeDesc shape, const BuiltGeometry& built, const Token& directive) {
+  const AreaLightSpec& light = *state_.area_light;
+  if (!light.power) {
+    shape.emission = AreaEmission{light.radiance, light.two_sided};
+    add_shape(std::move(shape), directive);
+    return;
+  }
+  double sides = light.two_sided ? 2 : 1;
+  auto radiance_for = [&](double area) {
+    if (!(area > 0))
+      throw_scene_error(at(directive), "Shape: the area light's \"power\" (at {}) cannot be spread over a "
+                        "primitive of zero area", light.where.to_string());
+    return light.radiance * static_cast<float>(*light.power / (std::numbers::pi * sides * area));
+  };
+  const auto* mesh_shape = std::get_if<MeshShape>(&shape.geometry);
+  if (built.object_area > 0 || !mesh_shape) {
+    shape.emission = AreaEmission{radiance_for(built.object_area), light.two_sided};
+    add_shape(std::move(shape), directive);
+    return;
+  }
+  const TriangleMesh& mesh = mesh_shape->mesh;
+  size_t triangles = mesh.triangle_count();
+  std::vector<double> triangle_area(triangles);
+  for (size_t t = 0; t < triangles; ++t) {
+    Point3 a = shape.to_world.point(mesh.positions[mesh.indices[3 * t]]);
+    Point3 b = shape.to_world.point(mesh.positions[mesh.indices[3 * t + 1]]);
+    Point3 c = shape.to_world.point(mesh.positions[mesh.indices[3 * t + 2]]);
+    triangle_area[t] = 0.5 * length(cross(b - a, c - a));
+  }
+  std::vector<double> area = triangle_area;  // of the primitive each triangle belongs to
+  if (!built.primitive_of_triangle.empty()) {
+    std::map<uint32_t, double> primitive_area;
+    for (size_t t = 0; t < triangles; ++t) primitive_area[built.primitive_of_triangle[t]] += triangle_area[t];
+    for (size_t t = 0; t < triangles; ++t) area[t] = primitive_area[built.primitive_of_triangle[t]];
+  }
+  std::vector<uint32_t> order(triangles);
+  for (uint32_t t = 0; t < triangles; ++t) order[t] = t;
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return area[a] < area[b]; });
+  std::vector<std::vector<uint32_t>> groups;
+  for (uint32_t t : order) {
+    if (groups.empty() || area[t] > area[groups.back().front()] * (1 + 1e-4)) groups.emplace_back();
+    groups.back().push_back(t);
+  }
+  for (std::vector<uint32_t>& group : groups) {
+    ShapeDesc part = shape;
+    part.emission = AreaEmission{radiance_for(area[group.front()]), light.two_sided};
+    if (groups.size() > 1) {
+      std::sort(group.begin(), group.end());
+      part.geometry = MeshShape{submesh(mesh, group)};
+      part.name =
+          fmt::format("{} (the {} triangles of primitive area {})", shape.name, group.size(), area[group.front()]);
+    }
+    add_shape(std::move(part), directive);
+  }
+}
+
+void SceneParser::add_shape(ShapeDesc shape, const Token& directive) {
+  if (!open_object_) {
+    scene_.shapes.push_back(std::move(shape));
+    return;
+  }
+  if (shape.emission)
+    throw_scene_error(at(directive),
+                      "Shape inside ObjectBegin \"{}\": area lights in object instances are not supported (nor "
+                      "are they in pbrt-v4)",
+                      open_object_->name);
+  open_object_->shapes.push_back(std::move(shape));
+}
+
+void SceneParser::shape(const Token& d) {
+  require_world(d);
+  Token type = expect_string(d, "the shape type");
+  ParamList params = read_params(d, fmt::format("Shape \"{}\"", type.text), kShapeAttributes);
+  BuiltGeometry built;
+  if (type.text == "sphere")
+    built = make_sphere(params);
+  else if (type.text == "trianglemesh")
+    built = make_triangle_mesh(params);
+  else if (type.text == "plymesh")
+    built = make_ply_mesh(params);
+  else if (type.text == "disk")
+    built = make_disk(params);
+  else if (type.text == "bilinearmesh")
+    built = make_bilinear_mesh(params);
+  else
+    reject_type(at(type), "shape", type.text, {"sphere", "trianglemesh", "plymesh", "disk", "bilinearmesh"},
+                {"curve", "cylinder", "loopsubdiv"}, "candela has no primitive or tessellation for it");
+  if (const Param* alpha = params.take("alpha", {"float", "texture"})) {
+    params.expect_count(*alpha, 1);
+    if (alpha->type == "texture")
+      params.fail("alpha", "textures are not supported: an alpha texture cuts the surface out where it is "
+                  "below 1, and candela's surfaces are opaque");
+    if (alpha->numbers[0] < 1)
+      params.fail("alpha", "below 1 is not supported: it makes the surface transparent, and candela's surfaces "
+                  "are opaque");
+  }
+  params.reject_unused();
+  ShapeDesc desc;
+  desc.geometry = built.geometry;
+  desc.to_world = state_.ctm.start;
+  if (state_.ctm.is_animated()) {
+    // Area lights are sampled at fixed positions.
+    if (state_.area_light)
+      throw_scene_error(at(d), "Shape: area lights must not move (the CTM is animated inside an AreaLightSource)");
+    if (open_object_)
+      throw_scene_error(at(d), "Shape inside ObjectBegin \"{}\": shapes of an object cannot move (the CTM is "
+                        "animated); animate the ObjectInstance instead", open_object_->name);
+    desc.to_world_end = state_.ctm.end;
+  }
+  desc.material = state_.material;
+  desc.reverse_orientation = state_.reverse_orientation;
+  desc.name = fmt::format("{} at {}", type.text, at(d).to_string());
+  desc.where = at(d);
+  if (state_.area_light)
+    add_emissive_shape(std::move(desc), built, d);
+  else
+    add_shape(std::move(desc), d);
+}
+
+// ---------------------------------------------------------------- object instancing
+
+void SceneParser::object_begin(const Token& d) {
+  require_world(d);
+  Token name = expect_string(d, "the object name");
+  if (open_object_)
+    throw_scene_error(at(d), "ObjectBegin inside the definition of \"{}\" (begun at {}); objects cannot nest",
+                      open_object_->name, open_object_->where.to_string());
+  if (auto earlier = objects_.find(name.text); earlier != objects_.end())
+    throw_scene_error(at(name), "ObjectBegin: object \"{}\" is already defined at {}", name.text,
+                      earlier->second.where.to_string());
+  push_block(d, BlockKind::Object);
+  open_object_ = ObjectDefinition{name.text, at(d), {}, -1};
+}
+
+void SceneParser::object_end(const Token& d) {
+  require_world(d);
+  if (!open_object_) throw_scene_error(at(d), "ObjectEnd without a matching ObjectBegin");
+  pop_block(d, BlockKind::Object);
+  std::string name = open_object_->name;
+  objects_.emplace(std::move(name), std::move(*open_object_));
+  open_object_.reset();
+}
+
+// As in pbrt-v4, the shapes of an object keep the CTM they had at their definition (their
+// to_world), and an instance places them with the CTM at ObjectInstance: world = instance.to_world *
+// shape.to_world. The object goes into SceneDesc::objects when it is first instanced.
+void SceneParser::object_instance(const Token& d) {
+  require_world(d);
+  Token name = expect_string(d, "the object name");
+  if (open_object_)
+    throw_scene_error(at(d), "ObjectInstance inside the definition of \"{}\"; instances cannot nest",
+                      open_object_->name);
+  auto object = objects_.find(name.text);
+  if (object == objects_.end())
+    throw_scene_error(at(name), "ObjectInstance: no object named \"{}\" is defined (ObjectBegin must come first)",
+                      name.text);
+  ObjectDefinition& definition = object->second;
+  if (definition.shapes.empty()) return;  // nothing to place
+  if (definition.index < 0) {
+    scene_.objects.push_back(ObjectDesc{definition.shapes, definition.name, definition.where});
+    definition.index = static_cast<int>(scene_.objects.size()) - 1;
+  }
+  InstanceDesc instance;
+  instance.object = definition.index;
+  instance.to_world = state_.ctm.start;
+  instance.where = at(d);
+  if (state_.ctm.is_animated()) instance.to_world_end = state_.ctm.end;
+  scene_.instances.push_back(instance);
+}
+
+
+}  // namespace candela::pbrt

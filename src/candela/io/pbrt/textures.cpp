@@ -1,0 +1,328 @@
+// Colours, spectra and textured parameters, and the Texture directive.
+#include <algorithm>
+#include <cmath>
+
+#include "candela/io/pbrt/scene_parser.h"
+
+namespace candela::pbrt {
+
+using pbrt_spectra::Role;
+
+namespace {
+
+// A "spectrum" parameter's value as RGB: a named spectrum or (wavelength, value) pairs.
+RGB spectrum_rgb(const Param& p, const ParamList& params, Role role) {
+  if (!p.strings.empty()) {
+    params.expect_count(p, 1);
+    const std::string& name = p.strings[0];
+    std::optional<pbrt_spectra::NamedSpectrum> named = pbrt_spectra::find_named(name);
+    if (!named) {
+      std::string names;
+      for (std::string_view n : pbrt_spectra::named_spectrum_names())
+        names += fmt::format("{}\"{}\"", names.empty() ? "" : ", ", n);
+      throw_scene_error(p.where,
+                        "{}: {}: unknown named spectrum \"{}\" (spectrum files are not supported; the named spectra "
+                        "are {})",
+                        params.owner(), p.declaration(), name, names);
+    }
+    bool fits = role == Role::Illuminant ? named->kind == pbrt_spectra::NamedKind::Illuminant
+                                         : named->kind != pbrt_spectra::NamedKind::Illuminant;
+    if (!fits || role == Role::Reflectance)
+      throw_scene_error(p.where, "{}: {}: \"{}\" is {} and does not fit here", params.owner(), p.declaration(), name,
+                        named->kind == pbrt_spectra::NamedKind::Illuminant ? "an illuminant spectrum"
+                        : named->kind == pbrt_spectra::NamedKind::Metal    ? "a conductor's optical constant"
+                                                                           : "a glass's refractive index");
+    return named->rgb;
+  }
+  params.expect_multiple(p, 2);
+  for (size_t i = 0; i < p.numbers.size(); i += 2) {
+    if (i > 0 && !(p.numbers[i] > p.numbers[i - 2]))
+      throw_scene_error(p.where, "{}: {}: the wavelengths must increase ({} follows {})", params.owner(),
+                        p.declaration(), p.numbers[i], p.numbers[i - 2]);
+    if (p.numbers[i + 1] < 0)
+      throw_scene_error(p.where, "{}: {}: the value at {} nm is negative ({})", params.owner(), p.declaration(),
+                        p.numbers[i], p.numbers[i + 1]);
+  }
+  RGB rgb = pbrt_spectra::sampled_spectrum_rgb(p.numbers, role);
+  for (int c = 0; c < 3; ++c) rgb[c] = std::max(rgb[c], 0.0f);
+  if (role == Role::Reflectance)
+    for (int c = 0; c < 3; ++c) rgb[c] = std::min(rgb[c], 1.0f);
+  return rgb;
+}
+
+}  // namespace
+
+// A colour parameter of a material or texture: "rgb", "spectrum" or "texture" (a spectrum texture).
+// `is_albedo` limits constant colours to [0, 1], as pbrt-v4 does for reflectances.
+std::optional<ColorInput> SceneParser::read_color(ParamList& params, std::string_view name, Role role) {
+  const Param* p = params.take(name, {"rgb", "spectrum", "texture"});
+  if (!p) return std::nullopt;
+  if (p->type == "rgb") return ColorInput(params.checked_rgb(*p, role == Role::Reflectance));
+  if (p->type == "spectrum") return ColorInput(spectrum_rgb(*p, params, role));
+  params.expect_count(*p, 1);
+  auto texture = spectrum_textures_.find(p->strings[0]);
+  if (texture == spectrum_textures_.end()) {
+    bool is_float = float_textures_.contains(p->strings[0]);
+    throw_scene_error(p->where, "{}: {}: no spectrum texture named \"{}\" is defined{}", params.owner(),
+                      p->declaration(), p->strings[0],
+                      is_float ? " (there is a \"float\" texture of that name; this parameter needs a \"spectrum\" one)"
+                               : " (Texture must come first)");
+  }
+  return texture->second.color;
+}
+
+// A float parameter that may be textured: "float" or "texture" (a float texture).
+std::optional<FloatInput> SceneParser::read_float_texture(ParamList& params, std::string_view name) {
+  const Param* p = params.take(name, {"float", "texture"});
+  if (!p) return std::nullopt;
+  params.expect_count(*p, 1);
+  if (p->type == "float") return FloatInput(static_cast<float>(p->numbers[0]));
+  auto texture = float_textures_.find(p->strings[0]);
+  if (texture == float_textures_.end()) {
+    bool is_spectrum = spectrum_textures_.contains(p->strings[0]);
+    throw_scene_error(p->where, "{}: {}: no float texture named \"{}\" is defined{}", params.owner(), p->declaration(),
+                      p->strings[0],
+                      is_spectrum
+                          ? " (there is a \"spectrum\" texture of that name; this parameter needs a \"float\" one)"
+                          : " (Texture must come first)");
+  }
+  return texture->second.value;
+}
+
+// A light's emission spectrum: "rgb", "spectrum" (named illuminant or pairs) or "blackbody" (a
+// temperature in kelvin). Named and sampled spectra are normalised to luminance 1 as in pbrt-v4;
+// RGB values are used as given (pbrt-v4 renders an RGB emission as that RGB).
+std::optional<RGB> SceneParser::read_emission(ParamList& params, std::string_view name) {
+  const Param* p = params.take(name, {"rgb", "spectrum", "blackbody"});
+  if (!p) return std::nullopt;
+  if (p->type == "rgb") return params.checked_rgb(*p, false);
+  if (p->type == "spectrum") return spectrum_rgb(*p, params, Role::Illuminant);
+  if (p->count() != 1)
+    throw_scene_error(p->where, "{}: {} takes one value, the temperature in kelvin, got {} (pbrt-v3's second "
+                      "\"scale\" value is not pbrt-v4 syntax)", params.owner(), p->declaration(), p->count());
+  double kelvin = p->numbers[0];
+  if (!(kelvin > 0))
+    throw_scene_error(p->where, "{}: {}: the temperature must be positive, got {}", params.owner(), p->declaration(),
+                      kelvin);
+  return pbrt_spectra::blackbody_rgb(static_cast<float>(kelvin));
+}
+
+// A dielectric's index of refraction: "float", or a "spectrum" (a named glass or pairs) taken at
+// 550 nm, since candela does not disperse light.
+std::optional<float> SceneParser::read_ior(ParamList& params, std::string_view name) {
+  const Param* p = params.take(name, {"float", "spectrum", "rgb"});
+  if (!p) return std::nullopt;
+  float ior = 0;
+  if (p->type == "float") {
+    params.expect_count(*p, 1);
+    ior = static_cast<float>(p->numbers[0]);
+  } else if (p->type == "rgb") {
+    RGB rgb = params.checked_rgb(*p, false);
+    ior = rgb.g;
+    warn(p->where, "{}: {}: candela does not disperse light; the green value {} is the index of refraction",
+         params.owner(), p->declaration(), ior);
+  } else if (!p->strings.empty()) {
+    params.expect_count(*p, 1);
+    std::optional<pbrt_spectra::NamedSpectrum> named = pbrt_spectra::find_named(p->strings[0]);
+    if (named && named->kind == pbrt_spectra::NamedKind::Glass)
+      ior = named->ior_550nm;
+    else
+      throw_scene_error(p->where,
+                        "{}: {}: \"{}\" is not one of pbrt-v4's glasses (\"glass-BK7\", \"glass-BAF10\", "
+                        "\"glass-FK51A\", \"glass-LASF9\", \"glass-F5\", \"glass-F10\", \"glass-F11\")",
+                        params.owner(), p->declaration(), p->strings[0]);
+  } else {
+    spectrum_rgb(*p, params, Role::Unbounded);  // validates the pairs
+    ior = pbrt_spectra::sampled_spectrum_at(p->numbers, 550);
+  }
+  if (!(ior > 0)) throw_scene_error(p->where, "{}: \"{}\" must be positive, got {}", params.owner(), name, ior);
+  return ior;
+}
+
+// pbrt-v4's microfacet roughness: "roughness" for both axes unless "uroughness"/"vroughness" are
+// given; "remaproughness" (true) reads them as roughness and uses alpha = sqrt(roughness).
+Roughness SceneParser::read_roughness(ParamList& params) {
+  Roughness roughness;
+  FloatInput both = read_float_texture(params, "roughness").value_or(FloatInput(0.0f));
+  roughness.u = read_float_texture(params, "uroughness").value_or(both);
+  roughness.v = read_float_texture(params, "vroughness").value_or(both);
+  roughness.remap = params.get_bool("remaproughness", true);
+  for (auto [name, value] : {std::pair{"roughness", both}, std::pair{"uroughness", roughness.u},
+                             std::pair{"vroughness", roughness.v}})
+    if (value.is_constant() && value.value < 0) params.fail(name, "must not be negative, got {}", value.value);
+  return roughness;
+}
+
+void SceneParser::ignore_shading_params(ParamList& params) {
+  ignore_param(params, "displacement", "displacement mapping is not supported");
+  ignore_param(params, "normalmap", "normal maps are not supported");
+}
+
+int SceneParser::add_texture(TextureDesc texture, const SourceLocation& where) {
+  scene_.textures.push_back(std::move(texture));
+  scene_.places.textures.push_back(where);
+  return static_cast<int>(scene_.textures.size()) - 1;
+}
+
+// ---------------------------------------------------------------- textures
+
+UVMapping SceneParser::read_uv_mapping(ParamList& params) {
+  std::string mapping = params.get_string("mapping", "uv");
+  if (mapping == "spherical" || mapping == "cylindrical" || mapping == "planar")
+    params.fail("mapping", "\"{}\" is not supported (only \"uv\")", mapping);
+  if (mapping != "uv")
+    params.fail("mapping", "must be \"uv\", \"spherical\", \"cylindrical\" or \"planar\", got \"{}\"", mapping);
+  UVMapping uv;
+  uv.su = params.get_float("uscale", 1);
+  uv.sv = params.get_float("vscale", 1);
+  uv.du = params.get_float("udelta", 0);
+  uv.dv = params.get_float("vdelta", 0);
+  return uv;
+}
+
+ImageTexture SceneParser::make_image_texture(ParamList& params) {
+  ImageTexture texture;
+  if (!params.has("filename")) params.fail("filename", "is required: name the image file");
+  std::string name = params.get_string("filename", "");
+  fs::path file = resolve_path(name, params.where("filename"), fmt::format("{}: \"filename\"", params.owner()));
+  texture.filename = file.string();
+
+  std::string filter = params.get_string("filter", "bilinear");
+  if (filter == "point") {
+    texture.bilinear = false;
+  } else if (filter == "trilinear" || filter == "ewa") {
+    warn(params.where("filter"),
+         "{}: filter \"{}\" is read as \"bilinear\": candela does not mipmap textures (minified textures alias "
+         "where pbrt would blur them)",
+         params.owner(), filter);
+  } else if (filter != "bilinear") {
+    params.fail("filter", "must be \"point\", \"bilinear\", \"trilinear\" or \"ewa\", got \"{}\"", filter);
+  }
+  params.get_float("maxanisotropy", 8);  // only for "ewa"
+
+  std::string wrap = params.get_string("wrap", "repeat");
+  if (wrap == "repeat")
+    texture.wrap = TextureWrap::Repeat;
+  else if (wrap == "black")
+    texture.wrap = TextureWrap::Black;
+  else if (wrap == "clamp")
+    texture.wrap = TextureWrap::Clamp;
+  else if (wrap == "octahedralsphere")
+    params.fail("wrap", "\"octahedralsphere\" is not supported for image textures (only for environment maps)");
+  else
+    params.fail("wrap", "must be \"repeat\", \"black\", \"clamp\" or \"octahedralsphere\", got \"{}\"", wrap);
+
+  texture.scale = params.get_float("scale", 1);
+  texture.invert = params.get_bool("invert", false);
+
+  // pbrt-v4's "encoding" defaults to "sRGB" for .png files and to "linear" for others, but it reads
+  // every 8-bit format other than PNG (.tga, .jpg, ...) through stb_image as sRGB whatever the
+  // parameter says: 8-bit files are sRGB, float files linear, which is ColorEncoding::Auto. (Checked
+  // on veach-ajar's .tga textures against its pbrt-v4 reference render.) An explicit "encoding" is
+  // honoured for every file.
+  texture.encoding = ColorEncoding::Auto;
+  if (params.has("encoding")) {
+    std::string encoding = params.get_string("encoding", "");
+    if (encoding == "sRGB") {
+      texture.encoding = ColorEncoding::SRGB;
+    } else if (encoding == "linear") {
+      texture.encoding = ColorEncoding::Linear;
+    } else if (encoding.starts_with("gamma ")) {
+      std::optional<double> gamma = parse_number(std::string_view(encoding).substr(6));
+      if (!gamma || !(*gamma > 0)) params.fail("encoding", "\"{}\" needs a positive gamma value", encoding);
+      if (std::abs(*gamma - 1) < 1e-3) {
+        texture.encoding = ColorEncoding::Linear;
+      } else if (std::abs(*gamma - 2.2) <= 0.1) {
+        texture.encoding = ColorEncoding::SRGB;
+        warn(params.where("encoding"), "{}: \"encoding\" \"{}\" is read as sRGB (the closest curve candela has)",
+             params.owner(), encoding);
+      } else {
+        params.fail("encoding", "\"{}\" is not supported (only \"sRGB\", \"linear\" and gammas near 1 or 2.2)",
+                    encoding);
+      }
+    } else {
+      params.fail("encoding", "must be \"sRGB\", \"linear\" or \"gamma <value>\", got \"{}\"", encoding);
+    }
+  }
+  texture.mapping = read_uv_mapping(params);
+  return texture;
+}
+
+// A texture's input: a spectrum texture's "rgb"/"spectrum"/"texture" or a float texture's
+// "float"/"texture" (as a grey colour).
+ColorInput SceneParser::read_texture_input(ParamList& params, std::string_view name, bool is_float, RGB fallback) {
+  if (!is_float) return read_color(params, name, Role::Unbounded).value_or(ColorInput(fallback));
+  std::optional<FloatInput> value = read_float_texture(params, name);
+  if (!value) return ColorInput(fallback);
+  ColorInput color;
+  if (value->is_constant())
+    color.value = RGB(value->value);
+  else
+    color.texture = value->texture;
+  return color;
+}
+
+void SceneParser::texture(const Token& d) {
+  require_world(d);
+  Token name = expect_string(d, "the texture name");
+  Token kind = expect_string(d, "the texture's value type (\"spectrum\" or \"float\")");
+  if (kind.text != "spectrum" && kind.text != "float")
+    throw_scene_error(at(kind), "Texture \"{}\": the value type must be \"spectrum\" or \"float\", got \"{}\"",
+                      name.text, kind.text);
+  bool is_float = kind.text == "float";
+  Token type = expect_string(d, "the texture type");
+  auto& table = is_float ? float_textures_ : spectrum_textures_;
+  if (auto earlier = table.find(name.text); earlier != table.end())
+    throw_scene_error(at(name), "Texture: {} texture \"{}\" is already defined at {}", kind.text, name.text,
+                      earlier->second.where.to_string());
+  ParamList params =
+      read_params(d, fmt::format("Texture \"{}\" \"{}\" \"{}\"", name.text, kind.text, type.text), kTextureAttributes);
+
+  NamedTexture named;
+  named.where = at(name);
+  if (type.text == "imagemap") {
+    named.index = add_texture(make_image_texture(params), at(d));
+  } else if (type.text == "checkerboard") {
+    int dimension = params.get_int("dimension", 2);
+    if (dimension == 3) params.fail("dimension", "3: solid (3D) checkerboards are not supported");
+    if (dimension != 2) params.fail("dimension", "must be 2 or 3, got {}", dimension);
+    CheckerboardTexture checkerboard;
+    checkerboard.mapping = read_uv_mapping(params);
+    checkerboard.tex1 = read_texture_input(params, "tex1", is_float, RGB(1.0f));
+    checkerboard.tex2 = read_texture_input(params, "tex2", is_float, RGB(0.0f));
+    named.index = add_texture(checkerboard, at(d));
+  } else if (type.text == "scale") {
+    ScaleTexture scale;
+    scale.tex = read_texture_input(params, "tex", is_float, RGB(1.0f));
+    scale.scale = read_float_texture(params, "scale").value_or(FloatInput(1.0f));
+    named.index = add_texture(scale, at(d));
+  } else if (type.text == "mix") {
+    MixTexture mix;
+    mix.tex1 = read_texture_input(params, "tex1", is_float, RGB(0.0f));
+    mix.tex2 = read_texture_input(params, "tex2", is_float, RGB(1.0f));
+    mix.amount = read_float_texture(params, "amount").value_or(FloatInput(0.5f));
+    named.index = add_texture(mix, at(d));
+  } else if (type.text == "constant") {
+    // No texture at all: parameters that name it get its value.
+    if (is_float) {
+      named.value = FloatInput(params.get_float("value", 1));
+      named.color = ColorInput(RGB(named.value.value));
+    } else {
+      named.color = read_color(params, "value", Role::Unbounded).value_or(ColorInput(RGB(1.0f)));
+      named.value = FloatInput(named.color.value.average());
+    }
+  } else {
+    reject_type(at(type), "texture", type.text, {"imagemap", "checkerboard", "scale", "mix", "constant"},
+                {"bilerp", "directionmix", "dots", "fbm", "marble", "ptex", "windy", "wrinkled"},
+                "candela has no such texture");
+  }
+  params.reject_unused();
+  if (named.index >= 0) {
+    named.color.texture = named.index;
+    named.value.texture = named.index;
+  }
+  table[name.text] = named;
+}
+
+
+}  // namespace candela::pbrt
