@@ -78,9 +78,11 @@ class Converter {
 
   FloatInput float_input(const Object& o, std::string_view name, float fallback);
 
-  int add_texture(TextureDesc t);
+  // Each texture, material and light is added with the place of the object it comes from (an empty
+  // Where for the default material), for SceneDesc::places.
+  int add_texture(TextureDesc t, const Where& where);
 
-  int constant_texture(RGB value);
+  int constant_texture(RGB value, const Where& where);
 
   UVMapping to_uv(const Object& o);
 
@@ -90,8 +92,9 @@ class Converter {
 
   PerturbedNormalOptions perturbed_normal_options(const Object& b);
 
-  int add_material(MaterialDesc m);
-  int one_sided(MaterialDesc m, bool two_sided);
+  int add_material(MaterialDesc m, const Where& where);
+  int one_sided(MaterialDesc m, bool two_sided, const Where& where);
+  void add_light(LightDesc l, const Where& where);
 
   float ior_value(const Object& o, std::string_view name, float fallback);
   float relative_ior(const Object& o, float int_default, float ext_default);

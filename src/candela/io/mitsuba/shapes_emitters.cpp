@@ -72,6 +72,7 @@ SdfGridShape Converter::sdf_grid(const Object& s) {
 
 void Converter::shape(const Object& s, ObjectDesc* group) {
   ShapeDesc out;
+  out.where = s.where.place();
   out.name = s.id.empty() ? s.type : s.id;
   out.to_world = get_transform(s, "to_world");
   const std::string& type = s.type;
@@ -105,6 +106,7 @@ void Converter::shape(const Object& s, ObjectDesc* group) {
     if (groups.size() != 1 || groups[0].second->type != "shapegroup")
       throw_scene_error(s.where.loc(), "instance needs exactly one reference to a shapegroup");
     InstanceDesc inst;
+    inst.where = s.where.place();
     inst.object = shapegroup(*groups[0].second);
     inst.to_world = out.to_world;
     check_all_used(s);
@@ -149,6 +151,7 @@ void Converter::shape(const Object& s, ObjectDesc* group) {
 int Converter::shapegroup(const Object& g) {
   if (auto it = group_memo_.find(&g); it != group_memo_.end()) return it->second;
   ObjectDesc obj;
+  obj.where = g.where.place();
   obj.name = g.id;
   for (size_t i = 0; i < g.props.size(); ++i) {
     const Property& p = g.props[i];
@@ -170,9 +173,14 @@ int Converter::shapegroup(const Object& g) {
 
 // ---------------------------------------------------------------- emitters
 
-Vec3 Converter::origin_of(const Transform& t) { return t.point({0, 0, 0}); }
+void Converter::add_light(LightDesc l, const Where& where) {
+  desc_.lights.push_back(std::move(l));
+  desc_.places.lights.push_back(where.place());
+}
 
-void Converter::emitter(const Object& e) {
+Vec3 Converter::origin_of(const Transform& t) { return t.point({0, 0, 0}); }
+                          
+                          void Converter::emitter(const Object& e) {
   const std::string& type = e.type;
   if (type == "point") {
     PointLight l;
@@ -183,11 +191,11 @@ void Converter::emitter(const Object& e) {
       l.position = *p;
     }
     l.intensity = constant_color(e, "intensity", RGB(1.0f));
-    desc_.lights.push_back(l);
+    add_light(l, e.where);
   } else if (type == "constant") {
     SkyLight l;
     l.zenith = l.horizon = l.ground = constant_color(e, "radiance", RGB(1.0f));
-    desc_.lights.push_back(l);
+    add_light(l, e.where);
   } else if (type == "envmap") {
     EnvironmentMap l;
     l.filename = resolve_file(e, "filename").string();
@@ -196,7 +204,7 @@ void Converter::emitter(const Object& e) {
     l.mapping = EnvironmentMapping::EquirectangularPoleRows;
     l.mis_compensation = get_bool(e, "mis_compensation", false);
     ignore(e, "filter_type");
-    desc_.lights.push_back(l);
+    add_light(l, e.where);
   } else if (type == "directional") {
     DistantLight l;
     Transform t = get_transform(e, "to_world");
@@ -207,7 +215,7 @@ void Converter::emitter(const Object& e) {
       l.direction = normalize(*d);
     }
     l.radiance = constant_color(e, "irradiance", RGB(1.0f));
-    desc_.lights.push_back(l);
+    add_light(l, e.where);
   } else if (type == "spot") {
     SpotLight l;
     Transform t = get_transform(e, "to_world");
@@ -226,12 +234,12 @@ void Converter::emitter(const Object& e) {
       if (p->kind != Property::Kind::Object && p->kind != Property::Kind::Ref) wrong_kind(e, *p, "a texture");
       l.texture = texture(deref(*p));
     }
-    desc_.lights.push_back(l);
+    add_light(l, e.where);
   } else if (type == "projector") {
     ProjectorLight l;
     l.to_world = get_transform(e, "to_world");
     ColorInput irr = color(e, "irradiance", RGB(1.0f), true);
-    l.irradiance = irr.is_constant() ? constant_texture(irr.value) : irr.texture;
+    l.irradiance = irr.is_constant() ? constant_texture(irr.value, e.where) : irr.texture;
     l.scale = RGB(get_float(e, "scale", 1.0f));
     std::string axis = get_string(e, "fov_axis", "x");
     if (!find(e, "fov")) axis = "diagonal";  // Mitsuba's default focal length of 50 mm
@@ -243,7 +251,7 @@ void Converter::emitter(const Object& e) {
     else if (axis == "diagonal") fov_x = 2 * std::atan(t * float(w) / std::hypot(float(w), float(h))) * 180 / kPi;
     else if (axis != "x") throw_scene_error(e.where.loc(), "projector: fov_axis \"{}\" (use x, y or diagonal)", axis);
     l.fov_degrees = w >= h ? fov_x : 2 * std::atan(std::tan(radians(fov_x) / 2) * float(h) / float(w)) * 180 / kPi;
-    desc_.lights.push_back(l);
+    add_light(l, e.where);
   } else if (type == "area") {
     throw_scene_error(e.where.loc(), "an area emitter must be inside the shape it lights");
   } else {

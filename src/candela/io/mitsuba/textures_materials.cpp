@@ -50,7 +50,7 @@ RGB Converter::spectrum_rgb(const Property& p, bool within_emitter) {
 }
 
 std::optional<ColorInput> Converter::color_input(const Object& o, std::string_view name, bool within_emitter,
-                                      TextureLookup lookup) {
+                                                 TextureLookup lookup) {
   const Property* p = find(o, name);
   if (!p) return std::nullopt;
   switch (p->kind) {
@@ -102,17 +102,18 @@ FloatInput Converter::float_input(const Object& o, std::string_view name, float 
   wrong_kind(o, *p, "a float or a texture");
 }
 
-int Converter::add_texture(TextureDesc t) {
+int Converter::add_texture(TextureDesc t, const Where& where) {
   desc_.textures.push_back(std::move(t));
+  desc_.places.textures.push_back(where.place());
   return int(desc_.textures.size()) - 1;
 }
 
 // A constant colour as a texture (for parameters that must be textures).
-int Converter::constant_texture(RGB value) {
+int Converter::constant_texture(RGB value, const Where& where) {
   ScaleTexture s;
   s.tex = ColorInput(value);
   s.scale = FloatInput(1.0f);
-  return add_texture(s);
+  return add_texture(s, where);
 }
 
 // Mitsuba's to_uv, an affine map of the texture coordinates (its 2D part; z is ignored):
@@ -159,7 +160,7 @@ int Converter::texture(const Object& t, TextureLookup lookup) {
     img.luminance = lookup == TextureLookup::Scalar;
     ignore(t, "format");  // "variant" / "rgb": the channels are read as RGB either way
     ignore(t, "accel");
-    index = add_texture(img);
+    index = add_texture(img, t.where);
   } else if (t.type == "checkerboard") {
     CheckerboardTexture c;
     c.tex1 = color_input(t, "color0", false, lookup).value_or(ColorInput(RGB(0.4f)));
@@ -170,7 +171,7 @@ int Converter::texture(const Object& t, TextureLookup lookup) {
     if (lookup == TextureLookup::Scalar) std::swap(c.tex1, c.tex2);
     UVMapping m = to_uv(t);
     c.mapping = {2 * m.su, 2 * m.sv, 2 * m.du, 2 * m.dv, 2 * m.s_from_v, 2 * m.t_from_u};
-    index = add_texture(c);
+    index = add_texture(c, t.where);
   } else if (t.type == "mesh_attribute") {
     std::string name = get_string(t, "name", "");
     MeshAttributeTexture a;
@@ -182,7 +183,7 @@ int Converter::texture(const Object& t, TextureLookup lookup) {
     else
       throw_scene_error(t.where.loc(), "mesh_attribute: \"name\" must start with vertex_ or face_ (got \"{}\")", name);
     get_float(t, "scale", 1);  // Mitsuba's mesh_attribute has no scale; accepted when 1
-    index = add_texture(a);
+    index = add_texture(a, t.where);
   } else if (t.type == "rawconstant" || t.type == "uniform" || t.type == "srgb") {
     RGB v(1.0f);
     if (std::optional<Vec3> vec = get_vector(t, "value"); vec) v = RGB(vec->x, vec->y, vec->z);
@@ -190,9 +191,9 @@ int Converter::texture(const Object& t, TextureLookup lookup) {
       if (!c->is_constant()) throw_scene_error(t.where.loc(), "{}: the value must be a constant", t.describe());
       v = c->value;
     }
-    index = constant_texture(v);
+    index = constant_texture(v, t.where);
   } else if (t.type == "blackbody") {
-    index = constant_texture(blackbody(t));
+    index = constant_texture(blackbody(t), t.where);
   } else {
     throw_scene_error(t.where.loc(), "unknown texture type \"{}\" (supported: bitmap, checkerboard, "
                                      "mesh_attribute, rawconstant)",
@@ -210,16 +211,17 @@ PerturbedNormalOptions Converter::perturbed_normal_options(const Object& b) {
   return {get_bool(b, "flip_invalid_normals", true), get_bool(b, "use_shadowing_function", true)};
 }
 
-int Converter::add_material(MaterialDesc m) {
+int Converter::add_material(MaterialDesc m, const Where& where) {
   desc_.materials.push_back(std::move(m));
+  desc_.places.materials.push_back(where.place());
   return int(desc_.materials.size()) - 1;
 }
 
 // Mitsuba's opaque BSDFs are one-sided; candela's are two-sided.
-int Converter::one_sided(MaterialDesc m, bool two_sided) {
-  int inner = add_material(std::move(m));
+int Converter::one_sided(MaterialDesc m, bool two_sided, const Where& where) {
+  int inner = add_material(std::move(m), where);
   if (two_sided) return inner;
-  return add_material(OneSidedMaterial{inner});
+  return add_material(OneSidedMaterial{inner}, where);
 }
 
 float Converter::ior_value(const Object& o, std::string_view name, float fallback) {
@@ -301,7 +303,7 @@ int Converter::bsdf(const Object& b, bool two_sided) {
   const std::string& type = b.type;
   int index = -1;
   if (type == "diffuse") {
-    index = one_sided(DiffuseMaterial{color(b, "reflectance", RGB(0.5f))}, two_sided);
+    index = one_sided(DiffuseMaterial{color(b, "reflectance", RGB(0.5f))}, two_sided, b.where);
   } else if (type == "dielectric" || type == "roughdielectric" || type == "thindielectric") {
     DielectricMaterial d;
     d.ior = relative_ior(b, 1.5046f, 1.000277f);
@@ -309,13 +311,13 @@ int Converter::bsdf(const Object& b, bool two_sided) {
     d.transmittance = color(b, "specular_transmittance", RGB(1.0f));
     if (type == "roughdielectric") d.roughness = roughness(b, 0.1f);
     d.thin = type == "thindielectric";
-    index = add_material(d);
+    index = add_material(d, b.where);
   } else if (type == "conductor" || type == "roughconductor") {
     ConductorMaterial c;
     conductor_ior(b, c);
     c.specular_tint = color(b, "specular_reflectance", RGB(1.0f));
     if (type == "roughconductor") c.roughness = roughness(b, 0.1f);
-    index = one_sided(c, two_sided);
+    index = one_sided(c, two_sided, b.where);
   } else if (type == "plastic" || type == "roughplastic") {
     CoatedDiffuseMaterial c;
     c.reflectance = color(b, "diffuse_reflectance", RGB(0.5f));
@@ -328,7 +330,7 @@ int Converter::bsdf(const Object& b, bool two_sided) {
         throw_scene_error(b.where.loc(), "roughplastic: Mitsuba's roughplastic is isotropic with a constant alpha");
       c.tabulated_coat = true;  // Mitsuba's tables of the rough coat
     }
-    index = one_sided(c, two_sided);
+    index = one_sided(c, two_sided, b.where);
   } else if (type == "twosided") {
     auto bsdfs = nested(b, "bsdf");
     if (bsdfs.empty() || bsdfs.size() > 2)
@@ -336,12 +338,12 @@ int Converter::bsdf(const Object& b, bool two_sided) {
     index = bsdf(*bsdfs[0].second, true);
     // Two BSDFs: the first for the front, the second for the back, each seen as from its front.
     if (bsdfs.size() == 2 && bsdfs[0].second != bsdfs[1].second)
-      index = add_material(TwoSidedMaterial{index, bsdf(*bsdfs[1].second, true)});
+      index = add_material(TwoSidedMaterial{index, bsdf(*bsdfs[1].second, true)}, b.where);
   } else if (type == "mask") {
     MaskMaterial m;
     m.opacity = float_input(b, "opacity", 0.5f);
     m.material = single_nested_bsdf(b, two_sided);
-    index = add_material(m);
+    index = add_material(m, b.where);
   } else if (type == "normalmap") {
     NormalMapMaterial n;
     const Property* p = find(b, "normalmap");
@@ -353,7 +355,7 @@ int Converter::bsdf(const Object& b, bool two_sided) {
       img->encoding = ColorEncoding::Linear;  // Mitsuba reads normal maps raw
     n.material = single_nested_bsdf(b, two_sided);
     n.options = perturbed_normal_options(b);
-    index = add_material(n);
+    index = add_material(n, b.where);
   } else if (type == "bumpmap") {
     BumpMapMaterial m;
     auto textures = nested(b, "texture");
@@ -362,7 +364,7 @@ int Converter::bsdf(const Object& b, bool two_sided) {
     m.scale = get_float(b, "scale", 1.0f);
     m.material = single_nested_bsdf(b, two_sided);
     m.options = perturbed_normal_options(b);
-    index = add_material(m);
+    index = add_material(m, b.where);
   } else if (type == "blendbsdf") {
     BlendMaterial m;
     m.weight = float_input(b, "weight", 0.5f);
@@ -370,9 +372,9 @@ int Converter::bsdf(const Object& b, bool two_sided) {
     if (bsdfs.size() != 2) throw_scene_error(b.where.loc(), "blendbsdf needs two nested bsdfs, got {}", bsdfs.size());
     m.material0 = bsdf(*bsdfs[0].second, two_sided);
     m.material1 = bsdf(*bsdfs[1].second, two_sided);
-    index = add_material(m);
+    index = add_material(m, b.where);
   } else if (type == "null") {
-    index = add_material(InterfaceMaterial{});
+    index = add_material(InterfaceMaterial{}, b.where);
   } else if (type == "principled" || type == "principledthin") {
     PrincipledMaterial p;
     p.thin = type == "principledthin";
@@ -405,7 +407,7 @@ int Converter::bsdf(const Object& b, bool two_sided) {
     ignore(b, "diffuse_transmittance_sampling_rate");
     // Mitsuba's principled scatters from both sides (its transmission lobes need the back), so
     // it is not wrapped in a OneSidedMaterial; the materials engineer implements its side rules.
-    index = add_material(p);
+    index = add_material(p, b.where);
   } else {
     throw_scene_error(b.where.loc(), "unknown bsdf type \"{}\"", type);
   }
@@ -415,7 +417,7 @@ int Converter::bsdf(const Object& b, bool two_sided) {
 }
 
 int Converter::default_material() {
-  if (default_material_ < 0) default_material_ = one_sided(DiffuseMaterial{ColorInput(RGB(0.5f))}, false);
+  if (default_material_ < 0) default_material_ = one_sided(DiffuseMaterial{ColorInput(RGB(0.5f))}, false, Where{});
   return default_material_;
 }
 
