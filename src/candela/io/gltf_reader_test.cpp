@@ -288,6 +288,34 @@ TEST(GltfTransforms, SimpleInstancingMakesOneObjectAndItsInstances) {
   }
 }
 
+// Shapes, objects, instances, textures, materials and lights name their place in the file: the
+// file and a JSON pointer (SceneDesc::places for the last three, parallel to their vectors).
+TEST(GltfPlaces, DescriptionsNameTheirElements) {
+  Scratch scratch;
+  std::vector<std::string> warnings;
+  SceneDesc cube = read_gltf_scene(asset("Cube"), warnings, GltfOptions{.cache_dir = scratch.dir() / "cache"});
+  EXPECT_EQ(cube.shapes.at(0).where.file, asset("Cube").string());
+  EXPECT_EQ(cube.shapes[0].where.key_path, "/meshes/0/primitives/0");
+  ASSERT_EQ(cube.places.materials.size(), cube.materials.size());
+  EXPECT_EQ(cube.places.materials[size_t(cube.shapes[0].material)].key_path, "/materials/0");
+  ASSERT_EQ(cube.places.textures.size(), cube.textures.size());
+  ASSERT_FALSE(cube.textures.empty());
+  for (const SourceLocation& t : cube.places.textures) EXPECT_TRUE(t.key_path.starts_with("/materials/0/")) << t.key_path;
+  ASSERT_EQ(cube.places.lights.size(), cube.lights.size());  // the sky added for a file without lights
+  EXPECT_TRUE(cube.places.lights[0].file.empty());
+
+  SceneDesc instancing = load(asset("SimpleInstancing"));
+  ASSERT_EQ(instancing.objects.size(), 1u);
+  EXPECT_TRUE(instancing.objects[0].where.key_path.starts_with("/meshes/")) << instancing.objects[0].where.key_path;
+  ASSERT_FALSE(instancing.instances.empty());
+  EXPECT_TRUE(instancing.instances[0].where.key_path.ends_with("/extensions/EXT_mesh_gpu_instancing[0]"))
+      << instancing.instances[0].where.key_path;
+
+  SceneDesc lamp = load(asset("LightsPunctualLamp"));
+  ASSERT_EQ(lamp.places.lights.size(), lamp.lights.size());
+  for (const SourceLocation& l : lamp.places.lights) EXPECT_TRUE(l.key_path.starts_with("/nodes/")) << l.key_path;
+}
+
 // ---------------------------------------------------------------- materials
 
 TEST(GltfMaterials, MetalRoughSpheresHaveTheirFactors) {

@@ -408,6 +408,60 @@ TEST(MitsubaReader, ErrorsNameFileAndLine) {
   EXPECT_NE(error_of("<shape type=\"sphere\">").find("malformed XML"), std::string::npos);
 }
 
+// The text entry point: the name given is the file in messages, and relative paths resolve
+// against the folder given (as if the text were a file there).
+TEST(MitsubaReader, TextEntryPointNamesItsTextAndResolvesAgainstItsFolder) {
+  const fs::path dir = temp_dir() / "text_entry";
+  fs::create_directories(dir);
+  {
+    std::ofstream f(dir / "grey.xml");
+    f << R"(<bsdf type="diffuse" id="grey"><rgb name="reflectance" value="0.25"/></bsdf>)";
+  }
+  std::vector<std::string> warnings;
+  SceneDesc s = read_mitsuba_scene_text(R"(<scene version="3.0.0"><include filename="grey.xml"/>
+      <shape type="sphere"><ref id="grey"/></shape></scene>)",
+                                        "in-memory.xml", dir, warnings);
+  ASSERT_EQ(s.shapes.size(), 1u);
+  EXPECT_EQ(s.source_file, "in-memory.xml");
+  const auto& one = std::get<OneSidedMaterial>(s.materials[s.shapes[0].material]);
+  EXPECT_FLOAT_EQ(std::get<DiffuseMaterial>(s.materials[one.material]).reflectance.value.g, 0.25f);
+  try {
+    read_mitsuba_scene_text("<scene version=\"3.0.0\">\n<shape type=\"teapot\"/></scene>", "in-memory.xml", dir,
+                            warnings);
+    ADD_FAILURE() << "no error";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("in-memory.xml:2: unknown shape type", 0), 0u) << e.what();
+  }
+}
+
+// Shapes, shapegroups, instances, textures, materials and lights carry the file:line:column of
+// the element they come from (SceneDesc::places for the last three, parallel to their vectors).
+TEST(MitsubaReader, DescriptionsKnowTheirPlaces) {
+  SceneDesc s = read_text(R"(<texture type="checkerboard" id="checks"/>
+<shape type="sphere">
+  <bsdf type="diffuse"><ref name="reflectance" id="checks"/></bsdf>
+</shape>
+<shape type="shapegroup" id="group">
+    <shape type="disk"/>
+</shape>
+  <shape type="instance"><ref id="group"/></shape>
+<emitter type="point"/>)");
+  // Line 1 is the <scene> that read_text adds.
+  ASSERT_EQ(s.shapes.size(), 1u);
+  EXPECT_EQ(s.shapes[0].where.to_string(), "test.xml:3:1");
+  ASSERT_EQ(s.objects.size(), 1u);
+  EXPECT_EQ(s.objects[0].where.to_string(), "test.xml:6:1");
+  EXPECT_EQ(s.objects[0].shapes[0].where.to_string(), "test.xml:7:5");
+  ASSERT_EQ(s.instances.size(), 1u);
+  EXPECT_EQ(s.instances[0].where.to_string(), "test.xml:9:3");
+  ASSERT_EQ(s.places.textures.size(), s.textures.size());
+  EXPECT_EQ(s.places.textures.at(0).to_string(), "test.xml:2:1");
+  ASSERT_EQ(s.places.materials.size(), s.materials.size());
+  EXPECT_EQ(s.places.materials[std::size_t(s.shapes[0].material)].to_string(), "test.xml:4:3");
+  ASSERT_EQ(s.places.lights.size(), 1u);
+  EXPECT_EQ(s.places.lights[0].to_string(), "test.xml:10:1");
+}
+
 // Every scene of Mitsuba's render tests either reads or fails naming a file missing from the
 // shared data.
 TEST(MitsubaReader, RenderTestScenes) {

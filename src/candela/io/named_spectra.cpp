@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "candela/spectral/blackbody.h"
 #include "candela/spectral/cie.h"
 
 namespace candela::pbrt_spectra {
@@ -126,11 +127,7 @@ const std::vector<std::string_view>& named_spectrum_names() {
 // pbrt-v4's BlackbodySpectrum is Planck's law normalised to a peak of 1; as a light it is then
 // normalised to luminance 1, which makes the peak normalisation irrelevant.
 RGB blackbody_rgb(float kelvin) {
-  const double c = 299792458.0, h = 6.62606957e-34, kb = 1.3806488e-23;
-  Xyz xyz = integrate([&](double nm) {
-    double l = nm * 1e-9;
-    return (2 * h * c * c) / (std::pow(l, 5) * (std::exp((h * c) / (l * kb * kelvin)) - 1));
-  });
+  Xyz xyz = integrate([&](double nm) { return planck(nm, kelvin, kPbrtPlanck); });
   return to_rgb({xyz.x / xyz.y, 1.0, xyz.z / xyz.y});
 }
 

@@ -21,6 +21,8 @@ void ParameterUsage::mark_used(std::string_view name) {
     if (p.name == name) p.used = true;
 }
 
+void ParameterUsage::mark_used_at(size_t index) { given_.at(index).used = true; }
+
 bool ParameterUsage::was_given(std::string_view name) const {
   return std::any_of(given_.begin(), given_.end(), [&](const Parameter& p) { return p.name == name; });
 }

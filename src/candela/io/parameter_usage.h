@@ -7,6 +7,7 @@
 // each name it asks for (`ask`, given or not). Once the entity is built, `first_unused` names the
 // first given parameter nothing asked for, and `asked_list` says what was asked for, for the
 // message ("parameters read here: ...").
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -34,6 +35,9 @@ class ParameterUsage {
   // Marks a given parameter used without recording it as read here (a parameter consumed on the
   // entity's behalf, e.g. by a default it inherits).
   void mark_used(std::string_view name);
+  // Marks the parameter given `index`-th (from 0) used, and no other copy of its name (Mitsuba's
+  // nested objects, taken by their kind rather than asked for by name).
+  void mark_used_at(size_t index);
 
   bool was_given(std::string_view name) const;
   const std::vector<Parameter>& given() const { return given_; }

@@ -1,0 +1,238 @@
+#pragma once
+// The glTF reader's parts (io/gltf/): reader.cpp (loading, accessors, the node tree),
+// meshes_cameras_lights.cpp, images_materials.cpp; gltf_reader.h is the entry.
+#include <fmt/format.h>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+// Without its stb_image decoding: images are only located, never decoded, by tinygltf (its
+// implementation is compiled into gltf/reader.cpp; see CMakeLists.txt).
+#define TINYGLTF_NO_STB_IMAGE
+#define TINYGLTF_NO_STB_IMAGE_WRITE
+#define TINYGLTF_NO_EXTERNAL_IMAGE
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wall"
+#pragma GCC diagnostic ignored "-Wextra"
+#pragma GCC diagnostic ignored "-Wpedantic"
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#include <tiny_gltf.h>
+#pragma GCC diagnostic pop
+
+#include "candela/base/error.h"
+#include "candela/io/gltf_reader.h"
+
+namespace candela::gltf {
+
+namespace fs = std::filesystem;
+namespace tg = tinygltf;
+
+inline constexpr int kMaxNodeDepth = 1024;
+inline constexpr int kMaxResolution = 65536;
+
+// ---------------------------------------------------------------- small helpers
+
+uint64_t fnv1a(std::string_view bytes, uint64_t h = 1469598103934665603ULL);
+// %XX escapes of a URI reference decoded (glTF URIs are RFC 3986 references).
+std::string uri_decode(const std::string& uri);
+float srgb_to_linear(float v);
+Matrix4 matrix_from_column_major(const std::vector<double>& a);
+// T * R * S as glTF composes a node's (or an instance's) transform; q = (x, y, z, w).
+Matrix4 trs_matrix(std::array<double, 3> t, std::array<double, 4> q, std::array<double, 3> s);
+RGB rgb_of(const std::vector<double>& v, RGB fallback);
+// A number from a tinygltf Value (ints and reals both), or `fallback`.
+double number_or(const tg::Value& object, const char* key, double fallback);
+
+// An accessor's elements as doubles, `components` per element (normalised integers already
+// divided, sparse substitutions applied).
+struct AccessorData {
+  int components = 0;
+  size_t count = 0;
+  std::vector<double> values;
+  double at(size_t element, int component) const { return values[element * size_t(components) + size_t(component)]; }
+};
+
+// One glTF material as candela materials: what a primitive using it gets.
+struct MaterialInfo {
+  int material = -1;
+  std::optional<AreaEmission> emission;
+  int uv_set = 0;
+  bool uses_vertex_colors = false;
+};
+
+// A primitive converted to a triangle mesh with its material.
+struct Primitive {
+  TriangleMesh mesh;
+  int material = -1;
+  std::optional<AreaEmission> emission;
+  std::string name;
+  std::string pointer;  // /meshes/m/primitives/p
+};
+
+// One placement of a mesh in the world.
+struct MeshUse {
+  int mesh;
+  Transform to_world;
+  std::string pointer;  // of the node
+};
+
+// What is done to an image before candela reads it.
+struct ImageOp {
+  enum Kind { Channel, Alpha, Multiply, NormalScale } kind = Channel;
+  int channel = 0;        // Channel
+  float alpha_factor = 1; // Alpha: alpha * alpha_factor ...
+  float cutoff = -1;      // ... thresholded (1 where >= cutoff, else 0) when cutoff >= 0
+  RGB factor{1.0f};       // Multiply: the linear RGB times this
+  float normal_scale = 1; // NormalScale
+  std::string describe() const {
+    return fmt::format("{}:{}:{}:{}:{},{},{}:{}", int(kind), channel, alpha_factor, cutoff, factor.r, factor.g,
+                       factor.b, normal_scale);
+  }
+};
+
+class GltfReader {
+ public:
+  GltfReader(const fs::path& file, std::vector<std::string>& warnings, const GltfOptions& options)
+      : file_(file), warnings_(warnings), options_(options) {
+    base_dir_ = file.parent_path();
+    cache_dir_ = options.cache_dir.empty() ? fs::temp_directory_path() / "candela-gltf" : options.cache_dir;
+  }
+
+  SceneDesc read();
+
+ private:
+  // ------------------------------------------------------------ messages
+
+  SourceLocation at(const std::string& pointer = {}) const;
+
+  template <typename... Args>
+  [[noreturn]] void fail(const std::string& pointer, fmt::format_string<Args...> format, Args&&... args) const {
+    throw_scene_error(at(pointer), format, std::forward<Args>(args)...);
+  }
+
+  template <typename... Args>
+  void warn(const std::string& pointer, fmt::format_string<Args...> format, Args&&... args) {
+    warnings_.push_back(
+        fmt::format("{}: warning: {}", at(pointer).to_string(), fmt::format(format, std::forward<Args>(args)...)));
+  }
+
+  // ------------------------------------------------------------ loading
+
+  static bool keep_image_bytes(tg::Image* image, const int, std::string*, std::string*, int, int,
+                               const unsigned char* bytes, int size, void*);
+
+  void load();
+
+  void refuse_draco_from_raw_json(bool binary);
+
+  static std::string draco_message(const std::string& mesh);
+
+  void check_extensions();
+
+  // ------------------------------------------------------------ accessors
+
+  AccessorData read_accessor(int index, const std::string& user);
+
+  void view_bytes(int view, size_t offset, const std::string& user, const std::byte*& base, size_t& available);
+
+  static void decode(const std::byte* p, int type, bool normalized, int n, double* out);
+
+  // ------------------------------------------------------------ the node tree
+
+  Matrix4 local_matrix(const tg::Node& node, const std::string& pointer);
+
+  void walk_scene();
+
+  void visit(int index, const Matrix4& parent, int depth, const std::string& from);
+
+  void add_gpu_instances(const tg::Node& node, const Matrix4& world, const tg::Value& ext, const std::string& pointer);
+
+  // ------------------------------------------------------------ meshes
+
+  void build_meshes();
+
+  std::vector<Primitive> convert_mesh(int m);
+
+  std::optional<Primitive> convert_primitive(const tg::Mesh& mesh, const tg::Primitive& prim, const std::string& pointer);
+
+  // ------------------------------------------------------------ images and textures
+
+  fs::path cache_file(uint64_t hash, const std::string& extension);
+
+  void write_file_atomically(const fs::path& target, std::string_view bytes);
+
+  std::string image_file(int index, const std::string& user);
+
+  struct Pixels {
+    int width = 0, height = 0, channels = 0;
+    bool integer = true;  // 8- or 16-bit data (sRGB-encoded where colour)
+    std::vector<float> data;
+  };
+
+  Pixels read_pixels(const std::string& file, const std::string& pointer);
+
+  int image_channels(const std::string& file, const std::string& pointer);
+
+  std::string derived_image(const std::string& source, const ImageOp& op, const std::string& pointer);
+
+  int add_texture(int index, int tex_coord, const tg::ExtensionMap& extensions, ColorEncoding encoding,
+                  std::optional<ImageOp> op, float scale, const std::string& pointer, int& uv_set);
+
+  // ------------------------------------------------------------ materials
+
+  RGB base_color_factor(int m) const;
+
+  MaterialInfo material_info(int m, bool has_vertex_colors);
+
+  MaterialInfo make_material(int m, bool vertex_colors, bool has_vertex_colors);
+
+  static tg::ExtensionMap texture_extensions(const tg::Value& info);
+
+  ColorInput attribute_texture();
+
+  // ------------------------------------------------------------ camera and lights
+
+  void add_camera();
+
+  void add_lights();
+
+  // ------------------------------------------------------------ state
+
+  fs::path file_, base_dir_, cache_dir_;
+  std::vector<std::string>& warnings_;
+  GltfOptions options_;
+  tg::Model model_;
+  SceneDesc scene_;
+
+  std::vector<int> roots_;
+  std::vector<bool> on_path_;
+  struct NodeRef {
+    int index;
+    Transform to_world;
+    std::string pointer;
+  };
+  std::optional<NodeRef> camera_;
+  int other_cameras_ = 0;
+  std::vector<NodeRef> lights_;
+  std::vector<MeshUse> uses_;
+  std::map<int, std::vector<Primitive>> converted_;
+  std::map<std::pair<int, bool>, MaterialInfo> materials_;
+  std::set<int> material_has_textures_;
+  std::map<int, std::string> image_files_;
+  std::map<std::string, int> channel_counts_;
+  std::set<int> warned_samplers_;
+  std::vector<Bounds3> object_bounds_;
+  Bounds3 bounds_;
+  int attribute_texture_ = -1;
+};
+
+}  // namespace candela::gltf

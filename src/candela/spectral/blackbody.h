@@ -1,0 +1,22 @@
+#pragma once
+// Planck's law: the spectral radiance of a black body. pbrt-v4 and Mitsuba 3 evaluate it with
+// different constants (CODATA 2010 and 2014), units and expressions; candela reproduces each bit
+// for bit for the scenes of that format, so the formula takes the difference as a recipe.
+namespace candela {
+
+struct PlanckRecipe {
+  double c, h, k;  // the speed of light, Planck's and Boltzmann's constants (SI units)
+  double scale;    // 1: W m^-2 sr^-1 per metre of wavelength; 1e-9: per nanometre
+  bool expm1;      // the denominator's e^x - 1 as std::expm1(x) rather than std::exp(x) - 1
+};
+
+// pbrt-v4's BlackbodySpectrum (before its normalisation), per metre of wavelength.
+inline constexpr PlanckRecipe kPbrtPlanck{299792458.0, 6.62606957e-34, 1.3806488e-23, 1.0, false};
+// Mitsuba 3's blackbody, per nanometre.
+inline constexpr PlanckRecipe kMitsubaPlanck{2.99792458e8, 6.62607004e-34, 1.38064852e-23, 1e-9, true};
+
+// The radiance at `wavelength_nm` of a black body at `kelvin`:
+// scale * 2 h c^2 / (l^5 (e^(h c / (l k T)) - 1)), l the wavelength in metres.
+double planck(double wavelength_nm, double kelvin, const PlanckRecipe& recipe);
+
+}  // namespace candela
