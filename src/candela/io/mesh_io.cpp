@@ -29,7 +29,7 @@ MeshFormat mesh_format_of(const std::filesystem::path& file) {
 
 TriangleMesh load_mesh_file(const std::filesystem::path& file, const SourceLocation& referenced_from,
                             int shape_index) {
-  try {
+  return mesh::with_mesh_file_errors(file, referenced_from, [&] {
     const MeshFormat format = mesh_format_of(file);
     if (shape_index != 0 && format != MeshFormat::MitsubaSerialized)
       fail_file_content("a shape index ({}) is only meaningful for a .serialized file", shape_index);
@@ -39,11 +39,7 @@ TriangleMesh load_mesh_file(const std::filesystem::path& file, const SourceLocat
                                                       : mesh::load_serialized(bytes, shape_index);
     mesh::validate_mesh(loaded);
     return loaded;
-  } catch (const FileContentError& problem) {
-    throw_scene_error(referenced_from, "cannot read mesh '{}': {}", file.string(), problem.what());
-  } catch (const std::bad_alloc&) {
-    throw_scene_error(referenced_from, "cannot read mesh '{}': out of memory", file.string());
-  }
+  });
 }
 
 }  // namespace candela

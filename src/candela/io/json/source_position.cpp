@@ -169,6 +169,19 @@ class SourceScanner {
     --depth_;
   }
 
+  // One member or element, named by `pointer` (its parent's pointer is `parent_length` long): walked
+  // into if `enter` says so, else skipped; then the comma after it.
+  template <class Enter>
+  void walk_entry(std::string& pointer, size_t parent_length, size_t offset, const Enter& enter) {
+    if (enter(pointer, offset))
+      walk_value(pointer, enter);
+    else
+      skip_value();
+    pointer.resize(parent_length);
+    skip_whitespace();
+    if (at(',')) ++pos_;
+  }
+
   template <class Enter>
   void walk_object(std::string& pointer, const Enter& enter) {
     ++pos_;  // '{'
@@ -185,13 +198,7 @@ class SourceScanner {
         stop_ = true;
         return;
       }
-      if (enter(pointer, key_offset))
-        walk_value(pointer, enter);
-      else
-        skip_value();
-      pointer.resize(parent_length);
-      skip_whitespace();
-      if (at(',')) ++pos_;
+      walk_entry(pointer, parent_length, key_offset, enter);
     }
     ++pos_;  // '}'
   }
@@ -203,13 +210,7 @@ class SourceScanner {
     for (skip_whitespace(); !stop_ && pos_ < text_.size() && !at(']'); skip_whitespace(), ++index) {
       size_t parent_length = pointer.size();
       pointer += '/' + std::to_string(index);
-      if (enter(pointer, pos_))
-        walk_value(pointer, enter);
-      else
-        skip_value();
-      pointer.resize(parent_length);
-      skip_whitespace();
-      if (at(',')) ++pos_;
+      walk_entry(pointer, parent_length, pos_, enter);
     }
     ++pos_;  // ']'
   }

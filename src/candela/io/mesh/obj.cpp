@@ -217,7 +217,7 @@ namespace candela {
 using namespace mesh;  // the helpers above
 
 ObjModel load_obj_model(const std::filesystem::path& file, const SourceLocation& referenced_from) {
-  try {
+  return mesh::with_mesh_file_errors(file, referenced_from, [&] {
     const std::string text = read_whole_file(file);
     ObjModel model;
     std::string mtl_text;
@@ -260,11 +260,7 @@ ObjModel load_obj_model(const std::filesystem::path& file, const SourceLocation&
     }
     if (model.parts.empty()) fail_file_content("the OBJ file contains no triangles");
     return model;
-  } catch (const FileContentError& problem) {
-    throw_scene_error(referenced_from, "cannot read mesh '{}': {}", file.string(), problem.what());
-  } catch (const std::bad_alloc&) {
-    throw_scene_error(referenced_from, "cannot read mesh '{}': out of memory", file.string());
-  }
+  });
 }
 
 }  // namespace candela
