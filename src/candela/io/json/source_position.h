@@ -43,8 +43,8 @@ class ErrorReporter {
 
   SourceLocation location_of_offset(size_t offset, std::string pointer = {}) const;
 
-  // The text is scanned again only when a location is needed (an error, or a mesh file that may
-  // report one), so reading a correct scene stays a single pass over its values.
+  // The text is scanned again for each location needed (an error, or a mesh file that may report
+  // one); the places of all entries are found together by locate().
   SourceLocation location(const std::string& pointer) const;
 
   // Fills in the line and column of each location's key_path (those of this file) in one walk over
