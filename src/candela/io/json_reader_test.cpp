@@ -1379,6 +1379,51 @@ TEST(JsonReader, BadObjectsAndInstancesAreErrors) {
       "at /shapes/0/transform/0/scale: scale factors must be non-zero");
 }
 
+TEST(JsonReader, EntriesRecordTheirPlaceInTheFile) {
+  const std::string text = R"({
+  "textures": {"checks": {"type": "checkerboard"}},
+  "materials": {
+    "red": {"type": "diffuse", "reflectance": [0.5, 0, 0]},
+    "coat": {"type": "coated_diffuse", "reflectance": {"type": "checkerboard"}}
+  },
+  "objects": {"pair": {"shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1}]}},
+  "shapes": [
+    {"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "red"},
+    {"type": "instance", "object": "pair"}
+  ],
+  "lights": [{"type": "point", "position": [0, 1, 0], "intensity": 1},
+             {"type": "sphere", "center": [0, 2, 0], "radius": 0.1, "radiance": 1}]
+})";
+  const SceneDesc scene = read(text);
+  auto expect_at = [](const SourceLocation& where, int line, int column, const std::string& key_path) {
+    EXPECT_EQ(where.file, "test.json");
+    EXPECT_EQ(where.line, line) << key_path;
+    EXPECT_EQ(where.column, column) << key_path;
+    EXPECT_EQ(where.key_path, key_path);
+  };
+  // An object member's place is its key; an array element's, its value.
+  ASSERT_EQ(scene.places.textures.size(), scene.textures.size());
+  ASSERT_EQ(scene.textures.size(), 2u);
+  expect_at(scene.places.textures[0], 2, 16, "/textures/checks");
+  expect_at(scene.places.textures[1], 5, 40, "/materials/coat/reflectance");  // inline
+  ASSERT_EQ(scene.places.materials.size(), scene.materials.size());
+  ASSERT_EQ(scene.materials.size(), 3u);
+  expect_at(scene.places.materials[0], 4, 5, "/materials/red");
+  expect_at(scene.places.materials[1], 5, 5, "/materials/coat");
+  EXPECT_TRUE(scene.places.materials[2].file.empty());  // the shape light's black material
+  ASSERT_EQ(scene.objects.size(), 1u);
+  expect_at(scene.objects[0].where, 7, 15, "/objects/pair");
+  expect_at(scene.objects[0].shapes[0].where, 7, 35, "/objects/pair/shapes/0");
+  ASSERT_EQ(scene.shapes.size(), 2u);
+  expect_at(scene.shapes[0].where, 9, 5, "/shapes/0");
+  expect_at(scene.shapes[1].where, 13, 14, "/lights/1");  // a sphere light is an emitting shape
+  ASSERT_EQ(scene.instances.size(), 1u);
+  expect_at(scene.instances[0].where, 10, 5, "/shapes/1");
+  ASSERT_EQ(scene.places.lights.size(), scene.lights.size());
+  ASSERT_EQ(scene.lights.size(), 1u);
+  expect_at(scene.places.lights[0], 12, 14, "/lights/0");
+}
+
 // ---------------------------------------------------------------- read_scene_file
 
 TEST(JsonReader, SceneFileWithUnknownExtensionIsAnError) {

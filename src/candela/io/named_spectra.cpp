@@ -1,10 +1,15 @@
 // pbrt-v4's named spectra and spectral parameters converted to RGB (see named_spectra.h).
 #include "candela/io/named_spectra.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <optional>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "candela/spectral/blackbody.h"
 #include "candela/spectral/cie.h"
@@ -168,6 +173,65 @@ RGB sampled_spectrum_rgb(std::span<const double> pairs, Role role) {
 
 }  // namespace candela::pbrt_spectra
 
+// ---------------------------------------------------------------- named conductors
+
+namespace candela {
+namespace {
+
+std::optional<ComplexIor> find_complex_ior(std::span<const NamedComplexIor> table, std::string_view name) {
+  for (const NamedComplexIor& entry : table)
+    if (entry.name == name) return entry.ior;
+  return std::nullopt;
+}
+
+std::vector<std::string_view> complex_ior_names(std::span<const NamedComplexIor> table) {
+  std::vector<std::string_view> names;
+  for (const NamedComplexIor& entry : table) names.push_back(entry.name);
+  return names;
+}
+
+// Metals that pbrt-v4's named spectra (named_spectra.h: Ag, Al, Au, Cu, CuZn, ...) lack, from the
+// same source as those: the published RGB values of Tungsten's ComplexIorData.hpp (also Mitsuba's
+// conductor presets). Na, Ni and V are that table's "_palik" entries, the only ones it has for them.
+constexpr NamedComplexIor kMoreMetals[] = {
+    {"Be", {{4.1850592788f, 3.1850604423f, 2.7840913457f}, {3.8354398268f, 3.0101260162f, 2.8690088743f}}},
+    {"Cr", {{4.3696828663f, 2.9167024892f, 1.6547005413f}, {5.2064337956f, 4.2313645277f, 3.7549467933f}}},
+    {"Hg", {{2.3989314904f, 1.4400254917f, 0.9095512090f}, {6.3276269444f, 4.3719414152f, 3.4217899270f}}},
+    {"Ir", {{3.0864098394f, 2.0821938440f, 1.6178866805f}, {5.5921510077f, 4.0671757150f, 3.2672611269f}}},
+    {"K", {{0.0640493070f, 0.0464100621f, 0.0381842017f}, {2.1042155920f, 1.3489364357f, 0.9132113889f}}},
+    {"Li", {{0.2657871942f, 0.1956102432f, 0.2209198538f}, {3.5401743407f, 2.3111306542f, 1.6685930000f}}},
+    {"Mo", {{4.4837010280f, 3.5254578255f, 2.7760769438f}, {4.1111307988f, 3.4208716252f, 3.1506031404f}}},
+    {"Na", {{0.0602665320f, 0.0561412435f, 0.0619909494f}, {3.1792906496f, 2.1124800781f, 1.5790940266f}}},
+    {"Nb", {{3.4201353595f, 2.7901921379f, 2.3955856658f}, {3.4413817900f, 2.7376437930f, 2.5799132708f}}},
+    {"Ni", {{2.3672753521f, 1.6633583302f, 1.4670554172f}, {4.4988329911f, 3.0501643957f, 2.3454274399f}}},
+    {"Rh", {{2.5857954933f, 1.8601866068f, 1.5544279524f}, {6.7822927110f, 4.7029501026f, 3.9760892461f}}},
+    {"Ta", {{2.0625846607f, 2.3930915569f, 2.6280684948f}, {2.4080467973f, 1.7413705864f, 1.9470377016f}}},
+    {"TiN", {{1.6484691607f, 1.1504482522f, 1.3797795097f}, {3.3684596226f, 1.9434888540f, 1.1020123347f}}},
+    {"V", {{4.2775126218f, 3.5131538236f, 2.7611257461f}, {3.4911844504f, 2.8893580874f, 3.1116965117f}}},
+    {"W", {{4.3707029924f, 3.3002972445f, 2.9982666528f}, {3.5006778591f, 2.6048652781f, 2.2731930614f}}},
+};
+
+}  // namespace
+
+std::optional<ComplexIor> named_metal(std::string_view name) {
+  std::string prefix = fmt::format("metal-{}-", name);
+  auto eta = pbrt_spectra::find_named(prefix + "eta"), k = pbrt_spectra::find_named(prefix + "k");
+  if (eta && k && eta->kind == pbrt_spectra::NamedKind::Metal) return ComplexIor{eta->rgb, k->rgb};
+  return find_complex_ior(kMoreMetals, name);
+}
+
+std::vector<std::string> named_metal_names() {
+  std::vector<std::string> names;
+  for (std::string_view spectrum : pbrt_spectra::named_spectrum_names())
+    if (spectrum.starts_with("metal-") && spectrum.ends_with("-eta"))
+      names.emplace_back(spectrum.substr(6, spectrum.size() - 6 - 4));
+  for (std::string_view metal : complex_ior_names(kMoreMetals)) names.emplace_back(metal);
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+}  // namespace candela
+
 // ---------------------------------------------------------------- Mitsuba 3
 
 namespace candela::mitsuba_spectra {
@@ -222,14 +286,10 @@ constexpr IorEntry kIors[] = {
     {"pet", 1.5750f},          {"diamond", 2.419f},
 };
 
-struct ConductorEntry {
-  std::string_view name;
-  Conductor value;
-};
 // Computed with spectrum_list_to_srgb above (after the kCieYNormalization Mitsuba applies) from
 // Mitsuba's measured spectra, data/ior/*.spd (luxpop.com); Ag agrees with Mitsuba 3's own output to
 // 1e-6. "none" is Mitsuba's perfect mirror (eta 0, k 1: Fresnel reflectance 1 at every angle).
-const ConductorEntry kConductors[] = {
+const NamedComplexIor kConductors[] = {
     {"none", {RGB(0.0f), RGB(1.0f)}},
     {"Ag", {RGB(0.155276f, 0.116728f, 0.138388f), RGB(4.828354f, 3.122222f, 2.146901f)}},
     {"Al", {RGB(1.657501f, 0.880405f, 0.521244f), RGB(9.223811f, 6.269502f, 4.837004f)}},
@@ -256,18 +316,10 @@ const std::vector<std::string_view>& named_ior_names() {
   return names;
 }
 
-std::optional<Conductor> named_conductor(std::string_view name) {
-  for (const ConductorEntry& e : kConductors)
-    if (e.name == name) return e.value;
-  return std::nullopt;
-}
+std::optional<Conductor> named_conductor(std::string_view name) { return find_complex_ior(kConductors, name); }
 
 const std::vector<std::string_view>& named_conductor_names() {
-  static const std::vector<std::string_view> names = [] {
-    std::vector<std::string_view> n;
-    for (const ConductorEntry& e : kConductors) n.push_back(e.name);
-    return n;
-  }();
+  static const std::vector<std::string_view> names = complex_ior_names(kConductors);
   return names;
 }
 

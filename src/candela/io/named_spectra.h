@@ -11,6 +11,26 @@
 
 #include "candela/math/color.h"
 
+namespace candela {
+
+// A conductor's complex index of refraction eta + i k, as RGB.
+struct ComplexIor {
+  RGB eta, k;
+};
+
+// An entry of a table of named conductors (pbrt-v4's metals, Mitsuba's conductor presets).
+struct NamedComplexIor {
+  std::string_view name;
+  ComplexIor ior;
+};
+
+// The metals candela's JSON format names in a conductor's "metal" (docs/scene-format.md): "Au" is
+// pbrt-v4's "metal-Au-eta" and "metal-Au-k", and Tungsten's metals that pbrt-v4 lacks (Be, Cr, ...).
+std::optional<ComplexIor> named_metal(std::string_view name);
+std::vector<std::string> named_metal_names();  // sorted
+
+}  // namespace candela
+
 namespace candela::pbrt_spectra {
 
 // What a spectrum describes decides how it becomes RGB.
@@ -60,9 +80,7 @@ const std::vector<std::string_view>& named_ior_names();
 
 // A conductor preset ("material" of conductor / roughconductor): eta and k as Mitsuba's RGB mode
 // converts the measured spectra (resources/data/ior/NAME.{eta,k}.spd through spectrum_list_to_srgb).
-struct Conductor {
-  RGB eta, k;
-};
+using Conductor = ComplexIor;
 std::optional<Conductor> named_conductor(std::string_view name);
 const std::vector<std::string_view>& named_conductor_names();
 

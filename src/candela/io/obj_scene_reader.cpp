@@ -97,6 +97,8 @@ SceneDesc read_obj_scene(const std::filesystem::path& file) {
   std::vector<int> material_index(model.materials.size(), -1);
   for (size_t i = 0; i < model.materials.size(); ++i) {
     scene.materials.push_back(material_of(model.materials[i], scene, warnings, file.string()));
+    // The MTL library that defined it is not kept: the OBJ file that loads it, and its name.
+    scene.places.materials.push_back({file.string(), 0, 0, "newmtl " + model.materials[i].name});
     material_index[i] = int(scene.materials.size() - 1);
   }
   Point3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
@@ -109,6 +111,7 @@ SceneDesc read_obj_scene(const std::filesystem::path& file) {
     ShapeDesc shape;
     shape.material = part.material >= 0 ? material_index[size_t(part.material)] : -1;
     shape.name = part.material >= 0 ? model.materials[size_t(part.material)].name : file.filename().string();
+    shape.where = {file.string(), 0, 0, part.material >= 0 ? "usemtl " + shape.name : std::string()};
     if (part.material >= 0) {
       const RGB& ke = model.materials[size_t(part.material)].emission;
       if (max_channel(ke) > 0) {

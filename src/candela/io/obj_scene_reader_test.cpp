@@ -36,6 +36,12 @@ TEST(ObjScene, McGuiresCornellBoxGetsItsMaterialsLightAndAFramingCamera) {
   EXPECT_EQ(left.reflectance.value, RGB(1.0f, 0.065f, 0.05f));
   EXPECT_FALSE(shape_named(scene, "floor").emission);
   EXPECT_TRUE(scene.lights.empty()) << "a scene with emitters gets no sky";
+  // Each shape and material records the OBJ file and its material's name, for messages.
+  const SourceLocation& where = shape_named(scene, "light").where;
+  EXPECT_EQ(where.file, (kCornell / "CornellBox-Original.obj").string());
+  EXPECT_EQ(where.key_path, "usemtl light");
+  ASSERT_EQ(scene.places.materials.size(), scene.materials.size());
+  EXPECT_EQ(scene.places.materials[size_t(shape_named(scene, "leftWall").material)].key_path, "newmtl leftWall");
   // The camera looks at the box's centre (0, ~1, 0) along -z from in front of its open side.
   const Point3 eye = scene.camera.world_from_camera.point(Point3(0.0f));
   const Vec3 forward = normalize(scene.camera.world_from_camera.vector(Vec3(0, 0, 1)));

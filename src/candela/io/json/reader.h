@@ -1,0 +1,196 @@
+#pragma once
+// The reader of candela's JSON scene format (docs/scene-format.md): one JsonSceneReader per file,
+// its sections read by the functions of reader.cpp (the document), settings.cpp (camera and render
+// settings), textures.cpp, materials.cpp, shapes.cpp (shapes, objects and instances, meshes,
+// transforms) and lights.cpp. Each reader of a kind of entry (texture, material, shape, light)
+// dispatches on a table of type names, from which its "unknown ... type" message lists the names.
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "candela/io/json/checked_object.h"
+#include "candela/io/json/source_position.h"
+#include "candela/io/named_spectra.h"
+#include "candela/scene/description.h"
+
+namespace candela::json {
+
+namespace fs = std::filesystem;
+
+constexpr int kMaxResolution = 65536;
+constexpr int64_t kMaxPixels = int64_t(1) << 28;
+constexpr float kMaxFilterRadius = 64;  // pixels; the filter is tabulated per unit of radius
+constexpr int kMaxTextureDepth = 64;    // textures using textures
+
+// The "type" of an entry of "shapes" that places an object.
+constexpr std::string_view kInstanceType = "instance";
+
+// A table the readers dispatch on: a type name and the function reading that type.
+template <typename Reader>
+struct NamedReader {
+  std::string_view name;
+  Reader read;
+};
+
+// "a, b, c": the names of a table, for messages.
+template <typename Reader, size_t N>
+std::string type_names(const NamedReader<Reader> (&table)[N]) {
+  std::string names;
+  for (const NamedReader<Reader>& entry : table) {
+    if (!names.empty()) names += ", ";
+    names += entry.name;
+  }
+  return names;
+}
+
+template <typename Reader, size_t N>
+const NamedReader<Reader>* find_reader(const NamedReader<Reader> (&table)[N], std::string_view name) {
+  for (const NamedReader<Reader>& entry : table)
+    if (entry.name == name) return &entry;
+  return nullptr;
+}
+
+class JsonSceneReader {
+ public:
+  JsonSceneReader(std::string_view text, const std::string& file_name, const fs::path& base_dir)
+      : text_(text), report_(text, file_name), base_dir_(base_dir) {}
+
+  SceneDesc read();
+
+ private:
+  // ---- the document (reader.cpp)
+  Json parse_document() const;
+  [[noreturn]] void throw_number_overflow(std::string_view what) const;
+  static std::string parse_error_reason(std::string_view what);
+  void reject_duplicate_keys() const;
+  SourceLocation place(const std::string& pointer) const;  // file and key path; line and column later
+  void locate_places();
+
+  // ---- camera and render settings (settings.cpp)
+  void read_camera(const Json& value, const std::string& pointer);
+  void read_lens_and_shutter(CheckedObject& camera);
+  void check_view_direction(const CheckedObject& camera, Point3 position, Point3 look_at, Vec3 up) const;
+  void read_render(const Json& value, const std::string& pointer);
+  void read_mlt(const Json& value, const std::string& pointer, RenderSettings& settings) const;
+  void read_transform_times(const Json& value, const std::string& pointer);
+  SamplerDesc read_sampler(const Json& value, const std::string& pointer) const;
+  FilterDesc read_filter(const Json& value, const std::string& pointer) const;
+  Vec2 read_filter_radius(const Json& value, const std::string& pointer) const;
+  void read_integrator_strategies(CheckedObject& render, RenderSettings& settings) const;
+  void read_adaptive(const Json& value, const std::string& pointer, RenderSettings& settings) const;
+
+  // ---- textures (textures.cpp)
+  // Named textures may refer to each other in any order. Each is read when first needed, so that
+  // SceneDesc::textures lists every texture after the textures it refers to.
+  struct NamedTexture {
+    const Json* value = nullptr;
+    std::string pointer;
+    bool reading = false;  // on the stack of textures being read: meeting it again is a cycle
+    int index = -1;        // in SceneDesc::textures, once read
+  };
+  void read_textures(const Json& value, const std::string& pointer);
+  int named_texture(const std::string& name, const std::string& pointer);
+  int add_texture(TextureDesc texture, SourceLocation where);
+  TextureDesc read_texture(const Json& value, const std::string& pointer);
+  ImageTexture read_image_texture(CheckedObject& t) const;
+  UVMapping read_uv_mapping(CheckedObject& t) const;
+  std::string existing_file(CheckedObject& object, std::string_view key, std::string_view what) const;
+
+  // ---- material and texture parameters: a constant, a texture name, or an inline texture object
+  ColorInput read_color_input(const Json& value, const std::string& pointer, ColorKind kind);
+  ColorInput color_input_or(CheckedObject& object, std::string_view key, ColorKind kind, ColorInput fallback);
+  FloatInput read_float_input(const Json& value, const std::string& pointer, Bound bound);
+  FloatInput float_input_or(CheckedObject& object, std::string_view key, Bound bound, FloatInput fallback);
+
+  // ---- materials (materials.cpp)
+  void read_materials(const Json& value, const std::string& pointer);
+  struct NamedMaterial {
+    const Json* value = nullptr;
+    std::string pointer;
+    bool reading = false;
+    int index = -1;
+  };
+  int add_material(MaterialDesc material, SourceLocation where);
+  MaterialDesc read_material(const Json& value, const std::string& pointer);
+  PhongMaterial read_phong(CheckedObject& m);
+  Roughness read_roughness(CheckedObject& m);
+  ConductorMaterial read_conductor(CheckedObject& m);
+  ComplexIor read_metal(const Json& value, const std::string& pointer) const;
+  void check_positive_color(const ColorInput& input, const Json& value, const std::string& pointer) const;
+  DielectricMaterial read_dielectric(CheckedObject& m);
+  CoatedDiffuseMaterial read_coated_diffuse(CheckedObject& m);
+  DiffuseTransmissionMaterial read_diffuse_transmission(CheckedObject& m);
+  int material_by_name(const std::string& name, const std::string& pointer);
+  int wrapped_material(CheckedObject& m, std::string_view key);
+  int texture_reference(CheckedObject& m, std::string_view key);
+  PrincipledMaterial read_principled(CheckedObject& m);
+  static PerturbedNormalOptions read_perturbed_normal_options(CheckedObject& m);
+  BlendMaterial read_blend(CheckedObject& m);
+  int black_material();
+
+  // ---- shapes (shapes.cpp)
+  void read_shapes(const Json& value, const std::string& pointer);
+  ShapeDesc read_shape(const Json& value, const std::string& pointer);
+  ShapeGeometry read_geometry(CheckedObject& s);
+  SdfGridShape read_sdf_grid(CheckedObject& s) const;
+  static SphereShape read_sphere(CheckedObject& s);
+  BoxShape read_box(CheckedObject& s) const;
+  RectangleShape read_rectangle(CheckedObject& s) const;
+  int read_shape_material(CheckedObject& s);
+  AreaEmission read_emission(const Json& value, const std::string& pointer);
+
+  // ---- objects and instances
+  static bool is_instance(const Json& shape);
+  void read_objects(const Json& value, const std::string& pointer);
+  ObjectDesc read_object(const Json& value, const std::string& pointer);
+  InstanceDesc read_instance(const Json& value, const std::string& pointer) const;
+  int object_by_name(const std::string& name, const std::string& pointer) const;
+
+  // ---- meshes
+  MeshShape read_mesh(CheckedObject& s) const;
+  TriangleMesh read_mesh_file(CheckedObject& s) const;
+  TriangleMesh read_inline_mesh(CheckedObject& s) const;
+  void read_mesh_attributes(const Json& value, const std::string& pointer, TriangleMesh& mesh) const;
+  std::vector<Vec3> read_vec3_list(const Json& value, const std::string& pointer, std::string_view of_what) const;
+  std::vector<Vec2> read_vec2_list(const Json& value, const std::string& pointer) const;
+  std::vector<uint32_t> read_indices(const Json& value, const std::string& pointer, size_t vertex_count) const;
+  void check_per_vertex_count(size_t count, size_t vertex_count, const std::string& pointer) const;
+  void check_nonzero_normals(const std::vector<Normal3>& normals, const std::string& pointer) const;
+
+  // ---- transforms
+  Transform read_moving_transform(const Json& value, CheckedObject& s, const ShapeDesc& shape) const;
+  Transform read_transform_key(CheckedObject& object) const;
+  Transform read_transform(const Json& value, const std::string& pointer) const;
+  Transform read_transform_step(const Json& value, const std::string& pointer) const;
+  Transform read_rotation(const Json& value, const std::string& pointer) const;
+  Transform read_scale(const Json& value, const std::string& pointer) const;
+  Transform read_matrix(const Json& value, const std::string& pointer) const;
+
+  // ---- lights (lights.cpp)
+  void read_lights(const Json& value, const std::string& pointer);
+  void read_light(const Json& value, const std::string& pointer);
+  ShapeDesc read_shape_light(CheckedObject& light, ShapeGeometry geometry);
+  SkyLight read_sky(CheckedObject& light) const;
+  ProjectorLight read_projector(CheckedObject& light);
+  SpotLight read_spot(CheckedObject& light);
+  EnvironmentMap read_environment(CheckedObject& light) const;
+  Transform read_environment_orientation(CheckedObject& light, EnvironmentMapping mapping) const;
+  static Transform rotation_between(Vec3 from, Vec3 to);
+  void check_rotation(const Transform& transform, const std::string& pointer) const;
+
+  std::string_view text_;
+  ErrorReporter report_;
+  fs::path base_dir_;
+  SceneDesc scene_;
+  std::map<std::string, NamedTexture> named_textures_;
+  std::vector<std::string> texture_stack_;  // the named textures being read, outermost first
+  int texture_depth_ = 0;                   // textures being read, named or inline
+  std::map<std::string, NamedMaterial> named_materials_;
+  std::map<std::string, int> object_index_;
+  std::optional<int> black_material_;
+};
+
+}  // namespace candela::json

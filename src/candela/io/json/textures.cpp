@@ -1,0 +1,222 @@
+#include "candela/io/json/reader.h"
+
+namespace candela::json {
+
+// ---- textures
+
+void JsonSceneReader::read_textures(const Json& value, const std::string& pointer) {
+  if (!value.is_object())
+    report_.fail(pointer, "expected an object mapping texture names to textures, got {}", describe(value));
+  std::vector<std::string> names;  // in the file's order
+  for (auto it = value.begin(); it != value.end(); ++it) {
+    if (it.key() == "_comment") continue;
+    names.push_back(it.key());
+    named_textures_[it.key()] = NamedTexture{&it.value(), child_pointer(pointer, it.key())};
+  }
+  for (const std::string& name : names) named_texture(name, named_textures_[name].pointer);
+}
+
+// The index of a named texture, read first (with what it refers to) if it has not been yet.
+// `pointer` is where the name was given.
+int JsonSceneReader::named_texture(const std::string& name, const std::string& pointer) {
+  auto it = named_textures_.find(name);
+  if (it == named_textures_.end()) {
+    std::vector<std::string> names;
+    for (const auto& entry : named_textures_) names.push_back(entry.first);
+    if (names.empty()) report_.fail(pointer, "unknown texture \"{}\" (\"textures\" defines none)", name);
+    report_.fail(pointer, "unknown texture \"{}\"; defined: {}", name, fmt::join(names, ", "));
+  }
+  NamedTexture& texture = it->second;  // std::map: stays valid while other textures are read
+  if (texture.index >= 0) return texture.index;
+  if (texture.reading) {
+    std::vector<std::string> cycle(std::find(texture_stack_.begin(), texture_stack_.end(), name),
+                                   texture_stack_.end());
+    cycle.push_back(name);
+    report_.fail(pointer, "textures refer to each other in a cycle: {}", fmt::join(cycle, " -> "));
+  }
+  texture.reading = true;
+  texture_stack_.push_back(name);
+  TextureDesc desc = read_texture(*texture.value, texture.pointer);
+  texture_stack_.pop_back();
+  texture.reading = false;
+  texture.index = add_texture(std::move(desc), place(texture.pointer));
+  return texture.index;
+}
+
+int JsonSceneReader::add_texture(TextureDesc texture, SourceLocation where) {
+  scene_.textures.push_back(std::move(texture));
+  scene_.places.textures.push_back(std::move(where));
+  return int(scene_.textures.size()) - 1;
+}
+
+TextureDesc JsonSceneReader::read_texture(const Json& value, const std::string& pointer) {
+  // Textures are read recursively: hostile nesting (inline, or a long chain of names) must not
+  // exhaust the stack.
+  if (texture_depth_ >= kMaxTextureDepth)
+    report_.fail(pointer, "textures nest too deeply: more than {} levels of textures using textures",
+                 kMaxTextureDepth);
+  struct DepthGuard {
+    int& depth;
+    explicit DepthGuard(int& d) : depth(++d) {}
+    ~DepthGuard() { --depth; }
+  } guard(texture_depth_);
+  CheckedObject t(report_, value, pointer);
+  std::string type = t.string("type");
+  // A texture may be used in any parameter, so the constants inside it are only checked to be >= 0.
+  static constexpr ColorKind kAny = ColorKind::NonNegative;
+  using Reader = TextureDesc (*)(JsonSceneReader&, CheckedObject&);
+  static constexpr NamedReader<Reader> kTextures[] = {
+      {"image", [](JsonSceneReader& r, CheckedObject& t) -> TextureDesc { return r.read_image_texture(t); }},
+      {"checkerboard",
+       [](JsonSceneReader& r, CheckedObject& t) -> TextureDesc {
+         CheckerboardTexture checkerboard;
+         checkerboard.tex1 = r.color_input_or(t, "tex1", kAny, checkerboard.tex1);
+         checkerboard.tex2 = r.color_input_or(t, "tex2", kAny, checkerboard.tex2);
+         checkerboard.mapping = r.read_uv_mapping(t);
+         return checkerboard;
+       }},
+      {"scale",
+       [](JsonSceneReader& r, CheckedObject& t) -> TextureDesc {
+         ScaleTexture scale;
+         scale.tex = r.color_input_or(t, "tex", kAny, scale.tex);
+         scale.scale = r.float_input_or(t, "scale", Bound::NonNegative, scale.scale);
+         return scale;
+       }},
+      {"mix",
+       [](JsonSceneReader& r, CheckedObject& t) -> TextureDesc {
+         MixTexture mix;
+         mix.tex1 = r.color_input_or(t, "tex1", kAny, mix.tex1);
+         mix.tex2 = r.color_input_or(t, "tex2", kAny, mix.tex2);
+         mix.amount = r.float_input_or(t, "amount", Bound::UnitInterval, mix.amount);
+         return mix;
+       }},
+      {"mesh_attribute",
+       [](JsonSceneReader&, CheckedObject& t) -> TextureDesc {
+         return MeshAttributeTexture{t.string("name"), t.boolean_or("per_face", false)};
+       }},
+  };
+  const NamedReader<Reader>* reader = find_reader(kTextures, type);
+  if (!reader)
+    report_.fail(t.pointer_of("type"), "unknown texture type \"{}\"; expected one of: {}", type, type_names(kTextures));
+  TextureDesc texture = reader->read(*this, t);
+  t.finish();
+  return texture;
+}
+
+ImageTexture JsonSceneReader::read_image_texture(CheckedObject& t) const {
+  ImageTexture image;
+  image.filename = existing_file(t, "filename", "image");
+  if (const Json* wrap = t.find("wrap"))
+    image.wrap = read_name<TextureWrap>(report_, *wrap, t.pointer_of("wrap"), "wrap mode",
+                                        {{"repeat", TextureWrap::Repeat},
+                                         {"clamp", TextureWrap::Clamp},
+                                         {"black", TextureWrap::Black},
+                                         {"mirror", TextureWrap::Mirror}});
+  if (const Json* encoding = t.find("encoding"))
+    image.encoding = read_name<ColorEncoding>(
+        report_, *encoding, t.pointer_of("encoding"), "colour encoding",
+        {{"auto", ColorEncoding::Auto}, {"srgb", ColorEncoding::SRGB}, {"linear", ColorEncoding::Linear}});
+  if (const Json* filter = t.find("filter"))
+    image.bilinear = read_name<bool>(report_, *filter, t.pointer_of("filter"), "texture filter",
+                                     {{"bilinear", true}, {"nearest", false}});
+  image.scale = t.number_or("scale", image.scale, Bound::NonNegative);
+  image.invert = t.boolean_or("invert", image.invert);
+  image.luminance = t.boolean_or("luminance", image.luminance);
+  image.mapping = read_uv_mapping(t);
+  return image;
+}
+
+// "uv_scale": [su, sv] (or one number for both) and "uv_offset": [du, dv].
+UVMapping JsonSceneReader::read_uv_mapping(CheckedObject& t) const {
+  UVMapping mapping;
+  if (const Json* matrix = t.find("uv_matrix")) {
+    // [[su, s_from_v, du], [t_from_u, sv, dv]]: any affine map (rotations, shears).
+    const std::string pointer = t.pointer_of("uv_matrix");
+    if (t.find("uv_scale") || t.find("uv_offset"))
+      report_.fail(pointer, "give either uv_matrix or uv_scale / uv_offset, not both");
+    if (!matrix->is_array() || matrix->size() != 2 || !(*matrix)[0].is_array() || (*matrix)[0].size() != 3 ||
+        !(*matrix)[1].is_array() || (*matrix)[1].size() != 3)
+      report_.fail(pointer, "expected [[su, s_from_v, du], [t_from_u, sv, dv]], got {}", describe(*matrix));
+    float m[2][3];
+    for (size_t r = 0; r < 2; ++r)
+      for (size_t c = 0; c < 3; ++c)
+        m[r][c] = read_float(report_, (*matrix)[r][c], fmt::format("{}/{}/{}", pointer, r, c));
+    if (m[0][0] * m[1][1] - m[0][1] * m[1][0] == 0)
+      report_.fail(pointer, "the uv matrix is singular (it maps the surface onto a line)");
+    mapping = {m[0][0], m[1][1], m[0][2], m[1][2], m[0][1], m[1][0]};
+    return mapping;
+  }
+  if (const Json* scale = t.find("uv_scale")) {
+    std::string pointer = t.pointer_of("uv_scale");
+    Vec2 s = scale->is_number() ? Vec2(read_float(report_, *scale, pointer), read_float(report_, *scale, pointer))
+                                : read_vec2(report_, *scale, pointer);
+    if (s.x == 0 || s.y == 0) report_.fail(pointer, "uv_scale factors must be non-zero, got [{}, {}]", s.x, s.y);
+    mapping.su = s.x;
+    mapping.sv = s.y;
+  }
+  if (const Json* offset = t.find("uv_offset")) {
+    Vec2 d = read_vec2(report_, *offset, t.pointer_of("uv_offset"));
+    mapping.du = d.x;
+    mapping.dv = d.y;
+  }
+  return mapping;
+}
+
+// A file named relative to the scene file's directory (as mesh files are). It must exist when the
+// scene is read, so that a typo is reported with its place in the scene file.
+std::string JsonSceneReader::existing_file(CheckedObject& object, std::string_view key, std::string_view what) const {
+  std::string name = object.string(key);
+  std::string pointer = object.pointer_of(key);
+  if (name.empty()) report_.fail(pointer, "the {} file name is empty", what);
+  fs::path path = base_dir_ / name;
+  std::error_code error;
+  fs::file_status status = fs::status(path, error);
+  if (status.type() == fs::file_type::not_found)
+    report_.fail(pointer, "cannot read {} '{}': no such file", what, path.string());
+  if (error) report_.fail(pointer, "cannot read {} '{}': {}", what, path.string(), error.message());
+  if (status.type() == fs::file_type::directory)
+    report_.fail(pointer, "cannot read {} '{}': it is a directory, not a file", what, path.string());
+  return path.string();
+}
+
+// ---- material and texture parameters: a constant, a texture name, or an inline texture object
+
+ColorInput JsonSceneReader::read_color_input(const Json& value, const std::string& pointer, ColorKind kind) {
+  ColorInput input;
+  if (value.is_string())
+    input.texture = named_texture(value.get<std::string>(), pointer);
+  else if (value.is_object())
+    input.texture = add_texture(read_texture(value, pointer), place(pointer));
+  else if (value.is_number() || value.is_array())
+    input.value = read_rgb(report_, value, pointer, kind);
+  else
+    report_.fail(pointer,
+                 "expected a colour, [r, g, b] or a single number, or a texture (a name or an object), got {}",
+                 describe(value));
+  return input;
+}
+
+ColorInput JsonSceneReader::color_input_or(CheckedObject& object, std::string_view key, ColorKind kind, ColorInput fallback) {
+  const Json* value = object.find(key);
+  return value ? read_color_input(*value, object.pointer_of(key), kind) : fallback;
+}
+
+FloatInput JsonSceneReader::read_float_input(const Json& value, const std::string& pointer, Bound bound) {
+  FloatInput input;
+  if (value.is_string())
+    input.texture = named_texture(value.get<std::string>(), pointer);
+  else if (value.is_object())
+    input.texture = add_texture(read_texture(value, pointer), place(pointer));
+  else if (value.is_number())
+    input.value = check_bound(report_, read_float(report_, value, pointer), bound, pointer);
+  else
+    report_.fail(pointer, "expected a number or a texture (a name or an object), got {}", describe(value));
+  return input;
+}
+
+FloatInput JsonSceneReader::float_input_or(CheckedObject& object, std::string_view key, Bound bound, FloatInput fallback) {
+  const Json* value = object.find(key);
+  return value ? read_float_input(*value, object.pointer_of(key), bound) : fallback;
+}
+
+}  // namespace candela::json
