@@ -94,7 +94,9 @@ std::vector<ContractCase> cases_of<PhongBsdf>() {
 
 template <>
 std::vector<ContractCase> cases_of<MirrorBsdf>() {
-  return {{"mirror", [] { return Bsdf(MirrorBsdf{RGB(0.9f)}); }, each({direction(0), direction(60)}, 0), 2000}};
+  auto wos = each({direction(0), direction(60), below(direction(85))}, 0);
+  return {{"mirror", [] { return Bsdf(MirrorBsdf{RGB(0.9f)}); }, wos, 2000},
+          {"mirror tinted", [] { return Bsdf(MirrorBsdf{RGB(0.2f, 0.5f, 0.8f)}); }, wos, 2000}};
 }
 
 template <>
