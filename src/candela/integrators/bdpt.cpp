@@ -356,7 +356,8 @@ bool BdptIntegrator::is_connectible(const BdptVertex& v) const {
   switch (v.kind) {
     case Kind::Camera: return true;
     case Kind::Light:
-      return v.light >= 0 && !std::holds_alternative<DistantLightSource>(scene_.lights()[size_t(v.light)]);
+      // (a light of a single direction cannot be reached from another point)
+      return v.light >= 0 && !has(light_flags(scene_.lights()[size_t(v.light)]), LightFlags::DeltaDirection);
     case Kind::Surface: return bsdf_has_non_delta(v.bsdf);
   }
   return false;

@@ -58,6 +58,7 @@ inline LightSample flat_light_sample(const Point3& p, const Normal3& n, float ar
 }
 
 struct TriangleLight {
+  static constexpr LightFlags flags = LightFlags::Area;
   Point3 p0, p1, p2;
   Normal3 n;  // unit, the emitting side
   float area;
@@ -101,6 +102,7 @@ struct TriangleLight {
 // the 2D sample mapped straight onto it, so stratified samples are stratified over the light (the
 // paper's stratified rectangular lights, sec. 4.5).
 struct RectangleLight {
+  static constexpr LightFlags flags = LightFlags::Area;
   Point3 corner;
   Vec3 edge_u, edge_v;
   Normal3 n;  // unit, the emitting side
@@ -134,6 +136,7 @@ struct RectangleLight {
 // A sphere seen from outside is sampled uniformly in the cone it subtends (every sample hits it);
 // from inside, uniformly by area.
 struct SphereLight {
+  static constexpr LightFlags flags = LightFlags::Area;
   Point3 center;
   float radius;
   RGB radiance;
@@ -220,6 +223,7 @@ struct SphereLight {
 // A disk (an ellipse under a non-uniform to_world): center + axis_u x + axis_v y over the unit disk,
 // sampled uniformly by area (the concentric map is area-preserving up to the constant Jacobian).
 struct DiskLight {
+  static constexpr LightFlags flags = LightFlags::Area;
   Point3 center;
   Vec3 axis_u, axis_v;  // the images of the unit disk's x and y axes
   Normal3 n;            // unit, the emitting side
@@ -264,6 +268,7 @@ struct DiskLight {
 // cylinder, not an elliptic or oblique tube: only then is (phi, z) proportional to area).
 // Sampled uniformly by area as Mitsuba does (z from u.x, phi from u.y).
 struct CylinderLight {
+  static constexpr LightFlags flags = LightFlags::Area;
   Point3 base;
   Vec3 axis_u, axis_v;  // unit, perpendicular to each other and to axis
   Vec3 axis;            // from the base circle's centre to the top circle's

@@ -11,6 +11,7 @@
 namespace candela {
 
 struct DistantLightSource {
+  static constexpr LightFlags flags = LightFlags::DeltaDirection;
   Vec3 direction{0, 0, 1};  // unit, the direction the light travels
   RGB radiance;
   float scene_radius = 1;  // bounding-sphere radius of the scene, for power()

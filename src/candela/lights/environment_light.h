@@ -26,6 +26,7 @@ namespace candela {
 
 class EnvironmentLight {
  public:
+  static constexpr LightFlags flags = LightFlags::Infinite;
   // `image` is linear RGB radiance (negative and NaN values count as zero) and is multiplied by
   // `scale`; world_from_light orients the map (a rotation; directions are normalised after it).
   // Throws SceneError for an empty image, or a non-square one with the octahedral mapping.

@@ -8,8 +8,10 @@
 //   sample_le(u_pos, u_dir, S) a ray of emitted light with its position and direction densities
 //                             (lights at infinity start theirs on a disk of the scene's sphere S)
 //   pdf_le(p, n, w, S)        the densities sample_le gives the ray from p along w
-// Lights at infinity (SkyLightSource, EnvironmentLight) also offer radiance(dir) for rays that escape
-// the scene; point, spot, projector and distant lights are delta lights, reached only by sampling them.
+//   static constexpr flags    what kind of emitter the type is (light_flags.h)
+// Lights that surround the scene (LightFlags::Infinite: sky, environment map) also offer radiance(dir)
+// for rays that escape the scene; delta lights (point, spot, projector, distant) are reached only by
+// sampling them.
 // The closed list of lights is the variant `Light`; dispatch happens once, here.
 #include <limits>
 #include <variant>
@@ -52,16 +54,28 @@ inline EmissionPdf light_pdf_le(const Light& l, const Point3& p, const Normal3& 
 inline float light_importance(const Light& l, const LightSampleContext& ctx) {
   return std::visit([&](const auto& x) { return x.importance(ctx); }, l);
 }
+// The light's flags (light_flags.h): what kind of emitter its type is.
+inline LightFlags light_flags(const Light& l) {
+  return std::visit([](const auto& x) { return std::decay_t<decltype(x)>::flags; }, l);
+}
 // Lights of a single point or direction: found only by sampling them, never by a ray.
 inline bool light_is_delta(const Light& l) {
-  return std::holds_alternative<PointLightSource>(l) || std::holds_alternative<SpotLightSource>(l) ||
-         std::holds_alternative<DistantLightSource>(l) || std::holds_alternative<ProjectorLightSource>(l);
+  return has(light_flags(l), LightFlags::DeltaPosition | LightFlags::DeltaDirection);
 }
-
-// Lights at infinity: their light paths start on the disk of the scene's bounding sphere.
+// Lights at infinity: their light paths start on the disk of the scene's bounding sphere (those
+// that surround the scene, and those of a single direction; pbrt-v4's IsInfiniteLight).
 inline bool light_is_at_infinity(const Light& l) {
-  return std::holds_alternative<SkyLightSource>(l) || std::holds_alternative<EnvironmentLight>(l) ||
-         std::holds_alternative<DistantLightSource>(l);
+  return has(light_flags(l), LightFlags::Infinite | LightFlags::DeltaDirection);
+}
+// Radiance arriving along -dir from a light that surrounds the scene (LightFlags::Infinite), seen by
+// a ray escaping along dir; the other lights are never seen by escaping rays.
+inline RGB light_escaped_radiance(const Light& l, const Vec3& dir) {
+  return std::visit(
+      [&](const auto& x) {
+        if constexpr (has(std::decay_t<decltype(x)>::flags, LightFlags::Infinite)) return x.radiance(dir);
+        else return RGB(0.0f);
+      },
+      l);
 }
 
 }  // namespace candela

@@ -1,6 +1,7 @@
 #pragma once
 #include <limits>
 
+#include "candela/lights/light_flags.h"
 #include "candela/math/color.h"
 #include "candela/math/frame.h"
 #include "candela/math/vec.h"

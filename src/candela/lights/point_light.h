@@ -5,6 +5,7 @@
 namespace candela {
 
 struct PointLightSource {
+  static constexpr LightFlags flags = LightFlags::DeltaPosition;
   Point3 position;
   RGB intensity;
 

@@ -23,6 +23,7 @@
 namespace candela {
 
 struct ProjectorLightSource {
+  static constexpr LightFlags flags = LightFlags::DeltaPosition;
   Point3 position;
   Transform to_world;
   float tan_x = 1, tan_y = 1;

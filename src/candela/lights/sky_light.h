@@ -9,6 +9,7 @@
 namespace candela {
 
 struct SkyLightSource {
+  static constexpr LightFlags flags = LightFlags::Infinite;
   RGB zenith, horizon, ground;
   Vec3 up{0, 1, 0};
   float scene_radius = 1;  // bounding-sphere radius of the scene, for power()

@@ -17,6 +17,7 @@
 namespace candela {
 
 struct SpotLightSource {
+  static constexpr LightFlags flags = LightFlags::DeltaPosition;
   Point3 position;
   Frame frame;    // frame.n is the unit cone axis, the direction the light points; s, t the texture's x, y
   RGB intensity;  // W/sr on the axis

@@ -11,6 +11,7 @@
 //   non_delta_probability(wo)    the probability that sample() picks a non-delta lobe for this wo; a
 //                                BSDF picks its non-delta lobes exactly when u_lobe < non_delta_probability(wo),
 //                                which lets the integrator swap in another direction-sampling strategy for them
+//   static constexpr flags       what the type can do, whatever its parameters (bsdf_flags.h)
 // Radiance-carrying (camera) paths are assumed: refraction scales radiance by 1 / eta^2, and
 // BsdfSample::eta reports the relative IOR crossed.
 // The closed list of BSDFs is the variant `Bsdf`; dispatch happens once, here.
@@ -52,20 +53,27 @@ inline float bsdf_non_delta_probability(const Bsdf& b, const Vec3& wo) {
 // Paths that carry importance (traced from the lights) need the adjoint BSDF f*(wo, wi) = f(wi, wo).
 // Every BSDF here is symmetric except in refraction, where radiance is scaled by 1 / eta'^2 and
 // importance is not (Veach 1997, sec. 5.2): the factor that turns eval() into the adjoint for a
-// transmitted pair (wo the direction the path arrived from). Sampled refractions report eta' in
+// transmitted pair (wo the direction the path arrived from), for the BSDFs whose flags say their
+// non-delta transmission refracts (BsdfFlags::Refraction). Sampled refractions report eta' in
 // BsdfSample::eta and are scaled by eta'^2 the same way.
 inline float bsdf_adjoint_scale(const Bsdf& b, const Vec3& wo, const Vec3& wi) {
   if (wo.z * wi.z >= 0) return 1;
-  if (const auto* d = std::get_if<DielectricBsdf>(&b)) {
-    float etap = wo.z > 0 ? d->eta : 1 / d->eta;
-    return etap * etap;
-  }
-  if (const auto* p = std::get_if<PrincipledBsdf>(&b)) {  // its specular transmission (the thin one does not bend)
-    float etap = wo.z > 0 ? p->eta : 1 / p->eta;
-    return etap * etap;
-  }
-  return 1;
+  return std::visit(
+      [&](const auto& x) -> float {
+        if constexpr (has(std::decay_t<decltype(x)>::flags, BsdfFlags::Refraction)) {
+          float etap = wo.z > 0 ? x.eta : 1 / x.eta;
+          return etap * etap;
+        } else {
+          return 1;
+        }
+      },
+      b);
 }
-inline bool bsdf_is_black(const Bsdf& b) { return std::holds_alternative<BlackBsdf>(b); }
+// The BSDF's flags (bsdf_flags.h): what its type can do.
+inline BsdfFlags bsdf_flags(const Bsdf& b) {
+  return std::visit([](const auto& x) { return std::decay_t<decltype(x)>::flags; }, b);
+}
+// Scatters nothing whatever the directions.
+inline bool bsdf_is_black(const Bsdf& b) { return is_black(bsdf_flags(b)); }
 
 }  // namespace candela

@@ -1,4 +1,5 @@
 #pragma once
+#include "candela/materials/bsdf_flags.h"
 #include "candela/math/color.h"
 #include "candela/math/vec.h"
 

@@ -47,6 +47,7 @@
 namespace candela {
 
 struct CoatedDiffuseBsdf {
+  static constexpr BsdfFlags flags = BsdfFlags::Reflection | BsdfFlags::Delta | BsdfFlags::NonDelta;
   RGB reflectance{0.5f};  // the diffuse base
   RGB specular{1.0f};     // tints the coat's reflection; 1 = physical
   float eta = 1.5f;       // n_coat / n_outside

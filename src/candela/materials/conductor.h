@@ -17,6 +17,7 @@
 namespace candela {
 
 struct ConductorBsdf {
+  static constexpr BsdfFlags flags = BsdfFlags::Reflection | BsdfFlags::Delta | BsdfFlags::NonDelta;
   // Complex index of refraction eta + i k relative to the outside medium; copper by default (as
   // ConductorMaterial). pbrt-v4's artist mode: eta = 1, k = conductor_k_from_reflectance(r).
   RGB eta{0.200438f, 0.924033f, 1.102212f}, k{3.912949f, 2.452848f, 2.142188f};

@@ -26,6 +26,8 @@
 namespace candela {
 
 struct DielectricBsdf {
+  static constexpr BsdfFlags flags = BsdfFlags::Reflection | BsdfFlags::Transmission | BsdfFlags::Delta |
+                                     BsdfFlags::NonDelta | BsdfFlags::Refraction;
   float eta = 1.5f;
   RGB reflectance{1.0f};
   RGB transmittance{1.0f};

@@ -8,6 +8,7 @@
 namespace candela {
 
 struct DiffuseBsdf {
+  static constexpr BsdfFlags flags = BsdfFlags::Reflection | BsdfFlags::NonDelta;
   RGB reflectance{0.5f};
 
   RGB eval(const Vec3& wo, const Vec3& wi) const {

@@ -10,6 +10,7 @@
 namespace candela {
 
 struct DiffuseTransmissionBsdf {
+  static constexpr BsdfFlags flags = BsdfFlags::Reflection | BsdfFlags::Transmission | BsdfFlags::NonDelta;
   RGB reflectance{0.25f};
   RGB transmittance{0.25f};
 

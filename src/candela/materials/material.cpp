@@ -1,6 +1,7 @@
 #include "candela/materials/material.h"
 
 #include "candela/base/error.h"
+#include "candela/base/overloaded.h"
 
 namespace candela {
 namespace {
@@ -8,6 +9,14 @@ namespace {
 bool is_constant(const ColorInput& c) { return c.is_constant(); }
 bool is_constant(const FloatInput& f) { return f.is_constant(); }
 bool is_constant(const Roughness& r) { return r.u.is_constant() && r.v.is_constant(); }
+
+// The materials that are a BSDF of their own (build()); the others wrap materials or have no surface.
+template <typename T>
+constexpr bool builds_bsdf =
+    std::is_same_v<T, DiffuseMaterial> || std::is_same_v<T, PhongMaterial> || std::is_same_v<T, MirrorMaterial> ||
+    std::is_same_v<T, DielectricMaterial> || std::is_same_v<T, BlackMaterial> ||
+    std::is_same_v<T, ConductorMaterial> || std::is_same_v<T, CoatedDiffuseMaterial> ||
+    std::is_same_v<T, DiffuseTransmissionMaterial> || std::is_same_v<T, PrincipledMaterial>;
 
 // Whether every input of the material is a constant (then its BSDF is the same at every hit).
 bool has_constant_inputs(const MaterialDesc& desc) {
@@ -35,7 +44,13 @@ bool has_constant_inputs(const MaterialDesc& desc) {
           return is_constant(m.reflectance) && is_constant(m.transmittance);
         else if constexpr (std::is_same_v<T, MaskMaterial>) return is_constant(m.opacity);  // and what it wraps
         else if constexpr (std::is_same_v<T, BlendMaterial>) return is_constant(m.weight);
-        else return true;
+        // No inputs of their own: black, interfaces, and wrappers whose maps only tilt the frame
+        // (what they wrap is checked by the caller).
+        else if constexpr (std::is_same_v<T, BlackMaterial> || std::is_same_v<T, InterfaceMaterial> ||
+                           std::is_same_v<T, OneSidedMaterial> || std::is_same_v<T, TwoSidedMaterial> ||
+                           std::is_same_v<T, NormalMapMaterial> || std::is_same_v<T, BumpMapMaterial>)
+          return true;
+        else static_assert(always_false<T>, "a material must say whether its inputs are constant");
       },
       desc);
 }
@@ -50,7 +65,8 @@ std::vector<int> nested_materials(const MaterialDesc& desc) {
         else if constexpr (std::is_same_v<T, OneSidedMaterial> || std::is_same_v<T, MaskMaterial> ||
                            std::is_same_v<T, NormalMapMaterial> || std::is_same_v<T, BumpMapMaterial>)
           return {m.material};
-        else return {};
+        else if constexpr (builds_bsdf<T> || std::is_same_v<T, InterfaceMaterial>) return {};
+        else static_assert(always_false<T>, "a material must say which materials it wraps");
       },
       desc);
 }
@@ -139,25 +155,31 @@ void MaterialTable::collect(int material, float weight, bool one_sided, const Te
   const Entry& entry = entries_[size_t(material)];
   const MaterialDesc& desc = entry.desc;
   auto clamp01 = [&](const FloatInput& f) { return std::clamp(textures_->eval(f, ctx), 0.0f, 1.0f); };
-  if (const auto* m = std::get_if<OneSidedMaterial>(&desc)) {
-    collect(m->material, weight, true, ctx, out);
-  } else if (const auto* mask = std::get_if<MaskMaterial>(&desc)) {
-    float opacity = clamp01(mask->opacity);
-    out.null_weight += weight * (1 - opacity);
-    if (opacity > 0) collect(mask->material, weight * opacity, one_sided, ctx, out);
-  } else if (const auto* blend = std::get_if<BlendMaterial>(&desc)) {
-    float t = clamp01(blend->weight);
-    if (t < 1) collect(blend->material0, weight * (1 - t), one_sided, ctx, out);
-    if (t > 0) collect(blend->material1, weight * t, one_sided, ctx, out);
-  } else if (const auto* nm = std::get_if<NormalMapMaterial>(&desc)) {
-    collect(nm->material, weight, one_sided, ctx, out);
-  } else if (const auto* bm = std::get_if<BumpMapMaterial>(&desc)) {
-    collect(bm->material, weight, one_sided, ctx, out);
-  } else if (std::holds_alternative<InterfaceMaterial>(desc)) {
-    out.null_weight += weight;  // no surface: a wrapped interface lets the ray pass
-  } else if (out.count < SurfaceBsdf::kMaxComponents) {
-    out.add(build(entry, ctx), weight, one_sided);
-  }
+  std::visit(
+      [&](const auto& m) {
+        using T = std::decay_t<decltype(m)>;
+        if constexpr (std::is_same_v<T, OneSidedMaterial>) {
+          collect(m.material, weight, true, ctx, out);
+        } else if constexpr (std::is_same_v<T, MaskMaterial>) {
+          float opacity = clamp01(m.opacity);
+          out.null_weight += weight * (1 - opacity);
+          if (opacity > 0) collect(m.material, weight * opacity, one_sided, ctx, out);
+        } else if constexpr (std::is_same_v<T, BlendMaterial>) {
+          float t = clamp01(m.weight);
+          if (t < 1) collect(m.material0, weight * (1 - t), one_sided, ctx, out);
+          if (t > 0) collect(m.material1, weight * t, one_sided, ctx, out);
+        } else if constexpr (std::is_same_v<T, NormalMapMaterial> || std::is_same_v<T, BumpMapMaterial>) {
+          collect(m.material, weight, one_sided, ctx, out);
+        } else if constexpr (std::is_same_v<T, InterfaceMaterial>) {
+          out.null_weight += weight;  // no surface: a wrapped interface lets the ray pass
+        } else if constexpr (builds_bsdf<T> || std::is_same_v<T, TwoSidedMaterial>) {
+          // (A two-sided material is never collected: it is the outermost, and a side is picked first.)
+          if (out.count < SurfaceBsdf::kMaxComponents) out.add(build(entry, ctx), weight, one_sided);
+        } else {
+          static_assert(always_false<T>, "a material must say how it joins a surface's mixture");
+        }
+      },
+      desc);
 }
 
 Shading MaterialTable::shading(uint32_t material, const TextureEvalContext& ctx, const SurfaceHit& hit,
@@ -295,8 +317,16 @@ Bsdf MaterialTable::build(const Entry& entry, const TextureEvalContext& ctx) con
             p.eta = principled_eta_from_specular(has_trans && specular == 0 ? 1e-3f : specular);
           }
           return PrincipledBsdf(p);
+        } else if constexpr (std::is_same_v<T, BlackMaterial>) {
+          return BlackBsdf{};
+        } else if constexpr (std::is_same_v<T, InterfaceMaterial>) {
+          return BlackBsdf{};  // never shaded: the integrator passes through (and collect() makes it null)
+        } else if constexpr (std::is_same_v<T, OneSidedMaterial> || std::is_same_v<T, TwoSidedMaterial> ||
+                             std::is_same_v<T, MaskMaterial> || std::is_same_v<T, BlendMaterial> ||
+                             std::is_same_v<T, NormalMapMaterial> || std::is_same_v<T, BumpMapMaterial>) {
+          return BlackBsdf{};  // wrappers are never built: resolve() and collect() take them apart
         } else {
-          return BlackBsdf{};  // black, interfaces (never shaded: the integrator passes through), wrappers (resolve())
+          static_assert(always_false<T>, "a material must say which BSDF it builds");
         }
       },
       desc);

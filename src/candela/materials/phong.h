@@ -16,6 +16,9 @@
 namespace candela {
 
 struct PhongBsdf {
+  // its transmission is an ideal (delta) refraction
+  static constexpr BsdfFlags flags =
+      BsdfFlags::Reflection | BsdfFlags::Transmission | BsdfFlags::Delta | BsdfFlags::NonDelta;
   RGB diffuse{0.5f};
   RGB specular{1.0f};
   float exponent = 32;

@@ -184,6 +184,8 @@ inline float principled_eta_from_specular(float specular) {
 }
 
 struct PrincipledBsdf {
+  static constexpr BsdfFlags flags = BsdfFlags::Reflection | BsdfFlags::Transmission | BsdfFlags::NonDelta |
+                                     BsdfFlags::Refraction;
   RGB base_color{0.5f};
   float roughness = 0.5f;
   TrowbridgeReitz distribution = principled_distribution(0.5f, 0);
@@ -374,6 +376,8 @@ struct PrincipledBsdf {
 };
 
 struct PrincipledThinBsdf {
+  // its transmission does not bend
+  static constexpr BsdfFlags flags = BsdfFlags::Reflection | BsdfFlags::Transmission | BsdfFlags::NonDelta;
   RGB base_color{0.5f};
   float roughness = 0.5f;
   TrowbridgeReitz distribution = principled_distribution(0.5f, 0);

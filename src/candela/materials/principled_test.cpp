@@ -1,5 +1,6 @@
 // Mitsuba's principled and principledthin BSDFs: eval against values of Mitsuba's formulas, sampling
-// against pdf (chi-square), sample weights, energy where the model conserves it, reciprocity.
+// against pdf (chi-square), energy where the model conserves it, reciprocity. (Sample weights:
+// bsdf_contract_test.cpp.)
 #include "candela/materials/principled.h"
 
 #include <gtest/gtest.h>
@@ -11,6 +12,7 @@
 
 #include "candela/materials/material.h"
 #include "candela/sampling/rng.h"
+#include "candela/testing/principled_cases.h"
 #include "candela/testing/statistics.h"
 
 namespace candela {
@@ -151,58 +153,8 @@ TEST(PrincipledEval, OpaqueSurfaceIsBlackFromBehind) {
 
 // ---------------------------------------------------------------- sampling
 
-struct SamplingCase {
-  std::string name;
-  PrincipledParams params;
-};
-
-std::vector<SamplingCase> principled_sampling_cases() {
-  std::vector<SamplingCase> cases;
-  PrincipledParams p;
-  p.base_color = RGB(0.8f, 0.6f, 0.4f);
-  p.roughness = 0.6f;
-  cases.push_back({"diffuse and specular", p});
-  PrincipledParams metal = p;
-  metal.metallic = 1;
-  metal.roughness = 0.4f;
-  cases.push_back({"metallic", metal});
-  PrincipledParams rough = p;
-  rough.roughness = 0.95f;
-  rough.metallic = 0.5f;
-  cases.push_back({"rough half metal", rough});
-  PrincipledParams smooth = p;
-  smooth.roughness = 0.25f;
-  smooth.metallic = 0.8f;
-  cases.push_back({"smooth", smooth});
-  PrincipledParams aniso = p;
-  aniso.roughness = 0.5f;
-  aniso.anisotropic = 0.8f;
-  aniso.metallic = 0.6f;
-  cases.push_back({"anisotropic", aniso});
-  PrincipledParams coat = p;
-  coat.roughness = 0.5f;
-  coat.clearcoat = 1;
-  coat.clearcoat_gloss = 0.3f;
-  coat.sheen = 1;
-  coat.sheen_tint = 0.5f;
-  cases.push_back({"clearcoat and sheen", coat});
-  PrincipledParams glass = p;
-  glass.roughness = 0.45f;
-  glass.spec_trans = 0.8f;
-  glass.eta = 1.5f;
-  glass.clearcoat = 0.5f;
-  glass.clearcoat_gloss = 0.1f;
-  cases.push_back({"spec_trans", glass});
-  PrincipledParams aniso_glass = glass;
-  aniso_glass.anisotropic = 0.7f;
-  aniso_glass.spec_trans = 1;
-  aniso_glass.eta = 1.33f;
-  cases.push_back({"anisotropic spec_trans 1", aniso_glass});
-  return cases;
-}
-
 TEST(PrincipledSampling, MatchesPdf) {
-  for (const SamplingCase& c : principled_sampling_cases()) {
+  for (const testing::PrincipledCase& c : testing::principled_sampling_cases()) {
     PrincipledBsdf b(c.params);
     std::vector<Vec3> wos = {direction(0), direction(35), direction(70), direction(87)};
     if (b.has_non_delta_transmission()) {
@@ -236,39 +188,6 @@ TEST(PrincipledThinSampling, MatchesPdf) {
       EXPECT_GT(chi_square(b, wo), testing::kChiSquareAlpha)
           << "spec_trans " << params.spec_trans << " wo.z " << wo.z;
   }
-}
-
-template <typename B>
-void expect_weights_are_eval_cos_over_pdf(const B& b, const Vec3& wo, const char* name) {
-  Rng rng(1, 1);
-  int checked = 0;
-  for (int i = 0; i < 5000; ++i) {
-    auto s = b.sample(wo, rng.next_float(), {rng.next_float(), rng.next_float()});
-    if (!s) continue;
-    ASSERT_FALSE(s->is_delta);
-    float pdf = b.pdf(wo, s->wi);
-    ASSERT_NEAR(s->pdf, pdf, 1e-4f * pdf) << name;
-    RGB expected = b.eval(wo, s->wi) * (std::abs(s->wi.z) / pdf);
-    for (int k = 0; k < 3; ++k) ASSERT_NEAR(s->weight[k], expected[k], 1e-4f * (1 + expected[k])) << name;
-    ASSERT_TRUE(s->weight.is_finite()) << name;
-    ++checked;
-  }
-  EXPECT_GT(checked, 2500) << name << " wo.z " << wo.z;
-}
-
-TEST(PrincipledSampling, WeightIsEvalCosOverPdf) {
-  for (const SamplingCase& c : principled_sampling_cases()) {
-    PrincipledBsdf b(c.params);
-    expect_weights_are_eval_cos_over_pdf(b, direction(40), c.name.c_str());
-    if (b.has_non_delta_transmission()) expect_weights_are_eval_cos_over_pdf(b, -direction(30), c.name.c_str());
-  }
-  PrincipledParams thin;
-  thin.spec_trans = 0.5f;
-  thin.diff_trans = 1;
-  thin.sheen = 0.3f;
-  thin.spec_tint = 0.5f;
-  expect_weights_are_eval_cos_over_pdf(PrincipledThinBsdf(thin), direction(50), "thin");
-  expect_weights_are_eval_cos_over_pdf(PrincipledThinBsdf(thin), -direction(20), "thin from the back");
 }
 
 TEST(PrincipledSampling, RefractionsReportTheRelativeIor) {

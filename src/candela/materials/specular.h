@@ -44,6 +44,7 @@ inline bool refract_local(const Vec3& w, float eta, Vec3& wt, float& eta_rel) {
 inline Vec3 reflect_local(const Vec3& w) { return {-w.x, -w.y, w.z}; }
 
 struct MirrorBsdf {
+  static constexpr BsdfFlags flags = BsdfFlags::Reflection | BsdfFlags::Delta;
   RGB reflectance{1.0f};
   RGB eval(const Vec3&, const Vec3&) const { return RGB(0.0f); }
   float pdf(const Vec3&, const Vec3&) const { return 0; }
@@ -56,6 +57,7 @@ struct MirrorBsdf {
 };
 
 struct BlackBsdf {
+  static constexpr BsdfFlags flags = BsdfFlags::None;
   RGB eval(const Vec3&, const Vec3&) const { return RGB(0.0f); }
   float pdf(const Vec3&, const Vec3&) const { return 0; }
   std::optional<BsdfSample> sample(const Vec3&, float, Vec2) const { return std::nullopt; }

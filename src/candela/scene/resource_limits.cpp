@@ -17,6 +17,7 @@
 #include "candela/film/film.h"
 #include "candela/geometry/sdf_grid.h"
 #include "candela/base/error.h"
+#include "candela/base/overloaded.h"
 #include "candela/lights/light.h"
 
 namespace candela {
@@ -69,21 +70,26 @@ ShapeCost triangle_cost(uint64_t vertices, uint64_t triangles, bool normals, boo
 ShapeCost shape_cost(const ShapeDesc& shape) {
   const bool moving = shape.to_world_end.has_value();
   const bool emissive = shape.emission.has_value();
-  if (const auto* mesh = std::get_if<MeshShape>(&shape.geometry)) {
-    const TriangleMesh& m = mesh->mesh;
-    return triangle_cost(m.positions.size(), m.triangle_count(), !m.normals.empty(), !m.uvs.empty(), moving,
-                         emissive);
-  }
-  if (std::holds_alternative<BoxShape>(shape.geometry)) return triangle_cost(24, 12, true, true, moving, emissive);
-  if (std::holds_alternative<RectangleShape>(shape.geometry)) return triangle_cost(4, 2, true, true, moving, emissive);
-  if (const auto* sdf = std::get_if<SdfGridShape>(&shape.geometry)) {
-    // The grid's values are the SceneDesc's own (shared); each voxel holding surface adds its index
-    // and a BVH leaf, as a triangle would.
-    const uint64_t voxels = count_surface_voxels(*sdf);
-    return {add(mul(voxels, sizeof(uint32_t) + (moving ? 2 : 1) * kEmbreeBvhBytesPerTriangle), kBytesPerSimpleShape),
-            0};
-  }
-  return {kBytesPerSimpleShape, 0};  // spheres, planes, disks and cylinders
+  const ShapeCost simple{kBytesPerSimpleShape, 0};
+  return std::visit(
+      overloaded{[&](const MeshShape& mesh) {
+                   const TriangleMesh& m = mesh.mesh;
+                   return triangle_cost(m.positions.size(), m.triangle_count(), !m.normals.empty(), !m.uvs.empty(),
+                                        moving, emissive);
+                 },
+                 [&](const BoxShape&) { return triangle_cost(24, 12, true, true, moving, emissive); },
+                 [&](const RectangleShape&) { return triangle_cost(4, 2, true, true, moving, emissive); },
+                 [&](const SdfGridShape& sdf) {
+                   // The grid's values are the SceneDesc's own (shared); each voxel holding surface adds its
+                   // index and a BVH leaf, as a triangle would.
+                   const uint64_t voxels = count_surface_voxels(sdf);
+                   return ShapeCost{add(mul(voxels, sizeof(uint32_t) + (moving ? 2 : 1) * kEmbreeBvhBytesPerTriangle),
+                                        kBytesPerSimpleShape),
+                                    0};
+                 },
+                 [&](const SphereShape&) { return simple; }, [&](const PlaneShape&) { return simple; },
+                 [&](const DiskShape&) { return simple; }, [&](const CylinderShape&) { return simple; }},
+      shape.geometry);
 }
 
 // ---------------------------------------------------------------- images
@@ -101,6 +107,28 @@ uint64_t image_bytes(const std::string& filename, uint64_t extra_per_texel) {
   const uint64_t file_pixel = mul(non_negative(spec.nchannels), spec.format.size());
   in->close();
   return mul(texels, add(add(3 * sizeof(float), file_pixel), extra_per_texel));
+}
+
+// The image a texture reads, in memory.
+uint64_t texture_image_bytes(const TextureDesc& texture) {
+  return std::visit(overloaded{[](const ImageTexture& image) { return image_bytes(image.filename, 0); },
+                               // no images of their own
+                               [](const CheckerboardTexture&) { return uint64_t(0); },
+                               [](const ScaleTexture&) { return uint64_t(0); },
+                               [](const MixTexture&) { return uint64_t(0); },
+                               [](const MeshAttributeTexture&) { return uint64_t(0); }},
+                    texture);
+}
+
+// The image a light reads, in memory with its sampling distribution (an environment map's two
+// floats per texel). Spot and projector lights name textures, counted with the textures.
+uint64_t light_image_bytes(const LightDesc& light) {
+  return std::visit(
+      overloaded{[](const EnvironmentMap& env) { return image_bytes(env.filename, 2 * sizeof(float)); },
+                 [](const PointLight&) { return uint64_t(0); }, [](const SkyLight&) { return uint64_t(0); },
+                 [](const SpotLight&) { return uint64_t(0); }, [](const DistantLight&) { return uint64_t(0); },
+                 [](const ProjectorLight&) { return uint64_t(0); }},
+      light);
 }
 
 }  // namespace
@@ -123,11 +151,8 @@ MemoryEstimate estimate_memory(const SceneDesc& desc) {
   scene = add(scene, mul(desc.lights.size() + desc.materials.size() + desc.textures.size(), 256));
 
   for (const TextureDesc& texture : desc.textures)
-    if (const auto* image = std::get_if<ImageTexture>(&texture))
-      e.texture_bytes = add(e.texture_bytes, image_bytes(image->filename, 0));
-  for (const LightDesc& light : desc.lights)
-    if (const auto* env = std::get_if<EnvironmentMap>(&light))
-      e.texture_bytes = add(e.texture_bytes, image_bytes(env->filename, 2 * sizeof(float)));
+    e.texture_bytes = add(e.texture_bytes, texture_image_bytes(texture));
+  for (const LightDesc& light : desc.lights) e.texture_bytes = add(e.texture_bytes, light_image_bytes(light));
 
   e.scene_bytes = add(scene, e.texture_bytes);
   e.total = add(e.film_bytes, e.scene_bytes);

@@ -6,6 +6,7 @@
 #include "candela/geometry/quadric_uv.h"
 #include "candela/geometry/sdf_grid.h"
 #include "candela/base/error.h"
+#include "candela/base/overloaded.h"
 #include "candela/math/frame.h"
 
 namespace candela {
@@ -84,27 +85,27 @@ void Scene::build(const SceneDesc& desc, SceneDesc* take_meshes) {
 
   float radius = bounds_.empty() ? 1.0f : std::max(1e-3f, length(bounds_.diagonal()) / 2);
   for (const auto& l : desc.lights) {
-    if (const auto* p = std::get_if<PointLight>(&l)) {
-      lights_.push_back(PointLightSource{p->position, p->intensity});
-    } else if (const auto* s = std::get_if<SkyLight>(&l)) {
-      infinite_lights_.push_back(uint32_t(lights_.size()));
-      lights_.push_back(SkyLightSource{s->zenith, s->horizon, s->ground, normalize(s->up), radius});
-    } else if (const auto* spot = std::get_if<SpotLight>(&l)) {
-      lights_.push_back(make_spot_light(*spot, &textures_));
-    } else if (const auto* projector = std::get_if<ProjectorLight>(&l)) {
-      lights_.push_back(make_projector_light(*projector, &textures_));
-    } else if (const auto* distant = std::get_if<DistantLight>(&l)) {
-      lights_.push_back(make_distant_light(*distant, radius));
-    } else if (const auto* env = std::get_if<EnvironmentMap>(&l)) {
-      Image image;
-      try {
-        image = read_image(env->filename);
-      } catch (const std::exception& e) {
-        throw SceneError(fmt::format("{}: environment map: {}", source_file_, e.what()));
-      }
-      infinite_lights_.push_back(uint32_t(lights_.size()));
-      lights_.push_back(EnvironmentLight(image, env->mapping, env->scale, env->to_world, radius));
-    }
+    Light light = std::visit(
+        overloaded{
+            [&](const PointLight& p) -> Light { return PointLightSource{p.position, p.intensity}; },
+            [&](const SkyLight& s) -> Light {
+              return SkyLightSource{s.zenith, s.horizon, s.ground, normalize(s.up), radius};
+            },
+            [&](const SpotLight& spot) -> Light { return make_spot_light(spot, &textures_); },
+            [&](const ProjectorLight& projector) -> Light { return make_projector_light(projector, &textures_); },
+            [&](const DistantLight& distant) -> Light { return make_distant_light(distant, radius); },
+            [&](const EnvironmentMap& env) -> Light {
+              Image image;
+              try {
+                image = read_image(env.filename);
+              } catch (const std::exception& e) {
+                throw SceneError(fmt::format("{}: environment map: {}", source_file_, e.what()));
+              }
+              return EnvironmentLight(image, env.mapping, env.scale, env.to_world, radius);
+            }},
+        l);
+    if (has(light_flags(light), LightFlags::Infinite)) infinite_lights_.push_back(uint32_t(lights_.size()));
+    lights_.push_back(std::move(light));
   }
 
   // Which light a shadow ray (or a light path) starts from: by power, or (LightSelection::Uniform)
@@ -203,65 +204,67 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int object, TriangleM
                                    desc.emission->texture));
   }
 
-  if (const auto* s = std::get_if<SphereShape>(&desc.geometry)) {
-    add_sphere(std::move(rec), *s, T, T_end, desc.reverse_orientation, desc.emission, object);
-    return;
-  }
-  if (const auto* p = std::get_if<PlaneShape>(&desc.geometry)) {
-    if (desc.emission)
-      throw SceneError(fmt::format("{}: {}: an infinite plane cannot emit light (its power would be infinite)",
-                                   source_file_, rec.name));
-    if (T_end)
-      throw SceneError(fmt::format("{}: {}: an infinite plane must not move (it has an end transform)", source_file_,
-                                   rec.name));
-    rec.kind = ShapeRecord::Kind::Plane;
-    rec.plane = PlaneGeometry{T.point(p->point), normalize(T.normal(p->normal))};
-    // Its Embree geometry is added once the size of everything else is known (see the constructor).
-    shapes_.push_back(std::move(rec));
-    return;
-  }
-  if (std::holds_alternative<DiskShape>(desc.geometry)) {
-    add_quadric(std::move(rec), QuadricGeometry::Kind::Disk, T, T_end, desc.emission, object);
-    return;
-  }
-  if (const auto* c = std::get_if<CylinderShape>(&desc.geometry)) {
-    // The unit tube placed on the segment p0-p1 with the radius (Mitsuba's to_frame of the axis,
-    // so phi = 0 lies along the axis frame's first vector), then to_world.
-    Vec3 d = c->p1 - c->p0;
-    float len = length(d);
-    if (!(len > 0) || !(c->radius > 0) || !std::isfinite(len) || !std::isfinite(c->radius))
-      throw SceneError(fmt::format("{}: {}: a cylinder needs a positive radius and two distinct end points",
-                                   source_file_, rec.name));
-    Frame f(d / len);
-    Matrix4 m = Matrix4::identity();
-    for (int r = 0; r < 3; ++r) {
-      m.m[r][0] = double(f.s[r]) * c->radius;
-      m.m[r][1] = double(f.t[r]) * c->radius;
-      m.m[r][2] = double(d[r]);
-      m.m[r][3] = double(c->p0[r]);
-    }
-    Transform place = *Transform::from_matrix(m);
-    Transform unit = T * place;
-    std::optional<Transform> unit_end;
-    if (T_end) unit_end = *T_end * place;
-    add_quadric(std::move(rec), QuadricGeometry::Kind::Cylinder, unit, unit_end ? &*unit_end : nullptr, desc.emission,
-                object);
-    return;
-  }
-  if (const auto* g = std::get_if<SdfGridShape>(&desc.geometry)) {
-    if (desc.emission)
-      throw SceneError(fmt::format("{}: {}: an SDF grid cannot emit light (as in Mitsuba: it has no area to sample)",
-                                   source_file_, rec.name));
-    add_sdf_grid(std::move(rec), *g, T, T_end, object);
-    return;
-  }
-  TriangleMesh mesh;
-  if (const auto* b = std::get_if<BoxShape>(&desc.geometry)) mesh = box_mesh(*b);
-  else if (const auto* r = std::get_if<RectangleShape>(&desc.geometry)) mesh = rectangle_mesh(*r);
-  else if (take_mesh) mesh = std::move(*take_mesh);
-  else mesh = std::get<MeshShape>(desc.geometry).mesh;
-  add_triangles(std::move(rec), std::move(mesh), T, T_end, desc.reverse_orientation, desc.emission,
-                std::holds_alternative<RectangleShape>(desc.geometry), object);
+  auto triangles = [&](TriangleMesh mesh, bool rectangle) {
+    add_triangles(std::move(rec), std::move(mesh), T, T_end, desc.reverse_orientation, desc.emission, rectangle,
+                  object);
+  };
+  std::visit(
+      overloaded{
+          [&](const SphereShape& s) {
+            add_sphere(std::move(rec), s, T, T_end, desc.reverse_orientation, desc.emission, object);
+          },
+          [&](const PlaneShape& p) {
+            if (desc.emission)
+              throw SceneError(fmt::format("{}: {}: an infinite plane cannot emit light (its power would be infinite)",
+                                           source_file_, rec.name));
+            if (T_end)
+              throw SceneError(fmt::format("{}: {}: an infinite plane must not move (it has an end transform)",
+                                           source_file_, rec.name));
+            rec.kind = ShapeRecord::Kind::Plane;
+            rec.plane = PlaneGeometry{T.point(p.point), normalize(T.normal(p.normal))};
+            // Its Embree geometry is added once the size of everything else is known (see the constructor).
+            shapes_.push_back(std::move(rec));
+          },
+          [&](const DiskShape&) {
+            add_quadric(std::move(rec), QuadricGeometry::Kind::Disk, T, T_end, desc.emission, object);
+          },
+          [&](const CylinderShape& c) {
+            // The unit tube placed on the segment p0-p1 with the radius (Mitsuba's to_frame of the axis,
+            // so phi = 0 lies along the axis frame's first vector), then to_world.
+            Vec3 d = c.p1 - c.p0;
+            float len = length(d);
+            if (!(len > 0) || !(c.radius > 0) || !std::isfinite(len) || !std::isfinite(c.radius))
+              throw SceneError(fmt::format("{}: {}: a cylinder needs a positive radius and two distinct end points",
+                                           source_file_, rec.name));
+            Frame f(d / len);
+            Matrix4 m = Matrix4::identity();
+            for (int r = 0; r < 3; ++r) {
+              m.m[r][0] = double(f.s[r]) * c.radius;
+              m.m[r][1] = double(f.t[r]) * c.radius;
+              m.m[r][2] = double(d[r]);
+              m.m[r][3] = double(c.p0[r]);
+            }
+            Transform place = *Transform::from_matrix(m);
+            Transform unit = T * place;
+            std::optional<Transform> unit_end;
+            if (T_end) unit_end = *T_end * place;
+            add_quadric(std::move(rec), QuadricGeometry::Kind::Cylinder, unit, unit_end ? &*unit_end : nullptr,
+                        desc.emission, object);
+          },
+          [&](const SdfGridShape& g) {
+            if (desc.emission)
+              throw SceneError(fmt::format(
+                  "{}: {}: an SDF grid cannot emit light (as in Mitsuba: it has no area to sample)", source_file_,
+                  rec.name));
+            add_sdf_grid(std::move(rec), g, T, T_end, object);
+          },
+          [&](const BoxShape& b) { triangles(box_mesh(b), false); },
+          [&](const RectangleShape& r) { triangles(rectangle_mesh(r), true); },
+          [&](const MeshShape& m) {
+            if (take_mesh) triangles(std::move(*take_mesh), false);
+            else triangles(m.mesh, false);
+          }},
+      desc.geometry);
 }
 
 void Scene::add_sphere(ShapeRecord rec, const SphereShape& s, const Transform& T, const Transform* T_end,

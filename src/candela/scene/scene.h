@@ -90,9 +90,7 @@ class Scene {
   const std::vector<uint32_t>& infinite_lights() const { return infinite_lights_; }
   // Radiance an escaping ray travelling along `dir` receives from infinite light `light`.
   RGB escaped_radiance(uint32_t light, const Vec3& dir) const {
-    const Light& l = lights_[light];
-    if (const auto* env = std::get_if<EnvironmentLight>(&l)) return env->radiance(dir);
-    return std::get<SkyLightSource>(l).radiance(dir);
+    return light_escaped_radiance(lights_[light], dir);
   }
   const PerspectiveCamera& camera() const { return camera_; }
   const Bounds3& bounds() const { return bounds_; }

@@ -15,6 +15,7 @@
 
 #include "candela/film/image_io.h"
 #include "candela/base/error.h"
+#include "candela/base/overloaded.h"
 
 namespace candela {
 namespace {
@@ -88,17 +89,21 @@ RGB clamp_zero(RGB c) { return {std::max(c.r, 0.0f), std::max(c.g, 0.0f), std::m
 // Calls f with every texture index a description refers to (-1 for constants), for validation.
 template <typename F>
 void for_each_reference(const TextureDesc& desc, F&& f) {
-  if (const auto* c = std::get_if<CheckerboardTexture>(&desc)) {
-    f(c->tex1.texture);
-    f(c->tex2.texture);
-  } else if (const auto* s = std::get_if<ScaleTexture>(&desc)) {
-    f(s->tex.texture);
-    f(s->scale.texture);
-  } else if (const auto* m = std::get_if<MixTexture>(&desc)) {
-    f(m->tex1.texture);
-    f(m->tex2.texture);
-    f(m->amount.texture);
-  }
+  std::visit(overloaded{[&](const CheckerboardTexture& c) {
+                          f(c.tex1.texture);
+                          f(c.tex2.texture);
+                        },
+                        [&](const ScaleTexture& s) {
+                          f(s.tex.texture);
+                          f(s.scale.texture);
+                        },
+                        [&](const MixTexture& m) {
+                          f(m.tex1.texture);
+                          f(m.tex2.texture);
+                          f(m.amount.texture);
+                        },
+                        [](const ImageTexture&) {}, [](const MeshAttributeTexture&) {}},
+             desc);
 }
 
 // A mesh attribute at the hit (Mitsuba's mesh_attribute): per vertex, interpolated with the
@@ -124,9 +129,16 @@ RGB eval_mesh_attribute(const MeshAttributeTexture& t, const MeshAttributeContex
 
 std::pair<int, int> TextureSet::resolution(int index) const {
   if (index < 0 || size_t(index) >= textures_.size()) return {1, 1};
-  if (const auto* t = std::get_if<ImageLookup>(&textures_[size_t(index)]))
-    return {std::max(1, t->image->width), std::max(1, t->image->height)};
-  return {1, 1};
+  using Resolution = std::pair<int, int>;
+  return std::visit(overloaded{[](const ImageLookup& t) {
+                                 return Resolution{std::max(1, t.image->width), std::max(1, t.image->height)};
+                               },
+                               // not images
+                               [](const CheckerboardTexture&) { return Resolution{1, 1}; },
+                               [](const ScaleTexture&) { return Resolution{1, 1}; },
+                               [](const MixTexture&) { return Resolution{1, 1}; },
+                               [](const MeshAttributeTexture&) { return Resolution{1, 1}; }},
+                    textures_[size_t(index)]);
 }
 
 TextureSet::TextureSet(const std::vector<TextureDesc>& descs) {
@@ -173,28 +185,31 @@ TextureSet::TextureSet(const std::vector<TextureDesc>& descs) {
 }
 
 RGB TextureSet::eval_texture(int index, const TextureEvalContext& ctx) const {
-  const Texture& texture = textures_[size_t(index)];
-  if (const auto* t = std::get_if<ImageLookup>(&texture)) {
-    RGB v = t->scale * lookup(*t->image, t->wrap, t->bilinear, apply_mapping(t->mapping, ctx.uv));
-    if (t->luminance) v = RGB(v.luminance());
-    return clamp_zero(t->invert ? RGB(1.0f) - v : v);  // pbrt-v4 clamps negative results too
-  }
-  if (const auto* t = std::get_if<CheckerboardTexture>(&texture)) {
-    Vec2 st = apply_mapping(t->mapping, ctx.uv);
-    // Sum in 64 bits: floor_index's range makes the sum fit, and & 1 is the parity for negatives too.
-    bool even = ((int64_t(floor_index(st.x)) + floor_index(st.y)) & 1) == 0;
-    return eval(even ? t->tex1 : t->tex2, ctx);
-  }
-  if (const auto* t = std::get_if<ScaleTexture>(&texture)) return eval(t->tex, ctx) * eval(t->scale, ctx);
-  if (const auto* t = std::get_if<MeshAttributeTexture>(&texture)) return eval_mesh_attribute(*t, ctx.mesh);
-  const auto& t = std::get<MixTexture>(texture);
-  float amount = eval(t.amount, ctx);
-  // A side with weight zero is not evaluated (as in pbrt-v4): cheaper, and an infinite value there
-  // cannot turn the result into NaN.
-  RGB result(0.0f);
-  if (amount != 1) result += (1 - amount) * eval(t.tex1, ctx);
-  if (amount != 0) result += amount * eval(t.tex2, ctx);
-  return result;
+  return std::visit(
+      overloaded{
+          [&](const ImageLookup& t) {
+            RGB v = t.scale * lookup(*t.image, t.wrap, t.bilinear, apply_mapping(t.mapping, ctx.uv));
+            if (t.luminance) v = RGB(v.luminance());
+            return clamp_zero(t.invert ? RGB(1.0f) - v : v);  // pbrt-v4 clamps negative results too
+          },
+          [&](const CheckerboardTexture& t) {
+            Vec2 st = apply_mapping(t.mapping, ctx.uv);
+            // Sum in 64 bits: floor_index's range makes the sum fit, and & 1 is the parity for negatives too.
+            bool even = ((int64_t(floor_index(st.x)) + floor_index(st.y)) & 1) == 0;
+            return eval(even ? t.tex1 : t.tex2, ctx);
+          },
+          [&](const ScaleTexture& t) { return eval(t.tex, ctx) * eval(t.scale, ctx); },
+          [&](const MeshAttributeTexture& t) { return eval_mesh_attribute(t, ctx.mesh); },
+          [&](const MixTexture& t) {
+            float amount = eval(t.amount, ctx);
+            // A side with weight zero is not evaluated (as in pbrt-v4): cheaper, and an infinite value
+            // there cannot turn the result into NaN.
+            RGB result(0.0f);
+            if (amount != 1) result += (1 - amount) * eval(t.tex1, ctx);
+            if (amount != 0) result += amount * eval(t.tex2, ctx);
+            return result;
+          }},
+      textures_[size_t(index)]);
 }
 
 }  // namespace candela
