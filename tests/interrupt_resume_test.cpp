@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -101,8 +102,10 @@ TEST_F(InterruptResume, SigintWritesThePartialImageAndExits3) {
   pid_t pid = start({"render", kScene, "-o", out, "--resolution", "256x256", "--spp", "100000", "-q", "--checkpoint",
                      ckpt, "--checkpoint-every", "0.2"});
   ASSERT_TRUE(wait_for(ckpt));  // rendering has begun: at least one pass is done
+  const auto sent = std::chrono::steady_clock::now();
   kill(pid, SIGINT);
   ASSERT_EQ(wait_exit(pid), 3) << log();
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count(), 1.0);
   EXPECT_NE(log().find("interrupted"), std::string::npos) << log();
   ASSERT_TRUE(fs::exists(out));
   auto meta = read_image_metadata(out);
@@ -284,6 +287,149 @@ TEST_F(MltInterrupt, SigtermDuringTheBootstrapOfADeepRenderIsAnsweredWithinASeco
   ASSERT_EQ(code, 3) << log();
   EXPECT_LT(seconds, 1.0) << log();
   EXPECT_EQ(read_image_metadata(out)["candela:interrupted"], "true");
+}
+
+}  // namespace
+}  // namespace candela
+
+namespace candela {
+namespace {
+
+// Before rendering begins there is nothing worth keeping: the first SIGINT/SIGTERM while the scene is
+// read or built (the BVH of a big mesh can take many seconds) leaves at once with status 3 and writes
+// nothing. Each test sends the signal, requires the exit within a second of it, and kills the child
+// after a few seconds so that a regression fails instead of hanging.
+class PrepareInterrupt : public InterruptResume {
+ protected:
+  // Sends `sig`, waits up to `limit` seconds for the exit; returns the status (-1 if it had to be
+  // killed) and the seconds from the signal to the exit.
+  static std::pair<int, double> signal_and_wait(pid_t pid, int sig, double limit = 5.0) {
+    const auto sent = std::chrono::steady_clock::now();
+    kill(pid, sig);
+    for (;;) {
+      int status = 0;
+      if (waitpid(pid, &status, WNOHANG) == pid) {
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+        return {WIFEXITED(status) ? WEXITSTATUS(status) : 1000 + WTERMSIG(status), seconds};
+      }
+      if (std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count() > limit) {
+        kill(pid, SIGKILL);
+        waitpid(pid, &status, 0);
+        return {-1, limit};
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  }
+  // Waits until the process catches SIGTERM (/proc/PID/status SigCgt): its handler is installed at the
+  // start of main, and a signal before that (while the shared libraries load) would simply kill it.
+  static void wait_until_handling_signals(pid_t pid) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (std::chrono::steady_clock::now() < until) {
+      std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+      std::string line;
+      while (std::getline(in, line))
+        if (line.starts_with("SigCgt:") && (std::stoull(line.substr(7), nullptr, 16) >> (SIGTERM - 1) & 1)) return;
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  }
+  // Bytes the process has read so far (/proc/PID/io rchar).
+  static long long bytes_read(pid_t pid) {
+    std::ifstream in("/proc/" + std::to_string(pid) + "/io");
+    std::string key;
+    long long value = 0;
+    while (in >> key >> value)
+      if (key == "rchar:") return value;
+    return -1;
+  }
+  // A binary PLY of an n x n grid of bumpy quads (2 n^2 triangles): quick to read, seconds of BVH build.
+  void write_grid_ply(const std::string& file, int n) {
+    std::ofstream out(file, std::ios::binary);
+    const int v = n + 1;
+    out << "ply\nformat binary_little_endian 1.0\nelement vertex " << v * v
+        << "\nproperty float x\nproperty float y\nproperty float z\nelement face " << 2LL * n * n
+        << "\nproperty list uchar int vertex_indices\nend_header\n";
+    std::vector<float> xyz;
+    xyz.reserve(size_t(v) * v * 3);
+    for (int j = 0; j < v; ++j)
+      for (int i = 0; i < v; ++i) {
+        const float x = float(i) / n - 0.5f, z = float(j) / n - 0.5f;
+        xyz.insert(xyz.end(), {x, 0.05f * std::sin(40 * x) * std::cos(37 * z), z});
+      }
+    out.write(reinterpret_cast<const char*>(xyz.data()), std::streamsize(xyz.size() * sizeof(float)));
+    std::vector<char> faces(size_t(2) * n * n * 13);
+    char* p = faces.data();
+    auto face = [&](int a, int b, int c) {
+      *p++ = 3;
+      for (int index : {a, b, c}) {
+        std::memcpy(p, &index, 4);
+        p += 4;
+      }
+    };
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const int a = j * v + i;
+        face(a, a + 1, a + v + 1);
+        face(a, a + v + 1, a + v);
+      }
+    out.write(faces.data(), std::streamsize(faces.size()));
+  }
+  void write_mesh_scene(const std::string& file, const std::string& mesh) {
+    std::ofstream(file) << R"({ "camera": { "position": [0, 2, -2], "look_at": [0, 0, 0], "fov": 40, "width": 32, "height": 32 },
+  "materials": { "white": { "type": "diffuse", "reflectance": [0.7, 0.7, 0.7] } },
+  "shapes": [ { "type": "mesh", "file": ")" << mesh << R"(", "material": "white" } ],
+  "lights": [ { "type": "sky", "zenith": [1, 1, 1], "horizon": [1, 1, 1] } ] })";
+  }
+  static std::string file_text(const std::string& file) {
+    std::ifstream in(file, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }
+};
+
+TEST_F(PrepareInterrupt, SigtermWhileTheSceneFileIsStillBeingReadLeavesAtOnceWritingNothing) {
+  // A scene file that never finishes arriving (a FIFO nobody writes: a stalled network share): the
+  // reader blocks and looks at no flag; the signal must still end the command at once.
+  const std::string scene = path("stalled.json"), out = path("out.exr");
+  ASSERT_EQ(mkfifo(scene.c_str(), 0644), 0) << std::strerror(errno);
+  std::ofstream(out) << "an earlier image";
+  pid_t pid = start({"render", scene, "-o", out, "-q"});
+  wait_until_handling_signals(pid);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const auto [code, seconds] = signal_and_wait(pid, SIGTERM);
+  ASSERT_EQ(code, 3) << log();
+  EXPECT_LT(seconds, 1.0);
+  EXPECT_NE(log().find("interrupted while reading the scene: nothing written"), std::string::npos) << log();
+  EXPECT_EQ(file_text(out), "an earlier image");  // the existing output is left as it was
+  for (const auto& entry : fs::directory_iterator(dir_))  // no temporaries either
+    EXPECT_TRUE(entry.path() == scene || entry.path() == out || entry.path().filename().string().starts_with("log"))
+        << entry.path();
+}
+
+TEST_F(PrepareInterrupt, SigintWhileABigMeshIsReadOrItsBvhBuiltLeavesAtOnceWritingNothing) {
+  // About a million triangles: seconds of reading (the PLY's conversion) and of (high-quality) BVH
+  // build, neither of which looks at a flag. The signal goes once the file's bytes are in, normally
+  // during the BVH build; under load it may still be converting, equally before rendering.
+  const std::string mesh = path("grid.ply"), scene = path("grid.json"), out = path("out.exr"),
+                    ckpt = path("ck.bin");
+  write_grid_ply(mesh, 700);
+  write_mesh_scene(scene, mesh);
+  const long long mesh_bytes = (long long)fs::file_size(mesh);
+  pid_t pid = start({"render", scene, "-o", out, "-q", "--checkpoint", ckpt});
+  wait_until_handling_signals(pid);
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (bytes_read(pid) < mesh_bytes && std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const auto [code, seconds] = signal_and_wait(pid, SIGINT);
+  ASSERT_EQ(code, 3) << log();
+  EXPECT_LT(seconds, 1.0);
+  EXPECT_TRUE(log().find("interrupted while building the scene (textures, BVH): nothing written") != std::string::npos ||
+              log().find("interrupted while reading the scene: nothing written") != std::string::npos)
+      << log();
+  std::printf("phase interrupted: %s", log().c_str());
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(ckpt));
 }
 
 }  // namespace

@@ -36,16 +36,38 @@ constexpr int kExitBadInput = 1;
 constexpr int kExitInterrupted = 3;     // SIGINT/SIGTERM: the partial image (and checkpoint) written
 constexpr int kExitSecondSignal = 130;  // a second SIGINT/SIGTERM: exit at once, nothing more written
 
+// What the command is doing, for the signal handler: before rendering begins nothing is worth
+// keeping, so the first SIGINT/SIGTERM leaves at once (reading a big scene file or building the BVH of
+// a big mesh can take many seconds, and neither looks at a flag); while rendering, the render loop
+// polls g_stop between tiles and passes and the partial image is written; while the finished images
+// are written, the writing (well under a second) completes.
+enum Phase : int { kReadingScene, kBuildingScene, kRendering, kWriting };
+std::atomic<int> g_phase{kReadingScene};
 // Set by the signal handler; the render loop polls it between tiles and passes.
 std::atomic<bool> g_stop{false};
 std::atomic<int> g_signals{0};
 static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_always_lock_free);
 
+template <size_t N>
+void say_from_handler(const char (&text)[N]) {
+  ssize_t ignored = write(STDERR_FILENO, text, N - 1);
+  (void)ignored;
+}
+
 extern "C" void on_stop_signal(int) {
-  // Only atomics and _exit (async-signal-safe). Files are written atomically (temporary + rename),
-  // so leaving at any moment never leaves a half-written image or checkpoint.
+  // Only atomics, write and _exit (async-signal-safe). Files are written atomically (temporary +
+  // rename), so leaving at any moment never leaves a half-written image or checkpoint.
   if (g_signals.fetch_add(1) > 0) _exit(kExitSecondSignal);
-  g_stop.store(true);
+  switch (g_phase.load()) {
+    case kReadingScene:
+      say_from_handler("candela: interrupted while reading the scene: nothing written\n");
+      _exit(kExitInterrupted);
+    case kBuildingScene:
+      say_from_handler("candela: interrupted while building the scene (textures, BVH): nothing written\n");
+      _exit(kExitInterrupted);
+    default:
+      g_stop.store(true);
+  }
 }
 
 void install_signal_handlers() {
@@ -345,6 +367,7 @@ int run_render(const RenderCommand& cmd) {
   }
 
   // The meshes move into the scene: every triangle is held once.
+  g_phase.store(kBuildingScene);
   Scene scene(desc, Scene::MeshData::Take);
   Film film(desc.film.width, desc.film.height);
   uint64_t earlier_non_finite = 0;
@@ -395,7 +418,9 @@ int run_render(const RenderCommand& cmd) {
       save_checkpoint(f, earlier_non_finite + non_finite_so_far);
       last_checkpoint = std::chrono::steady_clock::now();
     };
+  g_phase.store(kRendering);
   RenderStats stats = render(scene, desc.settings, film, options);
+  g_phase.store(kWriting);  // a signal from here on lets the (complete or partial) images be written
   const uint64_t non_finite = earlier_non_finite + stats.non_finite_samples;
   const bool stopped = stats.cancelled || stats.time_limited;
 
@@ -489,6 +514,7 @@ int run_convert(const std::string& in, const std::string& out) {
   if (output.extension() != ".json")
     throw UsageError(fmt::format("convert writes candela's JSON format: the output must end in .json, got \"{}\"", out));
   SceneDesc scene = read_scene_file(in);
+  g_phase.store(kWriting);
   write_json_scene(scene, output);
   std::fprintf(stderr, "%s -> %s: %zu shapes, %zu instances, %zu materials, %zu textures, %zu lights\n", in.c_str(),
                out.c_str(), scene.shapes.size(), scene.instances.size(), scene.materials.size(), scene.textures.size(),
