@@ -198,18 +198,60 @@ TEST_F(CommandLine, BidirectionalAndMetropolisIntegrators) {
 TEST_F(CommandLine, IntegratorOptionsAreChecked) {
   std::string scene = write("good.json", kGoodJson);
   expect_failure("render " + scene + " -o " + out() + " --integrator whitted", "unknown integrator 'whitted' \\(known: path, bdpt, mlt\\)");
-  expect_failure("render " + scene + " -o " + out() + " --bdpt-strategies " + dir_.string(), "--bdpt-strategies needs --integrator bdpt");
+  expect_failure("render " + scene + " -o " + out() + " --bdpt-strategies " + dir_.string(),
+                 "--bdpt-strategies: the path integrator writes no strategy images \\(bdpt does\\)");
   expect_failure("render " + scene + " -o " + out() + " --integrator bdpt --bdpt-strategies " + (dir_ / "nope").string(),
                  "not a directory");
   expect_failure("render " + scene + " -o " + out() + " --integrator mlt --checkpoint " + (dir_ / "c.ckpt").string(),
                  "not supported with the mlt integrator");
-  expect_failure("render " + scene + " -o " + out() + " --integrator mlt --adaptive-threshold 0.1", "does not apply to the mlt");
+  expect_failure("render " + scene + " -o " + out() + " --integrator mlt --adaptive-threshold 0.1",
+                 "--adaptive-threshold: the mlt integrator does not read adaptive");
   RunResult range = run_cli("render " + scene + " -o " + out() + " --integrator mlt --mlt-large-step 2");
   EXPECT_NE(range.exit_code, 0);
   EXPECT_THAT_MATCHES(range.output, "--mlt-large-step");
   expect_failure("render " + scene + " -o " + out() + " --integrator mlt --mlt-large-step 0.5 --mlt-lens 0.4 --mlt-caustic 0.2",
                  "must be at most 1, got 1.1");
   EXPECT_EQ(previous_output(), "previous render");
+}
+
+// Every flag of a setting only some integrators read (integrators/integrator.h) is an error with an
+// integrator that does not read it, naming both; the integrators that do read it accept it.
+TEST_F(CommandLine, AFlagTheIntegratorDoesNotReadIsAnError) {
+  std::string scene = write("good.json", kGoodJson);
+  struct Case {
+    const char* flag;
+    const char* key;
+    const char* refused_by;
+    const char* read_by;
+  };
+  const Case cases[] = {
+      {"--direction-sampling cosine", "direction_sampling", "bdpt", "path"},
+      {"--no-mis", "mis", "mlt", "path"},
+      {"--shadow-rays 4", "shadow_rays", "bdpt", "path"},
+      {"--light-selection paper", "light_selection=paper", "bdpt", "path"},
+      {"--adaptive-spp 32", "adaptive", "mlt", "path, bdpt"},
+      {"--adaptive-batch 8", "adaptive", "mlt", "path, bdpt"},
+      {"--max-spp 64", "adaptive", "mlt", "path, bdpt"},
+      {"--mlt-bootstrap 100", "mlt", "path", "mlt"},
+      {"--mlt-chains 10", "mlt", "bdpt", "mlt"},
+      {"--mlt-sigma 0.1", "mlt", "path", "mlt"},
+      {"--mlt-large-step 0.2", "mlt", "bdpt", "mlt"},
+      {"--mlt-lens 0.1", "mlt", "path", "mlt"},
+      {"--mlt-caustic 0.1", "mlt", "path", "mlt"},
+  };
+  for (const Case& c : cases) {
+    std::string flag_name = std::string(c.flag).substr(0, std::string(c.flag).find(' ', 2));
+    expect_failure("render " + scene + " -o " + out() + " --integrator " + c.refused_by + " " + c.flag,
+                   flag_name + ".*: the " + c.refused_by + " integrator does not read " + c.key + " \\(.*; read by: " +
+                       c.read_by + "\\)");
+  }
+  // A light selection by power or uniformly shapes the light distribution every integrator samples.
+  for (std::string integrator : {"path", "bdpt", "mlt"}) {
+    RunResult r = run_cli("render " + scene + " -o " + out() + " --integrator " + integrator +
+                          " --light-selection uniform --spp 1 --max-depth 2 -q" +
+                          (integrator == "mlt" ? " --mlt-bootstrap 100" : ""));
+    EXPECT_EQ(r.exit_code, 0) << integrator << ": " << r.output;
+  }
 }
 
 TEST_F(CommandLine, ConvertWritesJsonThatRendersTheSameImage) {

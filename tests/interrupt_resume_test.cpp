@@ -270,36 +270,8 @@ TEST_F(InterruptResume, PixelRendersOnePixelAsInTheFullImage) {
 namespace candela {
 namespace {
 
-class MltInterrupt : public InterruptResume {};
-
-TEST_F(MltInterrupt, SigtermDuringTheBootstrapOfADeepRenderIsAnsweredWithinASecond) {
-  // MLT's bootstrap and normalisation take one batch of paths per depth: at max depth 400 they run
-  // for many seconds before the first chain. A signal must still stop the render within a second,
-  // writing the image so far (the directly seen emission).
-  std::string out = path("mlt.exr");
-  pid_t pid = start({"render", kScene, "-o", out, "--integrator", "mlt", "--max-depth", "400", "--resolution",
-                     "32x32", "--spp", "64", "-q"});
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // the scene is read, the bootstrap runs
-  const auto sent = std::chrono::steady_clock::now();
-  kill(pid, SIGTERM);
-  const int code = wait_exit(pid);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
-  ASSERT_EQ(code, 3) << log();
-  EXPECT_LT(seconds, 1.0) << log();
-  EXPECT_EQ(read_image_metadata(out)["candela:interrupted"], "true");
-}
-
-}  // namespace
-}  // namespace candela
-
-namespace candela {
-namespace {
-
-// Before rendering begins there is nothing worth keeping: the first SIGINT/SIGTERM while the scene is
-// read or built (the BVH of a big mesh can take many seconds) leaves at once with status 3 and writes
-// nothing. Each test sends the signal, requires the exit within a second of it, and kills the child
-// after a few seconds so that a regression fails instead of hanging.
-class PrepareInterrupt : public InterruptResume {
+// Signals sent to a running render: after the handler is installed, with a bound on the wait.
+class SignalledRender : public InterruptResume {
  protected:
   // Sends `sig`, waits up to `limit` seconds for the exit; returns the status (-1 if it had to be
   // killed) and the seconds from the signal to the exit.
@@ -332,6 +304,37 @@ class PrepareInterrupt : public InterruptResume {
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
   }
+};
+
+class MltInterrupt : public SignalledRender {};
+
+TEST_F(MltInterrupt, SigtermDuringTheBootstrapOfADeepRenderIsAnsweredWithinASecond) {
+  // MLT's bootstrap and normalisation take one batch of paths per depth: at max depth 400 they run
+  // for many seconds before the first chain. A signal must still stop the render within a second,
+  // writing the image so far (the directly seen emission).
+  std::string out = path("mlt.exr");
+  pid_t pid = start({"render", kScene, "-o", out, "--integrator", "mlt", "--max-depth", "400", "--resolution",
+                     "32x32", "--spp", "64", "-q"});
+  wait_until_handling_signals(pid);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // the scene is read, the bootstrap runs
+  const auto [code, seconds] = signal_and_wait(pid, SIGTERM);
+  ASSERT_EQ(code, 3) << log();
+  EXPECT_LT(seconds, 1.0) << log();
+  EXPECT_EQ(read_image_metadata(out)["candela:interrupted"], "true");
+}
+
+}  // namespace
+}  // namespace candela
+
+namespace candela {
+namespace {
+
+// Before rendering begins there is nothing worth keeping: the first SIGINT/SIGTERM while the scene is
+// read or built (the BVH of a big mesh can take many seconds) leaves at once with status 3 and writes
+// nothing. Each test sends the signal, requires the exit within a second of it, and kills the child
+// after a few seconds so that a regression fails instead of hanging.
+class PrepareInterrupt : public SignalledRender {
+ protected:
   // Bytes the process has read so far (/proc/PID/io rchar).
   static long long bytes_read(pid_t pid) {
     std::ifstream in("/proc/" + std::to_string(pid) + "/io");

@@ -4,6 +4,7 @@
 //   "scene.json: at /shapes/3/radius: expected a positive number, got -1"
 #include <fmt/format.h>
 
+#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -23,6 +24,10 @@ struct SourceLocation {
     return s;
   }
 };
+
+// Names the place of entry i of a description list (a texture, a material) in messages; empty
+// = the entries' places are not known.
+using EntryPlace = std::function<std::string(size_t index)>;
 
 class SceneError : public std::runtime_error {
  public:

@@ -124,7 +124,7 @@ TEST(JsonReader, EmptySceneGetsDefaults) {
 TEST(JsonReader, ReadsCameraAndRenderSettings) {
   SceneDesc scene = read(R"({
     "camera": {"position": [1, 2, 3], "look_at": [1, 2, 4], "up": [0, 2, 0], "fov": 60, "width": 640, "height": 480},
-    "render": {"spp": 100, "max_depth": 5, "seed": 18446744073709551615, "integrator": "direct",
+    "render": {"spp": 100, "max_depth": 5, "seed": 18446744073709551615, "integrator": "bdpt",
                "output": "out.exr", "rr_start_depth": 0}})");
   EXPECT_EQ(scene.film.width, 640);
   EXPECT_EQ(scene.film.height, 480);
@@ -133,9 +133,37 @@ TEST(JsonReader, ReadsCameraAndRenderSettings) {
   EXPECT_EQ(scene.settings.spp, 100);
   EXPECT_EQ(scene.settings.max_depth, 5);
   EXPECT_EQ(scene.settings.seed, 18446744073709551615u);
-  EXPECT_EQ(scene.settings.integrator, "direct");
+  EXPECT_EQ(scene.settings.integrator, "bdpt");
   EXPECT_EQ(scene.film.filename, "out.exr");
   EXPECT_EQ(scene.settings.rr_start_depth, 0);
+}
+
+// A render key that the scene's integrator does not read is an error at that key, naming the
+// integrator and those that read it (integrators/integrator.h); an unknown integrator is an error.
+TEST(JsonReader, ARenderKeyTheIntegratorDoesNotReadIsAnError) {
+  EXPECT_NE(error_of(R"({"render": {"integrator": "whitted"}})")
+                .find("at /render/integrator: unknown integrator \"whitted\" (known: path, bdpt, mlt)"),
+            std::string::npos);
+  const std::pair<const char*, const char*> cases[] = {
+      {R"({"render": {"integrator": "bdpt", "mis": false}})", "at /render/mis: the bdpt integrator does not read mis"},
+      {R"({"render": {"integrator": "bdpt", "direction_sampling": "cosine"}})",
+       "at /render/direction_sampling: the bdpt integrator does not read direction_sampling"},
+      {R"({"render": {"integrator": "mlt", "shadow_rays": 2}})",
+       "at /render/shadow_rays: the mlt integrator does not read shadow_rays"},
+      {R"({"render": {"integrator": "bdpt", "light_selection": "paper"}})",
+       "at /render/light_selection: the bdpt integrator does not read light_selection=paper"},
+      {R"({"render": {"integrator": "mlt", "rr_start_depth": 2}})",
+       "at /render/rr_start_depth: the mlt integrator does not read rr_start_depth"},
+      {R"({"render": {"integrator": "mlt", "adaptive": {"threshold": 0.1}}})",
+       "at /render/adaptive: the mlt integrator does not read adaptive (adaptive sampling; read by: path, bdpt)"},
+      {R"({"render": {"mlt": {"chains": 10}}})", "at /render/mlt: the path integrator does not read mlt"},
+  };
+  for (const auto& [text, message] : cases) EXPECT_NE(error_of(text).find(message), std::string::npos) << text;
+  // What each integrator reads is accepted; power and uniform light selection by all.
+  EXPECT_NO_THROW(read(R"({"render": {"integrator": "path", "mis": false, "shadow_rays": 2, "light_selection": "paper",
+                                      "direction_sampling": "cosine", "rr_start_depth": 1, "adaptive": {"spp": 32}}})"));
+  EXPECT_NO_THROW(read(R"({"render": {"integrator": "bdpt", "rr_start_depth": 1, "light_selection": "uniform"}})"));
+  EXPECT_NO_THROW(read(R"({"render": {"integrator": "mlt", "mlt": {"chains": 10}, "light_selection": "power"}})"));
 }
 
 TEST(JsonReader, ReadsMetropolisSettings) {

@@ -11,6 +11,8 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "candela/integrators/integrator.h"
+
 
 namespace candela {
 namespace {
@@ -341,7 +343,10 @@ Json render_json(const SceneDesc& scene) {
   const RenderSettings& s = scene.settings;
   Json j{{"spp", s.spp}, {"max_depth", s.max_depth}, {"seed", s.seed}, {"integrator", s.integrator}};
   if (!scene.film.filename.empty()) j["output"] = scene.film.filename;
-  j["rr_start_depth"] = s.rr_start_depth;
+  // Only the selective settings the integrator reads: the reader rejects the others.
+  const IntegratorEntry* integrator = find_integrator(s.integrator);
+  auto reads = [&](std::string_view key) { return integrator && integrator->reads_setting(key); };
+  if (reads("rr_start_depth")) j["rr_start_depth"] = s.rr_start_depth;
   j["transform_times"] = Json::array({scene.transform_start_time, scene.transform_end_time});
   static const char* kSampler[] = {"independent", "stratified", "poisson", "zsobol"};
   Json sampler{{"type", kSampler[int(s.sampler.type)]}};
@@ -356,15 +361,16 @@ Json render_json(const SceneDesc& scene) {
   }
   j["filter"] = std::move(filter);
   static const char* kDirections[] = {"bsdf", "cosine", "uniform"};
-  j["direction_sampling"] = kDirections[int(s.path.direction_sampling)];
-  j["mis"] = s.path.mis;
+  if (reads("direction_sampling")) j["direction_sampling"] = kDirections[int(s.path.direction_sampling)];
+  if (reads("mis")) j["mis"] = s.path.mis;
   if (s.hide_emitters) j["hide_emitters"] = true;
   if (s.spectral) j["spectral"] = true;
   static const char* kSelection[] = {"power", "paper", "uniform"};
-  j["light_selection"] = kSelection[int(s.light_selection)];
-  j["shadow_rays"] = s.path.shadow_rays;
+  if (s.light_selection != LightSelection::Paper || reads("light_selection=paper"))
+    j["light_selection"] = kSelection[int(s.light_selection)];
+  if (reads("shadow_rays")) j["shadow_rays"] = s.path.shadow_rays;
   j["bvh"] = s.bvh == BvhLayout::Compact ? "compact" : "fast";
-  if (s.adaptive()) {
+  if (s.adaptive() && reads("adaptive")) {
     Json adaptive;
     if (s.adaptive_threshold > 0) adaptive["threshold"] = s.adaptive_threshold;
     if (s.adaptive_spp > 0) adaptive["spp"] = s.adaptive_spp;
@@ -372,7 +378,8 @@ Json render_json(const SceneDesc& scene) {
     if (s.adaptive_max_spp > 0) adaptive["max_spp"] = s.adaptive_max_spp;
     j["adaptive"] = std::move(adaptive);
   }
-  j["mlt"] = Json{{"bootstrap", s.mlt.bootstrap}, {"chains", s.mlt.chains},   {"sigma", s.mlt.sigma},
+  if (reads("mlt"))
+    j["mlt"] = Json{{"bootstrap", s.mlt.bootstrap}, {"chains", s.mlt.chains},   {"sigma", s.mlt.sigma},
                   {"large_step", s.mlt.large_step}, {"lens", s.mlt.lens}, {"caustic", s.mlt.caustic}};
   return j;
 }

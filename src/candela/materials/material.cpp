@@ -88,8 +88,10 @@ Microfacet microfacet(const Roughness& r, const TextureSet& tex, const TextureEv
 
 }  // namespace
 
-MaterialTable::MaterialTable(const std::vector<MaterialDesc>& descs, const TextureSet& textures)
+MaterialTable::MaterialTable(const std::vector<MaterialDesc>& descs, const TextureSet& textures,
+                             const EntryPlace& place_of)
     : textures_(&textures) {
+  auto name = [&](size_t i) { return place_of ? fmt::format("{}: material {}", place_of(i), i) : fmt::format("material {}", i); };
   entries_.reserve(descs.size() + 1);
   for (const auto& d : descs) entries_.push_back({d, std::nullopt, std::holds_alternative<InterfaceMaterial>(d), {}});
   entries_.push_back({DiffuseMaterial{RGB(0.5f)}, std::nullopt, false, {}});
@@ -101,7 +103,7 @@ MaterialTable::MaterialTable(const std::vector<MaterialDesc>& descs, const Textu
     constant[i] = has_constant_inputs(e.desc);
     if (const auto* coated = std::get_if<CoatedDiffuseMaterial>(&e.desc); coated && coated->tabulated_coat) {
       if (!is_constant(coated->roughness))
-        throw SceneError(fmt::format("material {}: a tabulated coat needs a constant roughness", i));
+        throw SceneError(fmt::format("{}: a tabulated coat needs a constant roughness", name(i)));
       e.coat_table = std::make_shared<const RoughCoatTable>(
           make_rough_coat_table(microfacet(coated->roughness, textures, TextureEvalContext{}), coated->ior));
     }
@@ -110,11 +112,10 @@ MaterialTable::MaterialTable(const std::vector<MaterialDesc>& descs, const Textu
     int count = 0;
     for (int n : nested) {
       if (n < 0 || size_t(n) >= i)
-        throw SceneError(fmt::format("material {}: wraps material {}, which is not a material before it", i, n));
+        throw SceneError(fmt::format("{}: wraps material {}, which is not a material before it", name(i), n));
       if (std::holds_alternative<TwoSidedMaterial>(entries_[size_t(n)].desc))
-        throw SceneError(fmt::format("material {}: wraps material {}, which has two sides; a two-sided material must be "
-                                     "the outermost (it is chosen per hit by the side seen)",
-                                     i, n));
+        throw SceneError(fmt::format("{}: wraps material {}, which has two sides; a two-sided material must be "
+                                     "the outermost (it is chosen per hit by the side seen)", name(i), n));
       count += leaves[size_t(n)];
       constant[i] = constant[i] && constant[size_t(n)];
     }
@@ -124,17 +125,16 @@ MaterialTable::MaterialTable(const std::vector<MaterialDesc>& descs, const Textu
     }
     leaves[i] = count;
     if (count > SurfaceBsdf::kMaxComponents)
-      throw SceneError(fmt::format("material {}: blends {} materials; at most {} can be mixed at one surface", i,
+      throw SceneError(fmt::format("{}: blends {} materials; at most {} can be mixed at one surface", name(i),
                                    count, SurfaceBsdf::kMaxComponents));
     e.perturbations = entries_[size_t(nested[0])].perturbations;
     if (nested.size() == 2 && entries_[size_t(nested[1])].perturbations != e.perturbations)
-      throw SceneError(fmt::format(
-          "material {}: blends materials with different normal or bump maps (one shading frame per surface point)", i));
+      throw SceneError(fmt::format("{}: blends materials with different normal or bump maps (one shading frame per surface point)", name(i)));
     if (std::holds_alternative<NormalMapMaterial>(e.desc) || std::holds_alternative<BumpMapMaterial>(e.desc)) {
       const int map = std::holds_alternative<NormalMapMaterial>(e.desc) ? std::get<NormalMapMaterial>(e.desc).normal_map
                                                                         : std::get<BumpMapMaterial>(e.desc).height;
       if (map < 0 || size_t(map) >= textures.size())
-        throw SceneError(fmt::format("material {}: the normal or bump map is texture {}, which does not exist", i, map));
+        throw SceneError(fmt::format("{}: the normal or bump map is texture {}, which does not exist", name(i), map));
       e.perturbations.insert(e.perturbations.begin(), int(i));
     }
   }

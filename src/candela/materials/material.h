@@ -16,6 +16,7 @@
 #include <optional>
 #include <vector>
 
+#include "candela/base/error.h"
 #include "candela/geometry/surface_hit.h"
 #include "candela/materials/bsdf.h"
 #include "candela/materials/surface_bsdf.h"
@@ -36,7 +37,7 @@ class MaterialTable {
   MaterialTable() = default;
   // `textures` must outlive the table. A default diffuse 0.5 material is appended at index
   // descs.size() (for shapes that name none).
-  MaterialTable(const std::vector<MaterialDesc>& descs, const TextureSet& textures);
+  MaterialTable(const std::vector<MaterialDesc>& descs, const TextureSet& textures, const EntryPlace& place_of = {});
 
   // Throws SceneError for wrappers that cannot be resolved (see above). A two-sided material gives
   // its front's BSDF here (use shading() to see the side the viewer is on).

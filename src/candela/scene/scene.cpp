@@ -53,6 +53,12 @@ TriangleMesh* mesh_to_take(SceneDesc* take_meshes, std::vector<ShapeDesc>& shape
   return mesh ? &mesh->mesh : nullptr;
 }
 
+// The place of entry i of a list the reader may have left shorter (unknown places).
+const SourceLocation& place_in(const std::vector<SourceLocation>& places, size_t i) {
+  static const SourceLocation unknown;
+  return i < places.size() ? places[i] : unknown;
+}
+
 }  // namespace
 
 static_assert(std::is_nothrow_move_constructible_v<ShapeRecord>,
@@ -70,9 +76,25 @@ Scene::Scene(SceneDesc& desc, MeshData mesh_data)
   build(desc, mesh_data == MeshData::Take ? &desc : nullptr);
 }
 
+std::string Scene::place(const SourceLocation& where) const {
+  return where.file.empty() ? source_file_ : where.to_string();
+}
+
+// Runs make() and puts `where` in front of the message of a SceneError it throws (the lights'
+// own checks do not know the file).
+template <typename Make>
+auto Scene::with_place(const SourceLocation& where, Make make) const -> decltype(make()) {
+  try {
+    return make();
+  } catch (const SceneError& e) {
+    throw SceneError(fmt::format("{}: {}", place(where), e.what()));
+  }
+}
+
 void Scene::build(const SceneDesc& desc, SceneDesc* take_meshes) {
-  textures_ = TextureSet(desc.textures);
-  materials_ = MaterialTable(desc.materials, textures_);
+  textures_ = TextureSet(desc.textures, [&](size_t i) { return place(place_in(desc.places.textures, i)); });
+  materials_ = MaterialTable(desc.materials, textures_,
+                             [&](size_t i) { return place(place_in(desc.places.materials, i)); });
   for (size_t i = 0; i < desc.shapes.size(); ++i)
     add_shape(desc.shapes[i], i, -1, take_meshes ? mesh_to_take(take_meshes, take_meshes->shapes, i) : nullptr);
   add_objects_and_instances(desc, take_meshes);
@@ -84,8 +106,9 @@ void Scene::build(const SceneDesc& desc, SceneDesc* take_meshes) {
   embree_.commit();
 
   float radius = bounds_.empty() ? 1.0f : std::max(1e-3f, length(bounds_.diagonal()) / 2);
-  for (const auto& l : desc.lights) {
-    Light light = std::visit(
+  for (size_t i = 0; i < desc.lights.size(); ++i) {
+    const LightDesc& l = desc.lights[i];
+    Light light = with_place(place_in(desc.places.lights, i), [&] { return std::visit(
         overloaded{
             [&](const PointLight& p) -> Light { return PointLightSource{p.position, p.intensity}; },
             [&](const SkyLight& s) -> Light {
@@ -94,16 +117,8 @@ void Scene::build(const SceneDesc& desc, SceneDesc* take_meshes) {
             [&](const SpotLight& spot) -> Light { return make_spot_light(spot, &textures_); },
             [&](const ProjectorLight& projector) -> Light { return make_projector_light(projector, &textures_); },
             [&](const DistantLight& distant) -> Light { return make_distant_light(distant, radius); },
-            [&](const EnvironmentMap& env) -> Light {
-              Image image;
-              try {
-                image = read_image(env.filename);
-              } catch (const std::exception& e) {
-                throw SceneError(fmt::format("{}: environment map: {}", source_file_, e.what()));
-              }
-              return EnvironmentLight(image, env.mapping, env.scale, env.to_world, radius);
-            }},
-        l);
+            [&](const EnvironmentMap& env) -> Light { return make_environment_light(env, radius); }},
+        l); });
     if (has(light_flags(light), LightFlags::Infinite)) infinite_lights_.push_back(uint32_t(lights_.size()));
     lights_.push_back(std::move(light));
   }
@@ -149,14 +164,13 @@ void Scene::add_objects_and_instances(const SceneDesc& desc, SceneDesc* take_mes
     embree_objects.push_back(embree_.add_object());
     for (size_t i = 0; i < object.shapes.size(); ++i) {
       const ShapeDesc& shape = object.shapes[i];
-      std::string what = fmt::format("{}: {}", label, shape_label(shape, i));
-      if (shape.emission)
-        throw SceneError(fmt::format("{}: {}: emissive shapes cannot be instanced", source_file_, what));
+      std::string what = fmt::format("{}: {}: {}", place(shape.where.file.empty() ? object.where : shape.where), label,
+                                     shape_label(shape, i));
+      if (shape.emission) throw SceneError(fmt::format("{}: emissive shapes cannot be instanced", what));
       if (moving_end_transform(shape))
-        throw SceneError(fmt::format("{}: {}: shapes inside an object cannot move (move the instance instead)",
-                                     source_file_, what));
+        throw SceneError(fmt::format("{}: shapes inside an object cannot move (move the instance instead)", what));
       if (std::holds_alternative<PlaneShape>(shape.geometry))
-        throw SceneError(fmt::format("{}: {}: an infinite plane cannot be instanced", source_file_, what));
+        throw SceneError(fmt::format("{}: an infinite plane cannot be instanced", what));
       add_shape(shape, i, embree_objects.back(),
                 take_meshes ? mesh_to_take(take_meshes, take_meshes->objects[o].shapes, i) : nullptr);
     }
@@ -169,12 +183,12 @@ void Scene::add_objects_and_instances(const SceneDesc& desc, SceneDesc* take_mes
   for (size_t i = 0; i < desc.instances.size(); ++i) {
     const InstanceDesc& inst = desc.instances[i];
     if (inst.object < 0 || size_t(inst.object) >= desc.objects.size())
-      throw SceneError(fmt::format("{}: instance {} refers to object {}, which does not exist", source_file_, i,
+      throw SceneError(fmt::format("{}: instance {} refers to object {}, which does not exist", place(inst.where), i,
                                    inst.object));
     const Transform* end = inst.to_world_end && *inst.to_world_end != inst.to_world ? &*inst.to_world_end : nullptr;
     if (end && end->swaps_handedness() != inst.to_world.swaps_handedness())
       throw SceneError(fmt::format("{}: instance {}: the end transform mirrors it relative to the start transform",
-                                   source_file_, i));
+                                   place(inst.where), i));
     instances_.push_back({inst.to_world, end ? std::optional<Transform>(*end) : std::nullopt});
     embree_.add_instance(first_id + uint32_t(i), embree_objects[size_t(inst.object)], inst.to_world, end);
     const Bounds3& ob = object_bounds[size_t(inst.object)];
@@ -188,7 +202,7 @@ void Scene::add_objects_and_instances(const SceneDesc& desc, SceneDesc* take_mes
 
 void Scene::add_shape(const ShapeDesc& desc, size_t index, int object, TriangleMesh* take_mesh) {
   ShapeRecord rec;
-  rec.name = shape_label(desc, index);
+  rec.name = place(desc.where) + ": " + shape_label(desc, index);
   rec.material = desc.material >= 0 && size_t(desc.material) < materials_.size() - 1 ? uint32_t(desc.material)
                                                                                     : materials_.default_material();
   rec.flip_normal = desc.reverse_orientation;
@@ -196,11 +210,11 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int object, TriangleM
   const Transform* T_end = moving_end_transform(desc);
   // Lights are sampled at fixed positions, so emitters stay put.
   if (T_end && desc.emission)
-    throw SceneError(fmt::format("{}: {}: area lights must not move (an emissive shape has an end transform)",
-                                 source_file_, rec.name));
+    throw SceneError(fmt::format("{}: area lights must not move (an emissive shape has an end transform)",
+                                 rec.name));
   if (desc.emission && desc.emission->texture >= 0) {
     if (size_t(desc.emission->texture) >= textures_.size())
-      throw SceneError(fmt::format("{}: {}: the emission texture {} does not exist", source_file_, rec.name,
+      throw SceneError(fmt::format("{}: the emission texture {} does not exist", rec.name,
                                    desc.emission->texture));
   }
 
@@ -215,11 +229,11 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int object, TriangleM
           },
           [&](const PlaneShape& p) {
             if (desc.emission)
-              throw SceneError(fmt::format("{}: {}: an infinite plane cannot emit light (its power would be infinite)",
-                                           source_file_, rec.name));
+              throw SceneError(fmt::format("{}: an infinite plane cannot emit light (its power would be infinite)",
+                                           rec.name));
             if (T_end)
-              throw SceneError(fmt::format("{}: {}: an infinite plane must not move (it has an end transform)",
-                                           source_file_, rec.name));
+              throw SceneError(fmt::format("{}: an infinite plane must not move (it has an end transform)",
+                                           rec.name));
             rec.kind = ShapeRecord::Kind::Plane;
             rec.plane = PlaneGeometry{T.point(p.point), normalize(T.normal(p.normal))};
             // Its Embree geometry is added once the size of everything else is known (see the constructor).
@@ -234,8 +248,8 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int object, TriangleM
             Vec3 d = c.p1 - c.p0;
             float len = length(d);
             if (!(len > 0) || !(c.radius > 0) || !std::isfinite(len) || !std::isfinite(c.radius))
-              throw SceneError(fmt::format("{}: {}: a cylinder needs a positive radius and two distinct end points",
-                                           source_file_, rec.name));
+              throw SceneError(fmt::format("{}: a cylinder needs a positive radius and two distinct end points",
+                                           rec.name));
             Frame f(d / len);
             Matrix4 m = Matrix4::identity();
             for (int r = 0; r < 3; ++r) {
@@ -254,8 +268,7 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int object, TriangleM
           [&](const SdfGridShape& g) {
             if (desc.emission)
               throw SceneError(fmt::format(
-                  "{}: {}: an SDF grid cannot emit light (as in Mitsuba: it has no area to sample)", source_file_,
-                  rec.name));
+                  "{}: an SDF grid cannot emit light (as in Mitsuba: it has no area to sample)", rec.name));
             add_sdf_grid(std::move(rec), g, T, T_end, object);
           },
           [&](const BoxShape& b) { triangles(box_mesh(b), false); },
@@ -279,8 +292,8 @@ void Scene::add_sphere(ShapeRecord rec, const SphereShape& s, const Transform& T
     float lx = length(ex), ly = length(ey), lz = length(ez);
     if (std::abs(lx - ly) > 1e-4f * lx || std::abs(lx - lz) > 1e-4f * lx || std::abs(dot(ex, ey)) > 1e-4f * lx * ly ||
         std::abs(dot(ex, ez)) > 1e-4f * lx * lz || std::abs(dot(ey, ez)) > 1e-4f * ly * lz)
-      throw SceneError(fmt::format("{}: {}: an emissive sphere must not be scaled non-uniformly or sheared",
-                                   source_file_, rec.name));
+      throw SceneError(fmt::format("{}: an emissive sphere must not be scaled non-uniformly or sheared",
+                                   rec.name));
     rec.first_light = int(lights_.size());
     rec.radiance = emission->radiance;
     rec.two_sided_emission = emission->two_sided;
@@ -301,7 +314,7 @@ void Scene::add_quadric(ShapeRecord rec, QuadricGeometry::Kind kind, const Trans
   const bool disk = kind == QuadricGeometry::Kind::Disk;
   rec.kind = disk ? ShapeRecord::Kind::Disk : ShapeRecord::Kind::Cylinder;
   if (!Transform::from_matrix(M.matrix()) || (M_end && !Transform::from_matrix(M_end->matrix())))
-    throw SceneError(fmt::format("{}: {}: the transform is singular", source_file_, rec.name));
+    throw SceneError(fmt::format("{}: the transform is singular", rec.name));
   rec.quadric = QuadricGeometry{kind, M, M_end ? std::optional<Transform>(*M_end) : std::nullopt};
   for (const Transform* X : {&M, M_end})
     if (X) bounds_.extend(quadric_world_bounds(rec.quadric, *X));
@@ -323,8 +336,8 @@ void Scene::add_quadric(ShapeRecord rec, QuadricGeometry::Kind kind, const Trans
       if (std::abs(lu - lv) > 1e-4f * lu || std::abs(dot(eu, ev)) > 1e-4f * lu * lv ||
           std::abs(dot(eu, ez)) > 1e-4f * lu * lz || std::abs(dot(ev, ez)) > 1e-4f * lv * lz)
         throw SceneError(fmt::format(
-            "{}: {}: an emissive cylinder must stay circular (no non-uniform scale across its axis, no shear)",
-            source_file_, rec.name));
+            "{}: an emissive cylinder must stay circular (no non-uniform scale across its axis, no shear)",
+            rec.name));
       lights_.push_back(CylinderLight{M.point(Point3(0.0f)), eu / lu, ev / lv, ez, lu, 2 * kPi * lu * lz,
                                       rec.radiance, rec.two_sided_emission, rec.flip_normal, texture});
     }
@@ -336,9 +349,9 @@ void Scene::add_quadric(ShapeRecord rec, QuadricGeometry::Kind kind, const Trans
 void Scene::add_sdf_grid(ShapeRecord rec, const SdfGridShape& grid, const Transform& T, const Transform* T_end,
                          int object) {
   if (std::string problem = sdf_grid_problem(grid); !problem.empty())
-    throw SceneError(fmt::format("{}: {}: SDF grid: {}", source_file_, rec.name, problem));
+    throw SceneError(fmt::format("{}: SDF grid: {}", rec.name, problem));
   if (!Transform::from_matrix(T.matrix()) || (T_end && !Transform::from_matrix(T_end->matrix())))
-    throw SceneError(fmt::format("{}: {}: the transform is singular", source_file_, rec.name));
+    throw SceneError(fmt::format("{}: the transform is singular", rec.name));
   rec.kind = ShapeRecord::Kind::SdfGrid;
   rec.sdf = SdfGridGeometry{std::make_shared<const SdfGrid>(grid), T, T_end ? std::optional<Transform>(*T_end) : std::nullopt};
   rec.sdf_normals = grid.normals;
@@ -358,8 +371,8 @@ void Scene::add_triangles(ShapeRecord rec, TriangleMesh mesh, const Transform& T
     // The winding below is baked once from the start transform: an end transform of the other
     // handedness would turn the shape inside out on the way (flattening it at some time).
     if (T_end->swaps_handedness() != T.swaps_handedness())
-      throw SceneError(fmt::format("{}: {}: the end transform mirrors the shape relative to the start transform",
-                                   source_file_, rec.name));
+      throw SceneError(fmt::format("{}: the end transform mirrors the shape relative to the start transform",
+                                   rec.name));
     rec.positions_end.reserve(mesh.positions.size());
     for (const auto& p : mesh.positions) {
       rec.positions_end.push_back(T_end->point(p));

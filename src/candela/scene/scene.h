@@ -128,6 +128,10 @@ class Scene {
   void reconstruct_sphere_hit(const ShapeRecord& rec, const Ray& ray, float t, SurfaceHit& hit) const;
 
   std::string source_file_;  // for messages
+  // "file:line:col" of a description entry, or the scene file where its place is unknown.
+  std::string place(const SourceLocation& where) const;
+  template <typename Make>
+  auto with_place(const SourceLocation& where, Make make) const -> decltype(make());
   EmbreeScene embree_;
   std::vector<ShapeRecord> shapes_;  // indexed by Embree geometry id (world and object shapes alike)
   struct InstanceRecord {

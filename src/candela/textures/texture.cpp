@@ -141,7 +141,8 @@ std::pair<int, int> TextureSet::resolution(int index) const {
                     textures_[size_t(index)]);
 }
 
-TextureSet::TextureSet(const std::vector<TextureDesc>& descs) {
+TextureSet::TextureSet(const std::vector<TextureDesc>& descs, const EntryPlace& place_of) {
+  auto name = [&](size_t i) { return place_of ? fmt::format("{}: texture {}", place_of(i), i) : fmt::format("texture {}", i); };
   // Keyed by the effective decoding, so Auto and SRGB on the same file share one image.
   std::map<std::pair<std::string, IntegerEncoding>, std::shared_ptr<const Image>> images;
   textures_.reserve(descs.size());
@@ -149,12 +150,11 @@ TextureSet::TextureSet(const std::vector<TextureDesc>& descs) {
     for_each_reference(descs[i], [&](int ref) {
       if (ref < 0) return;
       if (size_t(ref) >= descs.size())
-        throw SceneError(fmt::format("texture {}: refers to texture {}, but there are only {} textures", i, ref,
+        throw SceneError(fmt::format("{}: refers to texture {}, but there are only {} textures", name(i), ref,
                                      descs.size()));
-      if (size_t(ref) == i) throw SceneError(fmt::format("texture {}: refers to itself", i));
+      if (size_t(ref) == i) throw SceneError(fmt::format("{}: refers to itself", name(i)));
       if (size_t(ref) > i)
-        throw SceneError(fmt::format(
-            "texture {}: refers to texture {}, which comes after it (a cycle, or dependencies out of order)", i,
+        throw SceneError(fmt::format("{}: refers to texture {}, which comes after it (a cycle, or dependencies out of order)", name(i),
             ref));
     });
 
@@ -165,12 +165,12 @@ TextureSet::TextureSet(const std::vector<TextureDesc>& descs) {
       if (!image) {
         std::error_code ec;
         if (!std::filesystem::exists(desc->filename, ec))
-          throw SceneError(fmt::format("texture {}: image file \"{}\" not found", i, desc->filename));
+          throw SceneError(fmt::format("{}: image file \"{}\" not found", name(i), desc->filename));
         try {
           image = std::make_shared<const Image>(read_image(desc->filename, encoding));
         } catch (const std::exception& e) {
           // read_image's message already names the file.
-          throw SceneError(fmt::format("texture {}: {}", i, e.what()));
+          throw SceneError(fmt::format("{}: {}", name(i), e.what()));
         }
       }
       textures_.emplace_back(ImageLookup{image, desc->wrap, desc->bilinear, desc->scale, desc->invert, desc->luminance, desc->mapping});

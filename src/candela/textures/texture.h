@@ -8,6 +8,7 @@
 #include <variant>
 #include <vector>
 
+#include "candela/base/error.h"
 #include "candela/film/image.h"
 #include "candela/math/color.h"
 #include "candela/math/vec.h"
@@ -40,7 +41,7 @@ class TextureSet {
   // Loads every image once (textures naming the same file and decoding share it) and checks that
   // each texture refers only to textures before it, which also rules out cycles. Throws SceneError
   // for a bad reference or an unreadable image (naming the texture and the file).
-  explicit TextureSet(const std::vector<TextureDesc>& descs);
+  explicit TextureSet(const std::vector<TextureDesc>& descs, const EntryPlace& place_of = {});
 
   // The constant in.value, or texture in.texture; in.texture must be < size() (materials are not
   // checked here).

@@ -74,6 +74,7 @@ class JsonSceneReader {
   void read_lens_and_shutter(CheckedObject& camera);
   void check_view_direction(const CheckedObject& camera, Point3 position, Point3 look_at, Vec3 up) const;
   void read_render(const Json& value, const std::string& pointer);
+  void check_integrator_reads(const Json& value, const CheckedObject& render, const RenderSettings& settings) const;
   void read_mlt(const Json& value, const std::string& pointer, RenderSettings& settings) const;
   void read_transform_times(const Json& value, const std::string& pointer);
   SamplerDesc read_sampler(const Json& value, const std::string& pointer) const;

@@ -3,6 +3,8 @@
 
 #include <limits>
 
+#include "candela/integrators/integrator.h"
+
 namespace candela::json {
 
 // ---- camera and render settings
@@ -94,6 +96,25 @@ void JsonSceneReader::read_render(const Json& value, const std::string& pointer)
     read_adaptive(*adaptive, render.pointer_of("adaptive"), settings);
   if (const Json* mlt = render.find("mlt")) read_mlt(*mlt, render.pointer_of("mlt"), settings);
   render.finish();
+  check_integrator_reads(value, render, settings);
+}
+
+// The scene's integrator must exist and read every selective setting the scene gives
+// (integrators/integrator.h), as the command line's flags must.
+void JsonSceneReader::check_integrator_reads(const Json& value, const CheckedObject& render,
+                                             const RenderSettings& settings) const {
+  const IntegratorEntry* integrator = find_integrator(settings.integrator);
+  if (!integrator)
+    report_.fail(render.pointer_of("integrator"), "unknown integrator \"{}\" (known: {})", settings.integrator,
+                 integrator_names());
+  for (const SelectiveSetting& setting : kSelectiveSettings) {
+    // Every setting is a key of its own but the paper's light selection, a value of light_selection.
+    const bool paper = setting.key == "light_selection=paper";
+    const std::string key = paper ? "light_selection" : std::string(setting.key);
+    const bool given = paper ? settings.light_selection == LightSelection::Paper : value.contains(key);
+    if (given && !integrator->reads_setting(setting.key))
+      report_.fail(render.pointer_of(key), "{}", unread_setting_message(*integrator, setting.key));
+  }
 }
 
 // Metropolis light transport's parameters (integrator "mlt").
@@ -107,9 +128,7 @@ void JsonSceneReader::read_mlt(const Json& value, const std::string& pointer, Re
   settings.mlt.large_step = object.number_or("large_step", settings.mlt.large_step, Bound::UnitInterval);
   settings.mlt.lens = object.number_or("lens", settings.mlt.lens, Bound::UnitInterval);
   settings.mlt.caustic = object.number_or("caustic", settings.mlt.caustic, Bound::UnitInterval);
-  if (settings.mlt.large_step + settings.mlt.lens + settings.mlt.caustic > 1)
-    report_.fail(pointer, "large_step + lens + caustic must be at most 1, got {}",
-                 settings.mlt.large_step + settings.mlt.lens + settings.mlt.caustic);
+  if (std::string problem = settings.mlt.problem(); !problem.empty()) report_.fail(pointer, "{}", problem);
   object.finish();
 }
 
