@@ -88,7 +88,7 @@ SceneDesc SceneParser::parse(std::string text, const std::string& name, const fs
 }
 
 // pbrt-v4's defaults for a scene that leaves out a directive (the rendering options' are
-// RenderOptions').
+// RenderDirectives').
 void SceneParser::start(const std::string& source, const fs::path& top_directory) {
   scene_.source_file = source;
   scene_.camera.fov_degrees = 90;

@@ -3,7 +3,7 @@
 // pbrt's graphics state (graphics_state.h), build a SceneDesc. One class, its members defined by
 // subject in several files:
 //   scene_parser.cpp    files, Include/Import, the directive table, transforms, attribute blocks
-//   render_options.cpp  Camera, Film, Sampler, Integrator, PixelFilter and the other options
+//   render_directives.cpp  Camera, Film, Sampler, Integrator, PixelFilter and the other options
 //   textures.cpp        spectra, textured parameters and Texture
 //   materials.cpp       Material, MakeNamedMaterial, NamedMaterial
 //   lights.cpp          LightSource, AreaLightSource
@@ -63,7 +63,7 @@ struct NamedTexture {
 // What the Sampler, Integrator and PixelFilter directives chose, starting from pbrt-v4's defaults
 // for a scene that leaves them out. write_render_settings copies it into SceneDesc::settings: the
 // one place that writes RenderSettings.
-struct RenderOptions {
+struct RenderDirectives {
   SamplerDesc sampler{SamplerType::ZSobol};
   int spp = 16;  // pixel samples, or an "mlt" integrator's mutations per pixel
   std::optional<uint64_t> seed;
@@ -212,7 +212,7 @@ class SceneParser {
 
   std::vector<std::string>& warnings_;
   SceneDesc scene_;
-  RenderOptions options_;
+  RenderDirectives options_;
   GraphicsState state_;
   Section section_ = Section::Options;
   SourceLocation world_begin_;

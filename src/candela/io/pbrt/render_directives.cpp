@@ -180,7 +180,7 @@ void SceneParser::integrator(const Token& d) {
     float sigma = params.get_float("sigma", 0.01f);
     if (!(sigma > 0 && sigma <= 1)) params.fail("sigma", "must be in (0, 1], got {}", sigma);
     options_.spp = mutations;
-    options_.mlt = RenderOptions::Metropolis{bootstrap, chains, large_step, sigma};
+    options_.mlt = RenderDirectives::Metropolis{bootstrap, chains, large_step, sigma};
   } else {
     for (std::string_view name : known->second)
       ignore_param(params, name, "candela's path integrator has no such setting");
