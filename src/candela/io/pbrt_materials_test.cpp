@@ -1,0 +1,370 @@
+// Tests of the pbrt-v4 reader: materials, textures and named spectra.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "candela/base/error.h"
+#include "candela/io/named_spectra.h"
+#include "candela/io/pbrt_reader.h"
+#include "candela/io/scene_reader.h"
+#include "candela/scene/description.h"
+#include "candela/spectral/cie.h"
+#include "candela/testing/pbrt_reader_helpers.h"
+
+namespace candela {
+namespace {
+
+using namespace candela::testing::pbrt_reader;
+namespace fs = std::filesystem;
+
+// ---------------------------------------------------------------- materials
+
+TEST(PbrtReader, DiffuseReflectanceFromRgbSpectrumOrTexture) {
+  ScratchFile image("wood.png");
+  SceneDesc scene = read_lines({"WorldBegin",
+                                "Texture \"wood\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\"",
+                                "Material \"diffuse\" \"texture reflectance\" \"wood\"",
+                                "Material \"diffuse\" \"spectrum reflectance\" [ 300 0.5  800 0.5 ]",
+                                "Material \"diffuse\" \"rgb reflectance\" [ 0.1 0.2 0.3 ]"});
+  ASSERT_EQ(scene.materials.size(), 3u);
+  const auto& textured = std::get<DiffuseMaterial>(scene.materials[0]);
+  EXPECT_FALSE(textured.reflectance.is_constant());
+  EXPECT_EQ(textured.reflectance.texture, 0);
+  const auto& flat = std::get<DiffuseMaterial>(scene.materials[1]);
+  expect_near(Vec3(flat.reflectance.value.r, flat.reflectance.value.g, flat.reflectance.value.b), Vec3(0.5f));
+  EXPECT_EQ(std::get<DiffuseMaterial>(scene.materials[2]).reflectance.value, RGB(0.1f, 0.2f, 0.3f));
+}
+
+TEST(PbrtReader, ConductorMaterials) {
+  SceneDesc scene = read_lines(
+      {"WorldBegin",
+       "Texture \"rough\" \"float\" \"scale\" \"float tex\" 0.5 \"float scale\" 0.2",
+       "Material \"conductor\"",
+       "Material \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\" \"float roughness\" 0.2",
+       "Material \"conductor\" \"rgb eta\" [ 0.2 0.9 1.1 ] \"rgb k\" [ 3.9 2.4 2.1 ] \"float uroughness\" 0.01 "
+       "\"float vroughness\" 0.05 \"bool remaproughness\" false",
+       "Material \"conductor\" \"rgb reflectance\" [ 0.9 0.6 0.3 ] \"texture roughness\" \"rough\""});
+  ASSERT_EQ(scene.materials.size(), 4u);
+  const auto& copper = std::get<ConductorMaterial>(scene.materials[0]);
+  EXPECT_EQ(copper.eta.value, ConductorMaterial{}.eta.value);  // pbrt-v4's default "metal-Cu-eta"
+  EXPECT_EQ(copper.k.value, ConductorMaterial{}.k.value);
+  EXPECT_FALSE(copper.reflectance.has_value());
+  EXPECT_FLOAT_EQ(copper.roughness.u.value, 0);
+  EXPECT_TRUE(copper.roughness.remap);  // pbrt-v4's default
+  const auto& gold = std::get<ConductorMaterial>(scene.materials[1]);
+  EXPECT_EQ(gold.eta.value, RGB(0.143119f, 0.374957f, 1.442479f));
+  EXPECT_EQ(gold.k.value, RGB(3.983160f, 2.385721f, 1.603215f));
+  EXPECT_FLOAT_EQ(gold.roughness.u.value, 0.2f);
+  EXPECT_FLOAT_EQ(gold.roughness.v.value, 0.2f);
+  const auto& anisotropic = std::get<ConductorMaterial>(scene.materials[2]);
+  EXPECT_EQ(anisotropic.eta.value, RGB(0.2f, 0.9f, 1.1f));
+  EXPECT_FLOAT_EQ(anisotropic.roughness.u.value, 0.01f);
+  EXPECT_FLOAT_EQ(anisotropic.roughness.v.value, 0.05f);
+  EXPECT_FALSE(anisotropic.roughness.remap);
+  const auto& artist = std::get<ConductorMaterial>(scene.materials[3]);
+  ASSERT_TRUE(artist.reflectance.has_value());
+  EXPECT_EQ(artist.reflectance->value, RGB(0.9f, 0.6f, 0.3f));
+  EXPECT_EQ(artist.roughness.u.texture, 0);
+  EXPECT_EQ(artist.roughness.v.texture, 0);
+  expect_error({"WorldBegin", "Material \"conductor\" \"rgb eta\" [ 1 1 1 ] \"rgb reflectance\" [ 0.5 0.5 0.5 ]"}, 2,
+               "\"rgb reflectance\"", "cannot be given together with \"eta\"");
+  expect_error({"WorldBegin", "Material \"conductor\" \"float roughness\" -0.1"}, 2, "\"float roughness\"",
+               "must not be negative");
+}
+
+TEST(PbrtReader, DielectricMaterials) {
+  Warned read = read_warned({"WorldBegin",
+                             "Material \"dielectric\" \"float eta\" 1.33 \"float roughness\" 0.1",
+                             "Material \"dielectric\" \"spectrum eta\" \"glass-BK7\"",
+                             "Material \"dielectric\" \"spectrum eta\" [ 300 1.6  800 1.4 ]",
+                             "Material \"dielectric\" \"rgb eta\" [ 1.4 1.5 1.6 ]",
+                             "Material \"dielectric\" \"float uroughness\" 0.1 \"float vroughness\" 0.3 "
+                             "\"bool remaproughness\" false",
+                             "Material \"dielectric\""});
+  const SceneDesc& scene = read.scene;
+  ASSERT_EQ(scene.materials.size(), 6u);
+  const auto& water = std::get<DielectricMaterial>(scene.materials[0]);
+  EXPECT_FLOAT_EQ(water.ior, 1.33f);
+  EXPECT_FLOAT_EQ(water.roughness.u.value, 0.1f);
+  EXPECT_TRUE(water.roughness.remap);
+  EXPECT_NEAR(std::get<DielectricMaterial>(scene.materials[1]).ior, 1.5185f, 1e-4f);  // BK7 at 550 nm
+  EXPECT_NEAR(std::get<DielectricMaterial>(scene.materials[2]).ior, 1.5f, 1e-5f);
+  EXPECT_FLOAT_EQ(std::get<DielectricMaterial>(scene.materials[3]).ior, 1.5f);
+  const auto& rough = std::get<DielectricMaterial>(scene.materials[4]);
+  EXPECT_FLOAT_EQ(rough.roughness.v.value, 0.3f);
+  EXPECT_FALSE(rough.roughness.remap);
+  EXPECT_FLOAT_EQ(std::get<DielectricMaterial>(scene.materials[5]).ior, 1.5f);
+  ASSERT_EQ(read.warnings.size(), 1u) << joined(read.warnings);
+  EXPECT_NE(read.warnings[0].find("the green value 1.5 is the index of refraction"), std::string::npos);
+  expect_error({"WorldBegin", "Material \"dielectric\" \"float eta\" 0"}, 2, "\"float eta\"", "must be positive");
+  expect_error({"WorldBegin", "Material \"thindielectric\""}, 2, "\"thindielectric\"",
+               "material type \"thindielectric\" is not supported: candela has no thin-sheet BSDF");
+}
+
+TEST(PbrtReader, CoatedDiffuseIsTheClosedFormPlastic) {
+  Warned read = read_warned({"WorldBegin",
+                             "Material \"coateddiffuse\" \"rgb reflectance\" [ 0.2 0.4 0.6 ] \"float roughness\" 0.1 "
+                             "\"float eta\" 1.6 \"integer maxdepth\" 20 \"integer nsamples\" 4 "
+                             "\"rgb albedo\" [ 0 0 0 ] "
+                             "\"float g\" 0.3",
+                             "Material \"coateddiffuse\""});
+  EXPECT_TRUE(read.warnings.empty()) << joined(read.warnings);
+  const auto& coated = std::get<CoatedDiffuseMaterial>(read.scene.materials.at(0));
+  EXPECT_EQ(coated.reflectance.value, RGB(0.2f, 0.4f, 0.6f));
+  EXPECT_FLOAT_EQ(coated.ior, 1.6f);
+  EXPECT_FLOAT_EQ(coated.roughness.u.value, 0.1f);
+  EXPECT_TRUE(coated.roughness.remap);
+  EXPECT_EQ(coated.specular.value, RGB(1.0f));
+  const auto& defaults = std::get<CoatedDiffuseMaterial>(read.scene.materials.at(1));
+  EXPECT_EQ(defaults.reflectance.value, RGB(0.5f));
+  EXPECT_FLOAT_EQ(defaults.ior, 1.5f);
+  EXPECT_FLOAT_EQ(defaults.roughness.u.value, 0);
+  expect_warning({"WorldBegin", "Material \"coateddiffuse\" \"rgb albedo\" [ 0.5 0.5 0.5 ]"}, 2, "\"rgb albedo\"",
+                 "\"albedo\" is ignored: candela's coated diffuse has no scattering medium");
+  expect_warning({"WorldBegin", "Material \"coateddiffuse\" \"float thickness\" 0.1"}, 2, "\"float thickness\"",
+                 "\"thickness\" is ignored");
+}
+
+TEST(PbrtReader, DiffuseTransmissionInterfaceAndDisplacement) {
+  ScratchFile image("leaf.png");
+  SceneDesc scene = read_lines(
+      {"WorldBegin",
+       "Texture \"leaf\" \"spectrum\" \"imagemap\" \"string filename\" \"leaf.png\"",
+       "Material \"diffusetransmission\" \"rgb reflectance\" [ 0.5 0.5 0.5 ] \"rgb transmittance\" [ 0.4 0.2 0.8 ] "
+       "\"float scale\" 0.5",
+       "Material \"diffusetransmission\"",
+       "Material \"diffusetransmission\" \"texture transmittance\" \"leaf\" \"float scale\" 2",
+       "Material \"interface\"",
+       "Material \"none\""});
+  ASSERT_EQ(scene.materials.size(), 5u);
+  const auto& leaf = std::get<DiffuseTransmissionMaterial>(scene.materials[0]);
+  EXPECT_EQ(leaf.reflectance.value, RGB(0.25f));
+  EXPECT_EQ(leaf.transmittance.value, RGB(0.2f, 0.1f, 0.4f));
+  const auto& defaults = std::get<DiffuseTransmissionMaterial>(scene.materials[1]);
+  EXPECT_EQ(defaults.reflectance.value, RGB(0.25f));
+  EXPECT_EQ(defaults.transmittance.value, RGB(0.25f));
+  // A textured input with a scale becomes a ScaleTexture after the texture it scales.
+  const auto& textured = std::get<DiffuseTransmissionMaterial>(scene.materials[2]);
+  ASSERT_EQ(scene.textures.size(), 2u);
+  EXPECT_EQ(textured.transmittance.texture, 1);
+  const auto& scale = std::get<ScaleTexture>(scene.textures[1]);
+  EXPECT_EQ(scale.tex.texture, 0);
+  EXPECT_FLOAT_EQ(scale.scale.value, 2);
+  EXPECT_EQ(textured.reflectance.value, RGB(0.5f));
+  EXPECT_TRUE(std::holds_alternative<InterfaceMaterial>(scene.materials[3]));
+  EXPECT_TRUE(std::holds_alternative<InterfaceMaterial>(scene.materials[4]));
+  expect_warning({"WorldBegin", "Material \"diffuse\" \"float displacement\" 0.1"}, 2, "\"float displacement\"",
+                 "Material \"diffuse\": \"displacement\" is ignored: displacement mapping is not supported");
+  expect_warning({"WorldBegin", "Material \"conductor\" \"string normalmap\" \"n.png\""}, 2, "\"string normalmap\"",
+                 "\"normalmap\" is ignored: normal maps are not supported");
+}
+
+TEST(PbrtReader, MixMaterialSelectsWithAConstantAmountOnly) {
+  std::vector<std::string> prefix = {"WorldBegin", "MakeNamedMaterial \"a\" \"string type\" \"diffuse\"",
+                                     "MakeNamedMaterial \"b\" \"string type\" \"conductor\""};
+  auto with = [&](std::string line) {
+    std::vector<std::string> lines = prefix;
+    lines.push_back(line);
+    return lines;
+  };
+  SceneDesc first = read_lines(with("Material \"mix\" \"string materials\" [ \"a\" \"b\" ] \"float amount\" 0"));
+  EXPECT_TRUE(std::holds_alternative<DiffuseMaterial>(first.materials.back()));
+  SceneDesc second = read_lines(with("Material \"mix\" \"string materials\" [ \"a\" \"b\" ] \"float amount\" 1"));
+  EXPECT_TRUE(std::holds_alternative<ConductorMaterial>(second.materials.back()));
+  SceneDesc same = read_lines(with("Material \"mix\" \"string materials\" [ \"b\" \"b\" ]"));
+  EXPECT_TRUE(std::holds_alternative<ConductorMaterial>(same.materials.back()));
+  expect_error(with("Material \"mix\" \"string materials\" [ \"a\" \"b\" ] \"float amount\" 0.3"), 4, "\"mix\"",
+               "material type \"mix\" is not supported: candela cannot blend two materials");
+  expect_error(with("Material \"mix\" \"string materials\" [ \"a\" \"c\" ]"), 4, "\"string materials\"",
+               "names \"c\", which no MakeNamedMaterial before it defines");
+  expect_error(with("Material \"mix\" \"string materials\" \"a\""), 4, "\"string materials\"",
+               "must name exactly two materials");
+}
+
+// ---------------------------------------------------------------- textures
+
+TEST(PbrtReader, ImageTextures) {
+  ScratchFile png("wood.png"), tga("stone.tga"), exr("sky.exr");
+  Warned read = read_warned(
+      {"WorldBegin",
+       "Texture \"a\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\"",
+       "Texture \"b\" \"spectrum\" \"imagemap\" \"string filename\" \"stone.tga\" \"string filter\" \"point\" "
+       "\"string wrap\" \"clamp\" \"float scale\" 2 \"bool invert\" true \"float uscale\" 4 \"float vscale\" 3 "
+       "\"float udelta\" 0.5 \"float vdelta\" 0.25",
+       "Texture \"c\" \"float\" \"imagemap\" \"string filename\" \"stone.tga\" \"string encoding\" \"sRGB\" "
+       "\"string wrap\" \"black\"",
+       "Texture \"d\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\" \"string encoding\" \"linear\"",
+       "Texture \"e\" \"spectrum\" \"imagemap\" \"string filename\" \"sky.exr\" \"string encoding\" \"gamma 2.2\"",
+       "Texture \"f\" \"spectrum\" \"imagemap\" \"string filename\" \"sky.exr\" \"string mapping\" \"uv\"",
+       "Material \"diffuse\" \"texture reflectance\" \"b\"",
+       "Material \"conductor\" \"texture roughness\" \"c\""});
+  const SceneDesc& scene = read.scene;
+  ASSERT_EQ(scene.textures.size(), 6u);
+  const auto& a = std::get<ImageTexture>(scene.textures[0]);
+  EXPECT_EQ(fs::path(a.filename), scratch_dir() / "wood.png");  // beside the scene file
+  EXPECT_EQ(a.encoding, ColorEncoding::Auto);                     // sRGB for 8-bit files, as pbrt-v4
+  EXPECT_TRUE(a.bilinear);
+  EXPECT_EQ(a.wrap, TextureWrap::Repeat);
+  EXPECT_FLOAT_EQ(a.scale, 1);
+  EXPECT_FALSE(a.invert);
+  EXPECT_FLOAT_EQ(a.mapping.su, 1);
+  const auto& b = std::get<ImageTexture>(scene.textures[1]);
+  EXPECT_EQ(b.encoding, ColorEncoding::Auto);
+  EXPECT_FALSE(b.bilinear);
+  EXPECT_EQ(b.wrap, TextureWrap::Clamp);
+  EXPECT_FLOAT_EQ(b.scale, 2);
+  EXPECT_TRUE(b.invert);
+  EXPECT_FLOAT_EQ(b.mapping.su, 4);
+  EXPECT_FLOAT_EQ(b.mapping.sv, 3);
+  EXPECT_FLOAT_EQ(b.mapping.du, 0.5f);
+  EXPECT_FLOAT_EQ(b.mapping.dv, 0.25f);
+  const auto& c = std::get<ImageTexture>(scene.textures[2]);
+  EXPECT_EQ(c.encoding, ColorEncoding::SRGB);
+  EXPECT_EQ(c.wrap, TextureWrap::Black);
+  EXPECT_EQ(std::get<ImageTexture>(scene.textures[3]).encoding, ColorEncoding::Linear);
+  EXPECT_EQ(std::get<ImageTexture>(scene.textures[4]).encoding, ColorEncoding::SRGB);
+  EXPECT_EQ(std::get<ImageTexture>(scene.textures[5]).encoding, ColorEncoding::Auto);
+  EXPECT_EQ(std::get<DiffuseMaterial>(scene.materials[0]).reflectance.texture, 1);
+  EXPECT_EQ(std::get<ConductorMaterial>(scene.materials[1]).roughness.u.texture, 2);
+  ASSERT_EQ(read.warnings.size(), 1u) << joined(read.warnings);
+  EXPECT_NE(read.warnings[0].find("\"encoding\" \"gamma 2.2\" is read as sRGB"), std::string::npos);
+}
+
+TEST(PbrtReader, TrilinearAndEwaFiltersAreBilinearWithAWarning) {
+  ScratchFile png("wood.png");
+  for (std::string filter : {"trilinear", "ewa"})
+    expect_warning({"WorldBegin", "Texture \"a\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\" "
+                    "\"string filter\" \"" + filter + "\" \"float maxanisotropy\" 4"},
+                   2, "\"string filter\"",
+                   "filter \"" + filter + "\" is read as \"bilinear\": candela does not mipmap");
+}
+
+TEST(PbrtReader, BadImageTextures) {
+  ScratchFile png("wood.png");
+  const std::string texture = "Texture \"a\" \"spectrum\" \"imagemap\" ";
+  expect_error({"WorldBegin", texture + "\"string filename\" \"nope.png\""}, 2, "\"string filename\"",
+               "\"filename\": cannot find \"nope.png\"");
+  expect_error({"WorldBegin", texture}, 2, "Texture", "\"filename\" is required");
+  const std::string wood = texture + "\"string filename\" \"wood.png\" ";
+  expect_error({"WorldBegin", wood + "\"string wrap\" \"octahedralsphere\""}, 2, "\"string wrap\"",
+               "\"octahedralsphere\" is not supported for image textures");
+  expect_error({"WorldBegin", wood + "\"string filter\" \"gaussian\""}, 2, "\"string filter\"",
+               "must be \"point\", \"bilinear\", \"trilinear\" or \"ewa\"");
+  expect_error({"WorldBegin", wood + "\"string encoding\" \"gamma 1.8\""}, 2, "\"string encoding\"",
+               "\"gamma 1.8\" is not supported");
+  expect_error({"WorldBegin", wood + "\"string mapping\" \"spherical\""}, 2, "\"string mapping\"",
+               "\"spherical\" is not supported (only \"uv\")");
+  expect_error({"WorldBegin", wood, texture + "\"string filename\" \"wood.png\""}, 3, "\"a\"",
+               "spectrum texture \"a\" is already defined at");
+  expect_error({"WorldBegin", "Texture \"a\" \"color\" \"imagemap\""}, 2, "\"color\"",
+               "the value type must be \"spectrum\" or \"float\"");
+  expect_error({"WorldBegin", "Texture \"r\" \"float\" \"constant\"",
+                "Material \"diffuse\" \"texture reflectance\" \"r\""},
+               3, "\"texture reflectance\"", "there is a \"float\" texture of that name");
+  expect_error({"WorldBegin", "Texture \"r\" \"spectrum\" \"constant\"",
+                "Material \"conductor\" \"texture roughness\" \"r\""},
+               3, "\"texture roughness\"", "there is a \"spectrum\" texture of that name");
+}
+
+TEST(PbrtReader, ProceduralTexturesComeAfterTheTexturesTheyUse) {
+  ScratchFile png("wood.png");
+  SceneDesc scene = read_lines(
+      {"WorldBegin",
+       "Texture \"img\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\"",
+       "Texture \"checks\" \"spectrum\" \"checkerboard\" \"rgb tex1\" [ 1 0 0 ] \"texture tex2\" \"img\" "
+       "\"float uscale\" 8",
+       "Texture \"scaled\" \"spectrum\" \"scale\" \"texture tex\" \"checks\" \"float scale\" 0.5",
+       "Texture \"amount\" \"float\" \"checkerboard\" \"float tex1\" 0.25 \"float tex2\" 0.75",
+       "Texture \"mixed\" \"spectrum\" \"mix\" \"texture tex1\" \"scaled\" \"rgb tex2\" [ 0 0 1 ] "
+       "\"texture amount\" \"amount\"",
+       "Texture \"k\" \"spectrum\" \"constant\" \"rgb value\" [ 0.1 0.2 0.3 ]",
+       "Material \"diffuse\" \"texture reflectance\" \"mixed\"",
+       "Material \"diffuse\" \"texture reflectance\" \"k\""});
+  ASSERT_EQ(scene.textures.size(), 5u);  // the constant texture is no texture
+  const auto& checks = std::get<CheckerboardTexture>(scene.textures[1]);
+  EXPECT_EQ(checks.tex1.value, RGB(1, 0, 0));
+  EXPECT_EQ(checks.tex2.texture, 0);
+  EXPECT_FLOAT_EQ(checks.mapping.su, 8);
+  const auto& scaled = std::get<ScaleTexture>(scene.textures[2]);
+  EXPECT_EQ(scaled.tex.texture, 1);
+  EXPECT_FLOAT_EQ(scaled.scale.value, 0.5f);
+  const auto& amount = std::get<CheckerboardTexture>(scene.textures[3]);
+  EXPECT_EQ(amount.tex1.value, RGB(0.25f));
+  EXPECT_EQ(amount.tex2.value, RGB(0.75f));
+  const auto& mixed = std::get<MixTexture>(scene.textures[4]);
+  EXPECT_EQ(mixed.tex1.texture, 2);
+  EXPECT_EQ(mixed.tex2.value, RGB(0, 0, 1));
+  EXPECT_EQ(mixed.amount.texture, 3);
+  EXPECT_EQ(std::get<DiffuseMaterial>(scene.materials[0]).reflectance.texture, 4);
+  const auto& constant = std::get<DiffuseMaterial>(scene.materials[1]).reflectance;
+  EXPECT_TRUE(constant.is_constant());
+  EXPECT_EQ(constant.value, RGB(0.1f, 0.2f, 0.3f));
+  expect_error({"WorldBegin", "Texture \"c\" \"spectrum\" \"checkerboard\" \"integer dimension\" 3"}, 2,
+               "\"integer dimension\"", "solid (3D) checkerboards are not supported");
+  expect_error({"WorldBegin", "Texture \"c\" \"spectrum\" \"scale\" \"texture tex\" \"later\""}, 2, "\"texture tex\"",
+               "no spectrum texture named \"later\" is defined (Texture must come first)");
+}
+
+// ---------------------------------------------------------------- named spectra
+
+TEST(PbrtNamedSpectra, MetalsGlassesAndIlluminants) {
+  using namespace pbrt_spectra;
+  EXPECT_EQ(find_named("metal-Cu-eta")->rgb, ConductorMaterial{}.eta.value);
+  EXPECT_EQ(find_named("metal-Cu-k")->rgb, ConductorMaterial{}.k.value);
+  EXPECT_EQ(find_named("metal-Al-eta")->rgb, RGB(1.657460f, 0.880369f, 0.521229f));  // veach-ajar's "rgb eta"
+  for (std::string_view metal : {"Ag", "Al", "Au", "Cu", "CuZn", "MgO", "TiO2"})
+    for (std::string_view part : {"eta", "k"}) {
+      auto named = find_named(fmt::format("metal-{}-{}", metal, part));
+      ASSERT_TRUE(named.has_value()) << metal << part;
+      EXPECT_EQ(named->kind, NamedKind::Metal);
+      EXPECT_GE(named->rgb.min_component(), 0);
+    }
+  for (std::string_view glass : {"BK7", "BAF10", "FK51A", "LASF9", "F5", "F10", "F11"}) {
+    auto named = find_named(fmt::format("glass-{}", glass));
+    ASSERT_TRUE(named.has_value()) << glass;
+    EXPECT_TRUE(named->ior_550nm > 1.45f && named->ior_550nm < 1.9f) << glass;
+  }
+  EXPECT_NEAR(find_named("glass-BK7")->ior_550nm, 1.5185f, 1e-4f);
+  EXPECT_NEAR(find_named("glass-F11")->ior_550nm, 1.7911f, 1e-4f);
+  EXPECT_EQ(find_named("stdillum-D65")->rgb, RGB(1.0f));
+  for (std::string_view name : {"stdillum-A", "stdillum-D50", "stdillum-F1", "stdillum-F12", "illum-acesD60"}) {
+    auto named = find_named(name);
+    ASSERT_TRUE(named.has_value()) << name;
+    EXPECT_NEAR(named->rgb.luminance(), 1, 2e-3f) << name;
+  }
+  EXPECT_FALSE(find_named("glass-SF5").has_value());  // pbrt-v4 calls it "glass-F5"
+  EXPECT_FALSE(find_named("metal-Fe-eta").has_value());
+}
+
+TEST(PbrtNamedSpectra, SampledSpectraAndBlackbodies) {
+  using namespace pbrt_spectra;
+  const double flat[] = {300, 0.5, 900, 0.5};
+  RGB reflectance = sampled_spectrum_rgb(flat, Role::Reflectance);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(reflectance[c], 0.5f, 1e-5f);
+  EXPECT_NEAR(sampled_spectrum_rgb(flat, Role::Illuminant).luminance(), 1, 1e-3f);
+  const double ramp[] = {400, 1, 500, 2, 600, 4};
+  EXPECT_FLOAT_EQ(sampled_spectrum_at(ramp, 450), 1.5f);
+  EXPECT_FLOAT_EQ(sampled_spectrum_at(ramp, 300), 1);
+  EXPECT_FLOAT_EQ(sampled_spectrum_at(ramp, 700), 4);
+  RGB candle = blackbody_rgb(1900), sky = blackbody_rgb(12000);
+  EXPECT_NEAR(candle.luminance(), 1, 1e-3f);
+  EXPECT_GT(candle.r, candle.b);
+  EXPECT_GT(sky.b, sky.r);
+  // Tungsten's copper, reproduced from pbrt-v4's copper table by the same conversion to about 1%.
+  RGB xyz_white = cie::xyz_to_linear_srgb(0.95047, 1.0, 1.08883);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(xyz_white[c], 1, 1e-3f);
+}
+
+}  // namespace
+}  // namespace candela
