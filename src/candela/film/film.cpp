@@ -8,6 +8,18 @@
 #include <cmath>
 
 namespace candela {
+namespace {
+
+// The image whose pixel (x, y) is value(x, y).
+template <class PixelValue>
+Image image_of(int width, int height, PixelValue value) {
+  Image img(width, height);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) img.set(x, y, value(x, y));
+  return img;
+}
+
+}  // namespace
 
 RGB PixelSums::mean() const {
   if (weight == 0) return RGB(0.0f);
@@ -28,14 +40,11 @@ RGB PixelSums::standard_error() const {
 }
 
 Image Film::mean_image() const {
-  Image img(width_, height_);
-  for (int y = 0; y < height_; ++y)
-    for (int x = 0; x < width_; ++x) {
-      RGB v = pixel(x, y).mean();
-      if (has_splats()) v += splats_.at(x, y) * float(splat_scale_);
-      img.set(x, y, v);
-    }
-  return img;
+  return image_of(width_, height_, [&](int x, int y) {
+    RGB v = pixel(x, y).mean();
+    if (has_splats()) v += splats_.at(x, y) * float(splat_scale_);
+    return v;
+  });
 }
 
 void SplatImage::add_to_pixel(int x, int y, const RGB& v) {
@@ -86,27 +95,18 @@ RGB SplatImage::at(int x, int y) const {
 }
 
 Image SplatImage::image(double scale) const {
-  Image img(width_, height_);
-  for (int y = 0; y < height_; ++y)
-    for (int x = 0; x < width_; ++x) img.set(x, y, at(x, y) * float(scale));
-  return img;
+  return image_of(width_, height_, [&](int x, int y) { return at(x, y) * float(scale); });
 }
 
 Image Film::variance_of_mean_image() const {
-  Image img(width_, height_);
-  for (int y = 0; y < height_; ++y)
-    for (int x = 0; x < width_; ++x) {
-      RGB se = pixel(x, y).standard_error();
-      img.set(x, y, se * se);
-    }
-  return img;
+  return image_of(width_, height_, [&](int x, int y) {
+    RGB se = pixel(x, y).standard_error();
+    return se * se;
+  });
 }
 
 Image Film::sample_count_image() const {
-  Image img(width_, height_);
-  for (int y = 0; y < height_; ++y)
-    for (int x = 0; x < width_; ++x) img.set(x, y, RGB(float(pixel(x, y).count)));
-  return img;
+  return image_of(width_, height_, [&](int x, int y) { return RGB(float(pixel(x, y).count)); });
 }
 
 uint64_t Film::total_samples() const {

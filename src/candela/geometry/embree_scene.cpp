@@ -197,6 +197,16 @@ void user_occluded(const RTCOccludedFunctionNArguments* args, const Shape& shape
   }
 }
 
+// Embree's callbacks for a user geometry whose data is a Record and whose rays `hit` tests.
+template <typename Record, bool (*hit)(const Record&, const UserRay&, double&)>
+void intersect_callback(const RTCIntersectFunctionNArguments* args) {
+  user_intersect(args, *static_cast<const Record*>(args->geometryUserPtr), hit);
+}
+template <typename Record, bool (*hit)(const Record&, const UserRay&, double&)>
+void occluded_callback(const RTCOccludedFunctionNArguments* args) {
+  user_occluded(args, *static_cast<const Record*>(args->geometryUserPtr), hit);
+}
+
 }  // namespace
 
 Bounds3 sphere_world_bounds(const SphereGeometry& s, const Transform& to_world) {
@@ -382,14 +392,18 @@ void EmbreeScene::add_sphere(uint32_t id, const SphereGeometry& sphere, int obje
   spheres_.push_back(std::make_unique<SphereGeometry>(sphere));
   const bool moving = sphere.to_world_end.has_value();
   attach_user_geometry(id, spheres_.back().get(), 1, moving, sphere_bounds,
-                       moving ? moving_sphere_intersect : sphere_intersect,
-                       moving ? moving_sphere_occluded : sphere_occluded, object);
+                       moving ? intersect_callback<SphereGeometry, intersect_moving_sphere>
+                              : intersect_callback<SphereGeometry, intersect_sphere>,
+                       moving ? occluded_callback<SphereGeometry, intersect_moving_sphere>
+                              : occluded_callback<SphereGeometry, intersect_sphere>,
+                       object);
 }
 
 void EmbreeScene::add_quadric(uint32_t id, const QuadricGeometry& q, int object) {
   quadrics_.push_back(std::make_unique<QuadricGeometry>(q));
-  attach_user_geometry(id, quadrics_.back().get(), 1, q.to_world_end.has_value(), quadric_bounds, quadric_intersect,
-                       quadric_occluded, object);
+  attach_user_geometry(id, quadrics_.back().get(), 1, q.to_world_end.has_value(), quadric_bounds,
+                       intersect_callback<QuadricGeometry, intersect_quadric>,
+                       occluded_callback<QuadricGeometry, intersect_quadric>, object);
 }
 
 void EmbreeScene::add_sdf_grid(uint32_t id, const SdfGridGeometry& sdf, int object) {
@@ -484,34 +498,10 @@ void EmbreeScene::sphere_bounds(const RTCBoundsFunctionArguments* args) {
   write_padded_bounds(b, *args->bounds_o);
 }
 
-void EmbreeScene::sphere_intersect(const RTCIntersectFunctionNArguments* args) {
-  user_intersect(args, *static_cast<const SphereGeometry*>(args->geometryUserPtr), intersect_sphere);
-}
-
-void EmbreeScene::sphere_occluded(const RTCOccludedFunctionNArguments* args) {
-  user_occluded(args, *static_cast<const SphereGeometry*>(args->geometryUserPtr), intersect_sphere);
-}
-
-void EmbreeScene::moving_sphere_intersect(const RTCIntersectFunctionNArguments* args) {
-  user_intersect(args, *static_cast<const SphereGeometry*>(args->geometryUserPtr), intersect_moving_sphere);
-}
-
-void EmbreeScene::moving_sphere_occluded(const RTCOccludedFunctionNArguments* args) {
-  user_occluded(args, *static_cast<const SphereGeometry*>(args->geometryUserPtr), intersect_moving_sphere);
-}
-
 void EmbreeScene::quadric_bounds(const RTCBoundsFunctionArguments* args) {
   const auto& q = *static_cast<const QuadricGeometry*>(args->geometryUserPtr);
   Bounds3 b = quadric_world_bounds(q, args->timeStep == 0 ? q.to_world : *q.to_world_end);
   write_padded_bounds(b, *args->bounds_o);
-}
-
-void EmbreeScene::quadric_intersect(const RTCIntersectFunctionNArguments* args) {
-  user_intersect(args, *static_cast<const QuadricGeometry*>(args->geometryUserPtr), intersect_quadric);
-}
-
-void EmbreeScene::quadric_occluded(const RTCOccludedFunctionNArguments* args) {
-  user_occluded(args, *static_cast<const QuadricGeometry*>(args->geometryUserPtr), intersect_quadric);
 }
 
 void EmbreeScene::sdf_bounds(const RTCBoundsFunctionArguments* args) {

@@ -129,13 +129,7 @@ class EmbreeScene {
 
  private:
   static void sphere_bounds(const RTCBoundsFunctionArguments* args);
-  static void sphere_intersect(const RTCIntersectFunctionNArguments* args);
-  static void sphere_occluded(const RTCOccludedFunctionNArguments* args);
-  static void moving_sphere_intersect(const RTCIntersectFunctionNArguments* args);
-  static void moving_sphere_occluded(const RTCOccludedFunctionNArguments* args);
   static void quadric_bounds(const RTCBoundsFunctionArguments* args);
-  static void quadric_intersect(const RTCIntersectFunctionNArguments* args);
-  static void quadric_occluded(const RTCOccludedFunctionNArguments* args);
   static void sdf_bounds(const RTCBoundsFunctionArguments* args);
   static void sdf_intersect(const RTCIntersectFunctionNArguments* args);
   static void sdf_occluded(const RTCOccludedFunctionNArguments* args);

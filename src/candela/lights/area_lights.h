@@ -43,6 +43,22 @@ inline float flat_light_importance(const Point3& centroid, const Normal3& n, flo
   return radiance.luminance() * std::min(kPi, area * cos_l * cos_p / d2);
 }
 
+// The densities of a flat emitter (members n, area, two_sided) drawn uniformly by area with
+// cosine-weighted emission: Triangle, Rectangle and Disk lights.
+template <class FlatLight>
+EmissionPdf flat_light_pdf_le(const FlatLight& light, const Vec3& w) {
+  return {1 / light.area, cosine_emission_pdf(light.n, light.two_sided, w)};
+}
+template <class FlatLight>
+float flat_light_pdf_li(const FlatLight& light, const LightSampleContext& ctx, const Point3& p) {
+  return area_to_solid_angle_pdf(1 / light.area, ctx.p, p, light.n);
+}
+
+// The power of a diffuse emitter of constant radiance and the given area.
+inline float uniform_emitter_power(const RGB& radiance, float area, bool two_sided) {
+  return radiance.luminance() * area * kPi * (two_sided ? 2 : 1);
+}
+
 // The light sample for a point p drawn uniformly by area on a flat emitter, seen from ctx.
 inline LightSample flat_light_sample(const Point3& p, const Normal3& n, float area, const RGB& radiance,
                                      bool two_sided, const LightSampleContext& ctx) {
@@ -86,13 +102,9 @@ struct TriangleLight {
     if (emission_texture.texture < 0) return radiance;
     return emission_texture(radiance, uv0 * b.x + uv1 * b.y + uv2 * (1 - b.x - b.y), p);
   }
-  EmissionPdf pdf_le(const Point3&, const Normal3&, const Vec3& w, const SceneSphere&) const {
-    return {1 / area, cosine_emission_pdf(n, two_sided, w)};
-  }
-  float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const {
-    return area_to_solid_angle_pdf(1 / area, ctx.p, p, n);
-  }
-  float power() const { return radiance.luminance() * area * kPi * (two_sided ? 2 : 1); }
+  EmissionPdf pdf_le(const Point3&, const Normal3&, const Vec3& w, const SceneSphere&) const { return flat_light_pdf_le(*this, w); }
+  float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const { return flat_light_pdf_li(*this, ctx, p); }
+  float power() const { return uniform_emitter_power(radiance, area, two_sided); }
   float importance(const LightSampleContext& ctx) const {
     return flat_light_importance((p0 + p1 + p2) / 3.0f, n, area, radiance, two_sided, ctx);
   }
@@ -121,13 +133,9 @@ struct RectangleLight {
     Point3 p = corner + edge_u * u_pos.x + edge_v * u_pos.y;
     return {emission_texture(radiance, u_pos, p), p, w, n, 1 / area, pdf_dir};
   }
-  EmissionPdf pdf_le(const Point3&, const Normal3&, const Vec3& w, const SceneSphere&) const {
-    return {1 / area, cosine_emission_pdf(n, two_sided, w)};
-  }
-  float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const {
-    return area_to_solid_angle_pdf(1 / area, ctx.p, p, n);
-  }
-  float power() const { return radiance.luminance() * area * kPi * (two_sided ? 2 : 1); }
+  EmissionPdf pdf_le(const Point3&, const Normal3&, const Vec3& w, const SceneSphere&) const { return flat_light_pdf_le(*this, w); }
+  float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const { return flat_light_pdf_li(*this, ctx, p); }
+  float power() const { return uniform_emitter_power(radiance, area, two_sided); }
   float importance(const LightSampleContext& ctx) const {
     return flat_light_importance(corner + (edge_u + edge_v) * 0.5f, n, area, radiance, two_sided, ctx);
   }
@@ -251,13 +259,9 @@ struct DiskLight {
     Point3 p = point(u_pos, emitted);
     return {emitted, p, w, n, 1 / area, pdf_dir};
   }
-  EmissionPdf pdf_le(const Point3&, const Normal3&, const Vec3& w, const SceneSphere&) const {
-    return {1 / area, cosine_emission_pdf(n, two_sided, w)};
-  }
-  float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const {
-    return area_to_solid_angle_pdf(1 / area, ctx.p, p, n);
-  }
-  float power() const { return radiance.luminance() * area * kPi * (two_sided ? 2 : 1); }
+  EmissionPdf pdf_le(const Point3&, const Normal3&, const Vec3& w, const SceneSphere&) const { return flat_light_pdf_le(*this, w); }
+  float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const { return flat_light_pdf_li(*this, ctx, p); }
+  float power() const { return uniform_emitter_power(radiance, area, two_sided); }
   float importance(const LightSampleContext& ctx) const {
     return flat_light_importance(center, n, area, radiance, two_sided, ctx);
   }
@@ -315,7 +319,7 @@ struct CylinderLight {
   float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const {
     return area_to_solid_angle_pdf(1 / area, ctx.p, p, emitting_normal(p));
   }
-  float power() const { return radiance.luminance() * area * kPi * (two_sided ? 2 : 1); }
+  float power() const { return uniform_emitter_power(radiance, area, two_sided); }
   // Estimated irradiance at ctx: L times the tube's projected area seen from its centre over d^2.
   float importance(const LightSampleContext& ctx) const {
     Point3 c = base + axis * 0.5f;

@@ -54,6 +54,27 @@ inline bool refract_about(const Vec3& w, Vec3 n, float eta, Vec3& wt, float& eta
 }
 
 // How masking and shadowing combine: pbrt-v4's height-correlated form or Mitsuba's product of the two.
+// What both distributions share, given their own D(wm) and Smith Lambda(w):
+// Smith's masking from Lambda, 1 / (1 + Lambda(w)).
+template <class Distribution>
+float smith_G1(const Distribution& d, const Vec3& w) {
+  return 1 / (1 + d.Lambda(w));
+}
+// The density of normals visible from w: D_w(wm) = G1(w) / |cos theta_w| D(wm) |w . wm|.
+template <class Distribution>
+float visible_normal_density(const Distribution& d, const Vec3& w, const Vec3& wm) {
+  float cos_w = abs_cos_theta(w);
+  if (cos_w == 0) return 0;
+  return smith_G1(d, w) / cos_w * d.D(wm) * abs_dot(w, wm);
+}
+// w stretched into the configuration where the distribution is the isotropic alpha = 1 one, and
+// turned into the upper hemisphere (visible-normal sampling of a w below the surface uses -w).
+inline Vec3 stretched_to_unit_roughness(const Vec3& w, float alpha_x, float alpha_y) {
+  Vec3 wh = normalize(Vec3(alpha_x * w.x, alpha_y * w.y, w.z));
+  if (wh.z < 0) wh = -wh;
+  return wh;
+}
+
 enum class MaskingShadowing { HeightCorrelated, Separable };
 
 // The anisotropic Trowbridge-Reitz (GGX) microfacet distribution.
@@ -100,7 +121,7 @@ struct TrowbridgeReitz {
   }
 
   // Masking: the fraction of microfacets visible from w.
-  float G1(const Vec3& w) const { return 1 / (1 + Lambda(w)); }
+  float G1(const Vec3& w) const { return smith_G1(*this, w); }
 
   // Masking-shadowing: the fraction of microfacets visible from both wo and wi.
   float G(const Vec3& wo, const Vec3& wi) const {
@@ -109,11 +130,7 @@ struct TrowbridgeReitz {
   }
 
   // Distribution of normals visible from w: D_w(wm) = G1(w) / |cos theta_w| D(wm) |w . wm|.
-  float D(const Vec3& w, const Vec3& wm) const {
-    float cos_w = abs_cos_theta(w);
-    if (cos_w == 0) return 0;
-    return G1(w) / cos_w * D(wm) * abs_dot(w, wm);
-  }
+  float D(const Vec3& w, const Vec3& wm) const { return visible_normal_density(*this, w, wm); }
 
   // Density of sample_visible_normal(w, .) at wm.
   float pdf(const Vec3& w, const Vec3& wm) const { return D(w, wm); }
@@ -122,9 +139,7 @@ struct TrowbridgeReitz {
   // Normals", in pbrt-v4's formulation). A w below the surface samples the normals visible from -w,
   // so the returned normal always lies in the upper hemisphere.
   Vec3 sample_visible_normal(const Vec3& w, Vec2 u) const {
-    // Stretch w into the configuration where the distribution is the isotropic alpha = 1 one.
-    Vec3 wh = normalize(Vec3(alpha_x * w.x, alpha_y * w.y, w.z));
-    if (wh.z < 0) wh = -wh;
+    Vec3 wh = stretched_to_unit_roughness(w, alpha_x, alpha_y);
     // An orthonormal basis around wh (any one at normal incidence).
     Vec3 t1 = wh.z < 0.99999f ? normalize(cross(Vec3(0, 0, 1), wh)) : Vec3(1, 0, 0);
     Vec3 t2 = cross(wh, t1);
@@ -236,18 +251,13 @@ struct Beckmann {
   float G(const Vec3& wo, const Vec3& wi) const { return G1(wo) * G1(wi); }
 
   // The exact normalisation of the visible-normal density.
-  float visible_G1(const Vec3& w) const { return 1 / (1 + Lambda(w)); }
-  float D(const Vec3& w, const Vec3& wm) const {
-    float cos_w = abs_cos_theta(w);
-    if (cos_w == 0) return 0;
-    return visible_G1(w) / cos_w * D(wm) * abs_dot(w, wm);
-  }
+  float visible_G1(const Vec3& w) const { return smith_G1(*this, w); }
+  float D(const Vec3& w, const Vec3& wm) const { return visible_normal_density(*this, w, wm); }
   float pdf(const Vec3& w, const Vec3& wm) const { return D(w, wm); }
 
   Vec3 sample_visible_normal(const Vec3& w, Vec2 u) const {
     // Stretch to the alpha = 1 configuration; there, rotate w's azimuth onto +x.
-    Vec3 wh = normalize(Vec3(alpha_x * w.x, alpha_y * w.y, w.z));
-    if (wh.z < 0) wh = -wh;
+    Vec3 wh = stretched_to_unit_roughness(w, alpha_x, alpha_y);
     float sin_t = std::sqrt(sin2_theta(wh));
     float cos_p = cos_phi(wh), sin_p = sin_phi(wh);
     double sx, sy;

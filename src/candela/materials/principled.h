@@ -88,6 +88,13 @@ namespace principled_detail {
 inline float lerp_to(float a, float b, float t) { return a + t * (b - a); }
 inline RGB lerp_to(const RGB& a, const RGB& b, float t) { return a + (b - a) * t; }
 
+// Scales lobe weights to sum to 1, the sum taken left to right in the order given.
+template <class... Weights>
+void scale_to_unit_sum(Weights&... w) {
+  float inv_total = 1 / (... + w);
+  ((w *= inv_total), ...);
+}
+
 inline float schlick_weight(float c) {
   float m = std::clamp(1 - c, 0.0f, 1.0f);
   return sqr(sqr(m)) * m;
@@ -334,11 +341,7 @@ struct PrincipledBsdf {
       p.transmission = 1 - F;
       p.reflection = F;
     }
-    float inv_total = 1 / (p.diffuse + p.clearcoat + p.transmission + p.reflection);
-    p.diffuse *= inv_total;
-    p.clearcoat *= inv_total;
-    p.transmission *= inv_total;
-    p.reflection *= inv_total;
+    principled_detail::scale_to_unit_sum(p.diffuse, p.clearcoat, p.transmission, p.reflection);
     return p;
   }
 
@@ -508,11 +511,7 @@ struct PrincipledThinBsdf {
     p.transmission = spec_trans / 2;
     p.diffuse_reflection = (1 - spec_trans) * (1 - diff_trans);
     p.diffuse_transmission = (1 - spec_trans) * diff_trans;
-    float inv_total = 1 / (p.reflection + p.transmission + p.diffuse_reflection + p.diffuse_transmission);
-    p.reflection *= inv_total;
-    p.transmission *= inv_total;
-    p.diffuse_reflection *= inv_total;
-    p.diffuse_transmission *= inv_total;
+    principled_detail::scale_to_unit_sum(p.reflection, p.transmission, p.diffuse_reflection, p.diffuse_transmission);
     return p;
   }
 };

@@ -83,22 +83,23 @@ double relative_deviation_sq(const PixelSums& pixel) {
 // The mean of `v` over the (2r+1)^2 pixels around each pixel (fewer at the borders): one pixel's
 // variance estimated from a few samples is itself very noisy, and neighbours' variances are alike.
 std::vector<double> box_mean(const std::vector<double>& v, int w, int h, int r) {
-  std::vector<double> rows(v.size()), out(v.size());
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      double sum = 0;
-      int n = 0;
-      for (int dx = std::max(0, x - r); dx <= std::min(w - 1, x + r); ++dx, ++n) sum += v[size_t(y) * w + dx];
-      rows[size_t(y) * w + x] = sum / n;
-    }
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      double sum = 0;
-      int n = 0;
-      for (int dy = std::max(0, y - r); dy <= std::min(h - 1, y + r); ++dy, ++n) sum += rows[size_t(dy) * w + x];
-      out[size_t(y) * w + x] = sum / n;
-    }
-  return out;
+  // Separably: the mean over the 2r+1 pixels along x, then of that along y.
+  auto pass = [&](const std::vector<double>& in, bool along_y) {
+    std::vector<double> out(in.size());
+    const int size = along_y ? h : w;
+    const size_t stride = along_y ? size_t(w) : 1;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const int at = along_y ? y : x;
+        const size_t line_start = size_t(y) * w + x - size_t(at) * stride;
+        double sum = 0;
+        int n = 0;
+        for (int i = std::max(0, at - r); i <= std::min(size - 1, at + r); ++i, ++n) sum += in[line_start + size_t(i) * stride];
+        out[size_t(y) * w + x] = sum / n;
+      }
+    return out;
+  };
+  return pass(pass(v, false), true);
 }
 
 // How many samples each open pixel gets so that `total` are added and the counts come as close as

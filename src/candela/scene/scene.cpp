@@ -454,6 +454,15 @@ void Scene::add_triangles(ShapeRecord rec, TriangleMesh mesh, const Transform& T
   shapes_.push_back(std::move(rec));
 }
 
+const Transform& Scene::transform_at(const Transform& to_world, const std::optional<Transform>& to_world_end,
+                                     float time, std::optional<Transform>& storage) const {
+  if (to_world_end) {
+    storage = interpolate_transform(to_world, *to_world_end, embree_.normalized_time(time));
+    if (storage) return *storage;
+  }
+  return to_world;
+}
+
 bool Scene::intersect(const Ray& world_ray, SurfaceHit& hit) const {
   EmbreeHit eh;
   if (!embree_.intersect(world_ray, eh)) return false;
@@ -467,11 +476,7 @@ bool Scene::intersect(const Ray& world_ray, SurfaceHit& hit) const {
   Ray ray = world_ray;
   if (eh.instance >= 0) {
     const InstanceRecord& inst = instances_[size_t(eh.instance)];
-    instance_to_world = &inst.to_world;
-    if (inst.to_world_end) {
-      at_time = interpolate_transform(inst.to_world, *inst.to_world_end, embree_.normalized_time(ray.time));
-      if (at_time) instance_to_world = &*at_time;
-    }
+    instance_to_world = &transform_at(inst.to_world, inst.to_world_end, ray.time, at_time);
     const Transform& to_object = instance_to_world->inverse();
     ray.origin = to_object.point(world_ray.origin);
     ray.direction = to_object.vector(world_ray.direction);  // not normalised: t stays the world's
@@ -560,12 +565,8 @@ void Scene::reconstruct_sphere_hit(const ShapeRecord& rec, const Ray& ray, float
   const SphereGeometry& s = rec.sphere;
   // A moving sphere is where Embree found it: under its transform at the ray's time (invertible
   // there, or it would not have been hit).
-  const Transform* to_world = &s.to_world;
   std::optional<Transform> at_time;
-  if (s.to_world_end) {
-    at_time = interpolate_transform(s.to_world, *s.to_world_end, embree_.normalized_time(ray.time));
-    if (at_time) to_world = &*at_time;
-  }
+  const Transform* to_world = &transform_at(s.to_world, s.to_world_end, ray.time, at_time);
   hit.p = ray.at(t);
   // Re-project onto the surface in object space to remove the error of o + t d, then map back.
   Point3 po = to_world->inverse().point(hit.p) - s.center;
@@ -583,12 +584,9 @@ void Scene::reconstruct_sphere_hit(const ShapeRecord& rec, const Ray& ray, float
 
 void Scene::reconstruct_quadric_hit(const ShapeRecord& rec, const Ray& ray, float t, SurfaceHit& hit) const {
   const QuadricGeometry& q = rec.quadric;
-  const Transform* M = &q.to_world;
+  // Where a moving quadric is at the ray's time, as for spheres.
   std::optional<Transform> at_time;
-  if (q.to_world_end) {
-    at_time = interpolate_transform(q.to_world, *q.to_world_end, embree_.normalized_time(ray.time));
-    if (at_time) M = &*at_time;
-  }
+  const Transform* M = &transform_at(q.to_world, q.to_world_end, ray.time, at_time);
   // Back to the unit shape, projected onto it (removing the error of o + t d), and out again.
   Point3 local = M->inverse().point(ray.at(t));
   if (q.kind == QuadricGeometry::Kind::Disk) {

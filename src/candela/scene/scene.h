@@ -122,6 +122,10 @@ class Scene {
                    const Transform* unit_to_world_end, const std::optional<AreaEmission>& emission, int object);
   void add_sdf_grid(ShapeRecord rec, const SdfGridShape& grid, const Transform& to_world,
                     const Transform* to_world_end, int object);
+  // A shape or instance at a ray's time: to_world, or where it moves (to_world_end) and the
+  // interpolation exists, that interpolated transform, kept in storage.
+  const Transform& transform_at(const Transform& to_world, const std::optional<Transform>& to_world_end, float time,
+                                std::optional<Transform>& storage) const;
   void reconstruct_quadric_hit(const ShapeRecord& rec, const Ray& ray, float t, SurfaceHit& hit) const;
   void reconstruct_sdf_hit(const ShapeRecord& rec, const Ray& ray, float t, uint32_t voxel, SurfaceHit& hit) const;
   void reconstruct_triangle_hit(const ShapeRecord& rec, const EmbreeHit& eh, float time, SurfaceHit& hit) const;

@@ -302,21 +302,18 @@ MaterialInfo GltfReader::make_material(int m, bool vertex_colors, bool has_verte
   p.roughness = float(pbr.roughnessFactor);
   if (pbr.metallicRoughnessTexture.index >= 0) {
     const std::string where = pointer + "/pbrMetallicRoughness/metallicRoughnessTexture";
-    ImageOp op;
-    op.channel = 2;
-    if (pbr.metallicFactor != 0) {
+    // One channel of the texture times its factor, into `input` (a zero factor needs no texture).
+    auto read_channel = [&](int channel, double factor, auto& input) {
+      if (factor == 0) return;
+      ImageOp op;
+      op.channel = channel;
       int t = add_texture(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
-                          pbr.metallicRoughnessTexture.extensions, ColorEncoding::Linear, op, float(pbr.metallicFactor),
-                          where, uv_set);
-      if (t >= 0) p.metallic.texture = t;
-    }
-    op.channel = 1;
-    if (pbr.roughnessFactor != 0) {
-      int t = add_texture(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
-                          pbr.metallicRoughnessTexture.extensions, ColorEncoding::Linear, op, float(pbr.roughnessFactor),
-                          where, uv_set);
-      if (t >= 0) p.roughness.texture = t;
-    }
+                          pbr.metallicRoughnessTexture.extensions, ColorEncoding::Linear, op, float(factor), where,
+                          uv_set);
+      if (t >= 0) input.texture = t;
+    };
+    read_channel(2, pbr.metallicFactor, p.metallic);
+    read_channel(1, pbr.roughnessFactor, p.roughness);
   }
 
   // Extensions.

@@ -12,7 +12,9 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <system_error>
+#include <type_traits>
 
 namespace candela::gltf {
 namespace {
@@ -285,60 +287,35 @@ void GltfReader::view_bytes(int view, size_t offset, const std::string& user, co
   available = v.byteLength - offset;
 }
 
+namespace {
+// Component c of an array of T's (unaligned), mapped to [0, 1] or [-1, 1] where `normalized`
+// applies (8- and 16-bit integers; glTF's normalized signed ints clamp -max - 1 to -1).
+template <class T>
+double component(const std::byte* p, int c, bool normalized) {
+  T x;
+  std::memcpy(&x, p + sizeof(T) * c, sizeof(T));
+  double v = x;
+  if constexpr (std::is_integral_v<T> && sizeof(T) <= 2) {
+    constexpr double max = std::numeric_limits<T>::max();
+    if (normalized) v = std::is_signed_v<T> ? std::max(v / max, -1.0) : v / max;
+  }
+  return v;
+}
+}  // namespace
+
 void GltfReader::decode(const std::byte* p, int type, bool normalized, int n, double* out) {
   for (int c = 0; c < n; ++c) {
     double v = 0;
     switch (type) {
-      case TINYGLTF_COMPONENT_TYPE_BYTE: {
-        int8_t x;
-        std::memcpy(&x, p + c, 1);
-        v = normalized ? std::max(x / 127.0, -1.0) : x;
-        break;
-      }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
-        uint8_t x;
-        std::memcpy(&x, p + c, 1);
-        v = normalized ? x / 255.0 : x;
-        break;
-      }
-      case TINYGLTF_COMPONENT_TYPE_SHORT: {
-        int16_t x;
-        std::memcpy(&x, p + 2 * c, 2);
-        v = normalized ? std::max(x / 32767.0, -1.0) : x;
-        break;
-      }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-        uint16_t x;
-        std::memcpy(&x, p + 2 * c, 2);
-        v = normalized ? x / 65535.0 : x;
-        break;
-      }
-      case TINYGLTF_COMPONENT_TYPE_INT: {
-        int32_t x;
-        std::memcpy(&x, p + 4 * c, 4);
-        v = x;
-        break;
-      }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
-        uint32_t x;
-        std::memcpy(&x, p + 4 * c, 4);
-        v = x;
-        break;
-      }
-      case TINYGLTF_COMPONENT_TYPE_FLOAT: {
-        float x;
-        std::memcpy(&x, p + 4 * c, 4);
-        v = x;
-        break;
-      }
-      case TINYGLTF_COMPONENT_TYPE_DOUBLE: {
-        double x;
-        std::memcpy(&x, p + 8 * c, 8);
-        v = x;
-        break;
-      }
-      default:
-        break;
+      case TINYGLTF_COMPONENT_TYPE_BYTE: v = component<int8_t>(p, c, normalized); break;
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = component<uint8_t>(p, c, normalized); break;
+      case TINYGLTF_COMPONENT_TYPE_SHORT: v = component<int16_t>(p, c, normalized); break;
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: v = component<uint16_t>(p, c, normalized); break;
+      case TINYGLTF_COMPONENT_TYPE_INT: v = component<int32_t>(p, c, normalized); break;
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: v = component<uint32_t>(p, c, normalized); break;
+      case TINYGLTF_COMPONENT_TYPE_FLOAT: v = component<float>(p, c, normalized); break;
+      case TINYGLTF_COMPONENT_TYPE_DOUBLE: v = component<double>(p, c, normalized); break;
+      default: break;
     }
     out[c] = v;
   }

@@ -7,15 +7,8 @@ namespace candela::json {
 // Named materials may wrap (one_sided, mask, blend, normal_map, bump_map) materials named anywhere
 // in the file: each is read when first needed, after what it wraps, as named textures are.
 void JsonSceneReader::read_materials(const Json& value, const std::string& pointer) {
-  if (!value.is_object())
-    report_.fail(pointer, "expected an object mapping material names to materials, got {}", describe(value));
-  std::vector<std::string> names;  // in the file's order
-  for (auto it = value.begin(); it != value.end(); ++it) {
-    if (it.key() == "_comment") continue;
-    names.push_back(it.key());
-    named_materials_[it.key()] = NamedMaterial{&it.value(), child_pointer(pointer, it.key())};
-  }
-  for (const std::string& name : names) material_by_name(name, named_materials_[name].pointer);
+  for (const std::string& name : collect_named(value, pointer, "material", named_materials_))
+    material_by_name(name, named_materials_[name].pointer);
 }
 
 int JsonSceneReader::add_material(MaterialDesc material, SourceLocation where) {
@@ -216,14 +209,7 @@ DiffuseTransmissionMaterial JsonSceneReader::read_diffuse_transmission(CheckedOb
 }
 
 int JsonSceneReader::material_by_name(const std::string& name, const std::string& pointer) {
-  auto it = named_materials_.find(name);
-  if (it == named_materials_.end()) {
-    std::vector<std::string> names;
-    for (const auto& entry : named_materials_) names.push_back(entry.first);
-    if (names.empty()) report_.fail(pointer, "unknown material \"{}\" (\"materials\" defines none)", name);
-    report_.fail(pointer, "unknown material \"{}\"; defined: {}", name, fmt::join(names, ", "));
-  }
-  NamedMaterial& material = it->second;
+  NamedEntry& material = find_named(named_materials_, name, pointer, "material");
   if (material.index >= 0) return material.index;
   if (material.reading) report_.fail(pointer, "material \"{}\" wraps itself (a cycle of wrapping materials)", name);
   material.reading = true;

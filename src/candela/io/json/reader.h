@@ -83,15 +83,25 @@ class JsonSceneReader {
   void read_integrator_strategies(CheckedObject& render, RenderSettings& settings) const;
   void read_adaptive(const Json& value, const std::string& pointer, RenderSettings& settings) const;
 
-  // ---- textures (textures.cpp)
-  // Named textures may refer to each other in any order. Each is read when first needed, so that
-  // SceneDesc::textures lists every texture after the textures it refers to.
-  struct NamedTexture {
+  // ---- named textures and materials (textures.cpp)
+  // They may refer to each other in any order. Each is read when first needed, so that
+  // SceneDesc::textures (materials) lists every one after those it refers to.
+  struct NamedEntry {
     const Json* value = nullptr;
     std::string pointer;
-    bool reading = false;  // on the stack of textures being read: meeting it again is a cycle
-    int index = -1;        // in SceneDesc::textures, once read
+    bool reading = false;  // being read: meeting it again is a cycle
+    int index = -1;        // in SceneDesc::textures (materials), once read
   };
+  using NamedEntries = std::map<std::string, NamedEntry>;
+  // Records the entries of the object mapping names to `kind`s ("texture", "material"); returns
+  // their names in the file's order.
+  std::vector<std::string> collect_named(const Json& value, const std::string& pointer, std::string_view kind,
+                                         NamedEntries& entries);
+  // The entry called `name` (given at pointer); an unknown name fails, listing those defined.
+  NamedEntry& find_named(NamedEntries& entries, const std::string& name, const std::string& pointer,
+                         std::string_view kind);
+
+  // ---- textures (textures.cpp)
   void read_textures(const Json& value, const std::string& pointer);
   int named_texture(const std::string& name, const std::string& pointer);
   int add_texture(TextureDesc texture, SourceLocation where);
@@ -101,6 +111,8 @@ class JsonSceneReader {
   std::string existing_file(CheckedObject& object, std::string_view key, std::string_view what) const;
 
   // ---- material and texture parameters: a constant, a texture name, or an inline texture object
+  // The texture a parameter names (a string) or writes inline (an object); nothing for a constant.
+  std::optional<int> texture_reference(const Json& value, const std::string& pointer);
   ColorInput read_color_input(const Json& value, const std::string& pointer, ColorKind kind);
   ColorInput color_input_or(CheckedObject& object, std::string_view key, ColorKind kind, ColorInput fallback);
   FloatInput read_float_input(const Json& value, const std::string& pointer, Bound bound);
@@ -108,12 +120,6 @@ class JsonSceneReader {
 
   // ---- materials (materials.cpp)
   void read_materials(const Json& value, const std::string& pointer);
-  struct NamedMaterial {
-    const Json* value = nullptr;
-    std::string pointer;
-    bool reading = false;
-    int index = -1;
-  };
   int add_material(MaterialDesc material, SourceLocation where);
   MaterialDesc read_material(const Json& value, const std::string& pointer);
   PhongMaterial read_phong(CheckedObject& m);
@@ -186,10 +192,10 @@ class JsonSceneReader {
   ErrorReporter report_;
   fs::path base_dir_;
   SceneDesc scene_;
-  std::map<std::string, NamedTexture> named_textures_;
+  NamedEntries named_textures_;
   std::vector<std::string> texture_stack_;  // the named textures being read, outermost first
   int texture_depth_ = 0;                   // textures being read, named or inline
-  std::map<std::string, NamedMaterial> named_materials_;
+  NamedEntries named_materials_;
   std::map<std::string, int> object_index_;
   std::optional<int> black_material_;
 };

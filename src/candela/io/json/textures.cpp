@@ -4,29 +4,40 @@ namespace candela::json {
 
 // ---- textures
 
-void JsonSceneReader::read_textures(const Json& value, const std::string& pointer) {
+std::vector<std::string> JsonSceneReader::collect_named(const Json& value, const std::string& pointer,
+                                                        std::string_view kind, NamedEntries& entries) {
   if (!value.is_object())
-    report_.fail(pointer, "expected an object mapping texture names to textures, got {}", describe(value));
-  std::vector<std::string> names;  // in the file's order
+    report_.fail(pointer, "expected an object mapping {} names to {}s, got {}", kind, kind, describe(value));
+  std::vector<std::string> names;
   for (auto it = value.begin(); it != value.end(); ++it) {
     if (it.key() == "_comment") continue;
     names.push_back(it.key());
-    named_textures_[it.key()] = NamedTexture{&it.value(), child_pointer(pointer, it.key())};
+    entries[it.key()] = NamedEntry{&it.value(), child_pointer(pointer, it.key())};
   }
-  for (const std::string& name : names) named_texture(name, named_textures_[name].pointer);
+  return names;
+}
+
+JsonSceneReader::NamedEntry& JsonSceneReader::find_named(NamedEntries& entries, const std::string& name,
+                                                         const std::string& pointer, std::string_view kind) {
+  auto it = entries.find(name);
+  if (it == entries.end()) {
+    std::vector<std::string> names;
+    for (const auto& entry : entries) names.push_back(entry.first);
+    if (names.empty()) report_.fail(pointer, "unknown {} \"{}\" (\"{}s\" defines none)", kind, name, kind);
+    report_.fail(pointer, "unknown {} \"{}\"; defined: {}", kind, name, fmt::join(names, ", "));
+  }
+  return it->second;  // std::map: stays valid while other entries are read
+}
+
+void JsonSceneReader::read_textures(const Json& value, const std::string& pointer) {
+  for (const std::string& name : collect_named(value, pointer, "texture", named_textures_))
+    named_texture(name, named_textures_[name].pointer);
 }
 
 // The index of a named texture, read first (with what it refers to) if it has not been yet.
 // `pointer` is where the name was given.
 int JsonSceneReader::named_texture(const std::string& name, const std::string& pointer) {
-  auto it = named_textures_.find(name);
-  if (it == named_textures_.end()) {
-    std::vector<std::string> names;
-    for (const auto& entry : named_textures_) names.push_back(entry.first);
-    if (names.empty()) report_.fail(pointer, "unknown texture \"{}\" (\"textures\" defines none)", name);
-    report_.fail(pointer, "unknown texture \"{}\"; defined: {}", name, fmt::join(names, ", "));
-  }
-  NamedTexture& texture = it->second;  // std::map: stays valid while other textures are read
+  NamedEntry& texture = find_named(named_textures_, name, pointer, "texture");
   if (texture.index >= 0) return texture.index;
   if (texture.reading) {
     std::vector<std::string> cycle(std::find(texture_stack_.begin(), texture_stack_.end(), name),
@@ -181,12 +192,16 @@ std::string JsonSceneReader::existing_file(CheckedObject& object, std::string_vi
 
 // ---- material and texture parameters: a constant, a texture name, or an inline texture object
 
+std::optional<int> JsonSceneReader::texture_reference(const Json& value, const std::string& pointer) {
+  if (value.is_string()) return named_texture(value.get<std::string>(), pointer);
+  if (value.is_object()) return add_texture(read_texture(value, pointer), place(pointer));
+  return std::nullopt;
+}
+
 ColorInput JsonSceneReader::read_color_input(const Json& value, const std::string& pointer, ColorKind kind) {
   ColorInput input;
-  if (value.is_string())
-    input.texture = named_texture(value.get<std::string>(), pointer);
-  else if (value.is_object())
-    input.texture = add_texture(read_texture(value, pointer), place(pointer));
+  if (std::optional<int> texture = texture_reference(value, pointer))
+    input.texture = *texture;
   else if (value.is_number() || value.is_array())
     input.value = read_rgb(report_, value, pointer, kind);
   else
@@ -203,10 +218,8 @@ ColorInput JsonSceneReader::color_input_or(CheckedObject& object, std::string_vi
 
 FloatInput JsonSceneReader::read_float_input(const Json& value, const std::string& pointer, Bound bound) {
   FloatInput input;
-  if (value.is_string())
-    input.texture = named_texture(value.get<std::string>(), pointer);
-  else if (value.is_object())
-    input.texture = add_texture(read_texture(value, pointer), place(pointer));
+  if (std::optional<int> texture = texture_reference(value, pointer))
+    input.texture = *texture;
   else if (value.is_number())
     input.value = check_bound(report_, read_float(report_, value, pointer), bound, pointer);
   else
