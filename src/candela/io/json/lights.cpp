@@ -11,7 +11,6 @@ void JsonSceneReader::read_lights(const Json& value, const std::string& pointer)
 
 void JsonSceneReader::read_light(const Json& value, const std::string& pointer) {
   CheckedObject light(report_, value, pointer);
-  std::string type = light.string("type");
   // Each adds a light to SceneDesc::lights, or (sphere, rectangle) an emitting shape to its shapes.
   using Reader = void (*)(JsonSceneReader&, CheckedObject&);
   using R = JsonSceneReader;
@@ -34,11 +33,9 @@ void JsonSceneReader::read_light(const Json& value, const std::string& pointer) 
        [](R& r, L& light) { r.scene_.shapes.push_back(r.read_shape_light(light, r.read_rectangle(light))); }},
       {"projector", [](R& r, L& light) { r.scene_.lights.push_back(r.read_projector(light)); }},
   };
-  const NamedReader<Reader>* reader = find_reader(kLights, type);
-  if (!reader)
-    report_.fail(light.pointer_of("type"), "unknown light type \"{}\"; expected one of: {}", type, type_names(kLights));
+  const NamedReader<Reader>& reader = reader_for(kLights, light, "light");
   const size_t light_count = scene_.lights.size();
-  reader->read(*this, light);
+  reader.read(*this, light);
   if (scene_.lights.size() > light_count) scene_.places.lights.push_back(place(pointer));
   light.finish();
 }

@@ -19,7 +19,6 @@ int JsonSceneReader::add_material(MaterialDesc material, SourceLocation where) {
 
 MaterialDesc JsonSceneReader::read_material(const Json& value, const std::string& pointer) {
   CheckedObject m(report_, value, pointer);
-  std::string type = m.string("type");
   using Reader = MaterialDesc (*)(JsonSceneReader&, CheckedObject&);
   using R = JsonSceneReader;
   using M = CheckedObject;
@@ -74,10 +73,8 @@ MaterialDesc JsonSceneReader::read_material(const Json& value, const std::string
          return map;
        }},
   };
-  const NamedReader<Reader>* reader = find_reader(kMaterials, type);
-  if (!reader)
-    report_.fail(m.pointer_of("type"), "unknown material type \"{}\"; expected one of: {}", type, type_names(kMaterials));
-  MaterialDesc material = reader->read(*this, m);
+  const NamedReader<Reader>& reader = reader_for(kMaterials, m, "material");
+  MaterialDesc material = reader.read(*this, m);
   m.finish();
   return material;
 }

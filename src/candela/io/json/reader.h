@@ -46,11 +46,16 @@ std::string type_names(const NamedReader<Reader> (&table)[N]) {
   return names;
 }
 
+// The table's reader for the object's "type"; an unknown type is an error at /type naming the
+// known ones (and `also_known`, a type told apart before the table is consulted).
 template <typename Reader, size_t N>
-const NamedReader<Reader>* find_reader(const NamedReader<Reader> (&table)[N], std::string_view name) {
+const NamedReader<Reader>& reader_for(const NamedReader<Reader> (&table)[N], CheckedObject& object,
+                                      std::string_view kind, std::string_view also_known = {}) {
+  const std::string type = object.string("type");
   for (const NamedReader<Reader>& entry : table)
-    if (entry.name == name) return &entry;
-  return nullptr;
+    if (entry.name == type) return entry;
+  object.report().fail(object.pointer_of("type"), "unknown {} type \"{}\"; expected one of: {}{}{}", kind, type,
+                       type_names(table), also_known.empty() ? "" : ", ", also_known);
 }
 
 class JsonSceneReader {

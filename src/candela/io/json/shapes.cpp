@@ -35,7 +35,6 @@ ShapeDesc JsonSceneReader::read_shape(const Json& value, const std::string& poin
 }
 
 ShapeGeometry JsonSceneReader::read_geometry(CheckedObject& s) {
-  std::string type = s.string("type");
   using Reader = ShapeGeometry (*)(JsonSceneReader&, CheckedObject&);
   using R = JsonSceneReader;
   using S = CheckedObject;
@@ -55,10 +54,8 @@ ShapeGeometry JsonSceneReader::read_geometry(CheckedObject& s) {
        }},
       {"sdfgrid", [](R& r, S& s) -> ShapeGeometry { return r.read_sdf_grid(s); }},
   };
-  if (const NamedReader<Reader>* reader = find_reader(kShapes, type)) return reader->read(*this, s);
   // Instances are told apart before a shape is read (read_shapes).
-  report_.fail(s.pointer_of("type"), "unknown shape type \"{}\"; expected one of: {}, {}", type, type_names(kShapes),
-               kInstanceType);
+  return reader_for(kShapes, s, "shape", kInstanceType).read(*this, s);
 }
 
 // A Mitsuba .vol file, or the samples inline (as `candela convert` writes a grid made in memory).

@@ -72,7 +72,6 @@ TextureDesc JsonSceneReader::read_texture(const Json& value, const std::string& 
     ~DepthGuard() { --depth; }
   } guard(texture_depth_);
   CheckedObject t(report_, value, pointer);
-  std::string type = t.string("type");
   // A texture may be used in any parameter, so the constants inside it are only checked to be >= 0.
   static constexpr ColorKind kAny = ColorKind::NonNegative;
   using Reader = TextureDesc (*)(JsonSceneReader&, CheckedObject&);
@@ -106,10 +105,8 @@ TextureDesc JsonSceneReader::read_texture(const Json& value, const std::string& 
          return MeshAttributeTexture{t.string("name"), t.boolean_or("per_face", false)};
        }},
   };
-  const NamedReader<Reader>* reader = find_reader(kTextures, type);
-  if (!reader)
-    report_.fail(t.pointer_of("type"), "unknown texture type \"{}\"; expected one of: {}", type, type_names(kTextures));
-  TextureDesc texture = reader->read(*this, t);
+  const NamedReader<Reader>& reader = reader_for(kTextures, t, "texture");
+  TextureDesc texture = reader.read(*this, t);
   t.finish();
   return texture;
 }
