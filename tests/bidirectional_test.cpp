@@ -166,17 +166,7 @@ SceneDesc closed_sphere(float albedo) { return testing::closed_diffuse_sphere(al
 // A sphere under a uniform sky, as in the path tracer's furnace tests: light paths start on the
 // scene disk of the light at infinity.
 SceneDesc sphere_under_sky(const MaterialDesc& m) {
-  SceneDesc d;
-  d.film = {24, 24, ""};
-  d.camera = look_at_camera({0, 0, -4}, {0, 0, 0}, 20);  // the sphere fills the image
-  d.settings.max_depth = 100;
-  d.materials = {m};
-  ShapeDesc s;
-  s.geometry = SphereShape{{0, 0, 0}, 1};
-  s.material = 0;
-  d.shapes = {s};
-  d.lights = {SkyLight{RGB(1.0f), RGB(1.0f), RGB(1.0f), {0, 1, 0}}};
-  return d;
+  return testing::sphere_under_sky(m, RGB(1.0f), 24, 20, RenderSettings{}.spp, 100);  // the sphere fills the image
 }
 
 bool inside_disk(int x, int y) {

@@ -70,18 +70,7 @@ SceneDesc closed_sphere(float albedo) {
 
 // A unit sphere under a uniform sky, filling the middle of a 20-degree view.
 SceneDesc sphere_under_sky(const MaterialDesc& material, RGB sky) {
-  SceneDesc d;
-  d.film = {16, 16, ""};
-  d.camera = look_at_camera({0, 0, -4}, {0, 0, 0}, 20);
-  d.settings.spp = 8;
-  d.settings.max_depth = 30;
-  d.materials = {material};
-  ShapeDesc s;
-  s.geometry = SphereShape{{0, 0, 0}, 1};
-  s.material = 0;
-  d.shapes = {s};
-  d.lights = {SkyLight{sky, sky, sky, {0, 1, 0}}};
-  return d;
+  return testing::sphere_under_sky(material, sky, 16, 20, 8, 30);
 }
 
 // Pixels well inside the sphere's silhouette (it subtends 14.5 of the 20 degrees).

@@ -122,18 +122,7 @@ GroundPoint ground_point(const Ray& r) {
 // A unit sphere of `material` at the origin seen from z = -4 under a uniform sky (it subtends
 // asin(1/4) = 14.5 degrees; the fov is 40).
 SceneDesc sphere_under_sky(const MaterialDesc& material, const RGB& sky, int spp) {
-  SceneDesc d;
-  d.film = {kSize, kSize, ""};
-  d.camera = look_at_camera({0, 0, -4}, {0, 0, 0}, 40);
-  d.settings.spp = spp;
-  d.settings.max_depth = 64;
-  d.materials = {material};
-  ShapeDesc s;
-  s.geometry = SphereShape{{0, 0, 0}, 1};
-  s.material = 0;
-  d.shapes = {s};
-  d.lights = {SkyLight{sky, sky, sky, {0, 1, 0}}};
-  return d;
+  return testing::sphere_under_sky(material, sky, kSize, 40, spp, 64);
 }
 
 float angle_from_axis(int x, int y) {

@@ -10,8 +10,8 @@
 namespace candela {
 namespace {
 
-std::string build_error(const std::string& json) {
-  SceneDesc desc = read_json_scene(json, "errors.json", ".");
+// The message of the SceneError that building the scene throws ("" when it builds).
+std::string build_error(const SceneDesc& desc) {
   try {
     Scene scene(desc);
   } catch (const SceneError& e) {
@@ -19,6 +19,8 @@ std::string build_error(const std::string& json) {
   }
   return "";
 }
+
+std::string build_error(const std::string& json) { return build_error(read_json_scene(json, "errors.json", ".")); }
 
 TEST(SceneErrors, AShapeErrorNamesTheShapesLineInTheFile) {
   // Line 3 declares the emissive plane, which the scene refuses (its power would be infinite).
@@ -30,17 +32,9 @@ TEST(SceneErrors, AShapeErrorNamesTheShapesLineInTheFile) {
   EXPECT_EQ(error.rfind("errors.json:3:5: at /shapes/0: shape 0: an infinite plane cannot emit light", 0), 0u) << error;
 }
 
+
 // What a reader's checks cannot see (a light's own checks, material references) is named by the
 // places the reader recorded.
-std::string build_error(const SceneDesc& desc) {
-  try {
-    Scene scene(desc);
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  return "";
-}
-
 TEST(SceneErrors, LightAndMaterialErrorsNameTheirPlaces) {
   SceneDesc lights;
   lights.source_file = "scene.xml";

@@ -72,6 +72,24 @@ inline CameraDesc look_at_camera(const Point3& eye, const Point3& target, float 
 
 // A closed diffuse sphere of radius 2 around the origin, seen from just off its centre on a 16 x 16
 // image: the furnace scenes with analytic answers (Le / (1 - rho), rho I / (pi r^2 (1 - rho))).
+// A unit sphere of `material` at the origin seen from z = -4 (it subtends asin(1/4) = 14.5 degrees)
+// under a uniform sky: the furnace scene of several tests.
+inline SceneDesc sphere_under_sky(const MaterialDesc& material, const RGB& sky, int size, float fov_degrees,
+                                  int spp, int max_depth) {
+  SceneDesc d;
+  d.film = {size, size, ""};
+  d.camera = look_at_camera({0, 0, -4}, {0, 0, 0}, fov_degrees);
+  d.settings.spp = spp;
+  d.settings.max_depth = max_depth;
+  d.materials = {material};
+  ShapeDesc s;
+  s.geometry = SphereShape{{0, 0, 0}, 1};
+  s.material = 0;
+  d.shapes = {s};
+  d.lights = {SkyLight{sky, sky, sky, {0, 1, 0}}};
+  return d;
+}
+
 inline SceneDesc closed_diffuse_sphere(float albedo, int max_depth) {
   SceneDesc d;
   d.film = {16, 16, ""};
