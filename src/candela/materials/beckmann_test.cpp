@@ -11,10 +11,15 @@
 #include "candela/math/frame.h"
 #include "candela/sampling/rng.h"
 #include "candela/sampling/warp.h"
+#include "candela/testing/bsdf_chi_square.h"
 #include "candela/testing/statistics.h"
 
 namespace candela {
 namespace {
+
+using testing::Binning;
+using testing::bsdf_chi_square;
+using testing::zoomed_chi_square;
 
 constexpr int kSamples = testing::kChiSquareSamples;
 constexpr double kAlpha = testing::kChiSquareAlpha;
@@ -24,41 +29,6 @@ Vec3 direction(float theta_degrees, float phi_degrees = 30) {
   return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
 }
 Vec3 below(const Vec3& w) { return {w.x, w.y, -w.z}; }
-
-// Bins uniform in (cos theta, phi) around `axis`, the poles magnified by `zoom` (as in microfacet_test.cpp).
-struct Binning {
-  Vec3 axis{0, 0, 1};
-  float zoom = 1;
-  float z_min = -1;
-  int resolution = 12;
-};
-
-double chi_square(const std::function<Vec3(Vec2)>& sample_fn, const std::function<float(const Vec3&)>& pdf_fn,
-                  const Binning& binning, uint64_t seed = 17) {
-  Frame frame(normalize(binning.axis));
-  const float k = binning.zoom;
-  auto sample = [&](Vec2 u) {
-    Vec3 w = sample_fn(u);
-    if (length_squared(w) == 0) return w;
-    Vec3 v = frame.to_local(normalize(w));
-    return normalize(Vec3(k * v.x, k * v.y, v.z));
-  };
-  auto pdf = [&](const Vec3& warped) {
-    Vec3 u(warped.x / k, warped.y / k, warped.z);
-    float len = length(u);
-    return pdf_fn(frame.to_world(u / len)) / (k * k * len * len * len);
-  };
-  return testing::spherical_chi_square_p_value(sample, pdf, kSamples, seed, binning.z_min, 20, 40, binning.resolution);
-}
-
-double bsdf_chi_square(const Bsdf& bsdf, const Vec3& wo, const Binning& binning = {}) {
-  Rng lobe_rng(42, 43);
-  auto sample = [&](Vec2 u) {
-    auto s = bsdf_sample(bsdf, wo, lobe_rng.next_float(), u);
-    return s && !s->is_delta ? s->wi : Vec3(0.0f);
-  };
-  return chi_square(sample, [&](const Vec3& wi) { return bsdf_pdf(bsdf, wo, wi); }, binning);
-}
 
 struct Albedo {
   double mean = 0, standard_error = 0;
@@ -163,7 +133,7 @@ TEST(Beckmann, VisibleNormalSamplingMatchesPdf) {
     Vec3 w = direction(theta);
     auto sample = [&](Vec2 u) { return d.sample_visible_normal(w, u); };
     auto pdf = [&](const Vec3& wm) { return wm.z > 0 && dot(w, wm) > 0 ? d.pdf(w, wm) : 0.0f; };
-    EXPECT_GT(chi_square(sample, pdf, {Vec3(0, 0, 1), zoom, 0, resolution}), kAlpha)
+    EXPECT_GT(zoomed_chi_square(sample, pdf, {Vec3(0, 0, 1), zoom, 0, resolution}), kAlpha)
         << ax << " x " << ay << " theta " << theta;
   }
   // Sampled normals are unit, in the upper hemisphere and visible, also for directions below the surface.
