@@ -58,7 +58,6 @@ std::string unread_setting_message(const IntegratorEntry& integrator, std::strin
 std::vector<std::string_view> set_but_unread(const IntegratorEntry& integrator, const RenderSettings& settings) {
   const RenderSettings defaults;
   const PathSettings& p = settings.path;
-  const MltSettings& m = settings.mlt;
   auto set = [&](std::string_view key) {
     if (key == "direction_sampling") return p.direction_sampling != defaults.path.direction_sampling;
     if (key == "mis") return p.mis != defaults.path.mis;
@@ -66,9 +65,7 @@ std::vector<std::string_view> set_but_unread(const IntegratorEntry& integrator, 
     if (key == "light_selection=paper") return settings.light_selection == LightSelection::Paper;
     if (key == "rr_start_depth") return settings.rr_start_depth != defaults.rr_start_depth;
     if (key == "adaptive") return settings.adaptive();
-    if (key == "mlt")
-      return m.bootstrap != defaults.mlt.bootstrap || m.chains != defaults.mlt.chains || m.sigma != defaults.mlt.sigma ||
-             m.large_step != defaults.mlt.large_step || m.lens != defaults.mlt.lens || m.caustic != defaults.mlt.caustic;
+    if (key == "mlt") return settings.mlt != defaults.mlt;
     throw std::logic_error(fmt::format("set_but_unread: no check for the setting {}", key));
   };
   std::vector<std::string_view> unread;

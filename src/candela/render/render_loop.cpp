@@ -10,7 +10,6 @@
 #include <bit>
 #include <cmath>
 #include <mutex>
-#include <optional>
 #include <stdexcept>
 #include <tuple>
 

@@ -582,6 +582,7 @@ struct PathSettings {
   DirectionSampling direction_sampling = DirectionSampling::Bsdf;
   bool mis = true;  // false: light sampling for direct light, emission found by bounces ignored
   int shadow_rays = 1;  // per path vertex
+  bool operator==(const PathSettings&) const = default;
 };
 
 // Metropolis light transport's settings (integrator "mlt"; RenderSettings::spp is then the number
@@ -595,6 +596,7 @@ struct MltSettings {
   float large_step = 0.3f;
   float lens = 0;
   float caustic = 0;
+  bool operator==(const MltSettings&) const = default;
   // Why these are not a valid set (the mutation probabilities sum past 1), or empty: the one
   // check behind the command line's and the readers' messages.
   std::string problem() const {
