@@ -12,8 +12,10 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <optional>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -22,6 +24,7 @@
 #include "candela/io/json_writer.h"
 #include "candela/io/scene_reader.h"
 #include "candela/render/checkpoint.h"
+#include "candela/render/cluster.h"
 #include "candela/integrators/bdpt.h"
 #include "candela/integrators/integrator.h"
 #include "candela/scene/resource_limits.h"
@@ -84,6 +87,28 @@ constexpr long long kMaxPixels = 1LL << 28;
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+// An error every rank of the job has agreed on (the lowest failing rank's): the root prints it once
+// and every rank exits with kExitBadInput.
+struct AgreedError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Runs `step` on every rank. Whatever is read before rendering can fail on one rank only (a file
+// that differs on one node), so the ranks compare notes before the next collective step: if `step`
+// threw anywhere, every rank throws the same AgreedError.
+template <typename Step>
+void on_every_rank(Cluster& cluster, Step&& step) {
+  std::string error;
+  try {
+    step();
+  } catch (const std::exception& e) {
+    error = e.what();
+    if (error.empty()) error = "unknown error";
+  }
+  error = cluster.first_error(error);
+  if (!error.empty()) throw AgreedError(error);
+}
 
 struct RenderCommand {
   std::string scene_file;  // empty = built-in scene
@@ -309,61 +334,99 @@ std::string read_bytes(const fs::path& file) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-int run_render(const RenderCommand& cmd) {
-  SceneDesc desc = cmd.scene_file.empty() ? read_json_scene(builtin_scene_json(), "<built-in cornell-box.json>", ".")
-                                          : read_scene_file(cmd.scene_file);
-  apply_overrides(cmd, desc);
-  const bool adaptive = desc.settings.adaptive();
+// What the ranks of a job must all have read alike: the scene file's bytes and every mesh.
+uint64_t scene_content_hash(const std::string& scene_bytes, const SceneDesc& desc) {
+  uint64_t hash = fnv1a64(scene_bytes.data(), scene_bytes.size());
+  for (const ShapeDesc& shape : desc.shapes)
+    if (const auto* m = std::get_if<MeshShape>(&shape.geometry)) {
+      hash = fnv1a64(m->mesh.positions.data(), m->mesh.positions.size() * sizeof(Point3), hash);
+      hash = fnv1a64(m->mesh.indices.data(), m->mesh.indices.size() * sizeof(uint32_t), hash);
+    }
+  return hash;
+}
+
+int run_render(const RenderCommand& cmd, Cluster& cluster) {
+  SceneDesc desc;
+  bool adaptive = false;
   const bool pixel_mode = !cmd.pixel.empty();
-  if (cmd.checkpoint_every && cmd.checkpoint.empty()) throw UsageError("--checkpoint-every needs --checkpoint FILE");
-  if (adaptive && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
-    throw UsageError("--checkpoint and --resume are not supported with adaptive sampling (--adaptive-threshold, --adaptive-spp)");
-  if (pixel_mode && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
-    throw UsageError("--pixel cannot be combined with --checkpoint or --resume");
-  const IntegratorEntry& integrator = *find_integrator(desc.settings.integrator);
-  if (!integrator.resumable && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
-    throw UsageError(fmt::format("--checkpoint and --resume are not supported with the {} integrator (it cannot continue a partly rendered film)", integrator.name));
-  if (!integrator.single_pixel && pixel_mode)
-    throw UsageError(fmt::format("--pixel cannot be used with the {} integrator (it cannot render one pixel alone)", integrator.name));
-  if (!cmd.bdpt_strategies.empty() && !fs::is_directory(cmd.bdpt_strategies))
-    throw UsageError(fmt::format("--bdpt-strategies '{}': not a directory", cmd.bdpt_strategies));
   int px = -1, py = -1;
-  if (pixel_mode) {
-    std::smatch m;
-    static const std::regex pattern(R"((\d{1,9}),(\d{1,9}))");
-    if (!std::regex_match(cmd.pixel, m, pattern))
-      throw UsageError(fmt::format("--pixel: expected X,Y such as 10,20, got '{}'", cmd.pixel));
-    px = std::stoi(m[1]);
-    py = std::stoi(m[2]);
-    if (px >= desc.film.width || py >= desc.film.height)
-      throw UsageError(fmt::format("--pixel {},{} is outside the {}x{} image", px, py, desc.film.width, desc.film.height));
-  }
-  std::vector<fs::path> outputs = output_files(cmd, desc);
-  if (!pixel_mode) check_outputs(outputs);
-  // Refuse what cannot fit in memory before allocating the scene and the film.
-  check_resources(desc);
+  std::vector<fs::path> outputs;
+  std::string scene_bytes;
+  on_every_rank(cluster, [&] {
+    desc = cmd.scene_file.empty() ? read_json_scene(builtin_scene_json(), "<built-in cornell-box.json>", ".")
+                                  : read_scene_file(cmd.scene_file);
+    scene_bytes = cmd.scene_file.empty() ? std::string(builtin_scene_json()) : read_bytes(cmd.scene_file);
+    apply_overrides(cmd, desc);
+    adaptive = desc.settings.adaptive();
+    if (cmd.checkpoint_every && cmd.checkpoint.empty()) throw UsageError("--checkpoint-every needs --checkpoint FILE");
+    if (adaptive && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
+      throw UsageError("--checkpoint and --resume are not supported with adaptive sampling (--adaptive-threshold, --adaptive-spp)");
+    if (pixel_mode && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
+      throw UsageError("--pixel cannot be combined with --checkpoint or --resume");
+    if (pixel_mode && cluster.distributed())
+      throw UsageError("--pixel renders one pixel in one process: run it without mpirun");
+    const IntegratorEntry& chosen = *find_integrator(desc.settings.integrator);
+    if (!chosen.resumable && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
+      throw UsageError(fmt::format("--checkpoint and --resume are not supported with the {} integrator (it cannot continue a partly rendered film)", chosen.name));
+    if (!chosen.single_pixel && pixel_mode)
+      throw UsageError(fmt::format("--pixel cannot be used with the {} integrator (it cannot render one pixel alone)", chosen.name));
+    if (!cmd.bdpt_strategies.empty() && !fs::is_directory(cmd.bdpt_strategies))
+      throw UsageError(fmt::format("--bdpt-strategies '{}': not a directory", cmd.bdpt_strategies));
+    if (pixel_mode) {
+      std::smatch m;
+      static const std::regex pattern(R"((\d{1,9}),(\d{1,9}))");
+      if (!std::regex_match(cmd.pixel, m, pattern))
+        throw UsageError(fmt::format("--pixel: expected X,Y such as 10,20, got '{}'", cmd.pixel));
+      px = std::stoi(m[1]);
+      py = std::stoi(m[2]);
+      if (px >= desc.film.width || py >= desc.film.height)
+        throw UsageError(fmt::format("--pixel {},{} is outside the {}x{} image", px, py, desc.film.width, desc.film.height));
+    }
+    outputs = output_files(cmd, desc);
+    if (!pixel_mode && cluster.is_root()) check_outputs(outputs);
+    // Refuse what cannot fit in memory before allocating the scene and the film.
+    check_resources(desc);
+    if (!cmd.checkpoint.empty()) {
+      fs::path p(cmd.checkpoint);
+      fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+      if (cluster.is_root() && !fs::is_directory(dir))
+        throw UsageError(fmt::format("--checkpoint '{}': directory '{}' does not exist", cmd.checkpoint, dir.string()));
+    }
+  });
+  // Every rank must render the same scene: a file changed on one node is refused.
+  const uint64_t content_hash = scene_content_hash(scene_bytes, desc);
+  on_every_rank(cluster, [&] {
+    std::vector<uint64_t> hashes = cluster.gather_values(content_hash);
+    for (size_t r = 1; r < hashes.size(); ++r)
+      if (hashes[r] != hashes[0])
+        throw UsageError(fmt::format("rank {} read a different scene than rank 0 ('{}' or its meshes differ between "
+                                     "the nodes; hash {:016x} vs {:016x})",
+                                     r, cmd.scene_file, hashes[r], hashes[0]));
+  });
+  const IntegratorEntry& integrator = *find_integrator(desc.settings.integrator);
 
   const float clamp = cmd.clamp.value_or(0.0f);
   RenderFingerprint fingerprint;
   std::optional<Checkpoint> resumed;
-  if (!cmd.checkpoint.empty() || !cmd.resume.empty()) {
-    fingerprint = make_fingerprint(
-        cmd.scene_file.empty() ? std::string(builtin_scene_json()) : read_bytes(cmd.scene_file), desc, clamp);
-    if (!cmd.checkpoint.empty()) {
-      fs::path p(cmd.checkpoint);
-      fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-      if (!fs::is_directory(dir))
-        throw UsageError(fmt::format("--checkpoint '{}': directory '{}' does not exist", cmd.checkpoint, dir.string()));
-    }
-  }
+  if (!cmd.checkpoint.empty() || !cmd.resume.empty()) fingerprint = make_fingerprint(scene_bytes, desc, clamp);
   if (!cmd.resume.empty()) {
-    resumed = read_checkpoint(cmd.resume);
-    std::string diff = resumed->fingerprint.difference(fingerprint);
-    if (!diff.empty())
-      throw UsageError(fmt::format("cannot resume from '{}': {} (checkpoint vs now)", cmd.resume, diff));
-    if (resumed->width != desc.film.width || resumed->height != desc.film.height)
-      throw UsageError(fmt::format("cannot resume from '{}': its film is {}x{}, not {}x{}", cmd.resume,
-                                   resumed->width, resumed->height, desc.film.width, desc.film.height));
+    // The root reads the checkpoint and sends it to the others: only it needs to see the file.
+    std::string checkpoint_bytes;
+    on_every_rank(cluster, [&] {
+      if (cluster.is_root()) checkpoint_bytes = read_bytes(cmd.resume);
+    });
+    std::vector<std::byte> shared(reinterpret_cast<const std::byte*>(checkpoint_bytes.data()),
+                                  reinterpret_cast<const std::byte*>(checkpoint_bytes.data() + checkpoint_bytes.size()));
+    cluster.broadcast(shared);
+    on_every_rank(cluster, [&] {
+      resumed = parse_checkpoint(std::string_view(reinterpret_cast<const char*>(shared.data()), shared.size()), cmd.resume);
+      std::string diff = resumed->fingerprint.difference(fingerprint);
+      if (!diff.empty())
+        throw UsageError(fmt::format("cannot resume from '{}': {} (checkpoint vs now)", cmd.resume, diff));
+      if (resumed->width != desc.film.width || resumed->height != desc.film.height)
+        throw UsageError(fmt::format("cannot resume from '{}': its film is {}x{}, not {}x{}", cmd.resume,
+                                     resumed->width, resumed->height, desc.film.width, desc.film.height));
+    });
   }
 
   // The meshes move into the scene: every triangle is held once.
@@ -373,11 +436,12 @@ int run_render(const RenderCommand& cmd) {
   uint64_t earlier_non_finite = 0;
   if (resumed) {
     film.pixels() = std::move(resumed->pixels);
+    // Splats and counts are sums over the ranks: the root alone carries the checkpoint's.
     if (!resumed->splats.empty()) {
       film.enable_splats();
-      film.splats().sums() = std::move(resumed->splats);
+      if (cluster.is_root()) film.splats().sums() = std::move(resumed->splats);
     }
-    earlier_non_finite = resumed->non_finite_samples;
+    if (cluster.is_root()) earlier_non_finite = resumed->non_finite_samples;
   }
   // Per-strategy images of bidirectional path tracing, depth by depth up to 5 (or max-depth).
   const int strategy_depth = std::min(desc.settings.max_depth, 5);
@@ -386,11 +450,12 @@ int run_render(const RenderCommand& cmd) {
     strategy_images.assign(size_t(BdptIntegrator::strategy_count(strategy_depth)), SplatImage(film.width(), film.height()));
   }
   RenderOptions options;
-  options.threads = cmd.threads.value_or(0);
-  options.progress = !cmd.quiet;
+  options.threads = cmd.threads.value_or(cluster.default_threads());
+  options.progress = !cmd.quiet && cluster.is_root();
   options.cancel = &g_stop;
   options.time_limit_seconds = cmd.time_limit.value_or(0.0);
   options.clamp = clamp;
+  options.cluster = &cluster;
   if (!strategy_images.empty()) {
     options.bdpt_strategies = &strategy_images;
     options.bdpt_unweighted = cmd.bdpt_unweighted;
@@ -400,22 +465,30 @@ int run_render(const RenderCommand& cmd) {
     options.only_y = py;
     options.max_reported_non_finite = 1000;
   }
-  auto save_checkpoint = [&](const Film& f, uint64_t non_finite) {
+  // Called on every rank at the same moment; the root writes. `own_splats`: the film's splats are
+  // still each rank's own (during the render), to be added up first.
+  auto save_checkpoint = [&](const Film& f, uint64_t non_finite, bool own_splats) {
     Checkpoint cp;
-    cp.fingerprint = fingerprint;
-    cp.width = f.width();
-    cp.height = f.height();
-    cp.non_finite_samples = non_finite;
-    cp.pixels = f.pixels();
-    if (f.has_splats()) cp.splats = f.splats().sums();
-    write_checkpoint(cmd.checkpoint, cp);
+    if (f.has_splats()) {
+      cp.splats = f.splats().sums();
+      if (own_splats) cluster.sum_int64(cp.splats);
+    }
+    on_every_rank(cluster, [&] {
+      if (!cluster.is_root()) return;
+      cp.fingerprint = fingerprint;
+      cp.width = f.width();
+      cp.height = f.height();
+      cp.non_finite_samples = non_finite;
+      cp.pixels = f.pixels();
+      write_checkpoint(cmd.checkpoint, cp);
+    });
   };
   auto last_checkpoint = std::chrono::steady_clock::now();
   if (!cmd.checkpoint.empty() && cmd.checkpoint_every)
     options.after_pass = [&](const Film& f, uint64_t non_finite_so_far) {
       auto now = std::chrono::steady_clock::now();
-      if (std::chrono::duration<double>(now - last_checkpoint).count() < *cmd.checkpoint_every) return;
-      save_checkpoint(f, earlier_non_finite + non_finite_so_far);
+      if (!cluster.root_says(std::chrono::duration<double>(now - last_checkpoint).count() >= *cmd.checkpoint_every)) return;
+      save_checkpoint(f, earlier_non_finite + non_finite_so_far, true);
       last_checkpoint = std::chrono::steady_clock::now();
     };
   g_phase.store(kRendering);
@@ -446,7 +519,9 @@ int run_render(const RenderCommand& cmd) {
     return stats.cancelled ? kExitInterrupted : 0;
   }
 
-  if (stopped && !cmd.checkpoint.empty()) save_checkpoint(film, non_finite);
+  if (stopped && !cmd.checkpoint.empty()) save_checkpoint(film, non_finite, false);
+  // The root writes the images and reports; the other ranks are done.
+  if (!cluster.is_root()) return stats.cancelled ? kExitInterrupted : 0;
 
   const double pixels = double(film.width()) * film.height();
   const uint64_t min_spp = film.min_samples(), max_spp = film.max_samples();
@@ -473,6 +548,7 @@ int run_render(const RenderCommand& cmd) {
       {"candela:transport", desc.settings.spectral ? "spectral" : "rgb"},
       {"candela:max_depth", std::to_string(desc.settings.max_depth)},
       {"candela:seed", std::to_string(desc.settings.seed)},
+      {"candela:ranks", std::to_string(cluster.size())},
       {"Software", "candela " CANDELA_VERSION}};
   if (stats.cancelled) metadata["candela:interrupted"] = "true";
   if (stats.time_limited) metadata["candela:time-limited"] = "true";
@@ -498,6 +574,17 @@ int run_render(const RenderCommand& cmd) {
               desc.film.height, spp_text.c_str(), spp_unit, stats.seconds, double(stats.samples) / seconds * 1e-6,
               double(stats.rays.total()) / seconds * 1e-6,
               double(stats.rays.total()) / double(std::max<uint64_t>(stats.samples, 1)), written.c_str());
+  if (cluster.distributed()) {
+    // The job's parallel efficiency: the thread-seconds spent rendering over all threads x wall time.
+    double busy = 0;
+    std::string per_rank;
+    for (double b : stats.rank_busy_seconds) {
+      busy += b;
+      per_rank += fmt::format("{}{:.2f}", per_rank.empty() ? "" : " ", b);
+    }
+    std::printf("%d ranks, %d threads: parallel efficiency %.1f%% (busy thread-seconds per rank: %s)\n",
+                cluster.size(), stats.threads, 100 * busy / (double(stats.threads) * seconds), per_rank.c_str());
+  }
   if (stats.time_limited)
     std::fprintf(stderr, "candela: time limit reached: wrote the image with %s%s\n", spp_text.c_str(), spp_unit);
   if (stats.cancelled) {
@@ -526,9 +613,17 @@ int run_convert(const std::string& in, const std::string& out) {
 
 int main(int argc, char** argv) {
   install_signal_handlers();
+  // Under mpirun this process is one rank of a job (render/cluster.h); otherwise it is alone.
+  std::unique_ptr<Cluster> cluster;
+  try {
+    cluster = join_cluster(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "candela: error: %s\n", e.what());
+    return kExitBadInput;
+  }
   CLI::App app{"candela: a physically based Monte Carlo path tracer.\n"
                "With no arguments, renders the built-in Cornell box to cornell-box.png and cornell-box.exr."};
-  app.set_version_flag("--version", "candela " CANDELA_VERSION);
+  app.set_version_flag("--version", "candela " CANDELA_VERSION " (" + mpi_support() + ")");
   RenderCommand cmd;
   CLI::App* render_cmd = app.add_subcommand("render", "Render a scene file to an image");
   render_cmd->add_option("scene", cmd.scene_file, "Scene file: .json (candela's format), .pbrt (pbrt-v4), .xml (Mitsuba 3), .gltf/.glb, .obj")
@@ -637,13 +732,26 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    if (!cluster->is_root()) {  // every rank parsed the same words: the root alone says what is wrong
+      std::ostringstream ignored;
+      return app.exit(e, ignored, ignored);
+    }
     return app.exit(e);
   }
   try {
-    if (convert_cmd->parsed()) return run_convert(convert_in, convert_out);
-    return run_render(cmd);
+    if (convert_cmd->parsed()) return cluster->is_root() ? run_convert(convert_in, convert_out) : 0;
+    return run_render(cmd, *cluster);
+  } catch (const AgreedError& e) {  // every rank has it: one message
+    if (cluster->is_root()) std::fprintf(stderr, "candela: error: %s\n", e.what());
   } catch (const std::exception& e) {  // SceneError, UsageError, image I/O: one message, no output written
-    std::fprintf(stderr, "candela: error: %s\n", e.what());
+    if (!cluster->distributed()) {
+      std::fprintf(stderr, "candela: error: %s\n", e.what());
+    } else {
+      // Past the point where the ranks agree: the others may be waiting on this one, so end the job.
+      std::fprintf(stderr, "candela: error (rank %d): %s\n", cluster->rank(), e.what());
+      std::fflush(stderr);
+      cluster->abort(kExitBadInput);
+    }
   }
   return kExitBadInput;
 }

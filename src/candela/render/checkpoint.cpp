@@ -157,6 +157,10 @@ Checkpoint read_checkpoint(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
   if (!in) fail(file, "cannot open");
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return parse_checkpoint(bytes, file);
+}
+
+Checkpoint parse_checkpoint(std::string_view bytes, const std::filesystem::path& file) {
   if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
     fail(file, "not a candela checkpoint (bad magic header)");
   if (bytes.size() < kHeaderSize) fail(file, "truncated (header incomplete)");

@@ -50,5 +50,7 @@ void write_checkpoint(const std::filesystem::path& file, const Checkpoint& check
 // Throws std::runtime_error naming the file and the problem: missing, not a checkpoint, another
 // version, truncated, or corrupt (checksum mismatch).
 Checkpoint read_checkpoint(const std::filesystem::path& file);
+// The same for a checkpoint's bytes (read by one rank and sent to the others); `file` names it in errors.
+Checkpoint parse_checkpoint(std::string_view bytes, const std::filesystem::path& file);
 
 }  // namespace candela

@@ -11,6 +11,8 @@
 #include <cmath>
 #include <mutex>
 #include <stdexcept>
+#include <cstring>
+#include <span>
 #include <tuple>
 
 #include "candela/render/progress.h"
@@ -22,34 +24,86 @@ constexpr int kTileSize = 16;
 constexpr int kPassSpp = 16;  // samples per pixel per pass in plain renders: a responsive progress bar, and
                                // runs of one pixel's samples long enough for samplers to reuse per-pixel work
 
-std::vector<Tile> make_tiles(int width, int height) {
-  std::vector<Tile> tiles;
-  for (int y = 0; y < height; y += kTileSize)
-    for (int x = 0; x < width; x += kTileSize)
-      tiles.push_back({x, y, std::min(x + kTileSize, width), std::min(y + kTileSize, height)});
-  return tiles;
-}
-
 // Everything one pass needs, shared by all tiles.
 struct PassContext {
   const TileIntegrator& integrator;
   TileContext tile;
   tbb::enumerable_thread_specific<RayCounts>& ray_counts;
   const std::atomic<bool>* cancel;
+  Cluster& cluster;
+  std::atomic<uint64_t>& busy_nanoseconds;
 };
 
 bool cancelled(const PassContext& pc) { return pc.cancel && pc.cancel->load(std::memory_order_relaxed); }
 
+uint64_t tile_samples(const Tile& tile, const SampleRanges& range) {
+  uint64_t n = 0;
+  for (int y = tile.y0; y < tile.y1; ++y)
+    for (int x = tile.x0; x < tile.x1; ++x) n += uint64_t(std::max(range(x, y).count, 0));
+  return n;
+}
+
+// After a pass across ranks: each rank sends the sums of the tiles it rendered, and every rank
+// copies the others' into its film, so all films are again the same.
+void exchange_tiles(Cluster& cluster, Film& film, const std::vector<Tile>& tiles, const std::vector<uint8_t>& mine) {
+  std::vector<std::byte> bytes;
+  auto append = [&](const void* data, size_t size) {
+    const auto* p = static_cast<const std::byte*>(data);
+    bytes.insert(bytes.end(), p, p + size);
+  };
+  for (uint32_t t = 0; t < tiles.size(); ++t) {
+    if (!mine[t]) continue;
+    append(&t, sizeof t);
+    for (int y = tiles[t].y0; y < tiles[t].y1; ++y)
+      append(&film.pixel(tiles[t].x0, y), sizeof(PixelSums) * size_t(tiles[t].x1 - tiles[t].x0));
+  }
+  std::vector<std::vector<std::byte>> all = cluster.all_gather(bytes);
+  for (int r = 0; r < int(all.size()); ++r) {
+    if (r == cluster.rank()) continue;
+    const std::byte* p = all[size_t(r)].data();
+    const std::byte* end = p + all[size_t(r)].size();
+    while (p < end) {
+      uint32_t t;
+      std::memcpy(&t, p, sizeof t);
+      p += sizeof t;
+      const Tile& tile = tiles.at(t);
+      for (int y = tile.y0; y < tile.y1; ++y) {
+        size_t row = sizeof(PixelSums) * size_t(tile.x1 - tile.x0);
+        std::memcpy(&film.pixels()[size_t(y) * size_t(film.width()) + size_t(tile.x0)], p, row);
+        p += row;
+      }
+    }
+  }
+}
+
 // One pass over the tiles: pixel (x, y) gets the samples range(x, y) names. Tiles not yet started
-// when the cancel flag is set are skipped.
+// when the cancel flag is set are skipped. The tiles are handed out one by one (across ranks by the
+// cluster); which thread or rank renders a tile changes nothing in its pixels.
 void run_pass(const PassContext& pc, const std::vector<Tile>& tiles, tbb::task_arena& arena, const SampleRanges& range,
               ProgressBar& progress) {
-  arena.execute([&] {
-    tbb::parallel_for(size_t(0), tiles.size(), [&](size_t t) {
-      if (cancelled(pc)) return;
-      progress.advance(pc.integrator.render_tile(tiles[t], range, pc.tile, pc.ray_counts.local()));
-    });
-  });
+  std::vector<uint8_t> mine(tiles.size(), 0);
+  const int threads = arena.max_concurrency();
+  pc.cluster.share_work(
+      tiles.size(), threads,
+      [&](const Cluster::NextItem& next) {
+        arena.execute([&] {
+          tbb::parallel_for(0, threads, 1, [&](int) {
+            while (std::optional<uint64_t> t = next()) {
+              mine[*t] = 1;
+              if (cancelled(pc)) continue;
+              auto start = std::chrono::steady_clock::now();
+              progress.advance(pc.integrator.render_tile(tiles[*t], range, pc.tile, pc.ray_counts.local()));
+              pc.busy_nanoseconds.fetch_add(
+                  uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count()),
+                  std::memory_order_relaxed);
+            }
+          });
+        });
+      },
+      [&](uint64_t first, uint64_t count) {
+        for (uint64_t t = first; t < first + count; ++t) progress.advance(tile_samples(tiles[t], range));
+      });
+  if (pc.cluster.distributed()) exchange_tiles(pc.cluster, pc.tile.film, tiles, mine);
 }
 
 // ---- Adaptive sampling -------------------------------------------------------------------------
@@ -235,7 +289,42 @@ void render_adaptive(const PassContext& pc, const std::vector<Tile>& tiles, tbb:
   }
 }
 
+// After the last pass across ranks, what they rendered besides the film: the non-finite samples,
+// rays and busy time of every rank, and the splats of their light paths (integer sums, so adding
+// them is exact whatever the order).
+void combine_ranks(Cluster& cluster, Film& film, const RenderOptions& options, int limit, RenderStats& stats) {
+  uint64_t non_finite = 0;
+  for (uint64_t n : cluster.gather_values(stats.non_finite_samples)) non_finite += n;
+  stats.non_finite_samples = non_finite;
+  RayCounts rays;
+  for (const RayCounts& r : cluster.gather_values(stats.rays)) rays += r;
+  stats.rays = rays;
+  NonFiniteLog first(limit);
+  for (const auto& bytes : cluster.all_gather(std::as_bytes(std::span(stats.first_non_finite))))
+    for (size_t at = 0; at + sizeof(NonFiniteSample) <= bytes.size(); at += sizeof(NonFiniteSample)) {
+      NonFiniteSample n;
+      std::memcpy(&n, bytes.data() + at, sizeof n);
+      first.add(n.x, n.y, n.sample);
+    }
+  stats.first_non_finite = first.samples();
+  stats.rank_busy_seconds = cluster.gather_values(stats.rank_busy_seconds.at(0));
+  int threads = 0;
+  for (int t : cluster.gather_values(stats.threads)) threads += t;
+  stats.threads = threads;
+  if (film.has_splats()) cluster.sum_int64(film.splats().sums());
+  if (options.bdpt_strategies)
+    for (SplatImage& image : *options.bdpt_strategies) cluster.sum_int64(image.sums());
+}
+
 }  // namespace
+
+std::vector<Tile> make_tiles(int width, int height) {
+  std::vector<Tile> tiles;
+  for (int y = 0; y < height; y += kTileSize)
+    for (int x = 0; x < width; x += kTileSize)
+      tiles.push_back({x, y, std::min(x + kTileSize, width), std::min(y + kTileSize, height)});
+  return tiles;
+}
 
 NonFiniteLog::NonFiniteLog(int limit) : limit_(size_t(std::max(limit, 0))) {}
 
@@ -271,14 +360,25 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
   std::vector<Tile> tiles = options.only_x >= 0 ? std::vector<Tile>{{options.only_x, options.only_y,
                                                                      options.only_x + 1, options.only_y + 1}}
                                                 : make_tiles(film.width(), film.height());
-  const uint64_t pixel_count = options.only_x >= 0 ? 1 : uint64_t(film.width()) * film.height();
+  const uint64_t pixel_count = options.only_x >= 0                ? 1
+                               : options.part_count > 1 ? uint64_t(film.width()) * film.height() / uint64_t(options.part_count)
+                                                        : uint64_t(film.width()) * film.height();
+  if (options.part_count > 1) {
+    // A job-array part: every part_count-th tile, from part_index on.
+    std::vector<Tile> share;
+    for (size_t t = size_t(options.part_index); t < tiles.size(); t += size_t(options.part_count)) share.push_back(tiles[t]);
+    tiles = std::move(share);
+  }
+  Cluster& cluster = options.cluster ? *options.cluster : local_cluster();
   tbb::enumerable_thread_specific<RayCounts> ray_counts;
-  std::atomic<uint64_t> non_finite{0};
+  std::atomic<uint64_t> non_finite{0}, busy_nanoseconds{0};
   NonFiniteLog non_finite_log(options.max_reported_non_finite);
   PassContext pc{integrator,
                  {scene, filter, prototype, film, non_finite, non_finite_log, options.clamp, settings.spectral},
                  ray_counts,
-                 options.cancel};
+                 options.cancel,
+                 cluster,
+                 busy_nanoseconds};
   const uint64_t samples_before = film.total_samples();
   const uint64_t expected_spp = adaptive && settings.adaptive_spp > 0 ? uint64_t(settings.adaptive_spp) : uint64_t(max_spp);
   ProgressBar progress(pixel_count * expected_spp, options.progress);
@@ -286,13 +386,16 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   RenderStats stats;
   // After a whole pass: true when the render must stop (cancelled, or out of time).
+  // Across ranks the answer is agreed: any rank's interruption stops all, and the root's clock
+  // decides the time limit.
   auto stop_after_pass = [&](bool more_to_do) {
-    if (cancelled(pc)) {
+    if (cluster.any(cancelled(pc))) {
       stats.cancelled = true;
       return true;
     }
     if (more_to_do && options.time_limit_seconds > 0 &&
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= options.time_limit_seconds) {
+        cluster.root_says(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >=
+                          options.time_limit_seconds)) {
       stats.time_limited = true;
       return true;
     }
@@ -314,8 +417,13 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
                  return SampleRange{have, int(std::max<int64_t>(0, end - have))};
                },
                progress);
-      if (options.after_pass && !cancelled(pc)) options.after_pass(film, non_finite.load());
-      if (stop_after_pass(end < settings.spp)) break;
+      const bool stop = stop_after_pass(end < settings.spp);
+      if (options.after_pass && !stats.cancelled) {
+        uint64_t non_finite_so_far = 0;
+        for (uint64_t n : cluster.gather_values(non_finite.load())) non_finite_so_far += n;
+        options.after_pass(film, non_finite_so_far);
+      }
+      if (stop) break;
     }
   } else {
     if (samples_before > 0) throw std::invalid_argument("adaptive sampling cannot continue a partly rendered film");
@@ -327,8 +435,11 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
   stats.samples = film.total_samples() - samples_before;
   stats.non_finite_samples = non_finite.load();
   stats.first_non_finite = non_finite_log.samples();
-  if (cancelled(pc)) stats.cancelled = true;
+  stats.cancelled = cluster.any(stats.cancelled || cancelled(pc));
   for (const auto& c : ray_counts) stats.rays += c;
+  stats.rank_busy_seconds = {double(busy_nanoseconds.load()) * 1e-9};
+  stats.threads = arena.max_concurrency();
+  if (cluster.distributed()) combine_ranks(cluster, film, options, options.max_reported_non_finite, stats);
   return stats;
 }
 

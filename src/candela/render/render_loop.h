@@ -11,6 +11,10 @@
 // with a budget of samples, each pixel gets a share proportional to its estimated relative
 // deviation (RenderSettings::adaptive_spp).
 //
+// Across MPI ranks (RenderOptions::cluster) the tiles of each pass are handed out dynamically, every
+// rank keeps the whole film, and the ranks exchange the tiles they rendered after each pass, so the
+// image is bitwise the one a single process renders (render/cluster.h).
+//
 // An integrator gives the loop a TileIntegrator (usually CameraSampleTiles, render/camera_sample_tiles.h,
 // around its radiance function); integrators/integrator.h chooses the integrator.
 #include <atomic>
@@ -22,6 +26,7 @@
 
 #include "candela/film/film.h"
 #include "candela/film/filter.h"
+#include "candela/render/cluster.h"
 #include "candela/sampling/samplers.h"
 #include "candela/scene/scene.h"
 
@@ -42,14 +47,21 @@ struct RenderOptions {
   // How many non-finite samples to report (the ones with the smallest (sample, y, x)).
   int max_reported_non_finite = 5;
   // Called between whole passes (never while tiles run) with the film as it stands, e.g. to write
-  // a checkpoint, and the number of non-finite samples dropped so far in this call. Not called for
-  // adaptive renders.
+  // a checkpoint, and the number of non-finite samples dropped so far in this call (by all ranks).
+  // Across ranks it is called on every rank at the same passes; the film's splats are then this
+  // rank's own (add them with Cluster::sum_int64). Not called for adaptive renders.
   std::function<void(const Film&, uint64_t non_finite_so_far)> after_pass;
   // Integrator "bdpt": when set, every strategy's (s, t) contribution also goes to its own image
   // (BdptIntegrator::strategy_index; sized by the caller, images beyond its size are skipped), MIS
   // weighted or, with bdpt_unweighted, not. Scaled like the film's splats (RenderStats::splat_scale).
   std::vector<SplatImage>* bdpt_strategies = nullptr;
   bool bdpt_unweighted = false;
+  // The processes rendering this image together; null = this process alone. Every rank calls the
+  // render with the same scene, settings and film; after it every rank's film holds the whole image
+  // (splats included), and the stats count every rank's samples, rays and non-finite values.
+  Cluster* cluster = nullptr;
+  // Job-array parts (--part K/N): render only the tiles whose index is K-1 modulo N. {0, 1} = all.
+  int part_index = 0, part_count = 1;
 };
 
 struct NonFiniteSample {
@@ -65,6 +77,10 @@ struct RenderStats {
   bool cancelled = false;                         // stopped by RenderOptions::cancel
   bool time_limited = false;                      // stopped by the time limit before all samples
   RayCounts rays;
+  // Per rank, the thread-seconds it spent rendering (tiles, or Markov chains), and the threads of
+  // all ranks: the job's parallel efficiency is the busy time over threads x wall time.
+  std::vector<double> rank_busy_seconds;
+  int threads = 1;
   // Integrator "mlt": the estimate of the image's mean luminance that scales the chains' deposits,
   // its standard error relative to it, the samples it took and the seconds they took.
   double mlt_normalization = 0, mlt_normalization_relative_error = 0;
@@ -122,6 +138,9 @@ class TileIntegrator {
   virtual uint64_t render_tile(const Tile& tile, const SampleRanges& range, const TileContext& context,
                                RayCounts& counts) const = 0;
 };
+
+// The tiles a film is cut into, in the order the loop hands them out (row by row of tiles).
+std::vector<Tile> make_tiles(int width, int height);
 
 // Renders settings.spp samples per pixel into `film` (sized to the camera's resolution) with
 // `integrator`, or adaptively when settings.adaptive(). Without adaptive sampling the film may

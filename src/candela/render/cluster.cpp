@@ -1,0 +1,56 @@
+#include "candela/render/cluster.h"
+
+#include <atomic>
+#include <cstdlib>
+
+namespace candela {
+
+bool Cluster::any(bool flag) {
+  for (bool f : gather_values(flag))
+    if (f) return true;
+  return false;
+}
+
+bool Cluster::root_says(bool value) {
+  std::vector<std::byte> bytes(1, std::byte(value ? 1 : 0));
+  broadcast(bytes);
+  return bytes[0] != std::byte(0);
+}
+
+std::string Cluster::first_error(const std::string& error) {
+  std::vector<std::vector<std::byte>> all = all_gather(std::as_bytes(std::span(error.data(), error.size())));
+  for (size_t r = 0; r < all.size(); ++r)
+    if (!all[r].empty()) {
+      std::string message(reinterpret_cast<const char*>(all[r].data()), all[r].size());
+      return r == 0 ? message : "rank " + std::to_string(r) + ": " + message;
+    }
+  return "";
+}
+
+void LocalCluster::share_work(uint64_t items, int, const std::function<void(const NextItem&)>& work,
+                              const std::function<void(uint64_t, uint64_t)>&) {
+  std::atomic<uint64_t> next{0};
+  work([&]() -> std::optional<uint64_t> {
+    uint64_t i = next.fetch_add(1, std::memory_order_relaxed);
+    if (i >= items) return std::nullopt;
+    return i;
+  });
+}
+
+std::vector<std::vector<std::byte>> LocalCluster::all_gather(std::span<const std::byte> mine) {
+  return {std::vector<std::byte>(mine.begin(), mine.end())};
+}
+
+void LocalCluster::abort(int exit_code) { std::_Exit(exit_code); }
+
+Cluster& local_cluster() {
+  static LocalCluster alone;
+  return alone;
+}
+
+#ifndef CANDELA_HAVE_MPI
+std::unique_ptr<Cluster> join_cluster(int&, char**&) { return std::make_unique<LocalCluster>(); }
+std::string mpi_support() { return "built without MPI: renders in one process"; }
+#endif
+
+}  // namespace candela

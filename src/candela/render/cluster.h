@@ -1,0 +1,101 @@
+#pragma once
+// The processes that render one image together: one process (a plain run), or the ranks of an Open
+// MPI job (`mpirun -np N candela render ...`, render/mpi_cluster.cpp). The render loops use only
+// this interface, so the same code renders in one process and across ranks, and the image is the
+// same bit for bit either way (docs/distributed.md):
+//   - work is handed out dynamically (share_work), but a pixel's samples are always computed as a
+//     function of (pixel, sample index, seed) and added to its sums in sample order;
+//   - every rank holds the whole film, and after each pass the ranks exchange the tiles they
+//     rendered (all_gather), so all replicas stay identical and every decision taken from the film
+//     (adaptive sampling, the next pass) is the same on every rank;
+//   - splats are fixed-point integer sums, added across ranks exactly (sum_int64).
+// Only the calling thread of each rank talks MPI (MPI_THREAD_FUNNELED): render threads ask for work
+// through share_work's `next` function, which never calls MPI itself.
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace candela {
+
+class Cluster {
+ public:
+  virtual ~Cluster() = default;
+  virtual int rank() const = 0;
+  virtual int size() const = 0;
+  bool is_root() const { return rank() == 0; }
+  bool distributed() const { return size() > 1; }
+  // Render threads this rank uses by default: its share of the node's cores.
+  virtual int default_threads() const = 0;
+
+  // Hands out the items [0, items) across the ranks, dynamically: `work(next)` runs on every rank
+  // (in another thread where the rank must keep serving requests) and calls `next()`, from any of
+  // its threads, until it returns nothing. Every item goes to exactly one rank. On the root,
+  // `granted(first, count)` is called (on the calling thread) for each run of items handed to
+  // another rank, e.g. to advance a progress bar. `threads` is how many items a rank keeps queued.
+  using NextItem = std::function<std::optional<uint64_t>()>;
+  virtual void share_work(uint64_t items, int threads, const std::function<void(const NextItem&)>& work,
+                          const std::function<void(uint64_t first, uint64_t count)>& granted) = 0;
+
+  // Every rank's `mine`, in rank order, on every rank (collective).
+  virtual std::vector<std::vector<std::byte>> all_gather(std::span<const std::byte> mine) = 0;
+  // Adds `values` element by element across the ranks; every rank gets the sums (collective).
+  virtual void sum_int64(std::vector<int64_t>& values) = 0;
+  // The root's `bytes` on every rank (collective).
+  virtual void broadcast(std::vector<std::byte>& bytes) = 0;
+  // Ends every rank of the job at once with `exit_code` (a failure after the ranks agreed to
+  // render, where waiting for the others could hang).
+  [[noreturn]] virtual void abort(int exit_code) = 0;
+
+  // Helpers over the above for plain values.
+  template <typename T>
+  std::vector<T> gather_values(const T& value) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    std::vector<T> out;
+    for (const auto& bytes : all_gather(std::as_bytes(std::span(&value, 1)))) {
+      T v;
+      std::memcpy(&v, bytes.data(), sizeof(T));
+      out.push_back(v);
+    }
+    return out;
+  }
+  // True on every rank when `flag` is true on any.
+  bool any(bool flag);
+  // The root's `value` on every rank.
+  bool root_says(bool value);
+  // "" on every rank when every rank's `error` is empty; otherwise the lowest failing rank's
+  // message, prefixed with "rank K: " when that is not the root (collective).
+  std::string first_error(const std::string& error);
+};
+
+// The process on its own.
+class LocalCluster final : public Cluster {
+ public:
+  int rank() const override { return 0; }
+  int size() const override { return 1; }
+  int default_threads() const override { return 0; }
+  void share_work(uint64_t items, int threads, const std::function<void(const NextItem&)>& work,
+                  const std::function<void(uint64_t, uint64_t)>& granted) override;
+  std::vector<std::vector<std::byte>> all_gather(std::span<const std::byte> mine) override;
+  void sum_int64(std::vector<int64_t>&) override {}
+  void broadcast(std::vector<std::byte>&) override {}
+  [[noreturn]] void abort(int exit_code) override;
+};
+
+// The one LocalCluster, for callers that render alone.
+Cluster& local_cluster();
+
+// The cluster this process belongs to: an MPI job when launched by mpirun (and built with MPI),
+// initialising MPI, else the process alone. MPI is finalised when the returned object is destroyed.
+std::unique_ptr<Cluster> join_cluster(int& argc, char**& argv);
+
+// For --version: the MPI library this build renders across ranks with, or that it has none.
+std::string mpi_support();
+
+}  // namespace candela
