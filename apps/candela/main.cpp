@@ -487,7 +487,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   if (!cmd.checkpoint.empty() && cmd.checkpoint_every)
     options.after_pass = [&](const Film& f, uint64_t non_finite_so_far) {
       auto now = std::chrono::steady_clock::now();
-      if (!cluster.root_says(std::chrono::duration<double>(now - last_checkpoint).count() >= *cmd.checkpoint_every)) return;
+      if (!cluster.from_root(std::chrono::duration<double>(now - last_checkpoint).count() >= *cmd.checkpoint_every)) return;
       save_checkpoint(f, earlier_non_finite + non_finite_so_far, true);
       last_checkpoint = std::chrono::steady_clock::now();
     };

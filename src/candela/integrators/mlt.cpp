@@ -9,6 +9,7 @@
 #include <atomic>
 #include <chrono>
 #include <functional>
+#include <cstring>
 #include <limits>
 
 #include "candela/film/filter.h"
@@ -16,6 +17,7 @@
 #include "candela/integrators/mlt_sampler.h"
 #include "candela/integrators/path_integrator.h"
 #include "candela/render/progress.h"
+#include "candela/render/render_loop.h"
 #include "candela/sampling/distribution1d.h"
 #include "candela/sampling/sampler.h"
 
@@ -87,6 +89,37 @@ class MltPathSampler {
   bool spectral_;
 };
 
+// Adds the thread-seconds from its construction to its destruction to `total` (nanoseconds): the
+// busy time behind the closing line's parallel efficiency.
+class BusyTimer {
+ public:
+  explicit BusyTimer(std::atomic<uint64_t>& total) : total_(total), start_(std::chrono::steady_clock::now()) {}
+  ~BusyTimer() {
+    auto elapsed = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start_);
+    total_.fetch_add(uint64_t(elapsed.count()), std::memory_order_relaxed);
+  }
+
+ private:
+  std::atomic<uint64_t>& total_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+// After run_shared across ranks: every rank gets the others' items of `values` (`per_item` values
+// each).
+template <typename T>
+void exchange_values(Cluster& cluster, const std::vector<uint8_t>& mine, std::vector<T>& values, size_t per_item) {
+  exchange_items(
+      cluster, mine,
+      [&](uint64_t item, std::vector<std::byte>& out) {
+        const auto* p = reinterpret_cast<const std::byte*>(&values[item * per_item]);
+        out.insert(out.end(), p, p + per_item * sizeof(T));
+      },
+      [&](uint64_t item, const std::byte* in) {
+        std::memcpy(&values[item * per_item], in, per_item * sizeof(T));
+        return in + per_item * sizeof(T);
+      });
+}
+
 // The luminance of the whole image function, averaged over the film (margin included): every
 // bidirectional strategy of every depth for camera rays through a jittered grid over the film, plus
 // the luminance of what their light paths splat. Stratifying the film position matters: the
@@ -98,9 +131,13 @@ struct Normalization {
 };
 
 // Stops early (its result then unused) once `cancelled` says so.
+// The samples are taken in blocks handed out across the cluster's ranks; each block's sums are
+// added in block order, so the estimate is the same whichever rank or thread took a block.
 Normalization estimate_normalization(const Scene& scene, const BdptIntegrator& bdpt, const RenderSettings& settings,
-                                     tbb::task_arena& arena, tbb::enumerable_thread_specific<RayCounts>& ray_counts,
-                                     uint64_t samples, const std::function<bool()>& cancelled, uint64_t batch = 0) {
+                                     Cluster& cluster, tbb::task_arena& arena,
+                                     tbb::enumerable_thread_specific<RayCounts>& ray_counts,
+                                     std::atomic<uint64_t>& busy_nanoseconds, uint64_t samples,
+                                     const std::function<bool()>& cancelled, uint64_t batch = 0) {
   const PerspectiveCamera& camera = scene.camera();
   const Vec2 margin = camera.margin();
   const float width = float(camera.width()) + 2 * margin.x, height = float(camera.height()) + 2 * margin.y;
@@ -109,17 +146,24 @@ Normalization estimate_normalization(const Scene& scene, const BdptIntegrator& b
   const uint64_t n = uint64_t(gx) * uint64_t(gy);
   const int max_depth = settings.max_depth;
   const size_t depths = size_t(max_depth) + 1;
-  std::vector<double> luminance(n * depths);
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<uint64_t>(0, n, 64), [&](const auto& range) {
+  // Per block of kBlock samples: each depth's luminance summed, then the sum and the sum of squares
+  // of the samples' total luminance.
+  constexpr uint64_t kBlock = 64;
+  const uint64_t blocks = (n + kBlock - 1) / kBlock;
+  const size_t per_block = depths + 2;
+  std::vector<double> block_sums(blocks * per_block, 0.0);
+  std::vector<uint8_t> mine = run_shared(cluster, arena, blocks, [&](uint64_t block) {
+      BusyTimer busy(busy_nanoseconds);
       thread_local std::vector<BdptVertex> camera_path, light_path;
       thread_local std::vector<RGB> crossed;
+      thread_local std::vector<double> by_depth;
       camera_path.resize(size_t(max_depth) + 2);
       light_path.resize(size_t(max_depth) + 1);
       RayCounts& counts = ray_counts.local();
       IndependentSampler sampler(batch == 0 ? hash_values(settings.seed, 0x6e6f726d)
                                             : hash_values(settings.seed, 0x6e6f726d, batch));
-      for (uint64_t i = range.begin(); i < range.end(); ++i) {
+      double* sums = &block_sums[block * per_block];
+      for (uint64_t i = block * kBlock; i < std::min(n, (block + 1) * kBlock); ++i) {
         if (cancelled()) return;  // a deep max_depth makes each sample long: answer a signal promptly
         int cx = int(i % uint64_t(gx)), cy = int(i / uint64_t(gx));
         sampler.start_pixel_sample(cx, cy, 0);
@@ -134,30 +178,34 @@ Normalization estimate_normalization(const Scene& scene, const BdptIntegrator& b
         crossed.assign(size_t(max_depth) + 3, RGB(0.0f));
         int nc = bdpt.camera_subpath(ray, sampler, counts, max_depth + 2, camera_path.data(), crossed.data(), wl);
         int nl = bdpt.light_subpath(sampler, counts, max_depth + 1, time, light_path.data(), wl);
-        double* by_depth = &luminance[i * depths];
+        by_depth.assign(depths, 0.0);
         for (int t = 1; t <= nc; ++t)
           for (int s = 0; s <= nl; ++s) {
             int depth = s + t - 2;
             if ((s == 1 && t == 1) || depth < 0 || depth > max_depth) continue;
             RGB L = bdpt.connect(light_path.data(), camera_path.data(), s, t, sampler, counts, time, wl).L;
-            if (L.is_finite()) by_depth[depth] += luminance_of(L);
+            if (L.is_finite()) by_depth[size_t(depth)] += luminance_of(L);
           }
         for (size_t t = 2; t < crossed.size(); ++t)
           if (t - 2 <= size_t(max_depth) && crossed[t].is_finite()) by_depth[t - 2] += luminance_of(crossed[t]);
+        double v = 0;
+        for (size_t d = 0; d < depths; ++d) {
+          sums[d] += by_depth[d];
+          v += by_depth[d];
+        }
+        sums[depths] += v;
+        sums[depths + 1] += v * v;
       }
-    });
   });
+  if (cluster.distributed()) exchange_values(cluster, mine, block_sums, per_block);
   Normalization b;
   b.per_depth.assign(depths, 0.0);
   double sum = 0, sum_sq = 0;
-  for (uint64_t i = 0; i < n; ++i) {
-    double v = 0;
-    for (size_t d = 0; d < depths; ++d) {
-      b.per_depth[d] += luminance[i * depths + d] / double(n);
-      v += luminance[i * depths + d];
-    }
-    sum += v;
-    sum_sq += v * v;
+  for (uint64_t block = 0; block < blocks; ++block) {
+    const double* sums = &block_sums[block * per_block];
+    for (size_t d = 0; d < depths; ++d) b.per_depth[d] += sums[d] / double(n);
+    sum += sums[depths];
+    sum_sq += sums[depths + 1];
   }
   b.value = sum / double(n);
   double var = std::max(0.0, sum_sq / double(n) - b.value * b.value);
@@ -169,6 +217,10 @@ Normalization estimate_normalization(const Scene& scene, const BdptIntegrator& b
 
 RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options) {
   auto start_time = std::chrono::steady_clock::now();
+  // Across ranks: the depth-0 pass and the bootstrap and normalisation samples are shared out and
+  // exchanged, so every rank starts the same chains; each rank then runs every size()-th chain, and
+  // the chains' splats (integer sums) are added up at the end.
+  Cluster& cluster = options.cluster ? *options.cluster : local_cluster();
   // Depth 0, the emission that camera rays see directly, needs no Markov chain: it is rendered as the
   // path tracer renders it (stratified camera samples of one ray each) into the film's own pixel
   // sums, and the chains' splats of the depths >= 1 are added to it. Left to chains, the share of
@@ -199,6 +251,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   const int depths = settings.max_depth + 1;
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   tbb::enumerable_thread_specific<RayCounts> ray_counts;
+  std::atomic<uint64_t> busy_nanoseconds{0};
   const std::function<bool()> cancelled = [&] {
     return options.cancel && options.cancel->load(std::memory_order_relaxed);
   };
@@ -217,22 +270,33 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   // The bootstrap grows with max_depth (one per depth): the bar says which phase it is in.
   progress.set_label(fmt::format("MLT bootstrap ({} depths x {})", depths, settings.mlt.bootstrap));
 
-  // Bootstrap: the luminance of independent states, depth by depth in turn.
+  // Bootstrap: the luminance of independent states, depth by depth in turn, in blocks handed out
+  // across the ranks; every rank then has them all.
+  constexpr uint64_t kBootstrapBlock = 64;
   std::vector<float> weights(bootstrap_count);
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<uint64_t>(0, bootstrap_count, 64), [&](const auto& range) {
-      RayCounts& counts = ray_counts.local();
-      for (uint64_t i = range.begin(); i < range.end(); ++i) {
-        if (cancelled()) return;
-        int depth = int(i % uint64_t(depths));
-        if (depth == 0) continue;  // rendered directly above
-        MltSampler sampler(settings.seed, i, settings.mlt.sigma);
-        weights[i] = paths.sample(sampler, depth, counts).luminance();
-      }
-      progress.advance(range.size());
-    });
-  });
-  if (cancelled()) return stop_cancelled(progress);
+  const uint64_t bootstrap_blocks = (bootstrap_count + kBootstrapBlock - 1) / kBootstrapBlock;
+  std::vector<uint8_t> bootstrap_mine = run_shared(
+      cluster, arena, bootstrap_blocks,
+      [&](uint64_t block) {
+        BusyTimer busy(busy_nanoseconds);
+        RayCounts& counts = ray_counts.local();
+        const uint64_t end = std::min(bootstrap_count, (block + 1) * kBootstrapBlock);
+        for (uint64_t i = block * kBootstrapBlock; i < end; ++i) {
+          if (cancelled()) return;
+          int depth = int(i % uint64_t(depths));
+          if (depth == 0) continue;  // rendered directly above
+          MltSampler sampler(settings.seed, i, settings.mlt.sigma);
+          weights[i] = paths.sample(sampler, depth, counts).luminance();
+        }
+        progress.advance(end - block * kBootstrapBlock);
+      },
+      [&](uint64_t, uint64_t count) { progress.advance(count * kBootstrapBlock); });
+  if (cluster.any(cancelled())) return stop_cancelled(progress);
+  if (cluster.distributed()) {
+    weights.resize(bootstrap_blocks * kBootstrapBlock);  // whole blocks to exchange
+    exchange_values(cluster, bootstrap_mine, weights, kBootstrapBlock);
+    weights.resize(bootstrap_count);
+  }
   double sum = 0;
   for (float w : weights) sum += w;
   // The chains' deposits are scaled by b, the image's mean luminance, from its own estimator (the
@@ -248,9 +312,9 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
       uint64_t(settings.mlt.bootstrap), options.time_limit_seconds > 0 ? 0 : total_mutations / 8);
   const auto normalization_start = std::chrono::steady_clock::now();
   progress.set_label(fmt::format("MLT normalisation ({} paths)", normalization_samples));
-  Normalization normalization = estimate_normalization(scene, bdpt_with_roulette, settings, arena, ray_counts,
-                                                       normalization_samples, cancelled);
-  if (cancelled()) return stop_cancelled(progress);
+  Normalization normalization = estimate_normalization(scene, bdpt_with_roulette, settings, cluster, arena,
+                                                       ray_counts, busy_nanoseconds, normalization_samples, cancelled);
+  if (cluster.any(cancelled())) return stop_cancelled(progress);
   // Under a time limit the number of mutations is not known: further independent batches of
   // mlt_bootstrap samples, averaged, until the normalisation has taken about a ninth of the time
   // (1 sample per 8 mutations costs about that much).
@@ -260,10 +324,10 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
     auto elapsed = [&] {
       return std::chrono::duration<double>(std::chrono::steady_clock::now() - normalization_start).count();
     };
-    while (elapsed() < options.time_limit_seconds / 9 && !cancelled()) {
-      Normalization more = estimate_normalization(scene, bdpt_with_roulette, settings, arena, ray_counts,
-                                                  normalization_samples, cancelled, batches);
-      if (cancelled()) return stop_cancelled(progress);
+    while (cluster.from_root(elapsed() < options.time_limit_seconds / 9) && !cluster.any(cancelled())) {
+      Normalization more = estimate_normalization(scene, bdpt_with_roulette, settings, cluster, arena, ray_counts,
+                                                  busy_nanoseconds, normalization_samples, cancelled, batches);
+      if (cluster.any(cancelled())) return stop_cancelled(progress);
       double k = double(batches);
       for (size_t d = 0; d < normalization.per_depth.size(); ++d)
         normalization.per_depth[d] = (normalization.per_depth[d] * k + more.per_depth[d]) / (k + 1);
@@ -362,12 +426,15 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   std::atomic<uint64_t> non_finite{0};
   uint64_t mutations_per_chain = 0;
   bool first_round = true;
+  std::vector<uint64_t> my_chains;
+  for (uint64_t c = uint64_t(cluster.rank()); c < chains; c += uint64_t(cluster.size())) my_chains.push_back(c);
   while (mutations_per_chain < per_chain) {
     const uint64_t steps = std::min(round_length, per_chain - mutations_per_chain);
     const auto round_start = std::chrono::steady_clock::now();
     arena.execute([&] {
-      tbb::parallel_for(uint64_t(0), chains, [&](uint64_t index) {
-        Chain& c = chain_states[index];
+      tbb::parallel_for(size_t(0), my_chains.size(), [&](size_t mine) {
+        BusyTimer busy(busy_nanoseconds);
+        Chain& c = chain_states[my_chains[mine]];
         RayCounts& counts = ray_counts.local();
         if (first_round) c.current = paths.sample(c.sampler, c.depth, counts);
         for (uint64_t m = 0; m < steps; ++m) {
@@ -408,22 +475,27 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
         progress.advance(steps);
       });
     });
+    progress.advance(steps * (chains - my_chains.size()));  // the other ranks' chains
     first_round = false;
     mutations_per_chain += steps;
-    double round_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - round_start).count();
+    // The root's clock sets the rounds' length and the time limit for every rank.
+    double round_seconds =
+        cluster.from_root(std::chrono::duration<double>(std::chrono::steady_clock::now() - round_start).count());
     double growth = round_seconds > 0 ? std::clamp(0.5 / round_seconds, 0.5, 4.0) : 4.0;
     round_length = std::max<uint64_t>(1, uint64_t(double(round_length) * growth));
-    if (cancelled()) {
+    if (cluster.any(cancelled())) {
       stats.cancelled = true;
       break;
     }
     if (mutations_per_chain < per_chain && options.time_limit_seconds > 0 &&
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count() >= options.time_limit_seconds) {
+        cluster.from_root(std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count() >=
+                          options.time_limit_seconds)) {
       stats.time_limited = true;
       break;
     }
   }
   progress.finish();
+  if (cluster.distributed()) cluster.sum_int64(film.splats().sums());
 
   // A chain's deposits carry its depth's mean luminance over its chains, per mutation; times the
   // film's area they make the image.
@@ -432,8 +504,12 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
                            : 0);
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   stats.samples = mutations_per_chain * chains;
-  stats.non_finite_samples += non_finite.load();
-  for (const auto& c : ray_counts) stats.rays += c;  // added to the direct pass's
+  RayCounts chain_rays;
+  for (const auto& c : ray_counts) chain_rays += c;
+  for (const RayCounts& r : cluster.gather_values(chain_rays)) stats.rays += r;  // added to the direct pass's
+  for (uint64_t n : cluster.gather_values(non_finite.load())) stats.non_finite_samples += n;
+  std::vector<double> busy = cluster.gather_values(double(busy_nanoseconds.load()) * 1e-9);
+  for (size_t r = 0; r < busy.size() && r < stats.rank_busy_seconds.size(); ++r) stats.rank_busy_seconds[r] += busy[r];
   return stats;
 }
 

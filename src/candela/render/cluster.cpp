@@ -6,15 +6,10 @@
 namespace candela {
 
 bool Cluster::any(bool flag) {
+  if (!distributed()) return flag;
   for (bool f : gather_values(flag))
     if (f) return true;
   return false;
-}
-
-bool Cluster::root_says(bool value) {
-  std::vector<std::byte> bytes(1, std::byte(value ? 1 : 0));
-  broadcast(bytes);
-  return bytes[0] != std::byte(0);
 }
 
 std::string Cluster::first_error(const std::string& error) {

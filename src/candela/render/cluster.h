@@ -67,8 +67,17 @@ class Cluster {
   }
   // True on every rank when `flag` is true on any.
   bool any(bool flag);
-  // The root's `value` on every rank.
-  bool root_says(bool value);
+  // The root's `value` on every rank (collective): a decision taken by the root's clock.
+  template <typename T>
+  T from_root(T value) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    if (!distributed()) return value;
+    std::vector<std::byte> bytes(sizeof(T));
+    std::memcpy(bytes.data(), &value, sizeof(T));
+    broadcast(bytes);
+    std::memcpy(&value, bytes.data(), sizeof(T));
+    return value;
+  }
   // "" on every rank when every rank's `error` is empty; otherwise the lowest failing rank's
   // message, prefixed with "rank K: " when that is not the root (collective).
   std::string first_error(const std::string& error);

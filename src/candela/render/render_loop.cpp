@@ -43,67 +43,46 @@ uint64_t tile_samples(const Tile& tile, const SampleRanges& range) {
   return n;
 }
 
-// After a pass across ranks: each rank sends the sums of the tiles it rendered, and every rank
-// copies the others' into its film, so all films are again the same.
-void exchange_tiles(Cluster& cluster, Film& film, const std::vector<Tile>& tiles, const std::vector<uint8_t>& mine) {
-  std::vector<std::byte> bytes;
-  auto append = [&](const void* data, size_t size) {
-    const auto* p = static_cast<const std::byte*>(data);
-    bytes.insert(bytes.end(), p, p + size);
-  };
-  for (uint32_t t = 0; t < tiles.size(); ++t) {
-    if (!mine[t]) continue;
-    append(&t, sizeof t);
-    for (int y = tiles[t].y0; y < tiles[t].y1; ++y)
-      append(&film.pixel(tiles[t].x0, y), sizeof(PixelSums) * size_t(tiles[t].x1 - tiles[t].x0));
-  }
-  std::vector<std::vector<std::byte>> all = cluster.all_gather(bytes);
-  for (int r = 0; r < int(all.size()); ++r) {
-    if (r == cluster.rank()) continue;
-    const std::byte* p = all[size_t(r)].data();
-    const std::byte* end = p + all[size_t(r)].size();
-    while (p < end) {
-      uint32_t t;
-      std::memcpy(&t, p, sizeof t);
-      p += sizeof t;
-      const Tile& tile = tiles.at(t);
-      for (int y = tile.y0; y < tile.y1; ++y) {
-        size_t row = sizeof(PixelSums) * size_t(tile.x1 - tile.x0);
-        std::memcpy(&film.pixels()[size_t(y) * size_t(film.width()) + size_t(tile.x0)], p, row);
-        p += row;
-      }
-    }
-  }
-}
-
 // One pass over the tiles: pixel (x, y) gets the samples range(x, y) names. Tiles not yet started
-// when the cancel flag is set are skipped. The tiles are handed out one by one (across ranks by the
-// cluster); which thread or rank renders a tile changes nothing in its pixels.
+// when the cancel flag is set are skipped. Which thread or rank renders a tile changes nothing in
+// its pixels; across ranks, the ranks then exchange the tiles they rendered, so that every rank's
+// film is again the same.
 void run_pass(const PassContext& pc, const std::vector<Tile>& tiles, tbb::task_arena& arena, const SampleRanges& range,
               ProgressBar& progress) {
-  std::vector<uint8_t> mine(tiles.size(), 0);
-  const int threads = arena.max_concurrency();
-  pc.cluster.share_work(
-      tiles.size(), threads,
-      [&](const Cluster::NextItem& next) {
-        arena.execute([&] {
-          tbb::parallel_for(0, threads, 1, [&](int) {
-            while (std::optional<uint64_t> t = next()) {
-              mine[*t] = 1;
-              if (cancelled(pc)) continue;
-              auto start = std::chrono::steady_clock::now();
-              progress.advance(pc.integrator.render_tile(tiles[*t], range, pc.tile, pc.ray_counts.local()));
-              pc.busy_nanoseconds.fetch_add(
-                  uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count()),
-                  std::memory_order_relaxed);
-            }
-          });
-        });
+  Film& film = pc.tile.film;
+  std::vector<uint8_t> mine = run_shared(
+      pc.cluster, arena, tiles.size(),
+      [&](uint64_t t) {
+        if (cancelled(pc)) return;
+        auto start = std::chrono::steady_clock::now();
+        progress.advance(pc.integrator.render_tile(tiles[t], range, pc.tile, pc.ray_counts.local()));
+        pc.busy_nanoseconds.fetch_add(
+            uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count()),
+            std::memory_order_relaxed);
       },
       [&](uint64_t first, uint64_t count) {
         for (uint64_t t = first; t < first + count; ++t) progress.advance(tile_samples(tiles[t], range));
       });
-  if (pc.cluster.distributed()) exchange_tiles(pc.cluster, pc.tile.film, tiles, mine);
+  if (!pc.cluster.distributed()) return;
+  auto row_of = [&](const Tile& tile, int y) { return &film.pixels()[size_t(y) * size_t(film.width()) + size_t(tile.x0)]; };
+  exchange_items(
+      pc.cluster, mine,
+      [&](uint64_t t, std::vector<std::byte>& out) {
+        const Tile& tile = tiles[t];
+        for (int y = tile.y0; y < tile.y1; ++y) {
+          const auto* row = reinterpret_cast<const std::byte*>(row_of(tile, y));
+          out.insert(out.end(), row, row + sizeof(PixelSums) * size_t(tile.x1 - tile.x0));
+        }
+      },
+      [&](uint64_t t, const std::byte* in) {
+        const Tile& tile = tiles[t];
+        for (int y = tile.y0; y < tile.y1; ++y) {
+          size_t row = sizeof(PixelSums) * size_t(tile.x1 - tile.x0);
+          std::memcpy(row_of(tile, y), in, row);
+          in += row;
+        }
+        return in;
+      });
 }
 
 // ---- Adaptive sampling -------------------------------------------------------------------------
@@ -318,6 +297,51 @@ void combine_ranks(Cluster& cluster, Film& film, const RenderOptions& options, i
 
 }  // namespace
 
+std::vector<uint8_t> run_shared(Cluster& cluster, tbb::task_arena& arena, uint64_t items,
+                                const std::function<void(uint64_t)>& body,
+                                const std::function<void(uint64_t, uint64_t)>& granted) {
+  std::vector<uint8_t> mine(items, 0);
+  const int threads = arena.max_concurrency();
+  cluster.share_work(
+      items, threads,
+      [&](const Cluster::NextItem& next) {
+        arena.execute([&] {
+          tbb::parallel_for(0, threads, 1, [&](int) {
+            while (std::optional<uint64_t> item = next()) {
+              mine[*item] = 1;
+              body(*item);
+            }
+          });
+        });
+      },
+      granted);
+  return mine;
+}
+
+void exchange_items(Cluster& cluster, const std::vector<uint8_t>& mine,
+                    const std::function<void(uint64_t, std::vector<std::byte>&)>& write,
+                    const std::function<const std::byte*(uint64_t, const std::byte*)>& read) {
+  std::vector<std::byte> bytes;
+  for (uint64_t item = 0; item < mine.size(); ++item) {
+    if (!mine[item]) continue;
+    const auto* id = reinterpret_cast<const std::byte*>(&item);
+    bytes.insert(bytes.end(), id, id + sizeof item);
+    write(item, bytes);
+  }
+  std::vector<std::vector<std::byte>> all = cluster.all_gather(bytes);
+  for (int r = 0; r < int(all.size()); ++r) {
+    if (r == cluster.rank()) continue;
+    const std::byte* in = all[size_t(r)].data();
+    const std::byte* end = in + all[size_t(r)].size();
+    while (in < end) {
+      uint64_t item;
+      std::memcpy(&item, in, sizeof item);
+      if (item >= mine.size()) throw std::runtime_error("exchange_items: an item out of range came from rank " + std::to_string(r));
+      in = read(item, in + sizeof item);
+    }
+  }
+}
+
 std::vector<Tile> make_tiles(int width, int height) {
   std::vector<Tile> tiles;
   for (int y = 0; y < height; y += kTileSize)
@@ -394,7 +418,7 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
       return true;
     }
     if (more_to_do && options.time_limit_seconds > 0 &&
-        cluster.root_says(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >=
+        cluster.from_root(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >=
                           options.time_limit_seconds)) {
       stats.time_limited = true;
       return true;

@@ -24,6 +24,8 @@
 #include <string>
 #include <vector>
 
+#include <tbb/task_arena.h>
+
 #include "candela/film/film.h"
 #include "candela/film/filter.h"
 #include "candela/render/cluster.h"
@@ -138,6 +140,19 @@ class TileIntegrator {
   virtual uint64_t render_tile(const Tile& tile, const SampleRanges& range, const TileContext& context,
                                RayCounts& counts) const = 0;
 };
+
+// Runs body(item) for the items [0, items) on `arena`'s threads, the items handed out dynamically
+// across the cluster's ranks (each item runs on one rank). Returns which items ran on this rank.
+std::vector<uint8_t> run_shared(Cluster& cluster, tbb::task_arena& arena, uint64_t items,
+                                const std::function<void(uint64_t item)>& body,
+                                const std::function<void(uint64_t first, uint64_t count)>& granted = nullptr);
+
+// After run_shared across ranks: every rank sends what its items produced (`write` appends item's
+// bytes) and takes in the others' (`read` consumes one item's bytes from `in` and returns the
+// position after them), so every rank ends with every item's result.
+void exchange_items(Cluster& cluster, const std::vector<uint8_t>& mine,
+                    const std::function<void(uint64_t item, std::vector<std::byte>& out)>& write,
+                    const std::function<const std::byte*(uint64_t item, const std::byte* in)>& read);
 
 // The tiles a film is cut into, in the order the loop hands them out (row by row of tiles).
 std::vector<Tile> make_tiles(int width, int height);
