@@ -25,6 +25,7 @@
 #include "candela/io/scene_reader.h"
 #include "candela/render/checkpoint.h"
 #include "candela/render/cluster.h"
+#include "candela/render/film_part.h"
 #include "candela/integrators/bdpt.h"
 #include "candela/integrators/integrator.h"
 #include "candela/scene/resource_limits.h"
@@ -122,7 +123,7 @@ struct RenderCommand {
   std::optional<float> adaptive_threshold;
   bool no_mis = false;
   bool quiet = false;
-  std::string checkpoint, resume, pixel;
+  std::string checkpoint, resume, pixel, part;
   std::optional<double> checkpoint_every, time_limit;
   std::optional<float> clamp;
   std::string bdpt_strategies;
@@ -350,6 +351,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   bool adaptive = false;
   const bool pixel_mode = !cmd.pixel.empty();
   int px = -1, py = -1;
+  int part_index = 0, part_count = 1;
   std::vector<fs::path> outputs;
   std::string scene_bytes;
   on_every_rank(cluster, [&] {
@@ -382,7 +384,21 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
       if (px >= desc.film.width || py >= desc.film.height)
         throw UsageError(fmt::format("--pixel {},{} is outside the {}x{} image", px, py, desc.film.width, desc.film.height));
     }
+    if (!cmd.part.empty()) {
+      std::smatch m;
+      static const std::regex pattern(R"((\d{1,6})/(\d{1,6}))");
+      if (!std::regex_match(cmd.part, m, pattern) || std::stoi(m[1]) < 1 || std::stoi(m[1]) > std::stoi(m[2]))
+        throw UsageError(fmt::format("--part: expected K/N with 1 <= K <= N, such as 2/8, got '{}'", cmd.part));
+      part_index = std::stoi(m[1]) - 1;
+      part_count = std::stoi(m[2]);
+      if (adaptive) throw UsageError("--part cannot be combined with adaptive sampling (its decisions look across the whole image)");
+      if (pixel_mode) throw UsageError("--part cannot be combined with --pixel");
+      if (!chosen.resumable)
+        throw UsageError(fmt::format("--part: the {} integrator does not render tile by tile (path and bdpt do)", chosen.name));
+    }
     outputs = output_files(cmd, desc);
+    if (!cmd.part.empty() && (outputs.size() != 1 || outputs[0].extension() != ".exr"))
+      throw UsageError("--part writes a part file for candela merge: give one output ending in .exr (-o part-K.exr)");
     if (!pixel_mode && cluster.is_root()) check_outputs(outputs);
     // Refuse what cannot fit in memory before allocating the scene and the film.
     check_resources(desc);
@@ -408,7 +424,8 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   const float clamp = cmd.clamp.value_or(0.0f);
   RenderFingerprint fingerprint;
   std::optional<Checkpoint> resumed;
-  if (!cmd.checkpoint.empty() || !cmd.resume.empty()) fingerprint = make_fingerprint(scene_bytes, desc, clamp);
+  fingerprint = make_fingerprint(scene_bytes, desc, clamp);
+  if (part_count > 1) fingerprint.settings.push_back({"part", cmd.part});  // a checkpoint resumes its own part
   if (!cmd.resume.empty()) {
     // The root reads the checkpoint and sends it to the others: only it needs to see the file.
     std::string checkpoint_bytes;
@@ -456,6 +473,8 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   options.time_limit_seconds = cmd.time_limit.value_or(0.0);
   options.clamp = clamp;
   options.cluster = &cluster;
+  options.part_index = part_index;
+  options.part_count = part_count;
   if (!strategy_images.empty()) {
     options.bdpt_strategies = &strategy_images;
     options.bdpt_unweighted = cmd.bdpt_unweighted;
@@ -555,8 +574,15 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   if (clamp > 0) metadata["candela:clamp"] = fmt::format("{}", clamp);
   if (non_finite > 0) metadata["candela:non_finite_samples"] = std::to_string(non_finite);
   if (integrator.reads_setting("mlt")) metadata["candela:mlt"] = desc.settings.mlt.describe();
-  Image image = film.mean_image();
-  for (const auto& f : outputs) write_image(f, image, metadata);
+  if (!cmd.part.empty()) {
+    FilmPart part{part_index, part_count, make_fingerprint(scene_bytes, desc, clamp),
+                  double(scene.camera().importance_film_pixels()), non_finite, std::move(film)};
+    write_part(outputs[0], part, metadata);
+    film = std::move(part.film);
+  } else {
+    Image image = film.mean_image();
+    for (const auto& f : outputs) write_image(f, image, metadata);
+  }
   // One image per strategy: bdpt_d<depth>_s<s>_t<t>.exr, scaled like the light image.
   for (int depth = 0; depth <= strategy_depth && !strategy_images.empty(); ++depth)
     for (int s = 0; s <= depth + 1; ++s) {
@@ -606,6 +632,42 @@ int run_convert(const std::string& in, const std::string& out) {
   std::fprintf(stderr, "%s -> %s: %zu shapes, %zu instances, %zu materials, %zu textures, %zu lights\n", in.c_str(),
                out.c_str(), scene.shapes.size(), scene.instances.size(), scene.materials.size(), scene.textures.size(),
                scene.lights.size());
+  return 0;
+}
+
+// `candela merge PARTS... -o OUT`: parts of one render (--part K/N) put back together, and sample
+// sets of other seeds added (render/film_part.h).
+int run_merge(const std::vector<std::string>& inputs, const std::string& output) {
+  check_outputs({output});
+  std::vector<fs::path> files(inputs.begin(), inputs.end());
+  MergedRender merged = merge_parts(files);
+  g_phase.store(kWriting);
+  const Film& film = merged.film;
+  const double pixels = double(film.width()) * film.height();
+  const uint64_t min_spp = film.min_samples(), max_spp = film.max_samples();
+  std::string spp_text = min_spp == max_spp ? std::to_string(min_spp)
+                                            : fmt::format("min {}, mean {:.2f}", min_spp, double(film.total_samples()) / pixels);
+  std::string seeds;
+  for (const std::string& seed : merged.seeds) seeds += (seeds.empty() ? "" : ",") + seed;
+  auto setting = [&](const std::string& key) {
+    for (const auto& [k, v] : merged.fingerprint.settings)
+      if (k == key) return v;
+    return std::string();
+  };
+  std::map<std::string, std::string> metadata = {
+      {"candela:merged", merged.description},
+      {"candela:spp", spp_text},
+      {"candela:spp_min", std::to_string(min_spp)},
+      {"candela:spp_mean", fmt::format("{:.4f}", double(film.total_samples()) / pixels)},
+      {"candela:integrator", setting("integrator")},
+      {"candela:transport", setting("transport")},
+      {"candela:max_depth", setting("max-depth")},
+      {"candela:seed", seeds},
+      {"Software", "candela " CANDELA_VERSION}};
+  if (merged.non_finite_samples > 0) metadata["candela:non_finite_samples"] = std::to_string(merged.non_finite_samples);
+  write_image(output, film.mean_image(), metadata);
+  std::printf("merged %zu files (%s): %dx%d, %s spp -> %s\n", files.size(), merged.description.c_str(), film.width(),
+              film.height(), spp_text.c_str(), output.c_str());
   return 0;
 }
 
@@ -719,6 +781,9 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--clamp", cmd.clamp,
                          "Scale each sample so its largest RGB component is at most VALUE (biased; off by default)")
       ->check(CLI::PositiveNumber);
+  render_cmd->add_option("--part", cmd.part,
+                         "Render part K of N of the image (every N-th tile; for job arrays) and write it, with "
+                         "its exact sums, to the .exr output for candela merge");
   render_cmd->add_option("--pixel", cmd.pixel,
                          "Render only pixel X,Y (all its samples), print its value and its NaN/inf sample "
                          "indices; writes no image");
@@ -728,6 +793,14 @@ int main(int argc, char** argv) {
       "convert", "Write a scene (.json, .pbrt, .xml, .obj, .gltf, .glb) in candela's JSON format");
   convert_cmd->add_option("scene", convert_in, "The scene file to read")->required();
   convert_cmd->add_option("output", convert_out, "The JSON file to write (replaced atomically)")->required();
+
+  std::vector<std::string> merge_inputs;
+  std::string merge_output;
+  CLI::App* merge_cmd = app.add_subcommand(
+      "merge", "Put the parts of a render made with --part K/N back together (the image one process renders, bit "
+               "for bit), and add up renders of the same scene with other seeds");
+  merge_cmd->add_option("parts", merge_inputs, "The part files (.exr written with --part)")->required();
+  merge_cmd->add_option("-o,--output", merge_output, "The image to write (.exr, .png or .pfm)")->required();
 
   try {
     app.parse(argc, argv);
@@ -740,6 +813,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (convert_cmd->parsed()) return cluster->is_root() ? run_convert(convert_in, convert_out) : 0;
+    if (merge_cmd->parsed()) return cluster->is_root() ? run_merge(merge_inputs, merge_output) : 0;
     return run_render(cmd, *cluster);
   } catch (const AgreedError& e) {  // every rank has it: one message
     if (cluster->is_root()) std::fprintf(stderr, "candela: error: %s\n", e.what());

@@ -51,7 +51,7 @@ bool is_supported_output(const std::filesystem::path& file) {
 
 // Writes with OpenImageIO; returns an error message, empty on success.
 std::string write_with_oiio(const std::filesystem::path& tmp, const std::string& ext, const Image& image,
-                            const std::map<std::string, std::string>& metadata) {
+                            const std::map<std::string, std::string>& metadata, const ExactChannels* extra) {
   auto out = OIIO::ImageOutput::create(tmp.string());
   if (!out) return "cannot create image writer: " + OIIO::geterror();
   bool ok;
@@ -66,7 +66,23 @@ std::string write_with_oiio(const std::filesystem::path& tmp, const std::string&
     spec.attribute("oiio:ColorSpace", "Linear");
     spec.attribute("compression", "zip");
     for (const auto& [key, value] : metadata) spec.attribute(key, value);
-    ok = out->open(tmp.string(), spec) && out->write_image(OIIO::TypeDesc::FLOAT, image.rgb.data());
+    if (!extra || extra->names.empty()) {
+      ok = out->open(tmp.string(), spec) && out->write_image(OIIO::TypeDesc::FLOAT, image.rgb.data());
+    } else {
+      // R, G, B as float, then the exact channels as uint, interleaved per pixel (all 4 bytes).
+      const size_t n = extra->names.size(), per_pixel = 3 + n;
+      spec.nchannels = int(per_pixel);
+      spec.channelformats.assign(3, OIIO::TypeDesc::FLOAT);
+      spec.channelformats.resize(per_pixel, OIIO::TypeDesc::UINT32);
+      spec.channelnames = {"R", "G", "B"};
+      spec.channelnames.insert(spec.channelnames.end(), extra->names.begin(), extra->names.end());
+      std::vector<uint32_t> pixels(size_t(image.width) * size_t(image.height) * per_pixel);
+      for (size_t i = 0; i < size_t(image.width) * size_t(image.height); ++i) {
+        std::memcpy(&pixels[i * per_pixel], &image.rgb[i * 3], 3 * sizeof(float));
+        std::copy_n(&extra->values[i * n], n, &pixels[i * per_pixel + 3]);
+      }
+      ok = out->open(tmp.string(), spec) && out->write_image(OIIO::TypeDesc::UNKNOWN, pixels.data());
+    }
   }
   std::string error = ok ? "" : out->geterror();
   if (!out->close() && error.empty()) error = out->geterror();
@@ -75,6 +91,13 @@ std::string write_with_oiio(const std::filesystem::path& tmp, const std::string&
 
 void write_image(const std::filesystem::path& file, const Image& image,
                  const std::map<std::string, std::string>& metadata) {
+  write_image(file, image, metadata, ExactChannels{});
+}
+
+void write_image(const std::filesystem::path& file, const Image& image, const std::map<std::string, std::string>& metadata,
+                 const ExactChannels& extra) {
+  if (!extra.names.empty() && lower_extension(file) != ".exr")
+    throw std::runtime_error(fmt::format("{}: only .exr files keep exact channels", file.string()));
   if (!is_supported_output(file))
     throw std::runtime_error(fmt::format("{}: unsupported image format (use .exr, .png or .pfm)", file.string()));
   std::string ext = lower_extension(file);
@@ -82,7 +105,7 @@ void write_image(const std::filesystem::path& file, const Image& image,
   std::filesystem::path tmp = dir / fmt::format(".{}.{}.tmp{}", file.stem().string(), getpid(), ext);
 
   std::string error = ext == ".pfm" ? (write_pfm(tmp, image) ? "" : std::string(std::strerror(errno)))
-                                    : write_with_oiio(tmp, ext, image, metadata);
+                                    : write_with_oiio(tmp, ext, image, metadata, &extra);
   std::error_code ec;
   if (error.empty()) {
     std::filesystem::rename(tmp, file, ec);
@@ -152,6 +175,32 @@ Image read_image(const std::filesystem::path& file, IntegerEncoding encoding) {
 }
 
 Image read_image(const std::filesystem::path& file) { return read_image(file, IntegerEncoding::SRGB); }
+
+ExactChannels read_exact_channels(const std::filesystem::path& file, const std::string& prefix) {
+  auto in = OIIO::ImageInput::open(file.string());
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
+  const OIIO::ImageSpec& spec = in->spec();
+  ExactChannels result;
+  int first = -1, last = -1;
+  for (int c = 0; c < spec.nchannels; ++c)
+    if (spec.channelnames[size_t(c)].rfind(prefix, 0) == 0) {
+      if (first >= 0 && c != last + 1)
+        throw std::runtime_error(fmt::format("{}: the {}* channels are not together", file.string(), prefix));
+      if (spec.channelformat(c) != OIIO::TypeDesc::UINT32)
+        throw std::runtime_error(fmt::format("{}: channel {} is not 32-bit unsigned integer", file.string(),
+                                             spec.channelnames[size_t(c)]));
+      if (first < 0) first = c;
+      last = c;
+      result.names.push_back(spec.channelnames[size_t(c)]);
+    }
+  if (first >= 0) {
+    result.values.resize(size_t(spec.width) * size_t(spec.height) * result.names.size());
+    if (!in->read_image(0, 0, first, last + 1, OIIO::TypeDesc::UINT32, result.values.data()))
+      throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), in->geterror()));
+  }
+  in->close();
+  return result;
+}
 
 std::map<std::string, std::string> read_image_metadata(const std::filesystem::path& file) {
   auto in = OIIO::ImageInput::open(file.string());

@@ -3,7 +3,9 @@
 // metadata), .pfm (linear float), .png (sRGB-encoded 8-bit, values clipped to [0,1]).
 #include <filesystem>
 #include <map>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "candela/film/image.h"
 
@@ -17,6 +19,19 @@ bool is_supported_output(const std::filesystem::path& file);
 // as "candela:spp"). Throws std::runtime_error naming the file on failure.
 void write_image(const std::filesystem::path& file, const Image& image,
                  const std::map<std::string, std::string>& metadata = {});
+
+// 32-bit unsigned integer channels kept exactly beside an EXR's RGB (a render part's sums, bit for
+// bit): names.size() values per pixel in `values`, row-major.
+struct ExactChannels {
+  std::vector<std::string> names;
+  std::vector<uint32_t> values;
+};
+// write_image for an .exr with `extra` after its R, G, B channels.
+void write_image(const std::filesystem::path& file, const Image& image, const std::map<std::string, std::string>& metadata,
+                 const ExactChannels& extra);
+// The channels of `file` whose names start with `prefix`, which must be 32-bit unsigned integers
+// (an empty ExactChannels when there are none). Throws std::runtime_error naming the file.
+ExactChannels read_exact_channels(const std::filesystem::path& file, const std::string& prefix);
 
 // How 8- and 16-bit pixel values become linear: the exact sRGB decoding curve, or value / max.
 // Float pixels (EXR, HDR, PFM) are linear either way, as in pbrt-v4 and Mitsuba, whose encoding

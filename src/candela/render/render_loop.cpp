@@ -15,6 +15,7 @@
 #include <span>
 #include <tuple>
 
+#include "candela/render/film_part.h"
 #include "candela/render/progress.h"
 
 namespace candela {
@@ -390,7 +391,8 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
   if (options.part_count > 1) {
     // A job-array part: every part_count-th tile, from part_index on.
     std::vector<Tile> share;
-    for (size_t t = size_t(options.part_index); t < tiles.size(); t += size_t(options.part_count)) share.push_back(tiles[t]);
+    for (size_t t = 0; t < tiles.size(); ++t)
+      if (tile_in_part(t, options.part_index, options.part_count)) share.push_back(tiles[t]);
     tiles = std::move(share);
   }
   Cluster& cluster = options.cluster ? *options.cluster : local_cluster();
