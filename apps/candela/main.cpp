@@ -540,6 +540,9 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
 
   if (stopped && !cmd.checkpoint.empty()) save_checkpoint(film, non_finite, false);
   // The root writes the images and reports; the other ranks are done.
+  const std::vector<Cluster::Traffic> traffic = cluster.gather_values(cluster.traffic());
+  uint64_t most_sent = 0;
+  for (const Cluster::Traffic& t : traffic) most_sent = std::max(most_sent, t.bytes_sent);
   if (!cluster.is_root()) return stats.cancelled ? kExitInterrupted : 0;
 
   const double pixels = double(film.width()) * film.height();
@@ -600,7 +603,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
               desc.film.height, spp_text.c_str(), spp_unit, stats.seconds, double(stats.samples) / seconds * 1e-6,
               double(stats.rays.total()) / seconds * 1e-6,
               double(stats.rays.total()) / double(std::max<uint64_t>(stats.samples, 1)), written.c_str());
-  if (cluster.distributed()) {
+  if (cluster.mpi_job()) {
     // The job's parallel efficiency: the thread-seconds spent rendering over all threads x wall time.
     double busy = 0;
     std::string per_rank;
@@ -608,8 +611,10 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
       busy += b;
       per_rank += fmt::format("{}{:.2f}", per_rank.empty() ? "" : " ", b);
     }
-    std::printf("%d ranks, %d threads: parallel efficiency %.1f%% (busy thread-seconds per rank: %s)\n",
-                cluster.size(), stats.threads, 100 * busy / (double(stats.threads) * seconds), per_rank.c_str());
+    std::printf("%d ranks, %d threads: parallel efficiency %.1f%% (busy thread-seconds per rank: %s); "
+                "sent per rank: at most %.2f MB, rank 0 %.2f MB; rank 0 in collectives %.2f s\n",
+                cluster.size(), stats.threads, 100 * busy / (double(stats.threads) * seconds), per_rank.c_str(),
+                double(most_sent) * 1e-6, double(traffic[0].bytes_sent) * 1e-6, traffic[0].collective_seconds);
   }
   if (stats.time_limited)
     std::fprintf(stderr, "candela: time limit reached: wrote the image with %s%s\n", spp_text.c_str(), spp_unit);

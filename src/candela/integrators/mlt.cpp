@@ -89,21 +89,6 @@ class MltPathSampler {
   bool spectral_;
 };
 
-// Adds the thread-seconds from its construction to its destruction to `total` (nanoseconds): the
-// busy time behind the closing line's parallel efficiency.
-class BusyTimer {
- public:
-  explicit BusyTimer(std::atomic<uint64_t>& total) : total_(total), start_(std::chrono::steady_clock::now()) {}
-  ~BusyTimer() {
-    auto elapsed = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start_);
-    total_.fetch_add(uint64_t(elapsed.count()), std::memory_order_relaxed);
-  }
-
- private:
-  std::atomic<uint64_t>& total_;
-  std::chrono::steady_clock::time_point start_;
-};
-
 // After run_shared across ranks: every rank gets the others' items of `values` (`per_item` values
 // each).
 template <typename T>

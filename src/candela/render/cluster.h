@@ -31,6 +31,8 @@ class Cluster {
   virtual int size() const = 0;
   bool is_root() const { return rank() == 0; }
   bool distributed() const { return size() > 1; }
+  // Started by an MPI launcher (even as a job of one rank).
+  virtual bool mpi_job() const = 0;
   // Render threads this rank uses by default: its share of the node's cores.
   virtual int default_threads() const = 0;
 
@@ -49,6 +51,14 @@ class Cluster {
   virtual void sum_int64(std::vector<int64_t>& values) = 0;
   // The root's `bytes` on every rank (collective).
   virtual void broadcast(std::vector<std::byte>& bytes) = 0;
+  // What this rank has sent (bytes it contributed to messages and collectives) and the seconds its
+  // calling thread spent in collectives (waiting for the others included): for the closing line and
+  // the scaling model of docs/distributed.md.
+  struct Traffic {
+    uint64_t bytes_sent = 0;
+    double collective_seconds = 0;
+  };
+  virtual Traffic traffic() const { return {}; }
   // Ends every rank of the job at once with `exit_code` (a failure after the ranks agreed to
   // render, where waiting for the others could hang).
   [[noreturn]] virtual void abort(int exit_code) = 0;
@@ -89,6 +99,7 @@ class LocalCluster final : public Cluster {
   int rank() const override { return 0; }
   int size() const override { return 1; }
   int default_threads() const override { return 0; }
+  bool mpi_job() const override { return false; }
   void share_work(uint64_t items, int threads, const std::function<void(const NextItem&)>& work,
                   const std::function<void(uint64_t, uint64_t)>& granted) override;
   std::vector<std::vector<std::byte>> all_gather(std::span<const std::byte> mine) override;

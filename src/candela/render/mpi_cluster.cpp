@@ -91,6 +91,7 @@ class MpiCluster final : public Cluster {
   }
   ~MpiCluster() override { MPI_Finalize(); }
 
+  bool mpi_job() const override { return true; }
   int rank() const override { return rank_; }
   int size() const override { return size_; }
   int default_threads() const override {
@@ -118,8 +119,12 @@ class MpiCluster final : public Cluster {
     if (failure) std::rethrow_exception(failure);
   }
 
+  Traffic traffic() const override { return traffic_; }
+
   std::vector<std::vector<std::byte>> all_gather(std::span<const std::byte> mine) override {
+    CollectiveTimer timer(traffic_);
     const uint64_t length = mine.size();
+    traffic_.bytes_sent += length + sizeof length;
     std::vector<uint64_t> lengths(static_cast<size_t>(size_), 0);
     check(MPI_Allgather(&length, 1, MPI_UINT64_T, lengths.data(), 1, MPI_UINT64_T, MPI_COMM_WORLD), "MPI_Allgather");
     std::vector<std::vector<std::byte>> all(static_cast<size_t>(size_));
@@ -151,6 +156,8 @@ class MpiCluster final : public Cluster {
   }
 
   void sum_int64(std::vector<int64_t>& values) override {
+    CollectiveTimer timer(traffic_);
+    traffic_.bytes_sent += values.size() * sizeof(int64_t);
     constexpr size_t kSlice = size_t(1) << 26;
     for (size_t start = 0; start < values.size(); start += kSlice)
       check(MPI_Allreduce(MPI_IN_PLACE, values.data() + start, int(std::min(kSlice, values.size() - start)),
@@ -159,7 +166,9 @@ class MpiCluster final : public Cluster {
   }
 
   void broadcast(std::vector<std::byte>& bytes) override {
+    CollectiveTimer timer(traffic_);
     uint64_t length = bytes.size();
+    if (rank_ == 0) traffic_.bytes_sent += length + sizeof length;
     check(MPI_Bcast(&length, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD), "MPI_Bcast");
     bytes.resize(length);
     constexpr uint64_t kSlice = uint64_t(1) << 30;
@@ -200,6 +209,7 @@ class MpiCluster final : public Cluster {
         auto [first, count] = grant(want);
         uint64_t reply[2] = {first, count};
         MPI_Send(reply, 2, MPI_UINT64_T, status.MPI_SOURCE, kTagGrant, MPI_COMM_WORLD);
+        traffic_.bytes_sent += sizeof reply;
         if (count == 0)
           ++told_done;
         else if (granted)
@@ -228,6 +238,7 @@ class MpiCluster final : public Cluster {
       if (pending == MPI_REQUEST_NULL && queue.size() <= size_t(threads)) {
         int64_t want = threads;
         MPI_Send(&want, 1, MPI_INT64_T, 0, kTagRequest, MPI_COMM_WORLD);
+        traffic_.bytes_sent += sizeof want;
         MPI_Irecv(reply, 2, MPI_UINT64_T, 0, kTagGrant, MPI_COMM_WORLD, &pending);
       }
       int arrived = 0;
@@ -244,7 +255,18 @@ class MpiCluster final : public Cluster {
     }
   }
 
+  // Adds the time from its construction to its destruction to Traffic::collective_seconds.
+  struct CollectiveTimer {
+    explicit CollectiveTimer(Traffic& t) : traffic(t), start(std::chrono::steady_clock::now()) {}
+    ~CollectiveTimer() {
+      traffic.collective_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+    Traffic& traffic;
+    std::chrono::steady_clock::time_point start;
+  };
+
   int rank_ = 0, size_ = 1, ranks_on_node_ = 1;
+  Traffic traffic_;
 };
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <cstring>
 #include <span>
+#include <ctime>
 #include <tuple>
 
 #include "candela/render/film_part.h"
@@ -55,11 +56,8 @@ void run_pass(const PassContext& pc, const std::vector<Tile>& tiles, tbb::task_a
       pc.cluster, arena, tiles.size(),
       [&](uint64_t t) {
         if (cancelled(pc)) return;
-        auto start = std::chrono::steady_clock::now();
+        BusyTimer busy(pc.busy_nanoseconds);
         progress.advance(pc.integrator.render_tile(tiles[t], range, pc.tile, pc.ray_counts.local()));
-        pc.busy_nanoseconds.fetch_add(
-            uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count()),
-            std::memory_order_relaxed);
       },
       [&](uint64_t first, uint64_t count) {
         for (uint64_t t = first; t < first + count; ++t) progress.advance(tile_samples(tiles[t], range));
@@ -297,6 +295,17 @@ void combine_ranks(Cluster& cluster, Film& film, const RenderOptions& options, i
 }
 
 }  // namespace
+
+namespace {
+uint64_t thread_cpu_nanoseconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return uint64_t(t.tv_sec) * 1000000000u + uint64_t(t.tv_nsec);
+}
+}  // namespace
+
+BusyTimer::BusyTimer(std::atomic<uint64_t>& total) : total_(total), start_(thread_cpu_nanoseconds()) {}
+BusyTimer::~BusyTimer() { total_.fetch_add(thread_cpu_nanoseconds() - start_, std::memory_order_relaxed); }
 
 std::vector<uint8_t> run_shared(Cluster& cluster, tbb::task_arena& arena, uint64_t items,
                                 const std::function<void(uint64_t)>& body,

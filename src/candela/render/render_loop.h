@@ -141,6 +141,21 @@ class TileIntegrator {
                                RayCounts& counts) const = 0;
 };
 
+// Adds the CPU time the calling thread spends from its construction to its destruction to `total`
+// (nanoseconds): the busy time behind the parallel efficiency. CPU time, not wall time, so that
+// ranks sharing cores (oversubscribed) still report the work they did.
+class BusyTimer {
+ public:
+  explicit BusyTimer(std::atomic<uint64_t>& total);
+  ~BusyTimer();
+  BusyTimer(const BusyTimer&) = delete;
+  BusyTimer& operator=(const BusyTimer&) = delete;
+
+ private:
+  std::atomic<uint64_t>& total_;
+  uint64_t start_;
+};
+
 // Runs body(item) for the items [0, items) on `arena`'s threads, the items handed out dynamically
 // across the cluster's ranks (each item runs on one rank). Returns which items ran on this rank.
 std::vector<uint8_t> run_shared(Cluster& cluster, tbb::task_arena& arena, uint64_t items,
