@@ -12,42 +12,23 @@
 #include "candela/sampling/rng.h"
 #include "candela/sampling/warp.h"
 #include "candela/testing/bsdf_chi_square.h"
+#include "candela/testing/bsdf_helpers.h"
 #include "candela/testing/statistics.h"
 
 namespace candela {
 namespace {
 
+using testing::albedo;
+using testing::below;
 using testing::Binning;
 using testing::bsdf_chi_square;
+using testing::direction;
+using testing::Estimate;
+using testing::random_direction;
 using testing::zoomed_chi_square;
 
 constexpr int kSamples = testing::kChiSquareSamples;
 constexpr double kAlpha = testing::kChiSquareAlpha;
-
-Vec3 direction(float theta_degrees, float phi_degrees = 30) {
-  float t = radians(theta_degrees), p = radians(phi_degrees);
-  return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
-}
-Vec3 below(const Vec3& w) { return {w.x, w.y, -w.z}; }
-
-struct Albedo {
-  double mean = 0, standard_error = 0;
-};
-Albedo albedo(const Bsdf& bsdf, const Vec3& wo, int n = 100000, uint64_t seed = 7) {
-  Rng rng(seed, 99);
-  double sum = 0, sum2 = 0;
-  for (int i = 0; i < n; ++i) {
-    auto s = bsdf_sample(bsdf, wo, rng.next_float(), {rng.next_float(), rng.next_float()});
-    if (!s) continue;
-    double w = double(s->weight.g) * s->eta * s->eta;
-    sum += w;
-    sum2 += w * w;
-  }
-  double mean = sum / n;
-  return {mean, std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n)};
-}
-
-Vec3 random_direction(Rng& rng) { return square_to_uniform_sphere({rng.next_float(), rng.next_float()}); }
 
 ConductorBsdf beckmann_conductor(float ax, float ay) {
   return {RGB(0.2f, 0.9f, 1.1f), RGB(3.9f, 2.4f, 2.1f), RGB(1.0f), Beckmann(ax, ay)};
@@ -225,11 +206,11 @@ TEST(Beckmann, EnergyConservation) {
     for (Vec3 wo : {direction(0), direction(45), direction(80), direction(88)}) {
       for (const Bsdf& b : {Bsdf(white_conductor(alpha)), Bsdf(beckmann_glass(alpha, alpha)),
                             Bsdf(beckmann_plastic(alpha, RGB(1.0f)))}) {
-        Albedo a = albedo(b, wo);
+        Estimate a = albedo(b, wo);
         EXPECT_LE(a.mean, 1.0035 + 3 * a.standard_error) << alpha << " " << wo.z << " " << b.index();
         EXPECT_GE(a.mean, 0.2) << alpha << " " << wo.z << " " << b.index();  // single scattering loses some
       }
-      Albedo inside = albedo(beckmann_glass(alpha, alpha), below(wo));
+      Estimate inside = albedo(beckmann_glass(alpha, alpha), below(wo));
       EXPECT_LE(inside.mean, 1.0035 + 3 * inside.standard_error) << alpha << " " << wo.z;
     }
 }

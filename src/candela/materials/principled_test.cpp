@@ -12,16 +12,14 @@
 
 #include "candela/materials/material.h"
 #include "candela/sampling/rng.h"
+#include "candela/testing/bsdf_helpers.h"
 #include "candela/testing/principled_cases.h"
 #include "candela/testing/statistics.h"
 
 namespace candela {
 namespace {
 
-Vec3 direction(float theta_degrees, float phi_degrees = 30) {
-  float t = radians(theta_degrees), p = radians(phi_degrees);
-  return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
-}
+using testing::direction;
 
 // Chi-square of sample() against pdf(). The harness bins uniformly in cos theta around its pole,
 // which cannot resolve the narrow lobes that sit at the pole for near-normal incidence (the first
@@ -222,12 +220,10 @@ TEST(PrincipledSampling, RefractionsReportTheRelativeIor) {
 template <typename B>
 double albedo(const B& b, const Vec3& wo, int n = 200000) {
   Rng rng(3, uint64_t(1000 * wo.z + 7));
-  double sum = 0;
-  for (int i = 0; i < n; ++i) {
-    auto s = b.sample(wo, rng.next_float(), {rng.next_float(), rng.next_float()});
-    if (s) sum += s->weight.max_component();
-  }
-  return sum / n;
+  return testing::sample_mean(n, [&] {
+           auto s = b.sample(wo, rng.next_float(), {rng.next_float(), rng.next_float()});
+           return s ? double(s->weight.max_component()) : 0.0;
+         }).mean;
 }
 
 TEST(PrincipledEnergy, AlbedoAtMostOneWhereTheModelConservesEnergy) {

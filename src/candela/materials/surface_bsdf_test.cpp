@@ -9,18 +9,16 @@
 #include "candela/materials/material.h"
 #include "candela/sampling/rng.h"
 #include "candela/sampling/warp.h"
+#include "candela/testing/bsdf_helpers.h"
 #include "candela/testing/statistics.h"
 
 namespace candela {
 namespace {
 
-constexpr double kAlpha = testing::kChiSquareAlpha;
+using testing::below;
+using testing::direction;
 
-Vec3 direction(float theta_degrees, float phi_degrees = 30) {
-  float t = radians(theta_degrees), p = radians(phi_degrees);
-  return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
-}
-Vec3 below(const Vec3& w) { return {w.x, w.y, -w.z}; }
+constexpr double kAlpha = testing::kChiSquareAlpha;
 
 double chi_square(const SurfaceBsdf& b, const Vec3& wo) {
   Rng lobe_rng(42, 43);
@@ -51,12 +49,10 @@ int check_weights(const SurfaceBsdf& b, const Vec3& wo, int n = 20000) {
 // Directional albedo: the mean sample weight (green), the null part included.
 double albedo(const SurfaceBsdf& b, const Vec3& wo, int n = 200000) {
   Rng rng(3, 4);
-  double sum = 0;
-  for (int i = 0; i < n; ++i) {
-    auto s = b.sample(wo, rng.next_float(), {rng.next_float(), rng.next_float()});
-    if (s) sum += double(s->weight.g) * s->eta * s->eta;
-  }
-  return sum / n;
+  return testing::sample_mean(n, [&] {
+           auto s = b.sample(wo, rng.next_float(), {rng.next_float(), rng.next_float()});
+           return s ? double(s->weight.g) * s->eta * s->eta : 0.0;
+         }).mean;
 }
 
 ConductorBsdf rough_conductor(float alpha, bool beckmann = false) {
