@@ -20,6 +20,7 @@ namespace candela {
 namespace {
 
 using testing::direction;
+using testing::random_direction;
 
 // Chi-square of sample() against pdf(). The harness bins uniformly in cos theta around its pole,
 // which cannot resolve the narrow lobes that sit at the pole for near-normal incidence (the first
@@ -251,8 +252,7 @@ TEST(PrincipledReciprocity, ReflectionAndThinTransmissionAreReciprocal) {
   Rng rng(4, 4);
   int checked = 0;
   for (int i = 0; i < 20000; ++i) {
-    Vec3 a = square_to_uniform_sphere({rng.next_float(), rng.next_float()});
-    Vec3 c = square_to_uniform_sphere({rng.next_float(), rng.next_float()});
+    Vec3 a = random_direction(rng), c = random_direction(rng);
     if (std::abs(a.z) < 1e-2f || std::abs(c.z) < 1e-2f) continue;
     if (same_hemisphere(a, c) || thin_transmission_masks_agree(a, c)) {
       RGB t_ac = t.eval(a, c), t_ca = t.eval(c, a);
@@ -274,8 +274,7 @@ TEST(PrincipledReciprocity, TransmissionCarriesTheRadianceScaling) {
   Rng rng(6, 6);
   int checked = 0;
   for (int i = 0; i < 40000; ++i) {
-    Vec3 wo = square_to_uniform_sphere({rng.next_float(), rng.next_float()});
-    Vec3 wi = square_to_uniform_sphere({rng.next_float(), rng.next_float()});
+    Vec3 wo = random_direction(rng), wi = random_direction(rng);
     if (same_hemisphere(wo, wi) || std::min(std::abs(wo.z), std::abs(wi.z)) < 0.05f) continue;
     float etap = wo.z > 0 ? p.eta : 1 / p.eta;
     Vec3 wm = normalize(wo + wi * etap);
