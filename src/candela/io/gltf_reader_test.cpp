@@ -569,16 +569,20 @@ TEST(GltfCameras, NoCameraFramesTheModelUnderASky) {
 
 // ---------------------------------------------------------------- renders
 
+// A sample model rendered from its own camera on a width x height film: the mean image.
+Image render_model(const std::string& model, int width, int height, int spp, int max_depth) {
+  SceneDesc scene = load(asset(model));
+  scene.film = {width, height, ""};
+  scene.settings.spp = spp;
+  scene.settings.max_depth = max_depth;
+  return testing::render_description(scene).mean_image();
+}
+
 // The box under the white sky (radiance 1): the background is exactly 1, the red box (base colour
 // (0.8, 0, 0), dielectric) is redder than it is green, and nothing exceeds what a convex object
 // under a unit sky can reflect (1).
 TEST(GltfRender, BoxIsVisibleAgainstTheSky) {
-  SceneDesc scene = load(asset("Box"));
-  scene.film = {48, 36, ""};
-  scene.settings.spp = 16;
-  scene.settings.max_depth = 4;
-  Film film = testing::render_description(scene);
-  Image img = film.mean_image();
+  Image img = render_model("Box", 48, 36, 16, 4);
   auto corner = [&](int x, int y) { return x < 4 && y < 4; };
   auto centre = [&](int x, int y) { return std::abs(x - 24) < 4 && std::abs(y - 18) < 4; };
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(testing::region_mean(img, c, corner).mean, 1.0, 1e-3) << c;
@@ -590,12 +594,7 @@ TEST(GltfRender, BoxIsVisibleAgainstTheSky) {
 
 // The emissive cubes, seen directly: the strongest (x16) is far brighter than the sky.
 TEST(GltfRender, EmissiveStrengthOrdersBrightness) {
-  SceneDesc scene = load(asset("EmissiveStrengthTest"));
-  scene.film = {64, 48, ""};
-  scene.settings.spp = 4;
-  scene.settings.max_depth = 1;
-  Film film = testing::render_description(scene);
-  Image img = film.mean_image();
+  Image img = render_model("EmissiveStrengthTest", 64, 48, 4, 1);
   double brightest = 0;
   for (int y = 0; y < img.height; ++y)
     for (int x = 0; x < img.width; ++x) brightest = std::max<double>(brightest, img.at(x, y).b);
