@@ -13,11 +13,7 @@ namespace {
 // A soft-shadow test scene: a glossy sphere (the paper's material) over a diffuse floor, lit by a
 // rectangular area light, a sphere light, a point light and a dim sky.
 SceneDesc soft_shadow_scene(int spp) {
-  SceneDesc d;
-  d.film = {48, 36, ""};
-  d.camera = testing::look_at_camera({0, 2.5f, -6}, {0, 0.5f, 0}, 40);
-  d.settings.spp = spp;
-  d.settings.max_depth = 5;
+  SceneDesc d = testing::empty_scene(testing::look_at_camera({0, 2.5f, -6}, {0, 0.5f, 0}, 40), 48, 36, spp, 5);
   PhongMaterial glossy;
   glossy.diffuse = RGB(0.6f, 0.3f, 0.2f);
   glossy.specular = RGB(0.9f);

@@ -12,11 +12,7 @@ namespace candela {
 namespace {
 
 SceneDesc small_scene(int spp) {
-  SceneDesc d;
-  d.film = {24, 18, ""};
-  d.camera = testing::look_at_camera({0, 2, -6}, {0, 0.5f, 0}, 40);
-  d.settings.spp = spp;
-  d.settings.max_depth = 4;
+  SceneDesc d = testing::empty_scene(testing::look_at_camera({0, 2, -6}, {0, 0.5f, 0}, 40), 24, 18, spp, 4);
   d.settings.sampler.type = SamplerType::Stratified;
   d.materials = {DiffuseMaterial{RGB(0.7f)}};
   ShapeDesc floor{.geometry = PlaneShape{{0, 0, 0}, {0, 1, 0}}, .material = 0};

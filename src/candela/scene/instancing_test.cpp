@@ -10,12 +10,8 @@ namespace candela {
 namespace {
 
 SceneDesc base_scene() {
-  SceneDesc d;
-  d.film = {48, 48, ""};
-  d.settings.spp = 16;
-  d.settings.max_depth = 4;
+  SceneDesc d = testing::empty_scene(testing::look_at_camera({0, 3, 9}, {0, 0.5f, 0}, 40), 48, 48, 16, 4);
   d.settings.seed = 7;
-  d.camera = testing::look_at_camera({0, 3, 9}, {0, 0.5f, 0}, 40);
   d.camera.shutter_open = 0;
   d.camera.shutter_close = 1;
   d.textures.push_back(CheckerboardTexture{RGB(0.8f, 0.3f, 0.2f), RGB(0.1f, 0.6f, 0.9f), UVMapping{4, 4, 0, 0}});

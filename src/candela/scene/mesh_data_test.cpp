@@ -32,12 +32,8 @@ TriangleMesh bumpy_grid(int n) {
 }
 
 SceneDesc mesh_scene() {
-  SceneDesc d;
-  d.film = {40, 30, ""};
-  d.settings.spp = 8;
-  d.settings.max_depth = 5;
+  SceneDesc d = testing::empty_scene(testing::look_at_camera({0, 2.5f, -4}, {0, 0.2f, 0}, 45), 40, 30, 8, 5);
   d.settings.seed = 3;
-  d.camera = testing::look_at_camera({0, 2.5f, -4}, {0, 0.2f, 0}, 45);
   d.materials.push_back(DiffuseMaterial{RGB(0.7f, 0.5f, 0.3f)});
   ConductorMaterial metal;
   metal.roughness.u = metal.roughness.v = 0.3f;
