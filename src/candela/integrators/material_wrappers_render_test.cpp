@@ -10,10 +10,7 @@
 namespace candela {
 namespace {
 
-using testing::look_at_camera;
-using testing::MeanEstimate;
-using testing::region_mean;
-using testing::render_description;
+using namespace testing;  // the render helpers: render_description, region_mean, look_at_camera, ...
 
 void expect_mean(const testing::MeanEstimate& e, double expected, const std::string& what) {
   EXPECT_NEAR(e.mean, expected, 4 * e.standard_error + 1e-4 * std::max(1.0, std::abs(expected)))
