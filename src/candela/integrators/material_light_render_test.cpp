@@ -25,10 +25,7 @@
 namespace candela {
 namespace {
 
-using testing::look_at_camera;
-using testing::MeanEstimate;
-using testing::region_mean;
-using testing::render_description;
+using namespace testing;  // the render helpers: render_description, region_mean, look_at_camera, ...
 
 constexpr int kSize = 32;  // film width and height
 

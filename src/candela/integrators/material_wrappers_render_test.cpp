@@ -10,10 +10,7 @@
 namespace candela {
 namespace {
 
-using testing::look_at_camera;
-using testing::MeanEstimate;
-using testing::region_mean;
-using testing::render_description;
+using namespace testing;  // the render helpers: render_description, region_mean, look_at_camera, ...
 
 void expect_mean(const testing::MeanEstimate& e, double expected, const std::string& what) {
   EXPECT_NEAR(e.mean, expected, 4 * e.standard_error + 1e-4 * std::max(1.0, std::abs(expected)))
@@ -38,9 +35,7 @@ SceneDesc plane_scene(const std::vector<MaterialDesc>& materials, bool facing_up
 }
 
 MaskMaterial mask_of(int material, float opacity) {
-  MaskMaterial m;
-  m.material = material;
-  m.opacity = opacity;
+  MaskMaterial m{.opacity = opacity, .material = material};
   return m;
 }
 
@@ -212,10 +207,7 @@ TEST(MaterialWrappersRender, WhiteFurnaceNeverGainsEnergy) {
   white_metal.reflectance = ColorInput(RGB(0.9999f));
   white_metal.roughness.u = white_metal.roughness.v = 0.3f;
   white_metal.roughness.distribution = MicrofacetDistribution::Beckmann;
-  BlendMaterial blend;
-  blend.weight = 0.5f;
-  blend.material0 = 0;
-  blend.material1 = 1;
+  BlendMaterial blend{.weight = 0.5f, .material0 = 0, .material1 = 1};
   DielectricMaterial beckmann_glass;
   beckmann_glass.roughness.u = beckmann_glass.roughness.v = 0.2f;
   beckmann_glass.roughness.distribution = MicrofacetDistribution::Beckmann;

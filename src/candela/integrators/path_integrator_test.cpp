@@ -13,11 +13,7 @@ namespace {
 // A soft-shadow test scene: a glossy sphere (the paper's material) over a diffuse floor, lit by a
 // rectangular area light, a sphere light, a point light and a dim sky.
 SceneDesc soft_shadow_scene(int spp) {
-  SceneDesc d;
-  d.film = {48, 36, ""};
-  d.camera = testing::look_at_camera({0, 2.5f, -6}, {0, 0.5f, 0}, 40);
-  d.settings.spp = spp;
-  d.settings.max_depth = 5;
+  SceneDesc d = testing::empty_scene(testing::look_at_camera({0, 2.5f, -6}, {0, 0.5f, 0}, 40), 48, 36, spp, 5);
   PhongMaterial glossy;
   glossy.diffuse = RGB(0.6f, 0.3f, 0.2f);
   glossy.specular = RGB(0.9f);
@@ -26,20 +22,14 @@ SceneDesc soft_shadow_scene(int spp) {
   glossy.s = 0.4f;
   glossy.t = 0;
   d.materials = {DiffuseMaterial{RGB(0.7f)}, glossy, BlackMaterial{}};
-  ShapeDesc floor;
-  floor.geometry = PlaneShape{{0, 0, 0}, {0, 1, 0}};
-  floor.material = 0;
-  ShapeDesc sphere;
-  sphere.geometry = SphereShape{{0, 1, 0}, 1};
-  sphere.material = 1;
+  ShapeDesc floor{.geometry = PlaneShape{{0, 0, 0}, {0, 1, 0}}, .material = 0};
+  ShapeDesc sphere{.geometry = SphereShape{{0, 1, 0}, 1}, .material = 1};
   ShapeDesc panel;
   panel.geometry = RectangleShape{{-1, 4, -1}, {2, 0, 0}, {0, 0, 2}};  // normal cross(u, v) = -y: faces down
   panel.material = 2;
   panel.emission = AreaEmission{RGB(3.0f), false};
-  ShapeDesc bulb;
-  bulb.geometry = SphereShape{{2.5f, 2.5f, -1}, 0.3f};
-  bulb.material = 2;
-  bulb.emission = AreaEmission{RGB(8.0f, 6.0f, 4.0f), false};
+  ShapeDesc bulb{.geometry = SphereShape{{2.5f, 2.5f, -1}, 0.3f}, .material = 2,
+                 .emission = AreaEmission{RGB(8.0f, 6.0f, 4.0f), false}};
   d.shapes = {floor, sphere, panel, bulb};
   d.lights = {PointLight{{-3, 3, -2}, RGB(4.0f)}, SkyLight{RGB(0.1f), RGB(0.1f), RGB(0.1f), {0, 1, 0}}};
   return d;

@@ -133,6 +133,17 @@ std::string read_bytes(const fs::path& file) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+// The message of the SceneError that read() throws; a failure ("<what> loaded") and "" where it throws none.
+std::string scene_error_of(const std::function<void()>& read, const std::string& what) {
+  try {
+    read();
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << what << " loaded";
+  return "";
+}
+
 // ---------------------------------------------------------------- every sample model
 
 std::vector<std::string> sample_files() {
@@ -151,15 +162,10 @@ class GltfSampleModel : public ::testing::TestWithParam<std::string> {};
 TEST_P(GltfSampleModel, Loads) {
   const fs::path file = kAssets / GetParam();
   if (GetParam().find("Draco") != std::string::npos) {
-    try {
-      load(file);
-      FAIL() << "a Draco-compressed file loaded";
-    } catch (const SceneError& e) {
-      std::string message = e.what();
-      EXPECT_NE(message.find(file.string()), std::string::npos) << message;
-      EXPECT_NE(message.find("Draco"), std::string::npos) << message;
-      EXPECT_NE(message.find("mesh \""), std::string::npos) << message;
-    }
+    std::string message = scene_error_of([&] { load(file); }, "a Draco-compressed file");
+    EXPECT_NE(message.find(file.string()), std::string::npos) << message;
+    EXPECT_NE(message.find("Draco"), std::string::npos) << message;
+    EXPECT_NE(message.find("mesh \""), std::string::npos) << message;
     return;
   }
   SceneDesc scene = load(file);
@@ -563,16 +569,20 @@ TEST(GltfCameras, NoCameraFramesTheModelUnderASky) {
 
 // ---------------------------------------------------------------- renders
 
+// A sample model rendered from its own camera on a width x height film: the mean image.
+Image render_model(const std::string& model, int width, int height, int spp, int max_depth) {
+  SceneDesc scene = load(asset(model));
+  scene.film = {width, height, ""};
+  scene.settings.spp = spp;
+  scene.settings.max_depth = max_depth;
+  return testing::render_description(scene).mean_image();
+}
+
 // The box under the white sky (radiance 1): the background is exactly 1, the red box (base colour
 // (0.8, 0, 0), dielectric) is redder than it is green, and nothing exceeds what a convex object
 // under a unit sky can reflect (1).
 TEST(GltfRender, BoxIsVisibleAgainstTheSky) {
-  SceneDesc scene = load(asset("Box"));
-  scene.film = {48, 36, ""};
-  scene.settings.spp = 16;
-  scene.settings.max_depth = 4;
-  Film film = testing::render_description(scene);
-  Image img = film.mean_image();
+  Image img = render_model("Box", 48, 36, 16, 4);
   auto corner = [&](int x, int y) { return x < 4 && y < 4; };
   auto centre = [&](int x, int y) { return std::abs(x - 24) < 4 && std::abs(y - 18) < 4; };
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(testing::region_mean(img, c, corner).mean, 1.0, 1e-3) << c;
@@ -584,12 +594,7 @@ TEST(GltfRender, BoxIsVisibleAgainstTheSky) {
 
 // The emissive cubes, seen directly: the strongest (x16) is far brighter than the sky.
 TEST(GltfRender, EmissiveStrengthOrdersBrightness) {
-  SceneDesc scene = load(asset("EmissiveStrengthTest"));
-  scene.film = {64, 48, ""};
-  scene.settings.spp = 4;
-  scene.settings.max_depth = 1;
-  Film film = testing::render_description(scene);
-  Image img = film.mean_image();
+  Image img = render_model("EmissiveStrengthTest", 64, 48, 4, 1);
   double brightest = 0;
   for (int y = 0; y < img.height; ++y)
     for (int x = 0; x < img.width; ++x) brightest = std::max<double>(brightest, img.at(x, y).b);
@@ -603,23 +608,15 @@ TEST(GltfMalformed, TruncatedGlbNamesTheFile) {
   Scratch scratch;
   std::string bytes = read_bytes(asset("Box", "glTF-Binary"));
   fs::path file = scratch.write("truncated.glb", bytes.substr(0, bytes.size() / 2));
-  try {
-    load(file);
-    FAIL() << "a truncated .glb loaded";
-  } catch (const SceneError& e) {
-    EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
-  }
+  std::string message = scene_error_of([&] { load(file); }, "a truncated .glb");
+  EXPECT_NE(message.find(file.string()), std::string::npos) << message;
 }
 
 TEST(GltfMalformed, JsonSyntaxErrorNamesTheFile) {
   Scratch scratch;
   fs::path file = scratch.write("syntax.gltf", R"({"asset": {"version": "2.0"}, "nodes": [)");
-  try {
-    read_scene_file(file);
-    FAIL() << "malformed JSON loaded";
-  } catch (const SceneError& e) {
-    EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
-  }
+  std::string message = scene_error_of([&] { read_scene_file(file); }, "malformed JSON");
+  EXPECT_NE(message.find(file.string()), std::string::npos) << message;
 }
 
 TEST(GltfMalformed, IndexOutOfRangeNamesTheAccessor) {
@@ -632,14 +629,9 @@ TEST(GltfMalformed, IndexOutOfRangeNamesTheAccessor) {
   j["accessors"][0]["byteOffset"] = 12;  // from the second position on: 1.0f's bits as an index
   fs::copy_file(kAssets / "Triangle/glTF/simpleTriangle.bin", scratch.dir() / "simpleTriangle.bin");
   fs::path file = scratch.write("bad.gltf", j.dump());
-  try {
-    load(file);
-    FAIL() << "out-of-range indices loaded";
-  } catch (const SceneError& e) {
-    std::string message = e.what();
-    EXPECT_NE(message.find(file.string()), std::string::npos) << message;
-    EXPECT_NE(message.find("/meshes/0/primitives/0/indices"), std::string::npos) << message;
-  }
+  std::string message = scene_error_of([&] { load(file); }, "out-of-range indices");
+  EXPECT_NE(message.find(file.string()), std::string::npos) << message;
+  EXPECT_NE(message.find("/meshes/0/primitives/0/indices"), std::string::npos) << message;
 }
 
 TEST(GltfMalformed, UnsupportedRequiredExtensionIsRefused) {

@@ -12,6 +12,7 @@
 #include "candela/io/json_writer.h"
 #include "candela/io/scene_reader.h"
 #include "candela/testing/json_reader_helpers.h"
+#include "candela/testing/texture_expectations.h"
 
 namespace candela {
 namespace {
@@ -52,21 +53,13 @@ TEST(JsonReader, ReadsTexturesWithDependenciesFirst) {
   EXPECT_TRUE(checks.tex1.is_constant());
   EXPECT_EQ(checks.tex1.value, RGB(0.9f, 0.8f, 0.7f));
   EXPECT_EQ(checks.tex2.value, RGB(0.1f));
-  EXPECT_FLOAT_EQ(checks.mapping.su, 4);
-  EXPECT_FLOAT_EQ(checks.mapping.sv, 8);
-  EXPECT_FLOAT_EQ(checks.mapping.du, 0.5f);
-  EXPECT_FLOAT_EQ(checks.mapping.dv, 0.25f);
+  testing::expect_mapping(checks.mapping, {.su = 4, .sv = 8, .du = 0.5f, .dv = 0.25f}, "checks");
   const auto& wood = std::get<ImageTexture>(scene.textures[1]);
   EXPECT_EQ(wood.filename, (kTextureDir / "checker.ppm").string());  // relative to the scene's directory
-  EXPECT_EQ(wood.wrap, TextureWrap::Mirror);
-  EXPECT_EQ(wood.encoding, ColorEncoding::SRGB);
-  EXPECT_FALSE(wood.bilinear);
-  EXPECT_FLOAT_EQ(wood.scale, 2);
-  EXPECT_TRUE(wood.invert);
-  EXPECT_FLOAT_EQ(wood.mapping.su, 3);
-  EXPECT_FLOAT_EQ(wood.mapping.sv, 3);
-  EXPECT_FLOAT_EQ(wood.mapping.du, 1);
-  EXPECT_FLOAT_EQ(wood.mapping.dv, 2);
+  testing::expect_image_settings(wood,
+                                 {.wrap = TextureWrap::Mirror, .encoding = ColorEncoding::SRGB, .bilinear = false,
+                                  .scale = 2, .invert = true, .mapping = {.su = 3, .sv = 3, .du = 1, .dv = 2}},
+                                 "wood");
   const auto& scale = std::get<ScaleTexture>(scene.textures[2]);
   EXPECT_EQ(scale.tex.texture, 1);
   EXPECT_TRUE(scale.scale.is_constant());
@@ -89,13 +82,7 @@ TEST(JsonReader, TexturesGetTheDescriptionDefaults) {
   ASSERT_EQ(scene.textures.size(), 5u);
   const auto& image = std::get<ImageTexture>(scene.textures[0]);
   EXPECT_EQ(image.filename, absolute);
-  EXPECT_EQ(image.wrap, TextureWrap::Repeat);
-  EXPECT_EQ(image.encoding, ColorEncoding::Auto);
-  EXPECT_TRUE(image.bilinear);
-  EXPECT_FLOAT_EQ(image.scale, 1);
-  EXPECT_FALSE(image.invert);
-  EXPECT_FLOAT_EQ(image.mapping.su, 1);
-  EXPECT_FLOAT_EQ(image.mapping.du, 0);
+  testing::expect_image_settings(image, ImageTexture{}, "image");
   const auto& checks = std::get<CheckerboardTexture>(scene.textures[1]);
   EXPECT_EQ(checks.tex1.value, RGB(1));
   EXPECT_EQ(checks.tex2.value, RGB(0));

@@ -119,6 +119,10 @@ class MeshIo : public ::testing::Test {
     std::ifstream in(file, std::ios::binary);
     return std::string(std::istreambuf_iterator<char>(in), {});
   }
+  // A fuzzer's input from fuzz/regressions/ply_reader/, copied into the scratch directory.
+  fs::path fuzzed(const std::string& name) const {
+    return write(name, read(fs::path(CANDELA_SOURCE_DIR) / "fuzz" / "regressions" / "ply_reader" / name));
+  }
 
   fs::path dir_;
 };
@@ -625,8 +629,7 @@ TEST_F(MeshIo, PlyWithTwoFormatLinesIsAnError) {
                                                      kPlyTriangleHeader.substr(kPlyTriangleHeader.find("element")) +
                                                      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
                         {"more than one format line"});
-  const fs::path fuzzed = fs::path(CANDELA_SOURCE_DIR) / "fuzz" / "regressions" / "ply_reader";
-  expect_error_mentions(write("fuzzed1.ply", read(fuzzed / "leak-second-format-line.ply")), {"malformed PLY"});
+  expect_error_mentions(fuzzed("leak-second-format-line.ply"), {"malformed PLY"});
 }
 
 TEST_F(MeshIo, PlyElementDeclaredTwiceIsAnError) {
@@ -634,17 +637,15 @@ TEST_F(MeshIo, PlyElementDeclaredTwiceIsAnError) {
                                                    "element face 1\nproperty list uchar int vertex_indices\n"
                                                    "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n"),
                         {"element 'face' is declared twice"});
-  const fs::path fuzzed = fs::path(CANDELA_SOURCE_DIR) / "fuzz" / "regressions" / "ply_reader";
   // (This file also has a stray "endian 1.0" line, now refused first.)
-  expect_error_mentions(write("fuzzed2.ply", read(fuzzed / "leak-duplicate-elements.ply")), {"malformed PLY"});
+  expect_error_mentions(fuzzed("leak-duplicate-elements.ply"), {"malformed PLY"});
 }
 
 TEST_F(MeshIo, PlyElementNameMustStartWithALetter) {
   expect_error_mentions(write("digits.ply", "ply\nformat ascii 1.0\nelement 22222222222222222222 1\n"
                                             "property float x\nend_header\n0\n"),
                         {"element name '22222222222222222222' does not start with a letter"});
-  const fs::path fuzzed = fs::path(CANDELA_SOURCE_DIR) / "fuzz" / "regressions" / "ply_reader";
-  expect_error_mentions(write("fuzzed3.ply", read(fuzzed / "oom-numeric-element-name.ply")),
+  expect_error_mentions(fuzzed("oom-numeric-element-name.ply"),
                         {"does not start with a letter"});
 }
 
@@ -652,8 +653,7 @@ TEST_F(MeshIo, PlyWithoutAVertexElementIsAnError) {
   expect_error_mentions(write("novertex.ply", "ply\nformat ascii 1.0\nelement point 1\nproperty float x\n"
                                               "property float y\nproperty float z\nend_header\n0 0 0\n"),
                         {"declares no 'vertex' element"});
-  const fs::path fuzzed = fs::path(CANDELA_SOURCE_DIR) / "fuzz" / "regressions" / "ply_reader";
-  expect_error_mentions(write("fuzzed6.ply", read(fuzzed / "oom-no-vertex-element.ply")),
+  expect_error_mentions(fuzzed("oom-no-vertex-element.ply"),
                         {"declares no 'vertex' element"});
 }
 
@@ -661,14 +661,13 @@ TEST_F(MeshIo, PlyControlBytesInTheHeaderAreAnError) {
   expect_error_mentions(write("cr.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
                                         "property float y\nproperty float z\n\r\r\rend_header\n0 0 0\n"),
                         {"header line 7 has a carriage return inside it"});
-  const fs::path fuzzed = fs::path(CANDELA_SOURCE_DIR) / "fuzz" / "regressions" / "ply_reader";
-  expect_error_mentions(write("fuzzed5.ply", read(fuzzed / "segv-carriage-returns-before-end-header.ply")),
+  expect_error_mentions(fuzzed("segv-carriage-returns-before-end-header.ply"),
                         {"carriage return"});
   using namespace std::string_literals;
   expect_error_mentions(write("nul.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\0y\n"
                                          "property float y\nproperty float z\nend_header\n0 0 0\n"s),
                         {"header line 4 has a control byte (0x00) in it"});
-  expect_error_mentions(write("fuzzed7.ply", read(fuzzed / "oom-nul-in-header.ply")), {"control byte"});
+  expect_error_mentions(fuzzed("oom-nul-in-header.ply"), {"control byte"});
   // CRLF line ends are fine.
   EXPECT_EQ(load(write("crlf.ply", "ply\r\nformat ascii 1.0\r\nelement vertex 3\r\nproperty float x\r\n"
                                    "property float y\r\nproperty float z\r\nelement face 1\r\n"
@@ -692,8 +691,7 @@ TEST_F(MeshIo, PlyUnrecognisedLineInsideAnElementIsAnError) {
                                              "propeofy ltrat ny\nproperty float y\nproperty float z\n"
                                              "end_header\n0 0 0\n"),
                         {"unrecognised header line 'propeofy ltrat ny' after element 'vertex'"});
-  const fs::path fuzzed = fs::path(CANDELA_SOURCE_DIR) / "fuzz" / "regressions" / "ply_reader";
-  expect_error_mentions(write("fuzzed4.ply", read(fuzzed / "oom-unrecognised-header-line.ply")),
+  expect_error_mentions(fuzzed("oom-unrecognised-header-line.ply"),
                         {"unrecognised header line"});
   // Before the first element, a stray line (Blender 2.4's broken comment) is still skipped.
   const fs::path wuson = kShared / "ply-tests" / "Wuson.ply";

@@ -31,6 +31,12 @@ SceneDesc read_text(const std::string& body, const MitsubaReadOptions& options =
                                  warnings, options);
 }
 
+// The material wrapped in the one-sided material of shape `shape` (Mitsuba's BSDFs are one-sided).
+template <typename M>
+const M& inside_one_sided(const SceneDesc& s, size_t shape) {
+  return std::get<M>(s.materials[std::get<OneSidedMaterial>(s.materials[s.shapes[shape].material]).material]);
+}
+
 std::string error_of(const std::string& body) {
   try {
     read_text(body);
@@ -127,14 +133,12 @@ TEST(MitsubaReader, Bsdfs) {
     <shape type="sphere"><bsdf type="null"/></shape>)");
   const auto& d = std::get<DielectricMaterial>(s.materials[s.shapes[0].material]);
   EXPECT_NEAR(d.ior, 2.419f / 1.000277f, 1e-5);
-  const auto& c = std::get<ConductorMaterial>(
-      s.materials[std::get<OneSidedMaterial>(s.materials[s.shapes[1].material]).material]);
+  const auto& c = inside_one_sided<ConductorMaterial>(s, 1);
   EXPECT_EQ(c.roughness.distribution, MicrofacetDistribution::GGXSeparable);  // Mitsuba's G1(wo) G1(wi)
   EXPECT_FLOAT_EQ(c.roughness.u.value, 0.25f);
   EXPECT_FLOAT_EQ(c.roughness.v.value, 0.05f);
   EXPECT_NEAR(c.eta.value.r, 1.6575f, 1e-3);
-  const auto& p = std::get<CoatedDiffuseMaterial>(
-      s.materials[std::get<OneSidedMaterial>(s.materials[s.shapes[2].material]).material]);
+  const auto& p = inside_one_sided<CoatedDiffuseMaterial>(s, 2);
   EXPECT_EQ(p.roughness.distribution, MicrofacetDistribution::Beckmann);  // Mitsuba's default
   EXPECT_TRUE(p.nonlinear);
   EXPECT_TRUE(p.tabulated_coat);  // Mitsuba's roughplastic integrates its rough coat into tables
@@ -173,10 +177,8 @@ TEST(MitsubaReader, CheckerboardLookedUpAsAFloatSwapsItsColours) {
       <ref name="alpha" id="check"/></bsdf></shape>
     <shape type="sphere"><bsdf type="diffuse"><ref name="reflectance" id="check"/></bsdf></shape>)");
   ASSERT_EQ(s.textures.size(), 2u);
-  const auto& conductor = std::get<ConductorMaterial>(
-      s.materials[std::get<OneSidedMaterial>(s.materials[s.shapes[0].material]).material]);
-  const auto& diffuse = std::get<DiffuseMaterial>(
-      s.materials[std::get<OneSidedMaterial>(s.materials[s.shapes[1].material]).material]);
+  const auto& conductor = inside_one_sided<ConductorMaterial>(s, 0);
+  const auto& diffuse = inside_one_sided<DiffuseMaterial>(s, 1);
   const auto& as_float = std::get<CheckerboardTexture>(s.textures[size_t(conductor.roughness.u.texture)]);
   const auto& as_colour = std::get<CheckerboardTexture>(s.textures[size_t(diffuse.reflectance.texture)]);
   EXPECT_FLOAT_EQ(as_colour.tex1.value.r, 0.05f);  // candela's tex1: where floor(2u) + floor(2v) is even
@@ -192,10 +194,8 @@ TEST(MitsubaReader, BitmapLookedUpAsAFloatIsItsLuminance) {
     <shape type="sphere"><bsdf type="roughconductor"><ref name="alpha" id="map"/></bsdf></shape>
     <shape type="sphere"><bsdf type="diffuse"><ref name="reflectance" id="map"/></bsdf></shape>)");
   ASSERT_EQ(s.textures.size(), 2u);
-  const auto& conductor = std::get<ConductorMaterial>(
-      s.materials[std::get<OneSidedMaterial>(s.materials[s.shapes[0].material]).material]);
-  const auto& diffuse = std::get<DiffuseMaterial>(
-      s.materials[std::get<OneSidedMaterial>(s.materials[s.shapes[1].material]).material]);
+  const auto& conductor = inside_one_sided<ConductorMaterial>(s, 0);
+  const auto& diffuse = inside_one_sided<DiffuseMaterial>(s, 1);
   EXPECT_TRUE(std::get<ImageTexture>(s.textures[size_t(conductor.roughness.u.texture)]).luminance);
   EXPECT_FALSE(std::get<ImageTexture>(s.textures[size_t(diffuse.reflectance.texture)]).luminance);
 }

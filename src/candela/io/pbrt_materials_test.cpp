@@ -21,6 +21,7 @@
 #include "candela/scene/description.h"
 #include "candela/spectral/cie.h"
 #include "candela/testing/pbrt_reader_helpers.h"
+#include "candela/testing/texture_expectations.h"
 
 namespace candela {
 namespace {
@@ -213,22 +214,13 @@ TEST(PbrtReader, ImageTextures) {
   ASSERT_EQ(scene.textures.size(), 6u);
   const auto& a = std::get<ImageTexture>(scene.textures[0]);
   EXPECT_EQ(fs::path(a.filename), scratch_dir() / "wood.png");  // beside the scene file
-  EXPECT_EQ(a.encoding, ColorEncoding::Auto);                     // sRGB for 8-bit files, as pbrt-v4
-  EXPECT_TRUE(a.bilinear);
-  EXPECT_EQ(a.wrap, TextureWrap::Repeat);
-  EXPECT_FLOAT_EQ(a.scale, 1);
-  EXPECT_FALSE(a.invert);
-  EXPECT_FLOAT_EQ(a.mapping.su, 1);
+  // The defaults: encoding Auto (sRGB for 8-bit files, as pbrt-v4), bilinear, repeated, no scale or offset.
+  testing::expect_image_settings(a, ImageTexture{}, "a");
   const auto& b = std::get<ImageTexture>(scene.textures[1]);
-  EXPECT_EQ(b.encoding, ColorEncoding::Auto);
-  EXPECT_FALSE(b.bilinear);
-  EXPECT_EQ(b.wrap, TextureWrap::Clamp);
-  EXPECT_FLOAT_EQ(b.scale, 2);
-  EXPECT_TRUE(b.invert);
-  EXPECT_FLOAT_EQ(b.mapping.su, 4);
-  EXPECT_FLOAT_EQ(b.mapping.sv, 3);
-  EXPECT_FLOAT_EQ(b.mapping.du, 0.5f);
-  EXPECT_FLOAT_EQ(b.mapping.dv, 0.25f);
+  testing::expect_image_settings(b,
+                                 {.wrap = TextureWrap::Clamp, .encoding = ColorEncoding::Auto, .bilinear = false,
+                                  .scale = 2, .invert = true, .mapping = {.su = 4, .sv = 3, .du = 0.5f, .dv = 0.25f}},
+                                 "b");
   const auto& c = std::get<ImageTexture>(scene.textures[2]);
   EXPECT_EQ(c.encoding, ColorEncoding::SRGB);
   EXPECT_EQ(c.wrap, TextureWrap::Black);

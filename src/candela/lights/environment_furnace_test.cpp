@@ -8,44 +8,22 @@
 // Each check asserts a mean within 4 standard errors estimated from the render itself.
 #include <gtest/gtest.h>
 
-#include <filesystem>
 #include <string>
 
-#include <unistd.h>
-
-#include "candela/film/image_io.h"
 #include "candela/sampling/warp.h"
 #include "candela/testing/render_helpers.h"
+#include "candela/testing/temp_image_file.h"
 
 namespace candela {
 namespace {
 
 using testing::look_at_camera;
+using testing::TempImageFile;
 using testing::region_mean;
 using testing::render_description;
 
 constexpr int kSize = 32;  // film width and height
 constexpr float kAlbedo = 0.8f;
-
-// An image written to a fresh temporary directory, removed afterwards.
-class TempImageFile {
- public:
-  TempImageFile(const Image& image, const std::string& name) {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("candela-envmap-furnace-" + std::to_string(::getpid()) + "-" + name);
-    std::filesystem::create_directories(dir_);
-    path_ = dir_ / (name + ".exr");
-    write_image(path_, image);
-  }
-  ~TempImageFile() {
-    std::error_code ec;
-    std::filesystem::remove_all(dir_, ec);
-  }
-  std::string path() const { return path_.string(); }
-
- private:
-  std::filesystem::path dir_, path_;
-};
 
 // A unit sphere at the origin seen from z = -4 (it subtends asin(1/4) = 14.5 degrees; the fov is 40).
 SceneDesc sphere_under_environment(const EnvironmentMap& map, int spp) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <initializer_list>
 #include <string>
 
 #include "candela/film/image.h"
@@ -62,28 +63,19 @@ void expect_sample_densities_match_pdf_le(const Light& light, const SceneSphere&
   EXPECT_GT(valid, 19900) << what;
 }
 
-struct Estimate {
-  double mean = 0, standard_error = 0;
-};
+using testing::Estimate;
 
 // E[luminance(radiance) |cos(n, w)| / (pdf_pos pdf_dir)] (cos = 1 where n is zero) with independent
 // uniform position and direction samples: the emitted power.
 Estimate emitted_power(const Light& light, const SceneSphere& scene, int n = 400000, uint64_t seed = 3) {
   Rng rng(seed, 77);
-  double sum = 0, sum2 = 0;
-  for (int i = 0; i < n; ++i) {
+  return testing::sample_mean(n, [&] {
     Vec2 up{rng.next_float(), rng.next_float()}, ud{rng.next_float(), rng.next_float()};
     LightEmission e = light_sample_le(light, up, ud, scene);
-    double v = 0;
-    if (e.pdf_dir > 0 && e.pdf_pos > 0) {
-      double c = e.n == Normal3(0.0f) ? 1.0 : std::abs(dot(e.n, e.w));
-      v = double(e.radiance.luminance()) * c / (double(e.pdf_pos) * double(e.pdf_dir));
-    }
-    sum += v;
-    sum2 += v * v;
-  }
-  double mean = sum / n, var = std::max(0.0, sum2 / n - mean * mean);
-  return {mean, std::sqrt(var / n)};
+    if (!(e.pdf_dir > 0 && e.pdf_pos > 0)) return 0.0;
+    double c = e.n == Normal3(0.0f) ? 1.0 : std::abs(dot(e.n, e.w));
+    return double(e.radiance.luminance()) * c / (double(e.pdf_pos) * double(e.pdf_dir));
+  });
 }
 
 void expect_power(const Light& light, const SceneSphere& scene, const char* what) {
@@ -152,24 +144,26 @@ TEST(LightEmission, SpotLightDirectionsAreUniformInTheOuterCone) {
   EXPECT_EQ(light_pdf_le(l, spot.position, Normal3(0.0f), -spot.frame.n, kScene).dir, 0);
 }
 
-TEST(LightEmission, TriangleLightDirectionsAreCosineAboutTheNormal) {
+// A flat area light made by make(two_sided), one- and two-sided: directions cosine-distributed
+// about its normal from each sampled point, and densities matching pdf_le.
+template <typename FlatLight>
+void expect_cosine_about_the_normal(FlatLight (*make)(bool), std::initializer_list<Vec2> u_positions,
+                                    const std::string& name) {
   for (bool two_sided : {false, true}) {
-    TriangleLight t = test_triangle(two_sided);
-    Light l = t;
-    for (Vec2 u_pos : {Vec2{0.2f, 0.3f}, Vec2{0.8f, 0.1f}})
-      EXPECT_GT(emission_chi_square(l, u_pos, kScene, t.n), testing::kChiSquareAlpha) << "two-sided " << two_sided;
-    expect_sample_densities_match_pdf_le(l, kScene, two_sided ? "two-sided triangle" : "triangle");
+    FlatLight light = make(two_sided);
+    Light l = light;
+    for (Vec2 u_pos : u_positions)
+      EXPECT_GT(emission_chi_square(l, u_pos, kScene, light.n), testing::kChiSquareAlpha) << "two-sided " << two_sided;
+    expect_sample_densities_match_pdf_le(l, kScene, (two_sided ? "two-sided " + name : name).c_str());
   }
 }
 
+TEST(LightEmission, TriangleLightDirectionsAreCosineAboutTheNormal) {
+  expect_cosine_about_the_normal(test_triangle, {Vec2{0.2f, 0.3f}, Vec2{0.8f, 0.1f}}, "triangle");
+}
+
 TEST(LightEmission, RectangleLightDirectionsAreCosineAboutTheNormal) {
-  for (bool two_sided : {false, true}) {
-    RectangleLight r = test_rectangle(two_sided);
-    Light l = r;
-    for (Vec2 u_pos : {Vec2{0.5f, 0.5f}, Vec2{0.9f, 0.05f}})
-      EXPECT_GT(emission_chi_square(l, u_pos, kScene, r.n), testing::kChiSquareAlpha) << "two-sided " << two_sided;
-    expect_sample_densities_match_pdf_le(l, kScene, two_sided ? "two-sided rectangle" : "rectangle");
-  }
+  expect_cosine_about_the_normal(test_rectangle, {Vec2{0.5f, 0.5f}, Vec2{0.9f, 0.05f}}, "rectangle");
 }
 
 TEST(LightEmission, SphereLightDirectionsAreCosineAboutTheEmittingSide) {

@@ -5,35 +5,25 @@
 // with the emission sampling of all of them against pdf_le (chi-square) and power().
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <cmath>
-#include <filesystem>
 #include <string>
 
-#include "candela/film/image_io.h"
 #include "candela/lights/light.h"
 #include "candela/sampling/rng.h"
 #include "candela/scene/scene.h"
 #include "candela/testing/statistics.h"
+#include "candela/testing/temp_image_file.h"
 
 namespace candela {
 namespace {
 
-struct Estimate {
-  double mean = 0, standard_error = 0;
-};
+using testing::Estimate;
+
+// The mean of f(u) over n uniform points u of the unit square (seeded by `seed`).
 template <typename F>
 Estimate estimate(int n, uint64_t seed, F&& f) {
   Rng rng(seed, 5);
-  double sum = 0, sum2 = 0;
-  for (int i = 0; i < n; ++i) {
-    double v = f(Vec2{rng.next_float(), rng.next_float()});
-    sum += v;
-    sum2 += v * v;
-  }
-  double mean = sum / n;
-  return {mean, std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n)};
+  return testing::sample_mean(n, [&] { return double(f(Vec2{rng.next_float(), rng.next_float()})); });
 }
 void expect_estimate(const Estimate& e, double expected, const std::string& what, double rel = 1e-4) {
   EXPECT_NEAR(e.mean, expected, 4.5 * e.standard_error + rel * std::abs(expected))
@@ -253,24 +243,6 @@ TEST(MitsubaSpotLight, ProjectedTextureFollowsMitsubasUv) {
 
 // ---------------------------------------------------------------- projector
 
-class TempImage {
- public:
-  explicit TempImage(const Image& image) {
-    dir_ = std::filesystem::temp_directory_path() / ("candela-projector-test-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir_);
-    path_ = dir_ / "irradiance.exr";
-    write_image(path_, image);
-  }
-  ~TempImage() {
-    std::error_code ec;
-    std::filesystem::remove_all(dir_, ec);
-  }
-  std::string path() const { return path_.string(); }
-
- private:
-  std::filesystem::path dir_, path_;
-};
-
 // A 4 x 3 image with a black texel, read without filtering.
 Image projector_image() {
   Image img(4, 3);
@@ -280,15 +252,20 @@ Image projector_image() {
   return img;
 }
 
+// A set of one texture: the image in `file`, read as linear values.
+TextureSet linear_texture(const std::string& file, bool bilinear, TextureWrap wrap) {
+  ImageTexture tex;
+  tex.filename = file;
+  tex.encoding = ColorEncoding::Linear;
+  tex.bilinear = bilinear;
+  tex.wrap = wrap;
+  return TextureSet(std::vector<TextureDesc>{tex});
+}
+
 TEST(ProjectorLight, IrradianceOnAPlaneFacingItIsPiTimesScaleTimesTheImage) {
   Image img = projector_image();
-  TempImage file(img);
-  ImageTexture tex;
-  tex.filename = file.path();
-  tex.encoding = ColorEncoding::Linear;
-  tex.bilinear = false;
-  tex.wrap = TextureWrap::Clamp;
-  TextureSet textures(std::vector<TextureDesc>{tex});
+  testing::TempImageFile file(img, "projector");
+  TextureSet textures = linear_texture(file.path(), false, TextureWrap::Clamp);
   ProjectorLight desc;
   desc.to_world = Transform::translate({1, 2, 3}) * Transform::rotate(50, normalize(Vec3(1, 2, 3)));
   desc.fov_degrees = 70;  // on the wider axis, x; y from the aspect 4 : 3
@@ -335,13 +312,8 @@ TEST(ProjectorLight, IrradianceOnAPlaneFacingItIsPiTimesScaleTimesTheImage) {
 }
 
 TEST(ProjectorLight, EmissionIsImportanceSampledWithTheRightDensity) {
-  Image img = projector_image();
-  TempImage file(img);
-  ImageTexture tex;
-  tex.filename = file.path();
-  tex.encoding = ColorEncoding::Linear;
-  tex.bilinear = true;
-  TextureSet textures(std::vector<TextureDesc>{tex});
+  testing::TempImageFile file(projector_image(), "projector");
+  TextureSet textures = linear_texture(file.path(), true, TextureWrap::Repeat);
   ProjectorLight desc;
   desc.to_world = Transform::rotate(-30, normalize(Vec3(2, 1, 0)));
   desc.fov_degrees = 50;

@@ -17,17 +17,15 @@
 #include "candela/materials/rough_coat.h"
 #include "candela/sampling/rng.h"
 #include "candela/sampling/warp.h"
+#include "candela/testing/bsdf_helpers.h"
 #include "candela/testing/principled_cases.h"
 
 namespace candela {
 namespace {
 
-Vec3 direction(float theta_degrees, float phi_degrees = 30) {
-  float t = radians(theta_degrees), p = radians(phi_degrees);
-  return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
-}
-Vec3 below(const Vec3& w) { return {w.x, w.y, -w.z}; }
-Vec3 random_direction(Rng& rng) { return square_to_uniform_sphere({rng.next_float(), rng.next_float()}); }
+using testing::below;
+using testing::direction;
+using testing::random_direction;
 
 // One outgoing direction and how many of `samples` draws must be non-delta samples there.
 struct Outgoing {

@@ -5,17 +5,16 @@
 #include <gtest/gtest.h>
 
 #include "candela/sampling/rng.h"
+#include "candela/testing/bsdf_helpers.h"
 #include "candela/testing/statistics.h"
 
 namespace candela {
 namespace {
 
-constexpr int kSamples = testing::kChiSquareSamples;
+using testing::albedo;
+using testing::direction;
 
-Vec3 direction(float theta_degrees, float phi_degrees = 30) {
-  float t = radians(theta_degrees), p = radians(phi_degrees);
-  return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
-}
+constexpr int kSamples = testing::kChiSquareSamples;
 
 // Chi-square of the directions sample() returns against pdf(); non-delta samples only.
 double bsdf_chi_square(const Bsdf& bsdf, const Vec3& wo, float z_min = -1) {
@@ -92,14 +91,7 @@ TEST(Bsdf, EnergyConservationAndReciprocity) {
   p.d = 0.5f;
   p.s = 0.5f;
   for (float theta : {0.0f, 30.0f, 60.0f, 85.0f}) {
-    Rng rng(3, uint64_t(theta));
-    double sum = 0;
-    const int n = 200000;
-    for (int i = 0; i < n; ++i) {
-      auto s = p.sample(direction(theta), rng.next_float(), {rng.next_float(), rng.next_float()});
-      if (s) sum += s->weight.g;
-    }
-    EXPECT_LE(sum / n, 1.0 + 0.01) << theta;
+    EXPECT_LE(albedo(p, direction(theta), 200000, Rng(3, uint64_t(theta))).mean, 1.0 + 0.01) << theta;
   }
   Rng rng(4, 4);
   for (int i = 0; i < 1000; ++i) {

@@ -12,16 +12,15 @@
 
 #include "candela/materials/material.h"
 #include "candela/sampling/rng.h"
+#include "candela/testing/bsdf_helpers.h"
 #include "candela/testing/principled_cases.h"
 #include "candela/testing/statistics.h"
 
 namespace candela {
 namespace {
 
-Vec3 direction(float theta_degrees, float phi_degrees = 30) {
-  float t = radians(theta_degrees), p = radians(phi_degrees);
-  return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
-}
+using testing::direction;
+using testing::random_direction;
 
 // Chi-square of sample() against pdf(). The harness bins uniformly in cos theta around its pole,
 // which cannot resolve the narrow lobes that sit at the pole for near-normal incidence (the first
@@ -54,45 +53,21 @@ struct EvalCase {
 };
 
 std::vector<EvalCase> eval_cases() {
-  PrincipledParams all;  // every lobe of principled at once (no transmission)
-  all.base_color = RGB(0.8f, 0.4f, 0.2f);
-  all.roughness = 0.4f;
-  all.anisotropic = 0.5f;
-  all.metallic = 0.3f;
-  all.spec_tint = 0.4f;
-  all.sheen = 0.6f;
-  all.sheen_tint = 0.5f;
-  all.clearcoat = 0.7f;
-  all.clearcoat_gloss = 0.6f;
-  all.flatness = 0.3f;
-  all.eta = 1.5f;
-  PrincipledParams glass;  // with specular transmission
-  glass.base_color = RGB(0.3f, 0.6f, 0.8f);
-  glass.roughness = 0.3f;
-  glass.anisotropic = 0.2f;
-  glass.spec_trans = 0.7f;
-  glass.eta = 1.3f;
-  glass.clearcoat = 0.5f;
-  glass.clearcoat_gloss = 0.2f;
-  glass.sheen = 0.4f;
-  PrincipledParams gltf;  // glTF's metallic-roughness: specular 0.5 (eta 1.5), the rest off
-  gltf.base_color = RGB(0.9f, 0.6f, 0.3f);
-  gltf.roughness = 0.5f;
-  gltf.eta = 1.5f;
+  // Every lobe of principled at once (no transmission).
+  PrincipledParams all{.base_color = RGB(0.8f, 0.4f, 0.2f), .roughness = 0.4f, .anisotropic = 0.5f, .metallic = 0.3f,
+                       .spec_tint = 0.4f, .sheen = 0.6f, .sheen_tint = 0.5f, .clearcoat = 0.7f, .clearcoat_gloss = 0.6f,
+                       .flatness = 0.3f, .eta = 1.5f};
+  // With specular transmission.
+  PrincipledParams glass{.base_color = RGB(0.3f, 0.6f, 0.8f), .roughness = 0.3f, .anisotropic = 0.2f,
+                         .spec_trans = 0.7f, .sheen = 0.4f, .clearcoat = 0.5f, .clearcoat_gloss = 0.2f, .eta = 1.3f};
+  // glTF's metallic-roughness: specular 0.5 (eta 1.5), the rest off.
+  PrincipledParams gltf{.base_color = RGB(0.9f, 0.6f, 0.3f), .roughness = 0.5f, .eta = 1.5f};
   PrincipledParams metal = gltf;
   metal.roughness = 0.25f;
   metal.metallic = 1;
-  PrincipledParams thin;
-  thin.base_color = RGB(0.7f, 0.1f, 0.1f);
-  thin.roughness = 0.5f;
-  thin.anisotropic = 0.4f;
-  thin.spec_trans = 0.6f;
-  thin.diff_trans = 0.8f;
-  thin.sheen = 0.5f;
-  thin.sheen_tint = 0.3f;
-  thin.spec_tint = 0.3f;
-  thin.flatness = 0.4f;
-  thin.eta = 1.33f;
+  PrincipledParams thin{.base_color = RGB(0.7f, 0.1f, 0.1f), .roughness = 0.5f, .anisotropic = 0.4f, .spec_tint = 0.3f,
+                        .spec_trans = 0.6f, .sheen = 0.5f, .sheen_tint = 0.3f, .flatness = 0.4f, .eta = 1.33f,
+                        .diff_trans = 0.8f};
   return {
       {"all lobes", false, all, direction(30, 20), direction(50, 200), {0.655422927f, 0.349932783f, 0.197187711f}},
       {"all lobes near mirror", false, all, direction(40, 10), direction(38, 185),
@@ -131,19 +106,14 @@ TEST(PrincipledEval, SpecularMapsToEtaAsMitsubaDoes) {
 TEST(PrincipledEval, MetalReflectsBaseColorAtNormalIncidence) {
   // metallic = 1: Schlick's Fresnel with R0 = base_color, so at wo = wi = n the colour is exactly base_color
   // times the grey microfacet factor D G / 4.
-  PrincipledParams p;
-  p.base_color = RGB(0.9f, 0.5f, 0.2f);
-  p.metallic = 1;
-  p.roughness = 0.3f;
+  PrincipledParams p{.base_color = RGB(0.9f, 0.5f, 0.2f), .roughness = 0.3f, .metallic = 1};
   RGB f = PrincipledBsdf(p).eval(Vec3(0, 0, 1), Vec3(0, 0, 1));
   float dg = principled_distribution(0.3f, 0).D(Vec3(0, 0, 1)) / 4;
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(f[k], p.base_color[k] * dg, 1e-5f * dg);
 }
 
 TEST(PrincipledEval, OpaqueSurfaceIsBlackFromBehind) {
-  PrincipledParams p;
-  p.clearcoat = 1;
-  p.sheen = 1;
+  PrincipledParams p{.sheen = 1, .clearcoat = 1};
   PrincipledBsdf b(p);
   EXPECT_TRUE(b.eval(-direction(30), -direction(40, 200)).is_black());
   EXPECT_EQ(b.pdf(-direction(30), -direction(40, 200)), 0);
@@ -168,14 +138,8 @@ TEST(PrincipledSampling, MatchesPdf) {
 }
 
 TEST(PrincipledThinSampling, MatchesPdf) {
-  PrincipledParams p;
-  p.base_color = RGB(0.7f, 0.3f, 0.2f);
-  p.roughness = 0.5f;
-  p.anisotropic = 0.5f;
-  p.spec_trans = 0.5f;
-  p.diff_trans = 0.6f;
-  p.sheen = 0.5f;
-  p.eta = 1.33f;
+  PrincipledParams p{.base_color = RGB(0.7f, 0.3f, 0.2f), .roughness = 0.5f, .anisotropic = 0.5f, .spec_trans = 0.5f,
+                     .sheen = 0.5f, .eta = 1.33f, .diff_trans = 0.6f};
   PrincipledParams specular = p;
   specular.spec_trans = 1;
   specular.eta = 1.8f;
@@ -191,10 +155,7 @@ TEST(PrincipledThinSampling, MatchesPdf) {
 }
 
 TEST(PrincipledSampling, RefractionsReportTheRelativeIor) {
-  PrincipledParams p;
-  p.spec_trans = 1;
-  p.roughness = 0.3f;
-  p.eta = 1.5f;
+  PrincipledParams p{.roughness = 0.3f, .spec_trans = 1, .eta = 1.5f};
   PrincipledBsdf b(p);
   Rng rng(5, 5);
   int refracted = 0;
@@ -222,31 +183,21 @@ TEST(PrincipledSampling, RefractionsReportTheRelativeIor) {
 template <typename B>
 double albedo(const B& b, const Vec3& wo, int n = 200000) {
   Rng rng(3, uint64_t(1000 * wo.z + 7));
-  double sum = 0;
-  for (int i = 0; i < n; ++i) {
-    auto s = b.sample(wo, rng.next_float(), {rng.next_float(), rng.next_float()});
-    if (s) sum += s->weight.max_component();
-  }
-  return sum / n;
+  return testing::sample_mean(n, [&] {
+           auto s = b.sample(wo, rng.next_float(), {rng.next_float(), rng.next_float()});
+           return s ? double(s->weight.max_component()) : 0.0;
+         }).mean;
 }
 
 TEST(PrincipledEnergy, AlbedoAtMostOneWhereTheModelConservesEnergy) {
   // Single-scattering microfacet lobes with Fresnel weights that sum to at most 1: the metal (Schlick
   // of a white base), the dielectric with full specular transmission (entering: radiance scaled by 1 / eta^2),
   // and the thin sheet's specular pair. Uncorrelated lobes (below) are not covered.
-  PrincipledParams metal;
-  metal.base_color = RGB(1.0f);
-  metal.metallic = 1;
-  PrincipledParams glass;
-  glass.base_color = RGB(1.0f);
-  glass.spec_trans = 1;
-  glass.eta = 1.5f;
+  PrincipledParams metal{.base_color = RGB(1.0f), .metallic = 1};
+  PrincipledParams glass{.base_color = RGB(1.0f), .spec_trans = 1, .eta = 1.5f};
   PrincipledParams thin = glass;
   thin.eta = 1.33f;
-  PrincipledParams thin_diffuse;
-  thin_diffuse.base_color = RGB(1.0f);
-  thin_diffuse.roughness = 0;
-  thin_diffuse.diff_trans = 1;
+  PrincipledParams thin_diffuse{.base_color = RGB(1.0f), .roughness = 0, .diff_trans = 1};
   for (float roughness : {0.2f, 0.5f, 0.9f}) {
     metal.roughness = glass.roughness = thin.roughness = roughness;
     for (float theta : {0.0f, 30.0f, 60.0f, 80.0f}) {
@@ -264,9 +215,7 @@ TEST(PrincipledEnergy, MitsubasModelIsNotEnergyConservingElsewhere) {
   // Documents where Mitsuba's principled (like Burley's) creates energy, so that a "fix" would be a
   // deviation from Mitsuba: the retro-reflection of a rough white diffuse base at grazing angles, and
   // the sheen and specular lobes added on top of an undiminished diffuse lobe.
-  PrincipledParams rough;
-  rough.base_color = RGB(1.0f);
-  rough.roughness = 1;
+  PrincipledParams rough{.base_color = RGB(1.0f), .roughness = 1};
   rough.eta = 1.0001f;  // no specular lobe at all
   EXPECT_GT(albedo(PrincipledBsdf(rough), direction(80)), 1.05);
   PrincipledParams sheen = rough;
@@ -276,10 +225,7 @@ TEST(PrincipledEnergy, MitsubasModelIsNotEnergyConservingElsewhere) {
   EXPECT_GT(albedo(PrincipledBsdf(sheen), direction(75)), 1.05);
   // glTF's metallic-roughness case with a white base: the diffuse lobe keeps its full weight under the
   // specular reflection (albedo ~1.03 at normal incidence, ~1.23 at 80 degrees for roughness 0.2).
-  PrincipledParams gltf;
-  gltf.base_color = RGB(1.0f);
-  gltf.roughness = 0.2f;
-  gltf.eta = 1.5f;
+  PrincipledParams gltf{.base_color = RGB(1.0f), .roughness = 0.2f, .eta = 1.5f};
   EXPECT_GT(albedo(PrincipledBsdf(gltf), direction(80)), 1.1);
 }
 
@@ -298,26 +244,15 @@ bool thin_transmission_masks_agree(const Vec3& a, const Vec3& c) {
 }
 
 TEST(PrincipledReciprocity, ReflectionAndThinTransmissionAreReciprocal) {
-  PrincipledParams p;
-  p.base_color = RGB(0.8f, 0.5f, 0.3f);
-  p.roughness = 0.45f;
-  p.anisotropic = 0.6f;
-  p.metallic = 0.3f;
-  p.spec_tint = 0.5f;
-  p.sheen = 0.7f;
-  p.sheen_tint = 0.4f;
-  p.clearcoat = 0.8f;
-  p.clearcoat_gloss = 0.5f;
-  p.flatness = 0.5f;
-  p.spec_trans = 0.4f;
-  p.diff_trans = 0.7f;
+  PrincipledParams p{.base_color = RGB(0.8f, 0.5f, 0.3f), .roughness = 0.45f, .anisotropic = 0.6f, .metallic = 0.3f,
+                     .spec_tint = 0.5f, .spec_trans = 0.4f, .sheen = 0.7f, .sheen_tint = 0.4f, .clearcoat = 0.8f,
+                     .clearcoat_gloss = 0.5f, .flatness = 0.5f, .diff_trans = 0.7f};
   PrincipledBsdf b(p);
   PrincipledThinBsdf t(p);
   Rng rng(4, 4);
   int checked = 0;
   for (int i = 0; i < 20000; ++i) {
-    Vec3 a = square_to_uniform_sphere({rng.next_float(), rng.next_float()});
-    Vec3 c = square_to_uniform_sphere({rng.next_float(), rng.next_float()});
+    Vec3 a = random_direction(rng), c = random_direction(rng);
     if (std::abs(a.z) < 1e-2f || std::abs(c.z) < 1e-2f) continue;
     if (same_hemisphere(a, c) || thin_transmission_masks_agree(a, c)) {
       RGB t_ac = t.eval(a, c), t_ca = t.eval(c, a);
@@ -334,17 +269,12 @@ TEST(PrincipledReciprocity, ReflectionAndThinTransmissionAreReciprocal) {
 TEST(PrincipledReciprocity, TransmissionCarriesTheRadianceScaling) {
   // The refracted part follows Walter et al. for radiance: f(wi, wo) = eta'^2 f(wo, wi), eta' the
   // relative IOR crossed from wo's side (what bsdf_adjoint_scale turns into the adjoint).
-  PrincipledParams p;
-  p.base_color = RGB(0.6f, 0.7f, 0.9f);
-  p.spec_trans = 0.9f;
-  p.roughness = 0.5f;
-  p.eta = 1.4f;
+  PrincipledParams p{.base_color = RGB(0.6f, 0.7f, 0.9f), .roughness = 0.5f, .spec_trans = 0.9f, .eta = 1.4f};
   PrincipledBsdf b(p);
   Rng rng(6, 6);
   int checked = 0;
   for (int i = 0; i < 40000; ++i) {
-    Vec3 wo = square_to_uniform_sphere({rng.next_float(), rng.next_float()});
-    Vec3 wi = square_to_uniform_sphere({rng.next_float(), rng.next_float()});
+    Vec3 wo = random_direction(rng), wi = random_direction(rng);
     if (same_hemisphere(wo, wi) || std::min(std::abs(wo.z), std::abs(wi.z)) < 0.05f) continue;
     float etap = wo.z > 0 ? p.eta : 1 / p.eta;
     Vec3 wm = normalize(wo + wi * etap);
@@ -397,13 +327,8 @@ TEST(PrincipledMaterialTable, BuildsBothModelsFromTexturedInputs) {
     const auto* b = std::get_if<PrincipledBsdf>(&as_bsdf(built));
     ASSERT_TRUE(b);
     EXPECT_NEAR(b->metallic, metallic, 1e-6f);
-    PrincipledParams p;
-    p.base_color = opaque.base_color.value;
-    p.roughness = 0.15f;
-    p.metallic = metallic;
-    p.clearcoat = 0.9f;
-    p.sheen = 0.2f;
-    p.eta = principled_eta_from_specular(0.7f);
+    PrincipledParams p{.base_color = opaque.base_color.value, .roughness = 0.15f, .metallic = metallic, .sheen = 0.2f,
+                       .clearcoat = 0.9f, .eta = principled_eta_from_specular(0.7f)};
     RGB expected = PrincipledBsdf(p).eval(direction(30), direction(45, 200)), f = b->eval(direction(30), direction(45, 200));
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(f[k], expected[k], 1e-6f * (1 + expected[k]));
   }

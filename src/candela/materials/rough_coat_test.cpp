@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "candela/sampling/rng.h"
+#include "candela/testing/statistics.h"
 
 namespace candela {
 namespace {
@@ -32,13 +33,9 @@ Vec3 at_cosine(float mu) { return Vec3(std::sqrt(1 - mu * mu), 0, mu); }
 
 // An independent estimate of the same integral: uniform random points of the visible-normal
 // square instead of the quadrature's nodes.
-struct Estimate {
-  double mean, standard_error;
-};
-Estimate monte_carlo_albedo(const Microfacet& d, const Vec3& wi, float eta, bool transmitted, int n = 50000) {
+testing::Estimate monte_carlo_albedo(const Microfacet& d, const Vec3& wi, float eta, bool transmitted, int n = 50000) {
   Rng rng(11, 5);
-  double sum = 0, sum2 = 0;
-  for (int i = 0; i < n; ++i) {
+  return testing::sample_mean(n, [&] {
     Vec3 m = d.sample_visible_normal(wi, Vec2(rng.next_float(), rng.next_float()));
     float c = dot(wi, m), F = fresnel_dielectric(c, eta);
     double v = 0;
@@ -52,11 +49,8 @@ Estimate monte_carlo_albedo(const Microfacet& d, const Vec3& wi, float eta, bool
         if (wo.z < 0) v = (1 - F) * d.G1(wo);
       }
     }
-    sum += v;
-    sum2 += v * v;
-  }
-  double mean = sum / n;
-  return {mean, std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n)};
+    return v;
+  });
 }
 
 TEST(RoughCoat, InterfaceAlbedoAgreesWithMonteCarlo) {
@@ -67,7 +61,7 @@ TEST(RoughCoat, InterfaceAlbedoAgreesWithMonteCarlo) {
           for (bool transmitted : {false, true}) {
             Microfacet d = beckmann ? Microfacet(Beckmann(alpha, alpha)) : Microfacet(TrowbridgeReitz(alpha, alpha));
             double q = rough_interface_albedo(d, at_cosine(mu), eta, transmitted);
-            Estimate e = monte_carlo_albedo(d, at_cosine(mu), eta, transmitted);
+            testing::Estimate e = monte_carlo_albedo(d, at_cosine(mu), eta, transmitted);
             EXPECT_NEAR(q, e.mean, 5 * e.standard_error + 2e-4)
                 << (beckmann ? "beckmann" : "ggx") << " alpha " << alpha << " mu " << mu << " eta " << eta
                 << (transmitted ? " transmitted" : " reflected");

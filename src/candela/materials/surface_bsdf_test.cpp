@@ -9,18 +9,16 @@
 #include "candela/materials/material.h"
 #include "candela/sampling/rng.h"
 #include "candela/sampling/warp.h"
+#include "candela/testing/bsdf_helpers.h"
 #include "candela/testing/statistics.h"
 
 namespace candela {
 namespace {
 
-constexpr double kAlpha = testing::kChiSquareAlpha;
+using testing::below;
+using testing::direction;
 
-Vec3 direction(float theta_degrees, float phi_degrees = 30) {
-  float t = radians(theta_degrees), p = radians(phi_degrees);
-  return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
-}
-Vec3 below(const Vec3& w) { return {w.x, w.y, -w.z}; }
+constexpr double kAlpha = testing::kChiSquareAlpha;
 
 double chi_square(const SurfaceBsdf& b, const Vec3& wo) {
   Rng lobe_rng(42, 43);
@@ -51,12 +49,10 @@ int check_weights(const SurfaceBsdf& b, const Vec3& wo, int n = 20000) {
 // Directional albedo: the mean sample weight (green), the null part included.
 double albedo(const SurfaceBsdf& b, const Vec3& wo, int n = 200000) {
   Rng rng(3, 4);
-  double sum = 0;
-  for (int i = 0; i < n; ++i) {
-    auto s = b.sample(wo, rng.next_float(), {rng.next_float(), rng.next_float()});
-    if (s) sum += double(s->weight.g) * s->eta * s->eta;
-  }
-  return sum / n;
+  return testing::sample_mean(n, [&] {
+           auto s = b.sample(wo, rng.next_float(), {rng.next_float(), rng.next_float()});
+           return s ? double(s->weight.g) * s->eta * s->eta : 0.0;
+         }).mean;
 }
 
 ConductorBsdf rough_conductor(float alpha, bool beckmann = false) {
@@ -104,9 +100,7 @@ TEST(SurfaceBsdf, OneSidedIsBlackFromTheBack) {
 }
 
 TEST(SurfaceBsdf, MaskIsOpacityTimesTheMaterialPlusAStraightPassage) {
-  MaskMaterial mask;
-  mask.opacity = 0.3f;
-  mask.material = 0;
+  MaskMaterial mask{.opacity = 0.3f, .material = 0};
   SurfaceBsdf b = resolve({DiffuseMaterial{RGB(0.8f)}, mask});
   EXPECT_NEAR(b.null_weight, 0.7f, 1e-6f);
   Vec3 wo = direction(35);
@@ -147,10 +141,7 @@ TEST(SurfaceBsdf, MaskIsOpacityTimesTheMaterialPlusAStraightPassage) {
 TEST(SurfaceBsdf, BlendMixesEvalPdfAndSampling) {
   // (1 - w) diffuse + w rough conductor, and the conductor Beckmann.
   for (bool beckmann : {false, true}) {
-    BlendMaterial blend;
-    blend.weight = 0.35f;
-    blend.material0 = 0;
-    blend.material1 = 1;
+    BlendMaterial blend{.weight = 0.35f, .material0 = 0, .material1 = 1};
     ConductorMaterial metal;
     metal.roughness.u = metal.roughness.v = 0.2f;
     metal.roughness.distribution = beckmann ? MicrofacetDistribution::Beckmann : MicrofacetDistribution::GGX;
@@ -171,13 +162,8 @@ TEST(SurfaceBsdf, BlendMixesEvalPdfAndSampling) {
 TEST(SurfaceBsdf, BlendWithDeltaLobesKeepsTheContract) {
   // A smooth plastic (delta coat + diffuse) blended with a mirror and masked: non-delta parts come
   // first in u_lobe, then the delta parts, then the passage.
-  MaskMaterial mask;
-  mask.opacity = 0.8f;
-  mask.material = 2;
-  BlendMaterial blend;
-  blend.weight = 0.4f;
-  blend.material0 = 0;
-  blend.material1 = 1;
+  MaskMaterial mask{.opacity = 0.8f, .material = 2};
+  BlendMaterial blend{.weight = 0.4f, .material0 = 0, .material1 = 1};
   SurfaceBsdf b = resolve({CoatedDiffuseMaterial{}, MirrorMaterial{RGB(0.9f)}, blend, mask});
   ASSERT_EQ(b.count, 2);
   Rng rng(6, 7);
@@ -200,17 +186,9 @@ TEST(SurfaceBsdf, BlendWithDeltaLobesKeepsTheContract) {
 
 TEST(SurfaceBsdf, NestedWrappersFlatten) {
   // mask(blend(one-sided diffuse, blend(conductor, dielectric))): three components and a passage.
-  MaskMaterial mask;
-  mask.opacity = 0.5f;
-  mask.material = 5;
-  BlendMaterial inner;
-  inner.weight = 0.5f;
-  inner.material0 = 1;
-  inner.material1 = 2;
-  BlendMaterial outer;
-  outer.weight = 0.5f;
-  outer.material0 = 3;
-  outer.material1 = 4;
+  MaskMaterial mask{.opacity = 0.5f, .material = 5};
+  BlendMaterial inner{.weight = 0.5f, .material0 = 1, .material1 = 2};
+  BlendMaterial outer{.weight = 0.5f, .material0 = 3, .material1 = 4};
   SurfaceBsdf b = resolve({DiffuseMaterial{}, ConductorMaterial{}, DielectricMaterial{}, OneSidedMaterial{0}, inner,
                            outer, mask});
   ASSERT_EQ(b.count, 3);
@@ -223,15 +201,11 @@ TEST(SurfaceBsdf, NestedWrappersFlatten) {
 
 TEST(SurfaceBsdf, MaterialTableRejectsWhatCannotBeResolved) {
   TextureSet textures;
-  BlendMaterial self;
-  self.material0 = 0;
-  self.material1 = 0;
+  BlendMaterial self{.material0 = 0, .material1 = 0};
   EXPECT_THROW(MaterialTable({self}, textures), SceneError);  // wraps itself
   // Five components.
   std::vector<MaterialDesc> many = {DiffuseMaterial{}};
-  BlendMaterial b;
-  b.material0 = 0;
-  b.material1 = 0;
+  BlendMaterial b{.material0 = 0, .material1 = 0};
   many.push_back(b);  // 2
   b.material0 = 1;
   b.material1 = 1;
@@ -244,10 +218,7 @@ TEST(SurfaceBsdf, MaterialTableRejectsWhatCannotBeResolved) {
 }
 
 TEST(SurfaceBsdf, AdjointOfABlendWeighsEachComponent) {
-  BlendMaterial blend;
-  blend.weight = 0.5f;
-  blend.material0 = 0;
-  blend.material1 = 1;
+  BlendMaterial blend{.weight = 0.5f, .material0 = 0, .material1 = 1};
   DielectricMaterial glass;
   glass.roughness.u = glass.roughness.v = 0.3f;
   SurfaceBsdf b = resolve({DiffuseTransmissionMaterial{}, glass, blend});
@@ -261,13 +232,8 @@ TEST(SurfaceBsdf, AdjointOfABlendWeighsEachComponent) {
 TEST(SurfaceBsdf, NoMaterialGainsEnergy) {
   // White furnace of the BSDFs themselves: with white inputs every wrapper's directional albedo
   // (the passage counted as transmitted energy) stays at most 1.
-  MaskMaterial mask;
-  mask.opacity = 0.4f;
-  mask.material = 0;
-  BlendMaterial blend;
-  blend.weight = 0.5f;
-  blend.material0 = 0;
-  blend.material1 = 1;
+  MaskMaterial mask{.opacity = 0.4f, .material = 0};
+  BlendMaterial blend{.weight = 0.5f, .material0 = 0, .material1 = 1};
   ConductorMaterial white;
   white.reflectance = ColorInput(RGB(0.9999f));
   white.roughness.u = white.roughness.v = 0.3f;

@@ -12,19 +12,11 @@ namespace candela {
 namespace {
 
 SceneDesc small_scene(int spp) {
-  SceneDesc d;
-  d.film = {24, 18, ""};
-  d.camera = testing::look_at_camera({0, 2, -6}, {0, 0.5f, 0}, 40);
-  d.settings.spp = spp;
-  d.settings.max_depth = 4;
+  SceneDesc d = testing::empty_scene(testing::look_at_camera({0, 2, -6}, {0, 0.5f, 0}, 40), 24, 18, spp, 4);
   d.settings.sampler.type = SamplerType::Stratified;
   d.materials = {DiffuseMaterial{RGB(0.7f)}};
-  ShapeDesc floor;
-  floor.geometry = PlaneShape{{0, 0, 0}, {0, 1, 0}};
-  floor.material = 0;
-  ShapeDesc sphere;
-  sphere.geometry = SphereShape{{0, 1, 0}, 1};
-  sphere.material = 0;
+  ShapeDesc floor{.geometry = PlaneShape{{0, 0, 0}, {0, 1, 0}}, .material = 0};
+  ShapeDesc sphere{.geometry = SphereShape{{0, 1, 0}, 1}, .material = 0};
   d.shapes = {floor, sphere};
   d.lights = {PointLight{{-3, 3, -2}, RGB(20.0f)}, SkyLight{RGB(0.3f), RGB(0.3f), RGB(0.3f), {0, 1, 0}}};
   return d;
@@ -120,10 +112,8 @@ TEST(RenderControl, ClampBoundsEverySample) {
 TEST(RenderControl, NanSamplesAreDroppedCountedAndReported) {
   SceneDesc d = small_scene(8);
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  ShapeDesc bad;
-  bad.geometry = SphereShape{{0, 1.0f, -1.2f}, 0.3f};
-  bad.material = 0;
-  bad.emission = AreaEmission{RGB(nan, 1.0f, 1.0f), true};
+  ShapeDesc bad{.geometry = SphereShape{{0, 1.0f, -1.2f}, 0.3f}, .material = 0,
+                .emission = AreaEmission{RGB(nan, 1.0f, 1.0f), true}};
   d.shapes.push_back(bad);
   d.lights = {SkyLight{RGB(0.3f), RGB(0.3f), RGB(0.3f), {0, 1, 0}}};
   Scene scene(d);

@@ -10,12 +10,8 @@ namespace candela {
 namespace {
 
 SceneDesc base_scene() {
-  SceneDesc d;
-  d.film = {48, 48, ""};
-  d.settings.spp = 16;
-  d.settings.max_depth = 4;
+  SceneDesc d = testing::empty_scene(testing::look_at_camera({0, 3, 9}, {0, 0.5f, 0}, 40), 48, 48, 16, 4);
   d.settings.seed = 7;
-  d.camera = testing::look_at_camera({0, 3, 9}, {0, 0.5f, 0}, 40);
   d.camera.shutter_open = 0;
   d.camera.shutter_close = 1;
   d.textures.push_back(CheckerboardTexture{RGB(0.8f, 0.3f, 0.2f), RGB(0.1f, 0.6f, 0.9f), UVMapping{4, 4, 0, 0}});
@@ -26,14 +22,9 @@ SceneDesc base_scene() {
   ConductorMaterial metal;
   metal.roughness.u = metal.roughness.v = 0.2f;
   d.materials.push_back(metal);
-  ShapeDesc floor;
-  floor.geometry = RectangleShape{{-6, 0, 6}, {12, 0, 0}, {0, 0, -12}};
-  floor.material = 0;
+  ShapeDesc floor{.geometry = RectangleShape{{-6, 0, 6}, {12, 0, 0}, {0, 0, -12}}, .material = 0};
   d.shapes.push_back(floor);
-  ShapeDesc light;
-  light.geometry = SphereShape{{0, 6, 3}, 1};
-  light.emission = AreaEmission{RGB(8.0f), false};
-  light.material = -1;
+  ShapeDesc light{.geometry = SphereShape{{0, 6, 3}, 1}, .material = -1, .emission = AreaEmission{RGB(8.0f), false}};
   d.shapes.push_back(light);
   d.lights.push_back(SkyLight{RGB(0.2f), RGB(0.2f), RGB(0.2f), {0, 1, 0}});
   return d;
@@ -41,13 +32,9 @@ SceneDesc base_scene() {
 
 // The object: a textured box and a metal sphere, in object space.
 std::vector<ShapeDesc> object_shapes() {
-  ShapeDesc box;
-  box.geometry = BoxShape{{-0.5f, 0, -0.5f}, {0.5f, 1, 0.5f}};
-  box.material = 1;
-  ShapeDesc sphere;
-  sphere.geometry = SphereShape{{0, 0, 0}, 0.4f};
-  sphere.to_world = Transform::translate({0, 1.4f, 0});
-  sphere.material = 2;
+  ShapeDesc box{.geometry = BoxShape{{-0.5f, 0, -0.5f}, {0.5f, 1, 0.5f}}, .material = 1};
+  ShapeDesc sphere{.geometry = SphereShape{{0, 0, 0}, 0.4f}, .to_world = Transform::translate({0, 1.4f, 0}),
+                   .material = 2};
   return {box, sphere};
 }
 

@@ -32,37 +32,26 @@ TriangleMesh bumpy_grid(int n) {
 }
 
 SceneDesc mesh_scene() {
-  SceneDesc d;
-  d.film = {40, 30, ""};
-  d.settings.spp = 8;
-  d.settings.max_depth = 5;
+  SceneDesc d = testing::empty_scene(testing::look_at_camera({0, 2.5f, -4}, {0, 0.2f, 0}, 45), 40, 30, 8, 5);
   d.settings.seed = 3;
-  d.camera = testing::look_at_camera({0, 2.5f, -4}, {0, 0.2f, 0}, 45);
   d.materials.push_back(DiffuseMaterial{RGB(0.7f, 0.5f, 0.3f)});
   ConductorMaterial metal;
   metal.roughness.u = metal.roughness.v = 0.3f;
   d.materials.push_back(metal);
-  ShapeDesc ground;
-  ground.geometry = MeshShape{bumpy_grid(24)};
-  ground.to_world = Transform::scale({2, 1, 2});
-  ground.material = 0;
+  ShapeDesc ground{.geometry = MeshShape{bumpy_grid(24)}, .to_world = Transform::scale({2, 1, 2}), .material = 0};
   d.shapes.push_back(ground);
-  ShapeDesc mirrored;  // a mirroring transform bakes a swapped winding into the shared indices
-  mirrored.geometry = MeshShape{bumpy_grid(8)};
-  mirrored.to_world = Transform::translate({0.8f, 0.6f, 0}) * Transform::scale({-0.4f, 0.4f, 0.4f});
-  mirrored.material = 1;
+  // A mirroring transform bakes a swapped winding into the shared indices.
+  ShapeDesc mirrored{.geometry = MeshShape{bumpy_grid(8)},
+                     .to_world = Transform::translate({0.8f, 0.6f, 0}) * Transform::scale({-0.4f, 0.4f, 0.4f}),
+                     .material = 1};
   d.shapes.push_back(mirrored);
   // The same mesh inside an object, placed twice.
-  ShapeDesc in_object;
-  in_object.geometry = MeshShape{bumpy_grid(6)};
-  in_object.material = 1;
+  ShapeDesc in_object{.geometry = MeshShape{bumpy_grid(6)}, .material = 1};
   d.objects.push_back({{in_object}, "tile"});
   d.instances.push_back({0, Transform::translate({-1, 1, 0.5f}) * Transform::scale(Vec3(0.3f)), std::nullopt});
   d.instances.push_back({0, Transform::translate({-0.3f, 1.2f, 1}) * Transform::scale(Vec3(0.25f)), std::nullopt});
-  ShapeDesc light;
-  light.geometry = SphereShape{{0, 3, 0}, 0.5f};
-  light.emission = AreaEmission{RGB(10.0f), false};
-  light.material = -1;
+  ShapeDesc light{.geometry = SphereShape{{0, 3, 0}, 0.5f}, .material = -1,
+                  .emission = AreaEmission{RGB(10.0f), false}};
   d.shapes.push_back(light);
   d.lights.push_back(SkyLight{RGB(0.3f), RGB(0.3f), RGB(0.1f), {0, 1, 0}});
   return d;

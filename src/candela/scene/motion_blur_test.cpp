@@ -171,10 +171,8 @@ TEST(MotionBlur, MovingSphereCoverageMatchesTimeAveragedSilhouette) {
   const double R = 2, x_start = -6, x_end = 6;
   SceneDesc d = sky_scene();
   d.settings.spp = 64;
-  ShapeDesc ball;
-  ball.geometry = SphereShape{{float(x_start), 0, -kDepth}, float(R)};
-  ball.material = 0;
-  ball.to_world_end = Transform::translate({float(x_end - x_start), 0, 0});
+  ShapeDesc ball{.geometry = SphereShape{{float(x_start), 0, -kDepth}, float(R)}, .material = 0,
+                 .to_world_end = Transform::translate({float(x_end - x_start), 0, 0})};
   d.shapes = {ball};
   ColumnProfile p = column_profile(testing::render_description(d));
 
@@ -217,9 +215,7 @@ TEST(MotionBlurHits, MovingTrianglesAreInterpolatedAtTheRayTime) {
   quad.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
   quad.normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
   quad.indices = {0, 1, 2, 0, 2, 3};
-  ShapeDesc shape;
-  shape.geometry = MeshShape{quad};
-  shape.to_world_end = Transform::rotate(90, {0, 1, 0});
+  ShapeDesc shape{.geometry = MeshShape{quad}, .to_world_end = Transform::rotate(90, {0, 1, 0})};
   d.shapes = {shape};
   Scene scene(d);
 
@@ -240,13 +236,16 @@ TEST(MotionBlurHits, MovingTrianglesAreInterpolatedAtTheRayTime) {
   EXPECT_NEAR(hit.ns.z, 1, 1e-6f);
 }
 
-TEST(MotionBlurHits, MovingSphereIsIntersectedAtTheRayTime) {
+// The unit sphere at the origin at the shutter's opening, transformed by `end` at its close.
+Scene unit_sphere_moving_to(const Transform& end) {
+  ShapeDesc ball{.geometry = SphereShape{{0, 0, 0}, 1}, .to_world_end = end};
   SceneDesc d;
-  ShapeDesc ball;
-  ball.geometry = SphereShape{{0, 0, 0}, 1};
-  ball.to_world_end = Transform::translate({4, 0, 0});
   d.shapes = {ball};
-  Scene scene(d);
+  return Scene(d);
+}
+
+TEST(MotionBlurHits, MovingSphereIsIntersectedAtTheRayTime) {
+  Scene scene = unit_sphere_moving_to(Transform::translate({4, 0, 0}));
   const Point3 o(2, 0.5f, 10);
   const Vec3 down(0, 0, -1);
   SurfaceHit hit;
@@ -262,12 +261,7 @@ TEST(MotionBlurHits, MovingSphereIsIntersectedAtTheRayTime) {
 
 TEST(MotionBlurHits, SphereGrowingNonUniformlyStaysInsideItsBounds) {
   // Scaled by 1 to 3 along x: at time 0.5 an ellipsoid with x semi-axis 2.
-  SceneDesc d;
-  ShapeDesc ball;
-  ball.geometry = SphereShape{{0, 0, 0}, 1};
-  ball.to_world_end = Transform::scale({3, 1, 1});
-  d.shapes = {ball};
-  Scene scene(d);
+  Scene scene = unit_sphere_moving_to(Transform::scale({3, 1, 1}));
   SurfaceHit hit;
   ASSERT_TRUE(scene.intersect(ray_at({1.9f, 0, 10}, {0, 0, -1}, 0.5f), hit));
   EXPECT_NEAR(hit.p.z, std::sqrt(1 - 0.95f * 0.95f), 1e-4f);
@@ -286,28 +280,19 @@ void expect_scene_error(const SceneDesc& d, const std::string& fragment) {
 
 TEST(MotionBlurErrors, MovingLightsAndPlanesAreRejected) {
   SceneDesc d;
-  ShapeDesc lamp;
-  lamp.geometry = RectangleShape{};
-  lamp.emission = AreaEmission{};
-  lamp.name = "lamp";
-  lamp.to_world_end = Transform::translate({1, 0, 0});
+  ShapeDesc lamp{.geometry = RectangleShape{}, .emission = AreaEmission{},
+                 .to_world_end = Transform::translate({1, 0, 0}), .name = "lamp"};
   d.shapes = {lamp};
   expect_scene_error(d, "(\"lamp\"): area lights must not move");
   lamp.geometry = SphereShape{};
   d.shapes = {lamp};
   expect_scene_error(d, "(\"lamp\"): area lights must not move");
 
-  ShapeDesc floor;
-  floor.geometry = PlaneShape{};
-  floor.name = "floor";
-  floor.to_world_end = Transform::translate({0, 1, 0});
+  ShapeDesc floor{.geometry = PlaneShape{}, .to_world_end = Transform::translate({0, 1, 0}), .name = "floor"};
   d.shapes = {floor};
   expect_scene_error(d, "(\"floor\"): an infinite plane must not move");
 
-  ShapeDesc box;
-  box.geometry = BoxShape{};
-  box.name = "box";
-  box.to_world_end = Transform::scale({-1, 1, 1});
+  ShapeDesc box{.geometry = BoxShape{}, .to_world_end = Transform::scale({-1, 1, 1}), .name = "box"};
   d.shapes = {box};
   expect_scene_error(d, "(\"box\"): the end transform mirrors the shape");
 }

@@ -70,6 +70,16 @@ inline CameraDesc look_at_camera(const Point3& eye, const Point3& target, float 
   return c;
 }
 
+// A scene with nothing in it yet but its camera, film size, samples per pixel and path depth.
+inline SceneDesc empty_scene(const CameraDesc& camera, int width, int height, int spp, int max_depth) {
+  SceneDesc d;
+  d.film = {width, height, ""};
+  d.camera = camera;
+  d.settings.spp = spp;
+  d.settings.max_depth = max_depth;
+  return d;
+}
+
 // A closed diffuse sphere of radius 2 around the origin, seen from just off its centre on a 16 x 16
 // image: the furnace scenes with analytic answers (Le / (1 - rho), rho I / (pi r^2 (1 - rho))).
 // A unit sphere of `material` at the origin seen from z = -4 (it subtends asin(1/4) = 14.5 degrees)
