@@ -430,7 +430,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
     // The root reads the checkpoint and sends it to the others: only it needs to see the file.
     std::string checkpoint_bytes;
     on_every_rank(cluster, [&] {
-      if (cluster.is_root()) checkpoint_bytes = read_bytes(cmd.resume);
+      if (cluster.is_root()) checkpoint_bytes = read_checkpoint_bytes(cmd.resume);
     });
     std::vector<std::byte> shared(reinterpret_cast<const std::byte*>(checkpoint_bytes.data()),
                                   reinterpret_cast<const std::byte*>(checkpoint_bytes.data() + checkpoint_bytes.size()));

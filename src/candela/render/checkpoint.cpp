@@ -153,12 +153,13 @@ void write_checkpoint(const std::filesystem::path& file, const Checkpoint& cp) {
   }
 }
 
-Checkpoint read_checkpoint(const std::filesystem::path& file) {
+std::string read_checkpoint_bytes(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
   if (!in) fail(file, "cannot open");
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return parse_checkpoint(bytes, file);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
+
+Checkpoint read_checkpoint(const std::filesystem::path& file) { return parse_checkpoint(read_checkpoint_bytes(file), file); }
 
 Checkpoint parse_checkpoint(std::string_view bytes, const std::filesystem::path& file) {
   if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)

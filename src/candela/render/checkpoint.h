@@ -50,7 +50,9 @@ void write_checkpoint(const std::filesystem::path& file, const Checkpoint& check
 // Throws std::runtime_error naming the file and the problem: missing, not a checkpoint, another
 // version, truncated, or corrupt (checksum mismatch).
 Checkpoint read_checkpoint(const std::filesystem::path& file);
-// The same for a checkpoint's bytes (read by one rank and sent to the others); `file` names it in errors.
+// The two steps of read_checkpoint, for a checkpoint read by one rank and sent to the others: the
+// file's bytes, and the checkpoint they hold (`file` names it in errors).
+std::string read_checkpoint_bytes(const std::filesystem::path& file);
 Checkpoint parse_checkpoint(std::string_view bytes, const std::filesystem::path& file);
 
 }  // namespace candela
