@@ -40,7 +40,8 @@ class Cluster {
   // (in another thread where the rank must keep serving requests) and calls `next()`, from any of
   // its threads, until it returns nothing. Every item goes to exactly one rank. On the root,
   // `granted(first, count)` is called (on the calling thread) for each run of items handed to
-  // another rank, e.g. to advance a progress bar. `threads` is how many items a rank keeps queued.
+  // another rank, e.g. to advance a progress bar. `threads`: the rank asks for more items when it has
+  // no more than this many queued, and for up to twice this many at a time.
   using NextItem = std::function<std::optional<uint64_t>()>;
   virtual void share_work(uint64_t items, int threads, const std::function<void(const NextItem&)>& work,
                           const std::function<void(uint64_t first, uint64_t count)>& granted) = 0;
