@@ -32,8 +32,20 @@ void LocalCluster::share_work(uint64_t items, int, const std::function<void(cons
   });
 }
 
-std::vector<std::vector<std::byte>> LocalCluster::all_gather(std::span<const std::byte> mine) {
-  return {std::vector<std::byte>(mine.begin(), mine.end())};
+std::vector<std::vector<std::byte>> Cluster::all_gather(std::span<const std::byte> mine) {
+  std::vector<std::byte> all;
+  std::vector<uint64_t> offsets;
+  all_gather(mine, all, offsets);
+  std::vector<std::vector<std::byte>> ranks;
+  for (size_t r = 0; r + 1 < offsets.size(); ++r)
+    ranks.emplace_back(all.begin() + long(offsets[r]), all.begin() + long(offsets[r + 1]));
+  return ranks;
+}
+
+void LocalCluster::all_gather(std::span<const std::byte> mine, std::vector<std::byte>& all,
+                              std::vector<uint64_t>& offsets) {
+  all.assign(mine.begin(), mine.end());
+  offsets = {0, mine.size()};
 }
 
 void LocalCluster::abort(int exit_code) { std::_Exit(exit_code); }

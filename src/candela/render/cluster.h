@@ -46,8 +46,13 @@ class Cluster {
   virtual void share_work(uint64_t items, int threads, const std::function<void(const NextItem&)>& work,
                           const std::function<void(uint64_t first, uint64_t count)>& granted) = 0;
 
-  // Every rank's `mine`, in rank order, on every rank (collective).
-  virtual std::vector<std::vector<std::byte>> all_gather(std::span<const std::byte> mine) = 0;
+  // Every rank's `mine`, in rank order, on every rank (collective): rank r's bytes are
+  // all[offsets[r], offsets[r + 1]). The caller's buffers are reused, so that gathering a film's
+  // worth of bytes every pass does not allocate (and page in) a new one each time.
+  virtual void all_gather(std::span<const std::byte> mine, std::vector<std::byte>& all,
+                          std::vector<uint64_t>& offsets) = 0;
+  // The same into new vectors, one per rank.
+  std::vector<std::vector<std::byte>> all_gather(std::span<const std::byte> mine);
   // Adds `values` element by element across the ranks; every rank gets the sums (collective).
   virtual void sum_int64(std::vector<int64_t>& values) = 0;
   // The root's `bytes` on every rank (collective).
@@ -103,7 +108,8 @@ class LocalCluster final : public Cluster {
   bool mpi_job() const override { return false; }
   void share_work(uint64_t items, int threads, const std::function<void(const NextItem&)>& work,
                   const std::function<void(uint64_t, uint64_t)>& granted) override;
-  std::vector<std::vector<std::byte>> all_gather(std::span<const std::byte> mine) override;
+  using Cluster::all_gather;
+  void all_gather(std::span<const std::byte> mine, std::vector<std::byte>& all, std::vector<uint64_t>& offsets) override;
   void sum_int64(std::vector<int64_t>&) override {}
   void broadcast(std::vector<std::byte>&) override {}
   [[noreturn]] void abort(int exit_code) override;

@@ -25,9 +25,11 @@ namespace {
 
 constexpr int kTagRequest = 1;  // payload: int64, how many items the asking rank keeps queued
 constexpr int kTagGrant = 2;    // payload: uint64 first, uint64 count (0 = no more)
-// How often an idle calling thread looks for messages. Each look wakes a core that render threads are
-// using: at 50 us the ranks rendered 15-20% slower on 2 cores, at 1 ms the cost is not measurable.
-// Ranks ask for more tiles while they still have some queued, so the wait is hidden.
+// How often a calling thread that waits for a message looks for it. Each look wakes a core that render
+// threads are using and runs Open MPI's progress engine: looking every 50 us made two ranks render
+// 15-20% slower on 2 cores. So the root looks every millisecond, the other ranks only while a request
+// is out, and otherwise sleep until their queue runs low. Ranks ask for more while they still have
+// some queued, so the wait is hidden.
 constexpr auto kPoll = std::chrono::milliseconds(1);
 
 // True when this process was started by an MPI launcher (Open MPI's mpirun, or a PMI/PMIx one
@@ -66,12 +68,18 @@ class ItemQueue {
     if (items_.empty()) return std::nullopt;
     uint64_t i = items_.front();
     items_.pop_front();
+    taken_.notify_all();
     return i;
+  }
+  // Waits until at most `low` items are left, or for `timeout`.
+  void wait_until_at_most(size_t low, std::chrono::milliseconds timeout) {
+    std::unique_lock lock(mutex_);
+    taken_.wait_for(lock, timeout, [&] { return items_.size() <= low; });
   }
 
  private:
   std::mutex mutex_;
-  std::condition_variable ready_;
+  std::condition_variable ready_, taken_;
   std::deque<uint64_t> items_;
   bool closed_ = false;
 };
@@ -125,38 +133,50 @@ class MpiCluster final : public Cluster {
 
   Traffic traffic() const override { return traffic_; }
 
-  std::vector<std::vector<std::byte>> all_gather(std::span<const std::byte> mine) override {
+  using Cluster::all_gather;
+  void all_gather(std::span<const std::byte> mine, std::vector<std::byte>& all,
+                  std::vector<uint64_t>& offsets) override {
     CollectiveTimer timer(traffic_);
     const uint64_t length = mine.size();
     traffic_.bytes_sent += length + sizeof length;
     std::vector<uint64_t> lengths(static_cast<size_t>(size_), 0);
     check(MPI_Allgather(&length, 1, MPI_UINT64_T, lengths.data(), 1, MPI_UINT64_T, MPI_COMM_WORLD), "MPI_Allgather");
-    std::vector<std::vector<std::byte>> all(static_cast<size_t>(size_));
-    uint64_t longest = 0;
-    for (int r = 0; r < size_; ++r) {
-      all[size_t(r)].resize(lengths[size_t(r)]);
-      longest = std::max(longest, lengths[size_t(r)]);
+    offsets.assign(static_cast<size_t>(size_) + 1, 0);
+    for (int r = 0; r < size_; ++r) offsets[size_t(r) + 1] = offsets[size_t(r)] + lengths[size_t(r)];
+    all.resize(offsets.back());
+    if (offsets.back() <= uint64_t(INT_MAX)) {
+      // One round, straight into place.
+      std::vector<int> counts(static_cast<size_t>(size_)), displacements(static_cast<size_t>(size_));
+      for (int r = 0; r < size_; ++r) {
+        counts[size_t(r)] = int(lengths[size_t(r)]);
+        displacements[size_t(r)] = int(offsets[size_t(r)]);
+      }
+      check(MPI_Allgatherv(mine.data(), int(length), MPI_BYTE, all.data(), counts.data(), displacements.data(),
+                           MPI_BYTE, MPI_COMM_WORLD),
+            "MPI_Allgatherv");
+      return;
     }
     // MPI counts are ints: in rounds of at most INT_MAX bytes in all.
     const uint64_t slice = std::max<uint64_t>(1, uint64_t(INT_MAX) / uint64_t(size_));
-    std::vector<int> counts(static_cast<size_t>(size_)), offsets(static_cast<size_t>(size_));
+    const uint64_t longest = *std::max_element(lengths.begin(), lengths.end());
+    std::vector<int> counts(static_cast<size_t>(size_)), displacements(static_cast<size_t>(size_));
     std::vector<std::byte> received;
     for (uint64_t start = 0; start < longest; start += slice) {
       int total = 0;
       for (int r = 0; r < size_; ++r) {
         uint64_t len = lengths[size_t(r)];
         counts[size_t(r)] = int(start < len ? std::min(slice, len - start) : 0);
-        offsets[size_t(r)] = total;
+        displacements[size_t(r)] = total;
         total += counts[size_t(r)];
       }
       received.resize(size_t(total));
       check(MPI_Allgatherv(mine.data() + std::min<uint64_t>(start, length), counts[size_t(rank_)], MPI_BYTE,
-                           received.data(), counts.data(), offsets.data(), MPI_BYTE, MPI_COMM_WORLD),
+                           received.data(), counts.data(), displacements.data(), MPI_BYTE, MPI_COMM_WORLD),
             "MPI_Allgatherv");
       for (int r = 0; r < size_; ++r)
-        std::copy_n(received.begin() + offsets[size_t(r)], counts[size_t(r)], all[size_t(r)].begin() + long(start));
+        std::copy_n(received.begin() + displacements[size_t(r)], counts[size_t(r)],
+                    all.begin() + long(offsets[size_t(r)] + start));
     }
-    return all;
   }
 
   void sum_int64(std::vector<int64_t>& values) override {
@@ -230,17 +250,29 @@ class MpiCluster final : public Cluster {
         }
         busy = true;
       }
-      if (!busy) std::this_thread::sleep_for(kPoll);
+      // Sleep until the own queue runs low, or the next look for requests.
+      if (busy) continue;
+      if (own_closed)
+        std::this_thread::sleep_for(kPoll);
+      else
+        queue.wait_until_at_most(size_t(threads), kPoll);
     }
   }
 
-  // Any other rank: keeps its queue topped up from the root until the root has no more.
+  // Any other rank: keeps its queue topped up from the root until the root has no more. A reply
+  // that finds the queue already empty means the items go faster than a request goes round (cheap
+  // tiles of empty sky): ask for twice as many from then on, so the rank does not sit idle while the
+  // root, which needs no messages for its own queue, takes the rest.
   void ask(int threads, ItemQueue& queue) {
     uint64_t reply[2] = {0, 0};
     MPI_Request pending = MPI_REQUEST_NULL;
+    int64_t want = 2 * int64_t(threads);
     for (;;) {
-      if (pending == MPI_REQUEST_NULL && queue.size() <= size_t(threads)) {
-        int64_t want = 2 * int64_t(threads);
+      if (pending == MPI_REQUEST_NULL && queue.size() > size_t(want / 2)) {
+        queue.wait_until_at_most(size_t(want / 2), std::chrono::milliseconds(100));
+        continue;
+      }
+      if (pending == MPI_REQUEST_NULL) {
         MPI_Send(&want, 1, MPI_INT64_T, 0, kTagRequest, MPI_COMM_WORLD);
         traffic_.bytes_sent += sizeof want;
         MPI_Irecv(reply, 2, MPI_UINT64_T, 0, kTagGrant, MPI_COMM_WORLD, &pending);
@@ -252,6 +284,7 @@ class MpiCluster final : public Cluster {
           queue.close();
           return;
         }
+        if (queue.size() == 0) want = std::min<int64_t>(2 * want, 1024);
         queue.push(reply[0], reply[1]);
         continue;
       }

@@ -16,6 +16,8 @@ class ProgressBar {
   void finish();
   // A word on the phase under way, drawn before the bar (thread-safe).
   void set_label(std::string label);
+  // Whether it draws at all (stderr is a terminal and it was asked to).
+  bool enabled() const { return enabled_; }
 
  private:
   void draw(uint64_t done, bool final);

@@ -10,6 +10,7 @@
 #include <bit>
 #include <cmath>
 #include <mutex>
+#include <numeric>
 #include <stdexcept>
 #include <cstring>
 #include <span>
@@ -38,11 +39,19 @@ struct PassContext {
 
 bool cancelled(const PassContext& pc) { return pc.cancel && pc.cancel->load(std::memory_order_relaxed); }
 
+// A stride coprime to n near n / golden ratio: i -> i * stride mod n visits 0..n-1 once each, and any
+// run of consecutive i lands all over the range (a rank-1 lattice).
+uint64_t spread_stride(uint64_t n) {
+  if (n < 3) return 1;
+  uint64_t stride = std::max<uint64_t>(1, uint64_t(double(n) * 0.6180339887498949));
+  while (std::gcd(stride, n) != 1) ++stride;
+  return stride;
+}
+
+// About the samples a tile gets in a pass (as many per pixel as its first pixel's), for the progress
+// bar of another rank's tiles.
 uint64_t tile_samples(const Tile& tile, const SampleRanges& range) {
-  uint64_t n = 0;
-  for (int y = tile.y0; y < tile.y1; ++y)
-    for (int x = tile.x0; x < tile.x1; ++x) n += uint64_t(std::max(range(x, y).count, 0));
-  return n;
+  return uint64_t(tile.x1 - tile.x0) * uint64_t(tile.y1 - tile.y0) * uint64_t(std::max(range(tile.x0, tile.y0).count, 0));
 }
 
 // One pass over the tiles: pixel (x, y) gets the samples range(x, y) names. Tiles not yet started
@@ -52,17 +61,25 @@ uint64_t tile_samples(const Tile& tile, const SampleRanges& range) {
 void run_pass(const PassContext& pc, const std::vector<Tile>& tiles, tbb::task_arena& arena, const SampleRanges& range,
               ProgressBar& progress) {
   Film& film = pc.tile.film;
-  std::vector<uint8_t> mine = run_shared(
-      pc.cluster, arena, tiles.size(),
-      [&](uint64_t t) {
+  // The tiles are handed out in a strided order that visits the whole image early and evenly, so that
+  // any run of them costs about the same wherever the expensive regions are.
+  const uint64_t n = tiles.size();
+  const uint64_t stride = spread_stride(n);
+  std::vector<uint8_t> handed = run_shared(
+      pc.cluster, arena, n,
+      [&](uint64_t item) {
+        const uint64_t t = item * stride % n;
         if (cancelled(pc)) return;
         BusyTimer busy(pc.busy_nanoseconds);
         progress.advance(pc.integrator.render_tile(tiles[t], range, pc.tile, pc.ray_counts.local()));
       },
       [&](uint64_t first, uint64_t count) {
-        for (uint64_t t = first; t < first + count; ++t) progress.advance(tile_samples(tiles[t], range));
+        if (!progress.enabled()) return;
+        for (uint64_t item = first; item < first + count; ++item) progress.advance(tile_samples(tiles[item * stride % n], range));
       });
   if (!pc.cluster.distributed()) return;
+  std::vector<uint8_t> mine(n, 0);
+  for (uint64_t item = 0; item < n; ++item) mine[item * stride % n] = handed[item];
   auto row_of = [&](const Tile& tile, int y) { return &film.pixels()[size_t(y) * size_t(film.width()) + size_t(tile.x0)]; };
   exchange_items(
       pc.cluster, mine,
@@ -331,18 +348,22 @@ std::vector<uint8_t> run_shared(Cluster& cluster, tbb::task_arena& arena, uint64
 void exchange_items(Cluster& cluster, const std::vector<uint8_t>& mine,
                     const std::function<void(uint64_t, std::vector<std::byte>&)>& write,
                     const std::function<const std::byte*(uint64_t, const std::byte*)>& read) {
-  std::vector<std::byte> bytes;
+  // Kept from call to call (only the calling thread exchanges): a pass's worth of tiles is as large
+  // as the film, and fresh buffers would be paged in every pass.
+  thread_local std::vector<std::byte> bytes, all;
+  thread_local std::vector<uint64_t> offsets;
+  bytes.clear();
   for (uint64_t item = 0; item < mine.size(); ++item) {
     if (!mine[item]) continue;
     const auto* id = reinterpret_cast<const std::byte*>(&item);
     bytes.insert(bytes.end(), id, id + sizeof item);
     write(item, bytes);
   }
-  std::vector<std::vector<std::byte>> all = cluster.all_gather(bytes);
-  for (int r = 0; r < int(all.size()); ++r) {
+  cluster.all_gather(bytes, all, offsets);
+  for (int r = 0; r + 1 < int(offsets.size()); ++r) {
     if (r == cluster.rank()) continue;
-    const std::byte* in = all[size_t(r)].data();
-    const std::byte* end = in + all[size_t(r)].size();
+    const std::byte* in = all.data() + offsets[size_t(r)];
+    const std::byte* end = all.data() + offsets[size_t(r) + 1];
     while (in < end) {
       uint64_t item;
       std::memcpy(&item, in, sizeof item);
