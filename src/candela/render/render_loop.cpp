@@ -24,6 +24,9 @@ namespace candela {
 namespace {
 
 constexpr int kTileSize = 16;
+// Across MPI ranks passes grow until they last this long (up to kLongestPassSpp samples per pixel).
+constexpr double kDistributedPassSeconds = 2.0;
+constexpr int kLongestPassSpp = 1024;
 constexpr int kPassSpp = 16;  // samples per pixel per pass in plain renders: a responsive progress bar, and
                                // runs of one pixel's samples long enough for samplers to reuse per-pixel work
 
@@ -462,11 +465,12 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
     // A Poisson-disc set is built per pixel: render it in one pass rather than rebuilding it per pass.
     // Every pixel continues from its own count, so a film resumed from a checkpoint (or one whose
     // last pass was cut short) gets exactly the samples an uninterrupted render would add, in order.
-    const int pass_spp = settings.sampler.type == SamplerType::Poisson ? settings.spp : kPassSpp;
+    int pass_spp = settings.sampler.type == SamplerType::Poisson ? settings.spp : kPassSpp;
     uint64_t least = options.only_x >= 0 ? film.pixel(options.only_x, options.only_y).count : film.min_samples();
     const int first_pass = int(std::min<uint64_t>(least, uint64_t(settings.spp)) / uint64_t(pass_spp)) * pass_spp;
-    for (int pass = first_pass; pass < settings.spp; pass += pass_spp) {
-      const int end = std::min(pass + pass_spp, settings.spp);
+    for (int pass = first_pass, end = 0; pass < settings.spp; pass = end) {
+      end = std::min(pass + pass_spp, settings.spp);
+      const auto pass_start = std::chrono::steady_clock::now();
       run_pass(pc, tiles, arena,
                [&](int x, int y) {
                  int64_t have = int64_t(film.pixel(x, y).count);
@@ -480,6 +484,13 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
         options.after_pass(film, non_finite_so_far);
       }
       if (stop) break;
+      // Across ranks every pass ends with the film's exchange: passes grow (the root's clock decides)
+      // until they take a few seconds, so that it stays a small part of the time. Where passes end
+      // changes nothing in the image: every pixel continues from its own count.
+      if (cluster.distributed() &&
+          cluster.from_root(std::chrono::duration<double>(std::chrono::steady_clock::now() - pass_start).count()) <
+              kDistributedPassSeconds)
+        pass_spp = std::min(2 * pass_spp, kLongestPassSpp);
     }
   } else {
     if (samples_before > 0) throw std::invalid_argument("adaptive sampling cannot continue a partly rendered film");
