@@ -12,33 +12,21 @@
 #include <sstream>
 
 #include "candela/film/image_io.h"
+#include "candela/testing/command_line.h"
 
 namespace fs = std::filesystem;
 
 namespace candela {
 namespace {
 
-struct RunResult {
-  int exit_code;
-  std::string output;  // stdout and stderr together
-};
+using RunResult = testing::CommandResult;
 
-RunResult run_cli(const std::string& args) {
-  std::string cmd = std::string(CANDELA_CLI_PATH) + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (size_t n = fread(buf.data(), 1, buf.size(), pipe)) out.append(buf.data(), n);
-  int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+RunResult run_cli(const std::string& args) { return testing::run_command(std::string(CANDELA_CLI_PATH) + " " + args); }
 
 class CommandLine : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("candela_cli_test_" + std::to_string(getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
+    dir_ = testing::fresh_test_directory("candela_cli_test");
     // An existing output that must survive every failed run.
     std::ofstream(dir_ / "out.exr") << "previous render";
   }

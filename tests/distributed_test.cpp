@@ -3,47 +3,28 @@
 // is byte for byte the image one process renders (compared as .pfm files, which hold nothing but
 // the pixels); failures end the whole job with one message and leave the output untouched.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <array>
-#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <regex>
-#include <sstream>
 
 #include "candela/film/image_io.h"
+#include "candela/testing/command_line.h"
 
 namespace fs = std::filesystem;
 
 namespace candela {
 namespace {
 
-struct RunResult {
-  int exit_code;
-  std::string output;  // stdout and stderr together
-};
+using RunResult = testing::CommandResult;
+using testing::file_bytes;
 
 // Runs a bash command line in `dir`, with $CANDELA the CLI and $MPIRUN mpirun as root may run it.
 RunResult sh(const fs::path& dir, const std::string& script) {
-  std::string cmd = "cd '" + dir.string() + "' && CANDELA='" + CANDELA_CLI_PATH +
-                    "' MPIRUN='mpirun --oversubscribe' OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
-                    "OMPI_MCA_btl_vader_single_copy_mechanism=none bash -c '" + script + "' 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (size_t n = fread(buf.data(), 1, buf.size(), pipe)) out.append(buf.data(), n);
-  int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
-
-std::string file_bytes(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  return testing::run_command("cd '" + dir.string() + "' && CANDELA='" + CANDELA_CLI_PATH +
+                              "' MPIRUN='mpirun --oversubscribe' OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
+                              "OMPI_MCA_btl_vader_single_copy_mechanism=none bash -c '" + script + "'");
 }
 
 int count(const std::string& text, const std::string& what) {
@@ -55,10 +36,7 @@ int count(const std::string& text, const std::string& what) {
 class Distributed : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("candela_distributed_test_" + std::to_string(getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = testing::fresh_test_directory("candela_distributed_test");
     scene_ = std::string(CANDELA_SOURCE_DIR) + "/scenes/cornell-box.json";
   }
   void TearDown() override { fs::remove_all(dir_); }

@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "candela/testing/command_line.h"
 #include "candela/film/image_io.h"
 
 namespace fs = std::filesystem;
@@ -31,10 +32,7 @@ const std::string kScene = std::string(CANDELA_SOURCE_DIR) + "/scenes/cornell-bo
 class InterruptResume : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("candela_interrupt_test_" + std::to_string(getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = testing::fresh_test_directory("candela_interrupt_test");
   }
   void TearDown() override { fs::remove_all(dir_); }
 
