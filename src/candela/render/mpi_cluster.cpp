@@ -6,10 +6,12 @@
 // items, shorter as the items run out), so the ranks finish within about one item of each other
 // whatever the items cost. Only the calling thread makes MPI calls (MPI_THREAD_FUNNELED).
 #include <mpi.h>
+#include <sched.h>
 
 #include <algorithm>
 #include <chrono>
 #include <climits>
+#include <cstdio>
 #include <condition_variable>
 #include <cstdlib>
 #include <deque>
@@ -99,14 +101,25 @@ class MpiCluster final : public Cluster {
     MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank_, MPI_INFO_NULL, &node);
     MPI_Comm_size(node, &ranks_on_node_);
     MPI_Comm_free(&node);
+    // A rank alone on its node but bound to fewer of its cores renders slower than it could: say so.
+    const int cores = std::max(1, int(std::thread::hardware_concurrency()));
+    if (rank_ == 0 && ranks_on_node_ == 1 && allowed_cores() < cores)
+      std::fprintf(stderr,
+                   "candela: note: rank 0 may run on %d of its node's %d cores (mpirun bound it); to use them all, "
+                   "run mpirun with --bind-to none (or --map-by ppr:1:node:pe=%d)\n",
+                   allowed_cores(), cores, cores);
   }
   ~MpiCluster() override { MPI_Finalize(); }
 
   bool mpi_job() const override { return true; }
   int rank() const override { return rank_; }
   int size() const override { return size_; }
+  // The cores this rank may run on (mpirun binds ranks to cores by default when it starts two or
+  // fewer), shared with the other ranks on the node when it may run on all of them.
   int default_threads() const override {
-    int cores = int(std::thread::hardware_concurrency());
+    int cores = std::max(1, int(std::thread::hardware_concurrency()));
+    int allowed = allowed_cores();
+    if (allowed < cores) return allowed;
     return std::max(1, cores / std::max(1, ranks_on_node_));
   }
 
@@ -301,6 +314,13 @@ class MpiCluster final : public Cluster {
     Traffic& traffic;
     std::chrono::steady_clock::time_point start;
   };
+
+  static int allowed_cores() {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    if (sched_getaffinity(0, sizeof set, &set) != 0) return std::max(1, int(std::thread::hardware_concurrency()));
+    return std::max(1, CPU_COUNT(&set));
+  }
 
   int rank_ = 0, size_ = 1, ranks_on_node_ = 1;
   Traffic traffic_;
