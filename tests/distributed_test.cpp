@@ -27,6 +27,9 @@ RunResult sh(const fs::path& dir, const std::string& script) {
                               "OMPI_MCA_btl_vader_single_copy_mechanism=none bash -c '" + script + "'");
 }
 
+// Shell: wait (up to 60 s) until ck.bin exists.
+const std::string kWaitForCheckpoint = "for i in $(seq 1200); do [ -e ck.bin ] && break; sleep 0.05; done; ";
+
 int count(const std::string& text, const std::string& what) {
   int n = 0;
   for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
@@ -114,8 +117,10 @@ TEST_F(Distributed, InterruptingMpirunWritesTheImageAndACheckpointThatResumes) {
   need_mpi();
   if (IsSkipped()) return;
   const std::string settings = "--resolution 48x48 --spp 100000";
+  // Once the render is under way (its first checkpoint is written), Ctrl-C to mpirun.
   RunResult r = sh(dir_, "$MPIRUN -np 2 $CANDELA render " + scene_ + " -q " + settings +
-                             " -o cut.pfm --checkpoint ck.bin & p=$!; sleep 2; kill -INT $p; wait $p; echo exit=$?");
+                             " -o cut.pfm --checkpoint ck.bin --checkpoint-every 0.2 & p=$!; " + kWaitForCheckpoint +
+                             "kill -INT $p; wait $p; echo exit=$?");
   EXPECT_NE(r.output.find("interrupted: wrote the image"), std::string::npos) << r.output;
   EXPECT_TRUE(fs::exists(dir_ / "cut.pfm") && fs::exists(dir_ / "ck.bin")) << r.output;
   EXPECT_EQ(r.output.find("exit=0"), std::string::npos) << "an interrupted job exits non-zero:\n" << r.output;
@@ -128,8 +133,8 @@ TEST_F(Distributed, ARankKilledOutrightEndsTheJobAndItsCheckpointResumesInOnePro
   ASSERT_EQ(render(0, settings + " -o one.pfm").exit_code, 0);
   RunResult r = sh(dir_, "$MPIRUN -np 3 $CANDELA render " + scene_ + " -q " + settings +
                              " -o killed.pfm --checkpoint ck.bin --checkpoint-every 0.1 & p=$!; "
-                             "while [ ! -e ck.bin ]; do sleep 0.05; done; "
-                             "pkill -9 -n -f \"candela render\"; wait $p; echo exit=$?");
+                             + kWaitForCheckpoint +
+                             "pkill -9 -n -P $p; wait $p; echo exit=$?");  // the newest rank of this job
   EXPECT_EQ(r.output.find("exit=0"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir_ / "killed.pfm")) << "nothing is written when a rank dies";
   RunResult resumed = render(0, settings + " -o resumed.pfm --resume ck.bin");
