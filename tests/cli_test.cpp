@@ -140,7 +140,7 @@ TEST_F(CommandLine, HelpDocumentsEveryOption) {
                           "--shadow-rays", "--adaptive-threshold", "--adaptive-spp", "--adaptive-batch", "--max-spp", "--spp-map",
                           "--checkpoint", "--checkpoint-every", "--resume", "--time-limit", "--clamp", "--pixel",
                           "--bdpt-strategies", "--bdpt-unweighted", "--mlt-bootstrap", "--mlt-chains", "--mlt-sigma",
-                          "--mlt-large-step", "--mlt-lens", "--mlt-caustic", "--transport"})
+                          "--mlt-large-step", "--mlt-lens", "--mlt-caustic", "--transport", "--part"})
     EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
 }
 
@@ -164,6 +164,14 @@ TEST_F(CommandLine, RenderControlOptionsAreChecked) {
   expect_failure("render " + scene + " -o " + out() + " --resume " + (dir_ / "none.ckpt").string(), "none\\.ckpt.*cannot open");
   expect_failure("render " + scene + " -o " + out() + " --pixel 3", "--pixel");
   expect_failure("render " + scene + " -o " + out() + " --pixel 99,1", "outside");
+  for (const char* bad : {"10x", "m", "1m30", "0", "0s", "-5", "2h1h"})
+    expect_failure("render " + scene + " -o " + out() + " --time-limit " + bad, "--time-limit: (expected seconds or a duration|must be more than 0)");
+  // Durations: a limit far beyond the render does not cut it short.
+  for (const char* limit : {"90", "2.5", "90s", "10m", "2h", "1h30m", "1m0.5s"}) {
+    RunResult r = run_cli("render " + scene + " -o " + out() + " --spp 2 -q --time-limit " + limit);
+    ASSERT_EQ(r.exit_code, 0) << limit << ": " << r.output;
+    EXPECT_EQ(read_image_metadata(out()).count("candela:time-limited"), 0u) << limit;
+  }
 }
 
 TEST_F(CommandLine, BidirectionalAndMetropolisIntegrators) {

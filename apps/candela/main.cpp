@@ -124,7 +124,8 @@ struct RenderCommand {
   bool no_mis = false;
   bool quiet = false;
   std::string checkpoint, resume, pixel, part;
-  std::optional<double> checkpoint_every, time_limit;
+  std::optional<double> checkpoint_every;
+  std::string time_limit;
   std::optional<float> clamp;
   std::string bdpt_strategies;
   bool bdpt_unweighted = false;
@@ -335,6 +336,25 @@ std::string read_bytes(const fs::path& file) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
+// Seconds from "90", "2.5", "90s", "10m", "2h" or "1h30m" (each part a number with a unit, largest first).
+double parse_duration(const std::string& option, const std::string& text) {
+  static const std::regex plain(R"(\d{1,9}(\.\d{0,9})?)");
+  static const std::regex parts(R"((\d{1,9}(?:\.\d{0,9})?h)?(\d{1,9}(?:\.\d{0,9})?m)?(\d{1,9}(?:\.\d{0,9})?s)?)");
+  double seconds = 0;
+  std::smatch m;
+  if (std::regex_match(text, plain)) {
+    seconds = std::stod(text);
+  } else if (!text.empty() && std::regex_match(text, m, parts)) {
+    const double unit[] = {3600, 60, 1};
+    for (int i = 0; i < 3; ++i)
+      if (m[i + 1].matched) seconds += std::stod(m[i + 1].str()) * unit[i];
+  } else {
+    throw UsageError(fmt::format("{}: expected seconds or a duration such as 90s, 10m, 2h or 1h30m, got '{}'", option, text));
+  }
+  if (!(seconds > 0)) throw UsageError(fmt::format("{}: must be more than 0, got '{}'", option, text));
+  return seconds;
+}
+
 // What the ranks of a job must all have read alike: the scene file's bytes and every mesh.
 uint64_t scene_content_hash(const std::string& scene_bytes, const SceneDesc& desc) {
   uint64_t hash = fnv1a64(scene_bytes.data(), scene_bytes.size());
@@ -352,6 +372,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   const bool pixel_mode = !cmd.pixel.empty();
   int px = -1, py = -1;
   int part_index = 0, part_count = 1;
+  double time_limit_seconds = 0;
   std::vector<fs::path> outputs;
   std::string scene_bytes;
   on_every_rank(cluster, [&] {
@@ -361,6 +382,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
     apply_overrides(cmd, desc);
     adaptive = desc.settings.adaptive();
     if (cmd.checkpoint_every && cmd.checkpoint.empty()) throw UsageError("--checkpoint-every needs --checkpoint FILE");
+    if (!cmd.time_limit.empty()) time_limit_seconds = parse_duration("--time-limit", cmd.time_limit);
     if (adaptive && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
       throw UsageError("--checkpoint and --resume are not supported with adaptive sampling (--adaptive-threshold, --adaptive-spp)");
     if (pixel_mode && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
@@ -470,7 +492,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   options.threads = cmd.threads.value_or(cluster.default_threads());
   options.progress = !cmd.quiet && cluster.is_root();
   options.cancel = &g_stop;
-  options.time_limit_seconds = cmd.time_limit.value_or(0.0);
+  options.time_limit_seconds = time_limit_seconds;
   options.clamp = clamp;
   options.cluster = &cluster;
   options.part_index = part_index;
@@ -781,8 +803,8 @@ int main(int argc, char** argv) {
                          "Continue from a checkpoint made with the same scene file and settings; the result "
                          "equals an uninterrupted render bit for bit");
   render_cmd->add_option("--time-limit", cmd.time_limit,
-                         "Stop after the pass during which this many seconds have passed, and write the image")
-      ->check(CLI::PositiveNumber);
+                         "Stop after the pass during which this much time has passed, and write the image: "
+                         "seconds (90, 2.5) or a duration such as 90s, 10m, 2h, 1h30m");
   render_cmd->add_option("--clamp", cmd.clamp,
                          "Scale each sample so its largest RGB component is at most VALUE (biased; off by default)")
       ->check(CLI::PositiveNumber);
