@@ -707,7 +707,7 @@ int main(int argc, char** argv) {
   try {
     cluster = join_cluster(argc, argv);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "candela: error: %s\n", e.what());
+    if (*e.what()) std::fprintf(stderr, "candela: error: %s\n", e.what());  // empty: another rank says it
     return kExitBadInput;
   }
   CLI::App app{"candela: a physically based Monte Carlo path tracer.\n"

@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <cstdlib>
+#include <stdexcept>
 
 namespace candela {
 
@@ -55,8 +56,23 @@ Cluster& local_cluster() {
   return alone;
 }
 
+const char* mpi_launcher_rank() {
+  for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"})
+    if (const char* rank = std::getenv(name)) return rank;
+  if (std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE")) return "0";
+  return nullptr;
+}
+
 #ifndef CANDELA_HAVE_MPI
-std::unique_ptr<Cluster> join_cluster(int&, char**&) { return std::make_unique<LocalCluster>(); }
+std::unique_ptr<Cluster> join_cluster(int&, char**&) {
+  // Started by mpirun but unable to join: every process would render the whole image on its own.
+  if (const char* rank = mpi_launcher_rank())
+    throw std::runtime_error(std::string(rank) != "0"
+                                 ? ""
+                                 : "this candela was built without MPI, but an MPI launcher started it: build it "
+                                   "where CMake finds MPI (Debian: libopenmpi-dev), or run it without mpirun");
+  return std::make_unique<LocalCluster>();
+}
 std::string mpi_support() { return "built without MPI: renders in one process"; }
 #endif
 

@@ -120,7 +120,13 @@ Cluster& local_cluster();
 
 // The cluster this process belongs to: an MPI job when launched by mpirun (and built with MPI),
 // initialising MPI, else the process alone. MPI is finalised when the returned object is destroyed.
+// A build without MPI started by mpirun throws (the message is empty on ranks other than 0, so that
+// the job prints it once).
 std::unique_ptr<Cluster> join_cluster(int& argc, char**& argv);
+
+// The rank an MPI launcher (mpirun, srun) gave this process in its environment, or null when no
+// launcher started it.
+const char* mpi_launcher_rank();
 
 // For --version: the MPI library this build renders across ranks with, or that it has none.
 std::string mpi_support();

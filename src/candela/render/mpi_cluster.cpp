@@ -34,14 +34,6 @@ constexpr int kTagGrant = 2;    // payload: uint64 first, uint64 count (0 = no m
 // some queued, so the wait is hidden.
 constexpr auto kPoll = std::chrono::milliseconds(1);
 
-// True when this process was started by an MPI launcher (Open MPI's mpirun, or a PMI/PMIx one
-// such as srun): only then is MPI initialised, so a plain run never pays for it.
-bool launched_by_mpi() {
-  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"})
-    if (std::getenv(name)) return true;
-  return false;
-}
-
 void check(int code, const char* what) {
   if (code != MPI_SUCCESS) throw std::runtime_error(std::string("MPI call failed: ") + what);
 }
@@ -329,7 +321,8 @@ class MpiCluster final : public Cluster {
 }  // namespace
 
 std::unique_ptr<Cluster> join_cluster(int& argc, char**& argv) {
-  if (!launched_by_mpi()) return std::make_unique<LocalCluster>();
+  // Only a process an MPI launcher started initialises MPI, so a plain run never pays for it.
+  if (!mpi_launcher_rank()) return std::make_unique<LocalCluster>();
   return std::make_unique<MpiCluster>(argc, argv);
 }
 
