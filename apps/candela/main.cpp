@@ -378,7 +378,10 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   on_every_rank(cluster, [&] {
     desc = cmd.scene_file.empty() ? read_json_scene(builtin_scene_json(), "<built-in cornell-box.json>", ".")
                                   : read_scene_file(cmd.scene_file);
-    scene_bytes = cmd.scene_file.empty() ? std::string(builtin_scene_json()) : read_bytes(cmd.scene_file);
+    // The scene file's bytes again, for what must know they are the same: the ranks of a job, a
+    // checkpoint, a part. A plain render does not read the file twice.
+    if (cluster.distributed() || !cmd.checkpoint.empty() || !cmd.resume.empty() || !cmd.part.empty())
+      scene_bytes = cmd.scene_file.empty() ? std::string(builtin_scene_json()) : read_bytes(cmd.scene_file);
     apply_overrides(cmd, desc);
     adaptive = desc.settings.adaptive();
     if (cmd.checkpoint_every && cmd.checkpoint.empty()) throw UsageError("--checkpoint-every needs --checkpoint FILE");
@@ -432,9 +435,8 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
     }
   });
   // Every rank must render the same scene: a file changed on one node is refused.
-  const uint64_t content_hash = scene_content_hash(scene_bytes, desc);
-  on_every_rank(cluster, [&] {
-    std::vector<uint64_t> hashes = cluster.gather_values(content_hash);
+  if (cluster.distributed()) on_every_rank(cluster, [&] {
+    std::vector<uint64_t> hashes = cluster.gather_values(scene_content_hash(scene_bytes, desc));
     for (size_t r = 1; r < hashes.size(); ++r)
       if (hashes[r] != hashes[0])
         throw UsageError(fmt::format("rank {} read a different scene than rank 0 ('{}' or its meshes differ between "
@@ -444,10 +446,11 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   const IntegratorEntry& integrator = *find_integrator(desc.settings.integrator);
 
   const float clamp = cmd.clamp.value_or(0.0f);
-  RenderFingerprint fingerprint;
+  // What made the image, for checkpoints and parts; a checkpoint also names its part, as it resumes only that.
+  const RenderFingerprint render_fingerprint = make_fingerprint(scene_bytes, desc, clamp);
+  RenderFingerprint fingerprint = render_fingerprint;
+  if (part_count > 1) fingerprint.settings.push_back({"part", cmd.part});
   std::optional<Checkpoint> resumed;
-  fingerprint = make_fingerprint(scene_bytes, desc, clamp);
-  if (part_count > 1) fingerprint.settings.push_back({"part", cmd.part});  // a checkpoint resumes its own part
   if (!cmd.resume.empty()) {
     // The root reads the checkpoint and sends it to the others: only it needs to see the file.
     std::string checkpoint_bytes;
@@ -600,7 +603,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   if (non_finite > 0) metadata["candela:non_finite_samples"] = std::to_string(non_finite);
   if (integrator.reads_setting("mlt")) metadata["candela:mlt"] = desc.settings.mlt.describe();
   if (!cmd.part.empty()) {
-    FilmPart part{part_index, part_count, make_fingerprint(scene_bytes, desc, clamp),
+    FilmPart part{part_index, part_count, render_fingerprint,
                   double(scene.camera().importance_film_pixels()), non_finite, std::move(film)};
     write_part(outputs[0], part, metadata);
     film = std::move(part.film);
