@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "candela/film/error_estimate.h"
 #include "candela/film/image_io.h"
 #include "candela/base/error.h"
 #include "candela/io/json_writer.h"
@@ -83,6 +84,7 @@ void install_signal_handlers() {
   sigaction(SIGTERM, &sa, nullptr);
 }
 constexpr int kMaxResolution = 65536;
+constexpr int kTargetErrorMaxSpp = 65536;
 constexpr long long kMaxPixels = 1LL << 28;
 
 struct UsageError : std::runtime_error {
@@ -126,6 +128,8 @@ struct RenderCommand {
   std::string checkpoint, resume, pixel, part;
   std::optional<double> checkpoint_every;
   std::string time_limit;
+  std::optional<double> target_error;
+  bool estimate_error = false;
   std::optional<float> clamp;
   std::string bdpt_strategies;
   bool bdpt_unweighted = false;
@@ -213,6 +217,15 @@ void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
                                                        {"paper", LightSelection::Paper},
                                                        {"uniform", LightSelection::Uniform}});
   if (cmd.no_mis) rs.path.mis = false;
+  // An error estimate needs two independent halves of every pixel's samples; with a target the
+  // spp is the most a pixel may get (--spp, or 65536).
+  if (cmd.estimate_error || cmd.target_error) rs.sampler.replicas = true;
+  if (cmd.target_error) {
+    rs.spp = cmd.spp.value_or(kTargetErrorMaxSpp);
+    if (rs.adaptive())
+      throw UsageError("--target-error: adaptive sampling (--adaptive-threshold, --adaptive-spp) has its own stopping "
+                       "rule; use one or the other");
+  }
   if (!cmd.transport.empty())
     rs.spectral = parse_choice<bool>("--transport", cmd.transport, {{"rgb", false}, {"spectral", true}});
   if (cmd.mlt_bootstrap) rs.mlt.bootstrap = *cmd.mlt_bootstrap;
@@ -311,7 +324,8 @@ RenderFingerprint make_fingerprint(const std::string& scene_bytes, const SceneDe
       {"resolution", fmt::format("{}x{}", desc.film.width, desc.film.height)},
       {"spp", std::to_string(rs.spp)},
       {"seed", std::to_string(rs.seed)},
-      {"sampler", fmt::format("{}{}", sampler_name(rs.sampler.type), rs.sampler.jitter ? "" : " (no jitter)")},
+      {"sampler", fmt::format("{}{}{}", sampler_name(rs.sampler.type), rs.sampler.jitter ? "" : " (no jitter)",
+                              rs.sampler.replicas ? " (two independent halves)" : "")},
       {"filter", fmt::format("{} radius {},{} sigma {} b {} c {}", int(rs.filter.type), rs.filter.radius.x,
                              rs.filter.radius.y, rs.filter.gaussian_sigma, rs.filter.mitchell_b, rs.filter.mitchell_c)},
       {"max-depth", std::to_string(rs.max_depth)},
@@ -417,6 +431,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
       part_index = std::stoi(m[1]) - 1;
       part_count = std::stoi(m[2]);
       if (adaptive) throw UsageError("--part cannot be combined with adaptive sampling (its decisions look across the whole image)");
+      if (cmd.target_error) throw UsageError("--part cannot be combined with --target-error (the error is the whole image's)");
       if (pixel_mode) throw UsageError("--part cannot be combined with --pixel");
       if (!chosen.resumable)
         throw UsageError(fmt::format("--part: the {} integrator does not render tile by tile (path and bdpt do)", chosen.name));
@@ -481,7 +496,10 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
     // Splats and counts are sums over the ranks: the root alone carries the checkpoint's.
     if (!resumed->splats.empty()) {
       film.enable_splats();
-      if (cluster.is_root()) film.splats().sums() = std::move(resumed->splats);
+      if (cluster.is_root()) {
+        film.splats().sums() = std::move(resumed->splats);
+        if (!resumed->half_splats.empty()) film.half_splats().sums() = std::move(resumed->half_splats);
+      }
     }
     if (cluster.is_root()) earlier_non_finite = resumed->non_finite_samples;
   }
@@ -496,6 +514,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   options.progress = !cmd.quiet && cluster.is_root();
   options.cancel = &g_stop;
   options.time_limit_seconds = time_limit_seconds;
+  options.target_error = cmd.target_error.value_or(0.0);
   options.clamp = clamp;
   options.cluster = &cluster;
   options.part_index = part_index;
@@ -515,7 +534,11 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
     Checkpoint cp;
     if (f.has_splats()) {
       cp.splats = f.splats().sums();
-      if (own_splats) cluster.sum_int64(cp.splats);
+      cp.half_splats = f.half_splats().sums();
+      if (own_splats) {
+        cluster.sum_int64(cp.splats);
+        cluster.sum_int64(cp.half_splats);
+      }
     }
     on_every_rank(cluster, [&] {
       if (!cluster.is_root()) return;
@@ -599,6 +622,16 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
       {"Software", "candela " CANDELA_VERSION}};
   if (stats.cancelled) metadata["candela:interrupted"] = "true";
   if (stats.time_limited) metadata["candela:time-limited"] = "true";
+  // How good the image is, from its own two halves (film/error_estimate.h).
+  const ErrorEstimate error = estimate_error(film, stats.mlt_normalization_relative_error);
+  if (error.valid) {
+    metadata["candela:relmse_estimate"] = fmt::format("{:.6g}", error.relmse);
+    metadata["candela:relmse_interval95"] = fmt::format("{:.6g} {:.6g}", error.low, error.high);
+  }
+  if (options.target_error > 0) {
+    metadata["candela:target_error"] = fmt::format("{}", options.target_error);
+    metadata["candela:target_reached"] = stats.reached_target ? "true" : "false";
+  }
   if (clamp > 0) metadata["candela:clamp"] = fmt::format("{}", clamp);
   if (non_finite > 0) metadata["candela:non_finite_samples"] = std::to_string(non_finite);
   if (integrator.reads_setting("mlt")) metadata["candela:mlt"] = desc.settings.mlt.describe();
@@ -628,6 +661,13 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
               desc.film.height, spp_text.c_str(), spp_unit, stats.seconds, double(stats.samples) / seconds * 1e-6,
               double(stats.rays.total()) / seconds * 1e-6,
               double(stats.rays.total()) / double(std::max<uint64_t>(stats.samples, 1)), written.c_str());
+  if (error.valid || options.target_error > 0 || cmd.estimate_error)
+    std::printf("estimated error: %s%s\n", describe(error).c_str(),
+                options.target_error <= 0 ? ""
+                : stats.reached_target
+                    ? fmt::format("; target {} reached", options.target_error).c_str()
+                    : fmt::format("; target {} not reached (stopped at the {})", options.target_error,
+                                  stats.time_limited ? "time limit" : stats.cancelled ? "interruption" : "spp limit").c_str());
   if (cluster.mpi_job()) {
     // The job's parallel efficiency: the thread-seconds spent rendering over all threads x wall time.
     double busy = 0;
@@ -808,6 +848,13 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--time-limit", cmd.time_limit,
                          "Stop after the pass during which this much time has passed, and write the image: "
                          "seconds (90, 2.5) or a duration such as 90s, 10m, 2h, 1h30m");
+  render_cmd->add_option("--target-error", cmd.target_error,
+                         "Render until the image's estimated relMSE (eps 0.01, from two independent halves of the "
+                         "samples) is at most this, then stop; --spp (default 65536) and --time-limit cap it")
+      ->check(CLI::PositiveNumber);
+  render_cmd->add_flag("--estimate-error", cmd.estimate_error,
+                       "Render every pixel's samples as two independent halves and report the image's estimated "
+                       "relMSE with a 95% interval (always done with the random sampler and with --target-error)");
   render_cmd->add_option("--clamp", cmd.clamp,
                          "Scale each sample so its largest RGB component is at most VALUE (biased; off by default)")
       ->check(CLI::PositiveNumber);

@@ -40,9 +40,10 @@ RGB PixelSums::standard_error() const {
 }
 
 Image Film::mean_image() const {
+  const double scale = has_splats() ? splat_scale() : 0;
   return image_of(width_, height_, [&](int x, int y) {
     RGB v = pixel(x, y).mean();
-    if (has_splats()) v += splats_.at(x, y) * float(splat_scale_);
+    if (has_splats()) v += splats_.at(x, y) * float(scale);
     return v;
   });
 }
@@ -113,6 +114,24 @@ uint64_t Film::total_samples() const {
   uint64_t n = 0;
   for (const auto& px : pixels_) n += px.count;
   return n;
+}
+
+uint64_t Film::first_half_samples() const {
+  uint64_t n = 0;
+  for (const auto& px : pixels_) n += px.half_count;
+  return n;
+}
+
+double Film::splat_scale() const {
+  if (light_path_area_ <= 0) return splat_scale_;
+  const uint64_t paths = total_samples();
+  return paths > 0 ? light_path_area_ / double(paths) : 0;
+}
+
+double Film::splat_half_fraction() const {
+  if (light_path_area_ <= 0) return splat_half_fraction_;
+  const uint64_t paths = total_samples();
+  return paths > 0 ? double(first_half_samples()) / double(paths) : 0.5;
 }
 
 uint64_t Film::min_samples() const {

@@ -4,6 +4,10 @@
 // sum(w L) / sum(w). Sums of squares of w L give per-pixel error estimates (for adaptive sampling
 // and tests). Accumulated in double so long renders do not lose precision. A pixel is only ever
 // written by one thread at a time.
+//
+// Every pixel's samples also fall into two halves, each an independent estimate of the pixel
+// (render_loop.h says which samples go where): the sums of the first half are kept beside the
+// totals, so the difference of the two halves measures the image's error (film/error_estimate.h).
 #include <cstdint>
 #include <vector>
 
@@ -18,6 +22,9 @@ struct PixelSums {
   double weighted_sq[3] = {0, 0, 0};  // sum of (w L)^2
   double weight = 0;                  // sum of w
   uint64_t count = 0;                 // number of samples
+  double half_weighted[3] = {0, 0, 0};  // sum of w L over the first half's samples
+  double half_weight = 0;               // sum of w over them
+  uint64_t half_count = 0;              // their number
 
   RGB mean() const;
   // Standard error of mean() per channel, from the spread of the samples (0 with fewer than 2).
@@ -59,24 +66,42 @@ class Film {
   int width() const { return width_; }
   int height() const { return height_; }
 
-  void add_sample(int x, int y, const RGB& L, float weight = 1) {
+  void add_sample(int x, int y, const RGB& L, float weight = 1, bool first_half = true) {
     PixelSums& px = pixels_[size_t(y) * width_ + x];
     for (int c = 0; c < 3; ++c) {
       double v = double(weight) * L[c];
       px.weighted[c] += v;
       px.weighted_sq[c] += v * v;
+      if (first_half) px.half_weighted[c] += v;
     }
     px.weight += weight;
     ++px.count;
+    if (first_half) {
+      px.half_weight += weight;
+      ++px.half_count;
+    }
   }
   // Splats (see SplatImage), kept apart from the per-pixel sums and multiplied by splat_scale() in
-  // the image. Empty until enable_splats().
-  void enable_splats() { splats_ = SplatImage(width_, height_); }
+  // the image. Empty until enable_splats(). The splats of the first half's samples (or chains) are
+  // also added to half_splats().
+  void enable_splats() {
+    splats_ = SplatImage(width_, height_);
+    half_splats_ = SplatImage(width_, height_);
+  }
   bool has_splats() const { return !splats_.empty(); }
   SplatImage& splats() { return splats_; }
   const SplatImage& splats() const { return splats_; }
-  double splat_scale() const { return splat_scale_; }
+  SplatImage& half_splats() { return half_splats_; }
+  const SplatImage& half_splats() const { return half_splats_; }
+  // Either an explicit scale, or (bidirectional path tracing) one light path per camera sample: the
+  // light image is the splats times the importance film's area over the number of samples.
+  double splat_scale() const;
   void set_splat_scale(double s) { splat_scale_ = s; }
+  void set_one_light_path_per_sample(double importance_film_area) { light_path_area_ = importance_film_area; }
+  // The share of the splats' paths (or chains) in the first half: 0.5 unless set, or, with one light
+  // path per sample, the first half's share of the samples.
+  double splat_half_fraction() const;
+  void set_splat_half_fraction(double f) { splat_half_fraction_ = f; }
 
   const PixelSums& pixel(int x, int y) const { return pixels_[size_t(y) * width_ + x]; }
   // All pixels, row-major: for checkpoints, which store and restore the sums bit for bit.
@@ -90,6 +115,7 @@ class Film {
   // Per-pixel sample counts, in every channel.
   Image sample_count_image() const;
   uint64_t total_samples() const;
+  uint64_t first_half_samples() const;
   // Fewest and most samples any pixel has (0, 0 for an empty film).
   uint64_t min_samples() const;
   uint64_t max_samples() const;
@@ -97,8 +123,10 @@ class Film {
  private:
   int width_, height_;
   std::vector<PixelSums> pixels_;
-  SplatImage splats_;
+  SplatImage splats_, half_splats_;
   double splat_scale_ = 1;
+  double light_path_area_ = 0;  // > 0: one light path per camera sample
+  double splat_half_fraction_ = 0.5;
 };
 
 }  // namespace candela

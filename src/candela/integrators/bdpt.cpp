@@ -485,7 +485,7 @@ BdptIntegrator::Connection BdptIntegrator::connect(BdptVertex* light, BdptVertex
 
 template <typename Sampler>
 RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts, const BdptTarget& target, int x,
-                             int y, float filter_weight, const Wavelengths* wl) const {
+                             int y, float filter_weight, bool first_half, const Wavelengths* wl) const {
   thread_local std::vector<BdptVertex> camera_path, light_path;
   camera_path.resize(size_t(max_depth_) + 2);
   light_path.resize(size_t(max_depth_) + 1);
@@ -516,7 +516,11 @@ RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts
       if ((s == 1 && t == 1) || depth < 0 || depth > max_depth_ || (depth == 0 && hide_emitters_)) continue;
       Connection c = connect(lv, cv, s, t, sampler, counts, ray.time, wl);
       if (t == 1) {
-        if (!c.L.is_black()) target.film->splats().add(c.raster, to_rgb(c.L), *target.filter);
+        if (!c.L.is_black()) {
+          const RGB v = to_rgb(c.L);
+          target.film->splats().add(c.raster, v, *target.filter);
+          if (first_half) target.film->half_splats().add(c.raster, v, *target.filter);
+        }
       } else {
         L += c.L;
       }
@@ -541,19 +545,17 @@ RenderStats render_bdpt(const Scene& scene, const RenderSettings& settings, Film
   const BdptTarget target{&film, &filter, options.bdpt_strategies, options.bdpt_unweighted};
   CameraSampleTiles tiles([&](const Ray& ray, auto& sampler, RayCounts& counts, const PixelSample& pixel,
                               const Wavelengths* wl) {
-    return bdpt.radiance(ray, sampler, counts, target, pixel.x, pixel.y, pixel.filter_weight, wl);
+    return bdpt.radiance(ray, sampler, counts, target, pixel.x, pixel.y, pixel.filter_weight, pixel.first_half, wl);
   });
-  RenderStats stats = render_tiles(scene, settings, film, options, tiles);
-  // One light path was traced per camera sample: the light image is the splats times the
+  // One light path is traced per camera sample: the light image is the splats times the
   // importance film's area over their number.
-  uint64_t light_paths = film.total_samples();
-  film.set_splat_scale(light_paths > 0 ? double(scene.camera().importance_film_pixels()) / double(light_paths) : 0);
-  return stats;
+  film.set_one_light_path_per_sample(double(scene.camera().importance_film_pixels()));
+  return render_tiles(scene, settings, film, options, tiles);
 }
 
 // One instantiation per pixel sampler, and one for Metropolis light transport's sampler.
 #define CANDELA_INSTANTIATE(S)                                                                              \
-  template RGB BdptIntegrator::radiance<S>(const Ray&, S&, RayCounts&, const BdptTarget&, int, int, float,         \
+  template RGB BdptIntegrator::radiance<S>(const Ray&, S&, RayCounts&, const BdptTarget&, int, int, float, bool,   \
                                            const Wavelengths*) const;                                           \
   template int BdptIntegrator::camera_subpath<S>(const Ray&, S&, RayCounts&, int, BdptVertex*, RGB*,            \
                                                  const Wavelengths*) const;                                     \

@@ -69,8 +69,9 @@ class BdptIntegrator {
   // pixel with the filter weight by the caller); the t = 1 strategies are splatted onto target.film.
   // With wavelengths (a spectral render) the estimate is their values; splats are converted to RGB.
   template <typename Sampler>
+  // `first_half`: the camera sample is in the film's first half, and so are its light path's splats.
   RGB radiance(const Ray& ray, Sampler& sampler, RayCounts& counts, const BdptTarget& target, int x, int y,
-               float filter_weight, const Wavelengths* wl = nullptr) const;
+               float filter_weight, bool first_half, const Wavelengths* wl = nullptr) const;
 
   // The building blocks, shared with Metropolis light transport. `wl`: the wavelengths of a spectral
   // render (null: RGB), at which BSDFs and emission are evaluated.

@@ -218,6 +218,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   emission_options.progress = false;
   emission_options.after_pass = nullptr;
   emission_options.time_limit_seconds = 0;
+  emission_options.target_error = 0;
   emission_options.bdpt_strategies = nullptr;
   RenderStats stats = render_path(scene, emission, film, emission_options);
   stats.samples = 0;
@@ -294,7 +295,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   // evaluates every strategy of paths up to 16 bounces).
   const BdptIntegrator bdpt_with_roulette(scene, settings);
   const uint64_t normalization_samples = std::max<uint64_t>(
-      uint64_t(settings.mlt.bootstrap), options.time_limit_seconds > 0 ? 0 : total_mutations / 8);
+      uint64_t(settings.mlt.bootstrap), options.time_limit_seconds > 0 || options.target_error > 0 ? 0 : total_mutations / 8);
   const auto normalization_start = std::chrono::steady_clock::now();
   progress.set_label(fmt::format("MLT normalisation ({} paths)", normalization_samples));
   Normalization normalization = estimate_normalization(scene, bdpt_with_roulette, settings, cluster, arena,
@@ -340,7 +341,9 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   // The chains: each depth gets a share of them proportional to its brightness, and at least one if
   // it has any light (so no depth's light is lost to chance), starting from its bootstrap paths
   // chosen proportionally to their luminance, stratified over its chains. Each depth's deposits are
-  // then scaled by its own brightness over its number of chains.
+  // then scaled by its own brightness over its number of chains. Every depth has an even number of
+  // chains: its even-numbered chains deposit also into the film's first half, so the two halves are
+  // independent estimates of the image (film/error_estimate.h).
   std::vector<uint64_t> depth_chains(size_t(depths), 0);
   std::vector<Distribution1D> depth_bootstrap;
   depth_bootstrap.resize(size_t(depths));
@@ -356,7 +359,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   for (size_t d = 1; d < size_t(depths); ++d) b_chains += normalization.per_depth[d];
   for (size_t d = 0; d < size_t(depths); ++d)
     if (d > 0 && depth_found[d] && normalization.per_depth[d] > 0)
-      depth_chains[d] = std::max<uint64_t>(1, uint64_t(std::llround(double(wanted) * normalization.per_depth[d] / b_chains)));
+      depth_chains[d] = 2 * std::max<uint64_t>(1, uint64_t(std::llround(double(wanted) * normalization.per_depth[d] / b_chains / 2)));
   uint64_t chains = 0;
   for (uint64_t n : depth_chains) chains += n;
   if (chains == 0) {
@@ -373,6 +376,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
     int depth = 0;
     float scale = 0;
     float brightness = 0;  // the depth's mean luminance b_d
+    bool first_half = false;
   };
   const MltMutationProbabilities mutations{settings.mlt.large_step, settings.mlt.lens, settings.mlt.caustic};
   const PerspectiveCamera& camera = scene.camera();
@@ -388,7 +392,8 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
       float u = std::min((float(k) + pick.next_float()) / float(depth_chains[d]), 0x1.fffffep-1f);
       size_t index = depth_bootstrap[d].sample(u) * size_t(depths) + d;
       chain_states.push_back(Chain{MltSampler(settings.seed, index, settings.mlt.sigma, mutations, perturbed),
-                                   Rng(c, hash_values(settings.seed, 0x636861696e)), PathState{}, int(d), 0});
+                                   Rng(c, hash_values(settings.seed, 0x636861696e)), PathState{}, int(d), 0, 0,
+                                   k % 2 == 0});
     }
   // Deposits are kept near 1 (relative to the largest depth scale) for the fixed-point splat sums.
   std::vector<double> per_chain_share(size_t(depths), 0.0);
@@ -402,6 +407,12 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
     c.scale = largest > 0 ? float(per_chain_share[size_t(c.depth)] / largest) : 0.0f;
     c.brightness = float(normalization.per_depth[size_t(c.depth)]);
   }
+  // A chain's deposits carry its depth's mean luminance over its chains, per mutation; times the
+  // film's area they make the image.
+  auto splat_scale = [&](uint64_t mutations) {
+    return mutations > 0 ? largest * double(scene.camera().importance_film_pixels()) / double(mutations) : 0.0;
+  };
+  film.set_splat_half_fraction(0.5);
 
   // The chains advance in rounds, every chain by the same number of mutations, so that a render
   // stopped between rounds (time limit, interruption) has every depth equally far along.
@@ -442,14 +453,17 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
           // regions that chains seldom visit are estimated by the large steps instead.
           float large = c.sampler.large_step() ? 1.0f : 0.0f;
           float floor_density = settings.mlt.large_step * c.brightness;
-          if (y_proposed > 0 && accept + large > 0 &&
-              !film.splats().add(proposed.raster,
-                                 proposed.L * ((accept + large) * c.scale / (y_proposed + floor_density)), filter))
-            non_finite.fetch_add(1, std::memory_order_relaxed);
-          if (accept < 1 && y_current > 0 &&
-              !film.splats().add(c.current.raster,
-                                 c.current.L * ((1 - accept) * c.scale / (y_current + floor_density)), filter))
-            non_finite.fetch_add(1, std::memory_order_relaxed);
+          auto deposit = [&](Vec2 raster, const RGB& v) {
+            if (!film.splats().add(raster, v, filter)) {
+              non_finite.fetch_add(1, std::memory_order_relaxed);
+            } else if (c.first_half) {
+              film.half_splats().add(raster, v, filter);
+            }
+          };
+          if (y_proposed > 0 && accept + large > 0)
+            deposit(proposed.raster, proposed.L * ((accept + large) * c.scale / (y_proposed + floor_density)));
+          if (accept < 1 && y_current > 0)
+            deposit(c.current.raster, c.current.L * ((1 - accept) * c.scale / (y_current + floor_density)));
           if (c.rng.next_float() < accept) {
             c.current = proposed;
             c.sampler.accept();
@@ -478,15 +492,20 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
       stats.time_limited = true;
       break;
     }
+    if (options.target_error > 0 && mutations_per_chain < per_chain) {
+      film.set_splat_scale(splat_scale(mutations_per_chain));
+      if (agreed_error_estimate(cluster, film, normalization.relative_error) <= options.target_error) {
+        stats.reached_target = true;
+        break;
+      }
+    }
   }
   progress.finish();
-  if (cluster.distributed()) cluster.sum_int64(film.splats().sums());
-
-  // A chain's deposits carry its depth's mean luminance over its chains, per mutation; times the
-  // film's area they make the image.
-  film.set_splat_scale(mutations_per_chain > 0
-                           ? largest * double(scene.camera().importance_film_pixels()) / double(mutations_per_chain)
-                           : 0);
+  if (cluster.distributed()) {
+    cluster.sum_int64(film.splats().sums());
+    cluster.sum_int64(film.half_splats().sums());
+  }
+  film.set_splat_scale(splat_scale(mutations_per_chain));
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   stats.samples = mutations_per_chain * chains;
   RayCounts chain_rays;

@@ -16,6 +16,7 @@ namespace candela {
 struct PixelSample {
   int x = 0, y = 0;
   float filter_weight = 1;
+  bool first_half = true;  // which of the film's two independent halves the sample belongs to
 };
 
 // Radiance: a callable (const Ray&, auto& sampler, RayCounts&, const PixelSample&, const Wavelengths*)
@@ -64,7 +65,8 @@ class CameraSampleTiles final : public TileIntegrator {
       // A spectral render draws the path's wavelengths next; its radiance comes back as their values.
       Wavelengths storage;
       const Wavelengths* wl = sample_wavelengths_if(context.spectral, sampler, storage);
-      RGB L = wavelengths_to_rgb(radiance_(ray, sampler, counts, PixelSample{x, y, fs.weight}, wl), wl);
+      const bool first_half = context.first_half(s);
+      RGB L = wavelengths_to_rgb(radiance_(ray, sampler, counts, PixelSample{x, y, fs.weight, first_half}, wl), wl);
       if (!L.is_finite()) {
         // Never reaches the film: counted, the first few logged, and the sample counts as black.
         context.non_finite.fetch_add(1, std::memory_order_relaxed);
@@ -74,7 +76,7 @@ class CameraSampleTiles final : public TileIntegrator {
         float m = L.max_component();
         if (m > context.clamp) L *= context.clamp / m;
       }
-      context.film.add_sample(x, y, L, fs.weight);
+      context.film.add_sample(x, y, L, fs.weight, first_half);
     }
   }
 

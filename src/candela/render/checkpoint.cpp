@@ -12,9 +12,10 @@ namespace candela {
 namespace {
 
 constexpr char kMagic[8] = {'C', 'N', 'D', 'L', 'C', 'K', 'P', 'T'};
-constexpr uint32_t kVersion = 2;
+constexpr uint32_t kVersion = 3;
 constexpr size_t kHeaderSize = 8 + 4 + 8 + 8;
 constexpr size_t kPixelSize = 7 * 8 + 8;
+constexpr size_t kHalfSize = 4 * 8 + 8;  // version 3: the first half's sums
 
 struct Writer {
   std::string bytes;
@@ -107,10 +108,15 @@ void write_checkpoint(const std::filesystem::path& file, const Checkpoint& cp) {
     payload.raw(px.weighted_sq, sizeof px.weighted_sq);
     payload.put(px.weight);
     payload.put(px.count);
+    payload.raw(px.half_weighted, sizeof px.half_weighted);
+    payload.put(px.half_weight);
+    payload.put(px.half_count);
   }
-  if (!cp.splats.empty() && cp.splats.size() != cp.pixels.size() * 3) fail(file, "splat count does not match the size");
-  payload.put(uint64_t(cp.splats.size()));
-  for (int64_t v : cp.splats) payload.put(v);
+  for (const auto* splats : {&cp.splats, &cp.half_splats}) {
+    if (!splats->empty() && splats->size() != cp.pixels.size() * 3) fail(file, "splat count does not match the size");
+    payload.put(uint64_t(splats->size()));
+    for (int64_t v : *splats) payload.put(v);
+  }
   Writer header;
   header.raw(kMagic, sizeof kMagic);
   header.put(kVersion);
@@ -167,7 +173,7 @@ Checkpoint parse_checkpoint(std::string_view bytes, const std::filesystem::path&
   if (bytes.size() < kHeaderSize) fail(file, "truncated (header incomplete)");
   Reader header{bytes.data() + sizeof kMagic, bytes.data() + kHeaderSize, file.string()};
   uint32_t version = header.get<uint32_t>();
-  if (version != kVersion && version != 1)
+  if (version > kVersion || version == 0)
     fail(file, "unsupported version " + std::to_string(version) + " (this candela reads version " +
                    std::to_string(kVersion) + ")");
   uint64_t size = header.get<uint64_t>(), hash = header.get<uint64_t>();
@@ -188,7 +194,7 @@ Checkpoint parse_checkpoint(std::string_view bytes, const std::filesystem::path&
   cp.width = r.get<int32_t>();
   cp.height = r.get<int32_t>();
   cp.non_finite_samples = r.get<uint64_t>();
-  const uint64_t pixel_bytes = uint64_t(cp.width) * uint64_t(cp.height) * kPixelSize;
+  const uint64_t pixel_bytes = uint64_t(cp.width) * uint64_t(cp.height) * (kPixelSize + (version >= 3 ? kHalfSize : 0));
   const uint64_t left = uint64_t(r.end - r.p);
   if (cp.width < 0 || cp.height < 0 || (version == 1 ? left != pixel_bytes : left < pixel_bytes + 8))
     fail(file, "corrupt (pixel data does not match the size)");
@@ -198,13 +204,22 @@ Checkpoint parse_checkpoint(std::string_view bytes, const std::filesystem::path&
     r.raw(px.weighted_sq, sizeof px.weighted_sq);
     px.weight = r.get<double>();
     px.count = r.get<uint64_t>();
+    if (version >= 3) {
+      r.raw(px.half_weighted, sizeof px.half_weighted);
+      px.half_weight = r.get<double>();
+      px.half_count = r.get<uint64_t>();
+    }
   }
-  if (version >= 2) {
-    uint64_t splats = r.get<uint64_t>();
-    if ((splats != 0 && splats != uint64_t(cp.pixels.size()) * 3) || uint64_t(r.end - r.p) != splats * 8)
+  // Version 2 has the splats, version 3 also the first half's.
+  for (auto* splats : {&cp.splats, &cp.half_splats}) {
+    if (version < 2 || (version < 3 && splats == &cp.half_splats)) break;
+    const bool last = version < 3 || splats == &cp.half_splats;
+    uint64_t count = r.get<uint64_t>();
+    if ((count != 0 && count != uint64_t(cp.pixels.size()) * 3) || uint64_t(r.end - r.p) < count * 8 ||
+        (last && uint64_t(r.end - r.p) != count * 8))
       fail(file, "corrupt (splat data does not match the size)");
-    cp.splats.resize(size_t(splats));
-    for (int64_t& v : cp.splats) v = r.get<int64_t>();
+    splats->resize(size_t(count));
+    for (int64_t& v : *splats) v = r.get<int64_t>();
   }
   return cp;
 }

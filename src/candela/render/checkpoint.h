@@ -5,13 +5,15 @@
 //
 // File layout (little-endian, as the host writes it):
 //   8 bytes  magic "CNDLCKPT"
-//   u32      format version (2; version 1 files, without splats, are still read)
+//   u32      format version (3; versions 1, without splats, and 2, without the halves, are still read)
 //   u64      payload size in bytes
 //   u64      FNV-1a 64 hash of the payload
 //   payload: u64 scene hash; u32 n; n x (u32 length, key bytes, u32 length, value bytes) settings;
 //            i32 width, i32 height; u64 non-finite samples so far;
-//            width x height x (7 doubles: weighted[3], weighted_sq[3], weight; u64 count);
-//            u64 m (0 or 3 width height), m x i64 fixed-point splat sums (bidirectional light paths)
+//            width x height x (7 doubles: weighted[3], weighted_sq[3], weight; u64 count;
+//                              4 doubles: half_weighted[3], half_weight; u64 half_count);
+//            u64 m (0 or 3 width height), m x i64 fixed-point splat sums (bidirectional light paths);
+//            u64 m, m x i64: the first half's splat sums
 // Written atomically: a temporary file beside the target, fsynced, renamed over it, and the
 // directory fsynced, so a crash at any moment leaves the previous checkpoint intact.
 #include <cstdint>
@@ -43,6 +45,7 @@ struct Checkpoint {
   uint64_t non_finite_samples = 0;
   std::vector<PixelSums> pixels;  // row-major, width x height
   std::vector<int64_t> splats;    // SplatImage::sums(), or empty
+  std::vector<int64_t> half_splats;  // Film::half_splats()'s sums, or empty
 };
 
 // Throws std::runtime_error naming the file when it cannot be written.

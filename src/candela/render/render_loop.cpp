@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <numeric>
 #include <stdexcept>
@@ -17,6 +18,7 @@
 #include <ctime>
 #include <tuple>
 
+#include "candela/film/error_estimate.h"
 #include "candela/render/film_part.h"
 #include "candela/render/progress.h"
 
@@ -309,7 +311,10 @@ void combine_ranks(Cluster& cluster, Film& film, const RenderOptions& options, i
   int threads = 0;
   for (int t : cluster.gather_values(stats.threads)) threads += t;
   stats.threads = threads;
-  if (film.has_splats()) cluster.sum_int64(film.splats().sums());
+  if (film.has_splats()) {
+    cluster.sum_int64(film.splats().sums());
+    cluster.sum_int64(film.half_splats().sums());
+  }
   if (options.bdpt_strategies)
     for (SplatImage& image : *options.bdpt_strategies) cluster.sum_int64(image.sums());
 }
@@ -397,6 +402,23 @@ void NonFiniteLog::add(int x, int y, uint64_t s) {
   if (samples_.size() > limit_) samples_.pop_back();
 }
 
+double agreed_error_estimate(Cluster& cluster, const Film& film, double scale_relative_error) {
+  double e = std::numeric_limits<double>::infinity();
+  auto estimate = [&](const Film& f) {
+    ErrorEstimate estimate = estimate_error(f, scale_relative_error);
+    if (estimate.valid) e = estimate.relmse;
+  };
+  if (cluster.distributed() && film.has_splats()) {
+    Film total = film;
+    cluster.sum_int64(total.splats().sums());
+    cluster.sum_int64(total.half_splats().sums());
+    if (cluster.is_root()) estimate(total);
+  } else if (cluster.is_root()) {
+    estimate(film);
+  }
+  return cluster.from_root(e);
+}
+
 float relative_error(const PixelSums& pixel) {
   RGB mean = pixel.mean(), se = pixel.standard_error();
   float worst = 0;
@@ -413,8 +435,14 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
   const int max_spp = adaptive ? std::max(settings.adaptive_spp_limit(), settings.adaptive_batch) : settings.spp;
 
   const Filter filter(settings.filter);
-  const Sampler prototype = make_sampler(settings.sampler, adaptive ? adaptive_set_size(settings) : settings.spp,
-                                         settings.seed, film.width(), film.height());
+  const bool target = options.target_error > 0 && !adaptive;
+  // With replicas the set-based samplers come in sets of half the samples, or of one pass when the
+  // render stops at an error target: the sets alternate between the film's halves.
+  const SamplerType sampler_type = settings.sampler.type;
+  const bool set_based = sampler_type == SamplerType::Stratified || sampler_type == SamplerType::Poisson;
+  int set_size = adaptive ? adaptive_set_size(settings) : settings.spp;
+  if (settings.sampler.replicas && set_based && !adaptive) set_size = target ? kPassSpp : std::max(1, (settings.spp + 1) / 2);
+  const Sampler prototype = make_sampler(settings.sampler, set_size, settings.seed, film.width(), film.height());
   std::vector<Tile> tiles = options.only_x >= 0 ? std::vector<Tile>{{options.only_x, options.only_y,
                                                                      options.only_x + 1, options.only_y + 1}}
                                                 : make_tiles(film.width(), film.height());
@@ -433,7 +461,8 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
   std::atomic<uint64_t> non_finite{0}, busy_nanoseconds{0};
   NonFiniteLog non_finite_log(options.max_reported_non_finite);
   PassContext pc{integrator,
-                 {scene, filter, prototype, film, non_finite, non_finite_log, options.clamp, settings.spectral},
+                 {scene, filter, prototype, film, non_finite, non_finite_log, options.clamp, settings.spectral,
+                  half_block(settings.sampler, set_size)},
                  ray_counts,
                  options.cancel,
                  cluster,
@@ -465,11 +494,14 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
     // A Poisson-disc set is built per pixel: render it in one pass rather than rebuilding it per pass.
     // Every pixel continues from its own count, so a film resumed from a checkpoint (or one whose
     // last pass was cut short) gets exactly the samples an uninterrupted render would add, in order.
-    int pass_spp = settings.sampler.type == SamplerType::Poisson ? settings.spp : kPassSpp;
+    int pass_spp = sampler_type == SamplerType::Poisson ? set_size : kPassSpp;
+    // With an error target: where the estimate says the target will be met (the error of the mean
+    // falls as 1 / spp), so that the last pass does not overshoot by much.
+    int64_t target_end = settings.spp;
     uint64_t least = options.only_x >= 0 ? film.pixel(options.only_x, options.only_y).count : film.min_samples();
     const int first_pass = int(std::min<uint64_t>(least, uint64_t(settings.spp)) / uint64_t(pass_spp)) * pass_spp;
     for (int pass = first_pass, end = 0; pass < settings.spp; pass = end) {
-      end = std::min(pass + pass_spp, settings.spp);
+      end = int(std::min<int64_t>({int64_t(pass) + pass_spp, int64_t(settings.spp), std::max<int64_t>(target_end, pass + 1)}));
       const auto pass_start = std::chrono::steady_clock::now();
       run_pass(pc, tiles, arena,
                [&](int x, int y) {
@@ -477,7 +509,19 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
                  return SampleRange{have, int(std::max<int64_t>(0, end - have))};
                },
                progress);
-      const bool stop = stop_after_pass(end < settings.spp);
+      bool stop = stop_after_pass(end < settings.spp);
+      if (target && !stop && end < settings.spp) {
+        const double e = agreed_error_estimate(cluster, film);
+        if (e <= options.target_error) {
+          stats.reached_target = true;
+          stop = true;
+        } else if (std::isfinite(e)) {
+          // Whole blocks of the halves, at least one more of each half.
+          const int64_t block = int64_t(pc.tile.half_block);
+          const double predicted = double(end) * e / options.target_error;
+          target_end = std::max<int64_t>(end + block, int64_t(std::ceil(predicted / double(block))) * block);
+        }
+      }
       if (options.after_pass && !stats.cancelled) {
         uint64_t non_finite_so_far = 0;
         for (uint64_t n : cluster.gather_values(non_finite.load())) non_finite_so_far += n;

@@ -64,6 +64,9 @@ struct RenderOptions {
   Cluster* cluster = nullptr;
   // Job-array parts (--part K/N): render only the tiles whose index is K-1 modulo N. {0, 1} = all.
   int part_index = 0, part_count = 1;
+  // > 0: render until the image's estimated relMSE (film/error_estimate.h) is at most this, up to
+  // settings.spp samples per pixel (or the time limit). Needs independent halves (SamplerDesc::replicas).
+  double target_error = 0;
 };
 
 struct NonFiniteSample {
@@ -78,6 +81,7 @@ struct RenderStats {
   std::vector<NonFiniteSample> first_non_finite;  // up to max_reported_non_finite, by (sample, y, x)
   bool cancelled = false;                         // stopped by RenderOptions::cancel
   bool time_limited = false;                      // stopped by the time limit before all samples
+  bool reached_target = false;                    // stopped at RenderOptions::target_error
   RayCounts rays;
   // Per rank, the thread-seconds it spent rendering (tiles, or Markov chains), and the threads of
   // all ranks: the job's parallel efficiency is the busy time over threads x wall time.
@@ -129,6 +133,9 @@ struct TileContext {
   NonFiniteLog& non_finite_log;
   float clamp;
   bool spectral;
+  // Sample i of a pixel is in the film's first half when (i / half_block) is even (half_block()).
+  uint64_t half_block;
+  bool first_half(uint64_t sample_index) const { return (sample_index / half_block) % 2 == 0; }
 };
 
 // An integrator as the loop sees it: renders the samples `range` names for every pixel of a tile,
@@ -168,6 +175,11 @@ std::vector<uint8_t> run_shared(Cluster& cluster, tbb::task_arena& arena, uint64
 void exchange_items(Cluster& cluster, const std::vector<uint8_t>& mine,
                     const std::function<void(uint64_t item, std::vector<std::byte>& out)>& write,
                     const std::function<const std::byte*(uint64_t item, const std::byte* in)>& read);
+
+// The film's estimated relMSE (film/error_estimate.h; infinity when it has no estimate), computed
+// by the root and agreed. Across ranks, where each rank's film holds only its own splats, they are
+// added up first (in a copy).
+double agreed_error_estimate(Cluster& cluster, const Film& film, double scale_relative_error = 0);
 
 // The tiles a film is cut into, in the order the loop hands them out (row by row of tiles).
 std::vector<Tile> make_tiles(int width, int height);

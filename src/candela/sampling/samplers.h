@@ -1,6 +1,8 @@
 #pragma once
 // The pixel samplers (the paper's sec. 4.3 plus pbrt-v4's ZSobol) as one closed set: the integrator
 // is a template over the sampler type and the render loop dispatches with std::visit once per tile.
+#include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <variant>
 
@@ -24,10 +26,31 @@ inline Sampler make_sampler(const SamplerDesc& desc, int samples_per_set, uint64
   switch (desc.type) {
     case SamplerType::Stratified: return StratifiedSampler(samples_per_set, desc.jitter, seed);
     case SamplerType::Poisson: return PoissonSampler(samples_per_set, seed);
-    case SamplerType::ZSobol: return ZSobolSampler(samples_per_set, seed, width, height);
+    case SamplerType::ZSobol: {
+      // Each replica draws half the samples.
+      ZSobolSampler z(desc.replicas ? (samples_per_set + 1) / 2 : samples_per_set, seed, width, height);
+      z.set_replicas(desc.replicas);
+      return z;
+    }
     case SamplerType::Independent: break;
   }
   return IndependentSampler(seed);
+}
+
+// Which half of a pixel's samples sample i falls in (film.h: two independent estimates of the
+// pixel): the first when (i / block) is even. Sets of a set-based sampler are independently
+// randomised, so they alternate; ZSobol's replicas alternate every 8 samples, and so do independent
+// samples. Without replicas a ZSobol or stratified render of one set has no second half.
+inline uint64_t half_block(const SamplerDesc& desc, int samples_per_set) {
+  switch (desc.type) {
+    case SamplerType::Independent: return ZSobolSampler::kReplicaBlock;
+    case SamplerType::ZSobol:
+      return desc.replicas ? ZSobolSampler::kReplicaBlock
+                           : uint64_t(std::bit_ceil(unsigned(std::max(1, samples_per_set))));
+    case SamplerType::Stratified:
+    case SamplerType::Poisson: break;
+  }
+  return uint64_t(std::max(1, samples_per_set));
 }
 
 }  // namespace candela

@@ -156,13 +156,26 @@ class ZSobolSampler {
   // first vertex with up to 8 shadow rays.
   static constexpr int kScrambledDimensions = 32;
 
+  // With replicas, samples [8k, 8k + 8) belong to replica k % 2, and each replica is the whole
+  // construction above on its own, its sets reseeded apart from the other's: two independent
+  // randomisations of the sequence, each with its nets intact (an error estimate needs
+  // independent halves; SamplerDesc::replicas). In blocks of 8 so that the per-pixel work kept
+  // between samples is redone only every 8 samples.
+  static constexpr uint64_t kReplicaBlock = 8;
+  void set_replicas(bool on) { replicas_ = on; }
+
   void start_pixel_sample(int x, int y, uint64_t sample_index) {
     // The PCG stream of the deep dimensions is seeded when the first one is drawn (many paths end
     // before): set_sequence costs two hashes.
     rng_pixel_ = {x, y};
     rng_sample_ = sample_index;
     rng_seeded_ = false;
-    uint64_t set = sample_index >> log2_n_;
+    uint64_t replica = 0;
+    if (replicas_) {
+      replica = (sample_index / kReplicaBlock) & 1;
+      sample_index = (sample_index / (2 * kReplicaBlock)) * kReplicaBlock + sample_index % kReplicaBlock;
+    }
+    uint64_t set = ((sample_index >> log2_n_) << (replicas_ ? 1 : 0)) | replica;
     uint64_t index_in_set = sample_index & ((uint64_t(1) << log2_n_) - 1);
     uint64_t pixel_code = encode_morton2(uint32_t(x), uint32_t(y));
     morton_index_ = (pixel_code << log2_n_) | index_in_set;
@@ -310,6 +323,7 @@ class ZSobolSampler {
   }
 
   int log2_n_;
+  bool replicas_ = false;
   int base4_digits_;  // permuted digits: log2(resolution) + ceil(log2(n) / 2)
   uint64_t seed_;
   uint64_t morton_index_ = 0;

@@ -532,6 +532,11 @@ struct SamplerDesc {
   // and the most efficient measured in docs/performance.md).
   SamplerType type = SamplerType::Independent;
   bool jitter = true;  // stratified: false puts each sample at its stratum's centre
+  // Draw every pixel's samples as two independently randomised halves, so the render can estimate
+  // its own error (film/error_estimate.h): ZSobol as two interleaved replicas of its sequence, the
+  // set-based samplers (stratified, poisson) in sets of half the samples or of one pass. Set by
+  // --estimate-error and --target-error. The independent sampler's halves are always independent.
+  bool replicas = false;
 };
 
 // Pixel reconstruction filters; every sample contributes to its own pixel only, with the weight
