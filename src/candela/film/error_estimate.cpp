@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <vector>
 
 namespace candela {
 
@@ -16,10 +18,15 @@ ErrorEstimate estimate_error(const Film& film, double scale_relative_error) {
     e.why_not = "the light paths or chains are not split into two halves";
     return e;
   }
-  double sum = 0, sum_sq = 0;
+  const int w = film.width(), h = film.height();
+  const size_t n = size_t(w) * size_t(h);
+  // Per pixel and channel: the mean and the variance of the mean from its two halves; NaN where a
+  // pixel has no samples (not rendered) or lacks a half.
+  std::vector<double> mean(3 * n, std::nan("")), variance(3 * n, std::nan("")), lesser_half(3 * n, 0);
   uint64_t missing = 0, rendered = 0;
-  for (int y = 0; y < film.height(); ++y)
-    for (int x = 0; x < film.width(); ++x) {
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const size_t i = size_t(y) * size_t(w) + size_t(x);
       const PixelSums& p = film.pixel(x, y);
       if (p.count == 0) continue;  // not rendered (a part, one pixel)
       ++rendered;
@@ -28,39 +35,60 @@ ErrorEstimate estimate_error(const Film& film, double scale_relative_error) {
         ++missing;
         continue;
       }
-      // The pixel part's share of the weight in the first half sets the combination of the halves.
+      // The pixel sums' share of the weight in the first half sets how the halves combine (the
+      // splats split about evenly too).
       const double f = w_a / p.weight;
       const RGB splat_all = splats ? film.splats().at(x, y) : RGB(0.0f);
       const RGB splat_a = splats ? film.half_splats().at(x, y) : RGB(0.0f);
-      double pixel_error = 0;
       for (int c = 0; c < 3; ++c) {
         const double s_all = double(splat_all[c]) * scale, s_a = double(splat_a[c]) * scale;
         const double a = p.half_weighted[c] / w_a + (splats ? s_a / f_splat : 0);
         const double b = (p.weighted[c] - p.half_weighted[c]) / w_b + (splats ? (s_all - s_a) / (1 - f_splat) : 0);
-        const double m = p.weighted[c] / p.weight + s_all;
-        // Both parts split about evenly; the pixel sums' split weighs the difference.
-        double var = f * (1 - f) * (a - b) * (a - b);
-        var += scale_relative_error * scale_relative_error * s_all * s_all;
-        const double truth_sq = std::max(m * m - var, std::min(a * a, b * b));
-        pixel_error += var / (truth_sq + kErrorEpsilon);
+        mean[3 * i + size_t(c)] = p.weighted[c] / p.weight + s_all;
+        lesser_half[3 * i + size_t(c)] = std::min(a, b);
+        variance[3 * i + size_t(c)] = f * (1 - f) * (a - b) * (a - b) +
+                                      scale_relative_error * scale_relative_error * s_all * s_all;
+      }
+    }
+  // A few pixels may lack a half (adaptive sampling's pixels that got one batch); most may not.
+  if (rendered == 0 || missing * 100 > rendered) {
+    e.why_not = rendered == 0 ? "no pixel has samples"
+                              : fmt::format("{} of {} pixels have samples in only one of the two independent halves",
+                                            missing, rendered);
+    return e;
+  }
+  // The truth in the denominator: the pixel's mean, but no more than the brightest of its eight
+  // neighbours, and no less than the lesser of its two halves. A firefly (a rare bright path)
+  // inflates its own pixel's mean far above its neighbours', which would shrink its relative error
+  // many times over; capped by the neighbours it is not. A pixel at the edge of a bright light has
+  // a bright neighbour, so its mean stands; a light a pixel wide has two bright halves.
+  double sum = 0, sum_sq = 0;
+  uint64_t covered = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const size_t i = size_t(y) * size_t(w) + size_t(x);
+      if (std::isnan(variance[3 * i])) continue;
+      double pixel_error = 0;
+      for (int c = 0; c < 3; ++c) {
+        double brightest_neighbour = -std::numeric_limits<double>::infinity();
+        for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy)
+          for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx) {
+            const double m = mean[3 * (size_t(yy) * size_t(w) + size_t(xx)) + size_t(c)];
+            if ((xx != x || yy != y) && !std::isnan(m)) brightest_neighbour = std::max(brightest_neighbour, m);
+          }
+        const double truth = std::max(std::min(mean[3 * i + size_t(c)], brightest_neighbour), lesser_half[3 * i + size_t(c)]);
+        pixel_error += variance[3 * i + size_t(c)] / (truth * truth + kErrorEpsilon);
       }
       pixel_error /= 3;
       sum += pixel_error;
       sum_sq += pixel_error * pixel_error;
+      ++covered;
     }
-  const uint64_t covered = rendered - missing;
-  // A few pixels may lack a half (adaptive sampling's pixels that got one batch); most may not.
-  if (rendered == 0 || missing * 100 > rendered) {
-    e.why_not = rendered == 0 ? "no pixel has samples"
-                              : fmt::format("{} of {} pixels have samples in only one of the two independent halves", missing,
-                                            rendered);
-    return e;
-  }
   e.valid = true;
   e.pixels = covered;
-  const double n = double(covered);
-  e.relmse = sum / n;
-  const double sigma = std::sqrt(4.0 / 3.0 * sum_sq) / n;
+  const double count = double(covered);
+  e.relmse = sum / count;
+  const double sigma = std::sqrt(4.0 / 3.0 * sum_sq) / count;
   e.low = std::max(0.0, e.relmse - 1.96 * sigma);
   e.high = e.relmse + 1.96 * sigma;
   return e;

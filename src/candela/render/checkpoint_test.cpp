@@ -77,9 +77,15 @@ TEST_F(CheckpointFile, SplatSumsRoundTripAndMustMatchTheSize) {
   Checkpoint cp = sample_checkpoint();
   cp.splats.resize(18);
   for (size_t i = 0; i < cp.splats.size(); ++i) cp.splats[i] = int64_t(i * i) * (i % 2 ? -1 : 1) + (int64_t(1) << 40);
+  cp.half_splats.assign(cp.splats.rbegin(), cp.splats.rend());
+  cp.pixels[4].half_weighted[2] = 0.25;
+  cp.pixels[4].half_count = 3;
   write_checkpoint(file, cp);
   Checkpoint back = read_checkpoint(file);
   EXPECT_EQ(back.splats, cp.splats);
+  EXPECT_EQ(back.half_splats, cp.half_splats);  // the first half's, for error estimates
+  EXPECT_EQ(back.pixels[4].half_weighted[2], 0.25);
+  EXPECT_EQ(back.pixels[4].half_count, 3u);
   EXPECT_EQ(back.pixels.size(), 6u);
   // A checkpoint without splats reads back without them.
   write_checkpoint(file, sample_checkpoint());
