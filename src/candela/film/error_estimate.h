@@ -13,12 +13,12 @@
 // those correlations, and it does not exist for splats.
 //
 // One pixel's (A - B)^2 is a single draw (one degree of freedom), but the image's relMSE averages
-// thousands of them. The truth in the denominator is not known either: the square of the mean
-// overstates it by the mean's variance, and in a pixel where one half caught a rare bright path
-// (a firefly) the other half is the better guess, so truth^2 is taken as the larger of
-// M^2 - var and min(A^2, B^2). The interval treats each pixel's actual squared error and its
-// estimate as independent one-degree-of-freedom draws of the same variance (exact for Gaussian
-// halves), so the actual relMSE minus the estimate has variance sum 4/3 e_i^2 / N^2.
+// thousands of them. The truth in the denominator is not known either; error_estimate.cpp takes the
+// pixel's mean, capped against fireflies by its brightest neighbour, floored by its lesser half,
+// less half its variance. The 95% interval combines the spread of the pixels' draws (each pixel's
+// actual squared error and its estimate as independent one-degree-of-freedom draws of the same
+// variance, exact for Gaussian halves: variance sum 4/3 e_i^2 / N^2) with a systematic 30% for
+// the denominators, the largest miss measured against converged references.
 // docs/error-estimates.md measures how well this holds against converged references.
 #include <cstdint>
 #include <string>

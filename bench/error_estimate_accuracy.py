@@ -1,0 +1,116 @@
+#!/usr/bin/env python3
+"""How good is candela's own error estimate (--estimate-error, film/error_estimate.h), and how close does
+--target-error land? Against pbrt-v4's converged renders of Bitterli's scenes (../shared), relMSE with eps 0.01.
+
+1. Accuracy: each scene at three budgets and several seeds, rendered with --estimate-error; the reported
+   estimate against the true relMSE of the same image: the ratio estimate / truth and whether the truth lies in
+   the reported 95% interval.
+2. Targets: --target-error at two targets per scene: the true relMSE reached, and the time spent against what a
+   user who knew the right spp would have spent (the spp at which the true error meets the target, from the
+   truth's 1/spp law at the stopping point, times the plain render's time per spp).
+
+Usage: /usr/bin/python3 bench/error_estimate_accuracy.py [--build build] [--seeds 5] [--threads 2] [--skip-targets]
+       [--scenes cornell-box,veach-mis,veach-ajar,veach-bidir]
+Run it with Debian's /usr/bin/python3 (python3-numpy and python3-openimageio).
+"""
+import argparse
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+import OpenImageIO as oiio
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BITTERLI = os.path.join(os.path.dirname(ROOT), "shared", "scenes", "bitterli")
+
+# scene: resolution of the reference, integrator, budgets (spp), targets
+SCENES = {
+    "cornell-box": ("256x256", "path", [16, 64, 256], [0.01, 0.002]),
+    "veach-mis": ("320x180", "path", [16, 64, 256], [0.05, 0.01]),
+    "veach-ajar": ("320x180", "path", [16, 64, 256], [1.0, 0.3]),
+    "veach-bidir": ("192x192", "bdpt", [4, 16, 64], [0.05, 0.02]),
+}
+
+
+def read(path):
+    return oiio.ImageBuf(path).get_pixels(oiio.FLOAT)[:, :, :3].astype(np.float64)
+
+
+def relmse(test, ref):
+    return float(np.mean((test - ref) ** 2 / (ref ** 2 + 0.01)))
+
+
+def render(args, scene, extra, out):
+    res, integrator, _, _ = SCENES[scene]
+    cmd = [args.candela, "render", os.path.join(BITTERLI, scene, "scene-v4.pbrt"), "--resolution", res,
+           "--integrator", integrator, "--threads", str(args.threads), "-q", "-o", out] + extra
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode != 0:
+        sys.exit(f"failed: {' '.join(cmd)}\n{p.stderr}")
+    t = float(re.search(r" in ([\d.]+) s:", p.stdout).group(1))
+    spp = re.search(r", (?:min \d+, mean )?([\d.]+)(?: spp)? in ", p.stdout)
+    m = re.search(r"estimated error: relMSE ([\d.e+-]+) \(95% interval ([\d.e+-]+)-([\d.e+-]+)", p.stdout)
+    if not m:
+        sys.exit(f"no estimate from: {' '.join(cmd)}\n{p.stdout}")
+    return t, float(spp.group(1)) if spp else None, float(m.group(1)), float(m.group(2)), float(m.group(3))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--build", default=os.path.join(ROOT, "build"))
+    ap.add_argument("--seeds", type=int, default=5)
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--scenes", default=",".join(SCENES))
+    ap.add_argument("--skip-targets", action="store_true")
+    args = ap.parse_args()
+    args.candela = os.path.join(args.build, "candela")
+    scenes = args.scenes.split(",")
+    tmp = tempfile.mkdtemp(prefix="candela-error-")
+    out = os.path.join(tmp, "image.exr")
+
+    print("| scene (integrator) | spp | true relMSE (median) | estimate / truth: median, min, max | truth in 95% interval |")
+    print("|---|---|---|---|---|")
+    all_ratios, all_covered = [], 0
+    time_per_spp = {}
+    for scene in scenes:
+        ref = read(os.path.join(BITTERLI, scene, "pbrt-v4-reference.exr"))
+        _, integrator, budgets, _ = SCENES[scene]
+        for spp in budgets:
+            truths, ratios, covered = [], [], 0
+            for seed in range(1, args.seeds + 1):
+                t, _, est, low, high = render(args, scene, ["--spp", str(spp), "--seed", str(seed), "--estimate-error"], out)
+                time_per_spp[scene] = t / spp
+                truth = relmse(read(out), ref)
+                truths.append(truth)
+                ratios.append(est / truth)
+                covered += low <= truth <= high
+            all_ratios += ratios
+            all_covered += covered
+            print(f"| {scene} ({integrator}) | {spp} | {statistics.median(truths):.4g} | {statistics.median(ratios):.2f}, "
+                  f"{min(ratios):.2f}, {max(ratios):.2f} | {covered} of {len(ratios)} |", flush=True)
+    print(f"\nAll runs: estimate / truth from {min(all_ratios):.2f} to {max(all_ratios):.2f}; "
+          f"{sum(1 for r in all_ratios if 1 / 1.5 <= r <= 1.5)} of {len(all_ratios)} within a factor 1.5; "
+          f"truth in the interval in {all_covered} of {len(all_ratios)}.\n")
+    if args.skip_targets:
+        return
+    print("| scene (integrator) | target | stopped at spp | true relMSE | true / target | time s | oracle time s | time / oracle |")
+    print("|---|---|---|---|---|---|---|---|")
+    for scene in scenes:
+        ref = read(os.path.join(BITTERLI, scene, "pbrt-v4-reference.exr"))
+        _, integrator, _, targets = SCENES[scene]
+        for target in targets:
+            t, spp, est, _, _ = render(args, scene, ["--target-error", str(target), "--seed", "11"], out)
+            truth = relmse(read(out), ref)
+            # The spp a user who knew it would have asked for: where the truth meets the target (1/spp law).
+            oracle_spp = spp * truth / target
+            oracle_time = oracle_spp * time_per_spp[scene]
+            print(f"| {scene} ({integrator}) | {target} | {spp:.0f} | {truth:.4g} | {truth / target:.2f} | {t:.1f} | "
+                  f"{oracle_time:.1f} | {t / oracle_time:.2f} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
