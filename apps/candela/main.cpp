@@ -27,6 +27,7 @@
 #include "candela/render/checkpoint.h"
 #include "candela/render/cluster.h"
 #include "candela/render/film_part.h"
+#include "candela/integrators/auto_integrator.h"
 #include "candela/integrators/bdpt.h"
 #include "candela/integrators/integrator.h"
 #include "candela/scene/resource_limits.h"
@@ -151,9 +152,16 @@ Enum parse_choice(const std::string& option, const std::string& value,
 // The chosen integrator must read every selective setting the command line gives
 // (integrators/integrator.h); what the scene file sets for another integrator gets a note.
 void check_integrator_flags(const RenderCommand& cmd, const SceneDesc& scene) {
+  if (scene.settings.integrator == "auto") {
+    // Every candidate must read what the scene and the flags set.
+    if (auto_candidates(scene.settings).empty())
+      throw UsageError("--integrator auto: no integrator reads every setting given (see --help for who reads what)");
+    if (!cmd.bdpt_strategies.empty()) throw UsageError("--bdpt-strategies needs --integrator bdpt, not auto");
+    return;
+  }
   const IntegratorEntry* integrator = find_integrator(scene.settings.integrator);
   if (!integrator)
-    throw UsageError(fmt::format("unknown integrator '{}' (known: {})", scene.settings.integrator, integrator_names()));
+    throw UsageError(fmt::format("unknown integrator '{}' (known: {}, auto)", scene.settings.integrator, integrator_names()));
   struct SelectiveFlag {
     const char* flag;
     std::string_view key;
@@ -219,7 +227,10 @@ void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
   if (cmd.no_mis) rs.path.mis = false;
   // An error estimate needs two independent halves of every pixel's samples; with a target the
   // spp is the most a pixel may get (--spp, or 65536).
-  if (cmd.estimate_error || cmd.target_error) rs.sampler.replicas = true;
+  if (cmd.estimate_error || cmd.target_error || rs.integrator == "auto") rs.sampler.replicas = true;
+  // --integrator auto: the pilots and the winner share one sampler setup (spp sets its sets), so the
+  // winner can continue its pilot; the scene's or the given spp is then the budget, not the count.
+  if (rs.integrator == "auto" && !cmd.target_error) rs.spp = kTargetErrorMaxSpp;
   if (cmd.target_error) {
     rs.spp = cmd.spp.value_or(kTargetErrorMaxSpp);
     if (rs.adaptive())
@@ -340,7 +351,8 @@ RenderFingerprint make_fingerprint(const std::string& scene_bytes, const SceneDe
       {"adaptive-spp", std::to_string(rs.adaptive_spp)},
       {"clamp", clamp > 0 ? fmt::format("{}", clamp) : "off"},
   };
-  if (find_integrator(rs.integrator)->reads_setting("mlt")) fp.settings.push_back({"mlt", rs.mlt.describe()});
+  if (rs.integrator == "auto" || find_integrator(rs.integrator)->reads_setting("mlt"))
+    fp.settings.push_back({"mlt", rs.mlt.describe()});
   return fp;
 }
 
@@ -387,6 +399,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   int px = -1, py = -1;
   int part_index = 0, part_count = 1;
   double time_limit_seconds = 0;
+  int auto_budget_spp = 0;
   std::vector<fs::path> outputs;
   std::string scene_bytes;
   on_every_rank(cluster, [&] {
@@ -396,6 +409,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
     // checkpoint, a part. A plain render does not read the file twice.
     if (cluster.distributed() || !cmd.checkpoint.empty() || !cmd.resume.empty() || !cmd.part.empty())
       scene_bytes = cmd.scene_file.empty() ? std::string(builtin_scene_json()) : read_bytes(cmd.scene_file);
+    auto_budget_spp = cmd.spp.value_or(desc.settings.spp);
     apply_overrides(cmd, desc);
     adaptive = desc.settings.adaptive();
     if (cmd.checkpoint_every && cmd.checkpoint.empty()) throw UsageError("--checkpoint-every needs --checkpoint FILE");
@@ -406,7 +420,11 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
       throw UsageError("--pixel cannot be combined with --checkpoint or --resume");
     if (pixel_mode && cluster.distributed())
       throw UsageError("--pixel renders one pixel in one process: run it without mpirun");
-    const IntegratorEntry& chosen = *find_integrator(desc.settings.integrator);
+    const bool automatic = desc.settings.integrator == "auto";
+    if (automatic && (!cmd.checkpoint.empty() || !cmd.resume.empty() || pixel_mode || !cmd.part.empty()))
+      throw UsageError("--integrator auto cannot be combined with --checkpoint, --resume, --pixel or --part (name the integrator)");
+    // With auto, the path tracer stands in for the checks below, which auto does not reach.
+    const IntegratorEntry& chosen = *find_integrator(automatic ? "path" : desc.settings.integrator);
     if (!chosen.resumable && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
       throw UsageError(fmt::format("--checkpoint and --resume are not supported with the {} integrator (it cannot continue a partly rendered film)", chosen.name));
     if (!chosen.single_pixel && pixel_mode)
@@ -458,7 +476,6 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
                                      "the nodes; hash {:016x} vs {:016x})",
                                      r, cmd.scene_file, hashes[r], hashes[0]));
   });
-  const IntegratorEntry& integrator = *find_integrator(desc.settings.integrator);
 
   const float clamp = cmd.clamp.value_or(0.0f);
   // What made the image, for checkpoints and parts; a checkpoint also names its part, as it resumes only that.
@@ -559,7 +576,19 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
       last_checkpoint = std::chrono::steady_clock::now();
     };
   g_phase.store(kRendering);
+  // --integrator auto: pilots of each integrator measure which reaches the lowest error in the budget.
+  std::optional<AutoChoice> choice;
+  if (desc.settings.integrator == "auto") {
+    choice = choose_integrator(scene, desc.settings, film, options, auto_budget_spp);
+    desc.settings.integrator = std::string(choice->integrator->name);
+    if (cluster.is_root()) std::printf("auto: %s\n", choice->summary().c_str());
+    // The rest of the budget; a cancelled pilot leaves none.
+    if (choice->budget_seconds > 0)
+      options.time_limit_seconds = std::max(choice->budget_seconds - choice->pilot_seconds, 1e-3);
+  }
+  const IntegratorEntry& integrator = *find_integrator(desc.settings.integrator);
   RenderStats stats = render(scene, desc.settings, film, options);
+  if (choice) stats.seconds += choice->pilot_seconds;
   g_phase.store(kWriting);  // a signal from here on lets the (complete or partial) images be written
   const uint64_t non_finite = earlier_non_finite + stats.non_finite_samples;
   const bool stopped = stats.cancelled || stats.time_limited;
@@ -635,6 +664,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   if (clamp > 0) metadata["candela:clamp"] = fmt::format("{}", clamp);
   if (non_finite > 0) metadata["candela:non_finite_samples"] = std::to_string(non_finite);
   if (integrator.reads_setting("mlt")) metadata["candela:mlt"] = desc.settings.mlt.describe();
+  if (choice) metadata["candela:auto"] = choice->summary();
   if (!cmd.part.empty()) {
     FilmPart part{part_index, part_count, render_fingerprint,
                   double(scene.camera().importance_film_pixels()), non_finite, std::move(film)};
@@ -772,6 +802,8 @@ int main(int argc, char** argv) {
   std::string integrator_help = "Integrator:";
   for (const IntegratorEntry& entry : integrators())
     integrator_help += fmt::format(" {} ({}){}", entry.name, entry.description, &entry == &integrators().back() ? "" : ";");
+  integrator_help += "; auto (short pilots of each measure which reaches the lowest error in the budget: "
+                     "--time-limit, --target-error, or the path tracer's time for --spp; the pilots take about 10%)";
   render_cmd->add_option("--integrator", cmd.integrator, integrator_help);
   render_cmd->add_option("--bdpt-strategies", cmd.bdpt_strategies,
                          "bdpt: also write each strategy's contribution (depth <= 5) to "

@@ -338,6 +338,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   }
 
   progress.set_label("MLT chains");
+  stats.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   // The chains: each depth gets a share of them proportional to its brightness, and at least one if
   // it has any light (so no depth's light is lost to chance), starting from its bootstrap paths
   // chosen proportionally to their luminance, stratified over its chains. Each depth's deposits are

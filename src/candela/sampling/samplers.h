@@ -38,12 +38,13 @@ inline Sampler make_sampler(const SamplerDesc& desc, int samples_per_set, uint64
 }
 
 // Which half of a pixel's samples sample i falls in (film.h: two independent estimates of the
-// pixel): the first when (i / block) is even. Sets of a set-based sampler are independently
-// randomised, so they alternate; ZSobol's replicas alternate every 8 samples, and so do independent
-// samples. Without replicas a ZSobol or stratified render of one set has no second half.
+// pixel): the first when (i / block) is even. Independent samples alternate; sets of a set-based
+// sampler are independently randomised, so they alternate; ZSobol's replicas alternate every 8
+// samples (so a ZSobol render needs 16 spp for an estimate). Without replicas a ZSobol or
+// stratified render of one set has no second half.
 inline uint64_t half_block(const SamplerDesc& desc, int samples_per_set) {
   switch (desc.type) {
-    case SamplerType::Independent: return ZSobolSampler::kReplicaBlock;
+    case SamplerType::Independent: return 1;
     case SamplerType::ZSobol:
       return desc.replicas ? ZSobolSampler::kReplicaBlock
                            : uint64_t(std::bit_ceil(unsigned(std::max(1, samples_per_set))));

@@ -1,0 +1,123 @@
+#include "candela/integrators/auto_integrator.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "candela/render/cluster.h"
+
+namespace candela {
+
+std::vector<const IntegratorEntry*> auto_candidates(const RenderSettings& settings) {
+  std::vector<const IntegratorEntry*> candidates;
+  for (const IntegratorEntry& entry : integrators())
+    if (set_but_unread(entry, settings).empty()) candidates.push_back(&entry);
+  return candidates;
+}
+
+std::string AutoChoice::summary() const {
+  std::string s;
+  for (const PilotRun& p : pilots) {
+    s += fmt::format("{}{}: ", s.empty() ? "" : "; ", p.integrator->name);
+    if (!p.error.valid) {
+      s += "no estimate (" + p.error.why_not + ")";
+      continue;
+    }
+    s += fmt::format("relMSE {:.3g} in {:.2f} s", p.error.relmse, p.seconds);
+    if (budget_seconds > 0)
+      s += fmt::format(", predicts {:.3g} in {:.1f} s", p.predicted, budget_seconds);
+    else
+      s += fmt::format(", predicts the target in {:.1f} s", p.predicted);
+  }
+  return s + fmt::format("; chose {} (pilots {:.2f} s{})", integrator->name, pilot_seconds,
+                         budget_seconds > 0 ? fmt::format(", {:.0f}% of the budget", 100 * pilot_seconds / budget_seconds)
+                                            : std::string());
+}
+
+AutoChoice choose_integrator(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options,
+                             int budget_spp) {
+  if (!settings.sampler.replicas) throw std::logic_error("choose_integrator: the pilots need the sampler's replicas");
+  Cluster& cluster = options.cluster ? *options.cluster : local_cluster();
+  AutoChoice choice;
+  const std::vector<const IntegratorEntry*> candidates = auto_candidates(settings);
+  if (candidates.empty()) throw std::invalid_argument("--integrator auto: no integrator reads every setting the scene sets");
+  const double time_limit = options.time_limit_seconds;
+  const double slice = time_limit > 0 ? 0.1 * time_limit / double(candidates.size()) : kPilotSeconds;
+
+  std::vector<Film> pilot_films;
+  for (const IntegratorEntry* entry : candidates) {
+    RenderSettings pilot_settings = settings;
+    pilot_settings.integrator = std::string(entry->name);
+    // MLT's set-up (bootstrap and normalisation, in proportion to mlt.bootstrap) would take the
+    // whole slice and more on a deep scene: its pilot bootstraps with a hundredth (at least 1000)
+    // and its set-up time is scaled back up for the prediction.
+    double setup_scale = 1;
+    if (entry->reads_setting("mlt")) {
+      pilot_settings.mlt.bootstrap = std::min(settings.mlt.bootstrap, std::max(1000, settings.mlt.bootstrap / 100));
+      setup_scale = double(settings.mlt.bootstrap) / double(pilot_settings.mlt.bootstrap);
+    }
+    RenderOptions pilot = options;
+    pilot.progress = false;
+    pilot.after_pass = nullptr;
+    pilot.target_error = 0;
+    pilot.time_limit_seconds = slice;
+    Film pilot_film(film.width(), film.height());
+    RenderStats stats = render(scene, pilot_settings, pilot_film, pilot);
+    PilotRun run;
+    run.integrator = entry;
+    // The root's clock, so every rank decides alike (the films, and so the estimates, are the same).
+    run.seconds = cluster.from_root(stats.seconds);
+    run.setup_seconds = cluster.from_root(stats.setup_seconds);
+    run.full_setup_seconds = run.setup_seconds * setup_scale;
+    run.error = estimate_error(pilot_film, stats.mlt_normalization_relative_error);
+    choice.pilot_seconds += run.seconds;
+    choice.pilots.push_back(run);
+    pilot_films.push_back(std::move(pilot_film));
+    if (stats.cancelled) break;
+  }
+
+  // The budget in seconds: the time limit, or the path tracer's time for the spp (from its pilot's
+  // pace); none with an error target.
+  if (time_limit > 0) {
+    choice.budget_seconds = time_limit;
+  } else if (options.target_error <= 0) {
+    for (size_t i = 0; i < choice.pilots.size(); ++i)
+      if (choice.pilots[i].integrator->name == "path" && pilot_films[i].total_samples() > 0)
+        choice.budget_seconds = choice.pilots[i].seconds * double(budget_spp) /
+                                (double(pilot_films[i].total_samples()) / (double(film.width()) * film.height()));
+    if (choice.budget_seconds <= 0) choice.budget_seconds = double(candidates.size()) * slice / 0.1;
+  }
+  const double remaining = std::max(0.0, choice.budget_seconds - choice.pilot_seconds);
+  double best = std::numeric_limits<double>::infinity();
+  size_t winner = 0;
+  for (size_t i = 0; i < choice.pilots.size(); ++i) {
+    PilotRun& p = choice.pilots[i];
+    if (!p.error.valid) {
+      p.predicted = std::numeric_limits<double>::infinity();
+      continue;
+    }
+    // The pilot's own rendering time (set-up aside), the work behind its error.
+    const double work = std::max(p.seconds - p.setup_seconds, 1e-6);
+    if (options.target_error > 0) {
+      // Seconds from now to the target: a continued pilot adds to its work, a restart redoes the set-up.
+      const double needed = work * p.error.relmse / options.target_error;
+      p.predicted = p.integrator->resumable ? std::max(0.0, needed - work) : p.full_setup_seconds + needed;
+    } else {
+      p.predicted = p.integrator->resumable ? p.error.relmse * work / (work + remaining)
+                                            : p.error.relmse * work / std::max(remaining - p.full_setup_seconds, 1e-6);
+    }
+    if (p.predicted < best) {
+      best = p.predicted;
+      winner = i;
+    }
+  }
+  choice.integrator = choice.pilots[winner].integrator;
+  choice.continues_pilot = choice.integrator->resumable;
+  film = choice.continues_pilot ? std::move(pilot_films[winner]) : Film(film.width(), film.height());
+  return choice;
+}
+
+}  // namespace candela
