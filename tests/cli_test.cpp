@@ -193,7 +193,7 @@ TEST_F(CommandLine, BidirectionalAndMetropolisIntegrators) {
 
 TEST_F(CommandLine, IntegratorOptionsAreChecked) {
   std::string scene = write("good.json", kGoodJson);
-  expect_failure("render " + scene + " -o " + out() + " --integrator whitted", "unknown integrator 'whitted' \\(known: path, bdpt, mlt\\)");
+  expect_failure("render " + scene + " -o " + out() + " --integrator whitted", "unknown integrator 'whitted' \\(known: path, bdpt, mlt, auto\\)");
   expect_failure("render " + scene + " -o " + out() + " --bdpt-strategies " + dir_.string(),
                  "--bdpt-strategies: the path integrator writes no strategy images \\(bdpt does\\)");
   expect_failure("render " + scene + " -o " + out() + " --integrator bdpt --bdpt-strategies " + (dir_ / "nope").string(),
@@ -207,6 +207,48 @@ TEST_F(CommandLine, IntegratorOptionsAreChecked) {
   EXPECT_THAT_MATCHES(range.output, "--mlt-large-step");
   expect_failure("render " + scene + " -o " + out() + " --integrator mlt --mlt-large-step 0.5 --mlt-lens 0.4 --mlt-caustic 0.2",
                  "must be at most 1, got 1.1");
+  EXPECT_EQ(previous_output(), "previous render");
+}
+
+// --estimate-error, --target-error and --integrator auto (docs/error-estimates.md): the estimate in
+// the closing lines and the metadata, the target reached, the auto choice reported; what cannot go
+// with them refused with one message.
+TEST_F(CommandLine, ErrorEstimatesTargetsAndTheAutoIntegrator) {
+  std::string scene = write("good.json", kGoodJson);
+  const std::string ok = (dir_ / "ok.exr").string();  // out() must survive the refused runs below
+  RunResult plain = run_cli("render " + scene + " -o " + ok + " --spp 16 -q");  // one ZSobol net: no estimate
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  EXPECT_EQ(plain.output.find("estimated error"), std::string::npos) << plain.output;
+  RunResult estimated = run_cli("render " + scene + " -o " + ok + " --spp 16 --estimate-error -q");
+  ASSERT_EQ(estimated.exit_code, 0) << estimated.output;
+  EXPECT_THAT_MATCHES(estimated.output, "estimated error: relMSE [0-9.e-]+ \\(95% interval [0-9.e-]+-[0-9.e-]+, eps 0.01\\)");
+  EXPECT_TRUE(read_image_metadata(ok).count("candela:relmse_estimate"));
+
+  RunResult target = run_cli("render " + scene + " -o " + ok + " --target-error 0.02 --resolution 32x24 -q");
+  ASSERT_EQ(target.exit_code, 0) << target.output;
+  EXPECT_THAT_MATCHES(target.output, "; target 0.02 reached");
+  auto meta = read_image_metadata(ok);
+  EXPECT_EQ(meta["candela:target_reached"], "true");
+  EXPECT_LE(std::stod(meta["candela:relmse_estimate"]), 0.02);
+  RunResult capped = run_cli("render " + scene + " -o " + ok + " --target-error 1e-9 --spp 32 -q");
+  ASSERT_EQ(capped.exit_code, 0) << capped.output;
+  EXPECT_THAT_MATCHES(capped.output, "target 1e-09 not reached \\(stopped at the spp limit\\)");
+  EXPECT_EQ(read_image_metadata(ok)["candela:spp"], "32");
+
+  RunResult chosen = run_cli("render " + scene + " -o " + ok + " --integrator auto --time-limit 3 -q");
+  ASSERT_EQ(chosen.exit_code, 0) << chosen.output;
+  EXPECT_THAT_MATCHES(chosen.output, "auto: path: relMSE .* bdpt: relMSE .* mlt: .*; chose (path|bdpt|mlt) \\(pilots");
+  meta = read_image_metadata(ok);
+  EXPECT_TRUE(meta["candela:integrator"] == "path" || meta["candela:integrator"] == "bdpt" || meta["candela:integrator"] == "mlt");
+  EXPECT_NE(meta["candela:auto"].find("chose " + meta["candela:integrator"]), std::string::npos);
+
+  expect_failure("render " + scene + " -o " + out() + " --target-error 0.01 --adaptive-spp 16",
+                 "--target-error: adaptive sampling .* has its own stopping rule");
+  expect_failure("render " + scene + " -o " + out() + " --integrator auto --checkpoint " + (dir_ / "c.ckpt").string(),
+                 "--integrator auto cannot be combined with --checkpoint");
+  expect_failure("render " + scene + " -o " + out() + " --target-error 0.01 --part 1/2", "--part cannot be combined with --target-error");
+  RunResult negative = run_cli("render " + scene + " -o " + out() + " --target-error -1");
+  EXPECT_NE(negative.exit_code, 0);
   EXPECT_EQ(previous_output(), "previous render");
 }
 

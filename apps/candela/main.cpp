@@ -231,12 +231,7 @@ void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
   // --integrator auto: the pilots and the winner share one sampler setup (spp sets its sets), so the
   // winner can continue its pilot; the scene's or the given spp is then the budget, not the count.
   if (rs.integrator == "auto" && !cmd.target_error) rs.spp = kTargetErrorMaxSpp;
-  if (cmd.target_error) {
-    rs.spp = cmd.spp.value_or(kTargetErrorMaxSpp);
-    if (rs.adaptive())
-      throw UsageError("--target-error: adaptive sampling (--adaptive-threshold, --adaptive-spp) has its own stopping "
-                       "rule; use one or the other");
-  }
+  if (cmd.target_error) rs.spp = cmd.spp.value_or(kTargetErrorMaxSpp);
   if (!cmd.transport.empty())
     rs.spectral = parse_choice<bool>("--transport", cmd.transport, {{"rgb", false}, {"spectral", true}});
   if (cmd.mlt_bootstrap) rs.mlt.bootstrap = *cmd.mlt_bootstrap;
@@ -275,6 +270,9 @@ void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
       (long long)f.width * f.height > kMaxPixels)
     throw UsageError(fmt::format("resolution {}x{} is out of range (each side 1..{}, at most {} pixels)", f.width,
                                  f.height, kMaxResolution, kMaxPixels));
+  if (cmd.target_error && rs.adaptive())
+    throw UsageError("--target-error: adaptive sampling (--adaptive-threshold, --adaptive-spp) has its own stopping "
+                     "rule; use one or the other");
   check_integrator_flags(cmd, scene);
   if (cmd.bdpt_unweighted && cmd.bdpt_strategies.empty()) throw UsageError("--bdpt-unweighted needs --bdpt-strategies DIR");
 }
