@@ -91,6 +91,13 @@ TEST_F(Distributed, MetropolisChainsAcrossRanksAreTheOneProcessImage) {
   expect_ranks_agree("--integrator mlt --resolution 40x30 --spp 4 --mlt-bootstrap 3000 --mlt-chains 48");
 }
 
+// With an error target the render stops where the film's estimate says, the same for any number of
+// ranks (passes and rounds do not grow with the clock then).
+TEST_F(Distributed, AnErrorTargetAcrossRanksIsTheOneProcessImage) {
+  expect_ranks_agree("--integrator bdpt --resolution 40x30 --target-error 0.02");
+  expect_ranks_agree("--integrator mlt --resolution 40x30 --target-error 0.05 --mlt-bootstrap 3000 --mlt-chains 48");
+}
+
 TEST_F(Distributed, AdaptiveSamplingWithAThresholdAcrossRanksIsTheOneProcessImage) {
   expect_ranks_agree("--resolution 40x30 --adaptive-threshold 0.08 --max-spp 64");
 }

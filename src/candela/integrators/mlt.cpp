@@ -420,13 +420,17 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   // Rounds grow towards half a second each (how a chain's mutations are cut into rounds changes
   // nothing in what it computes, so the image stays the same whatever the timing).
   uint64_t round_length = 16;
+  uint64_t next_check = 16;  // with an error target: the next mutation count at which it is checked
   std::atomic<uint64_t> non_finite{0};
   uint64_t mutations_per_chain = 0;
   bool first_round = true;
   std::vector<uint64_t> my_chains;
   for (uint64_t c = uint64_t(cluster.rank()); c < chains; c += uint64_t(cluster.size())) my_chains.push_back(c);
   while (mutations_per_chain < per_chain) {
-    const uint64_t steps = std::min(round_length, per_chain - mutations_per_chain);
+    // With an error target, rounds also end at fixed mutation counts (16, then 1.25x each time),
+    // where the estimate is checked: where the render stops then depends on the chains, not the clock.
+    const uint64_t steps = std::min({round_length, per_chain - mutations_per_chain,
+                                     options.target_error > 0 ? next_check - mutations_per_chain : round_length});
     const auto round_start = std::chrono::steady_clock::now();
     arena.execute([&] {
       tbb::parallel_for(size_t(0), my_chains.size(), [&](size_t mine) {
@@ -493,7 +497,8 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
       stats.time_limited = true;
       break;
     }
-    if (options.target_error > 0 && mutations_per_chain < per_chain) {
+    if (options.target_error > 0 && mutations_per_chain == next_check && mutations_per_chain < per_chain) {
+      next_check = std::max(next_check + 1, next_check * 5 / 4);
       film.set_splat_scale(splat_scale(mutations_per_chain));
       if (agreed_error_estimate(cluster, film, normalization.relative_error) <= options.target_error) {
         stats.reached_target = true;

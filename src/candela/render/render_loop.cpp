@@ -531,7 +531,9 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
       // Across ranks every pass ends with the film's exchange: passes grow (the root's clock decides)
       // until they take a few seconds, so that it stays a small part of the time. Where passes end
       // changes nothing in the image: every pixel continues from its own count.
-      if (cluster.distributed() &&
+      // With an error target the passes stay as they are, so that where the render stops depends on
+      // the film alone, not on the clock: the same image for any number of ranks.
+      if (cluster.distributed() && !target &&
           cluster.from_root(std::chrono::duration<double>(std::chrono::steady_clock::now() - pass_start).count()) <
               kDistributedPassSeconds)
         pass_spp = std::min(2 * pass_spp, kLongestPassSpp);
