@@ -47,8 +47,9 @@ std::vector<double> box_mean(const std::vector<double>& v, int w, int h, int r) 
 }
 }  // namespace
 
-ErrorEstimate estimate_error(const Film& film, double scale_relative_error) {
+ErrorEstimate estimate_error(const Film& film, double scale_relative_error, std::vector<double>* pixel_errors) {
   ErrorEstimate e;
+  if (pixel_errors) pixel_errors->assign(size_t(film.width()) * size_t(film.height()), std::nan(""));
   const bool splats = film.has_splats();
   const double scale = splats ? film.splat_scale() : 0;
   const double f_splat = splats ? film.splat_half_fraction() : 0.5;
@@ -141,6 +142,7 @@ ErrorEstimate estimate_error(const Film& film, double scale_relative_error) {
         pixel_error += var / (truth_sq + kErrorEpsilon);
       }
       pixel_error /= 3;
+      if (pixel_errors) (*pixel_errors)[i] = pixel_error;
       sum += pixel_error;
       sum_sq += pixel_error * pixel_error;
       ++covered;

@@ -22,6 +22,7 @@
 // docs/error-estimates.md measures how well this holds against converged references.
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "candela/film/film.h"
 
@@ -38,8 +39,10 @@ struct ErrorEstimate {
 inline constexpr double kErrorEpsilon = 0.01;
 
 // `scale_relative_error`: the relative standard error of a factor that scales all splats alike
-// (MLT's normalisation), which the two halves share and so cannot see.
-ErrorEstimate estimate_error(const Film& film, double scale_relative_error = 0);
+// (MLT's normalisation), which the two halves share and so cannot see. `pixel_errors`, when given,
+// receives each pixel's estimated relative squared error (row-major; NaN where it has none).
+ErrorEstimate estimate_error(const Film& film, double scale_relative_error = 0,
+                             std::vector<double>* pixel_errors = nullptr);
 
 // "relMSE 0.0031 (95% interval 0.0028-0.0034)" or "not available: ...".
 std::string describe(const ErrorEstimate& e);
