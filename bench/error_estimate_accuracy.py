@@ -31,7 +31,7 @@ BITTERLI = os.path.join(os.path.dirname(ROOT), "shared", "scenes", "bitterli")
 SCENES = {
     "cornell-box": ("256x256", "path", [16, 64, 256], [0.01, 0.002]),
     "veach-mis": ("320x180", "path", [16, 64, 256], [0.05, 0.01]),
-    "veach-ajar": ("320x180", "path", [16, 64, 256], [1.0, 0.3]),
+    "veach-ajar": ("320x180", "path", [16, 64, 256], [2.0, 1.0]),
     "veach-bidir": ("192x192", "bdpt", [4, 16, 64], [0.05, 0.02]),
 }
 

@@ -64,6 +64,14 @@ AutoChoice choose_integrator(const Scene& scene, const RenderSettings& settings,
     pilot.after_pass = nullptr;
     pilot.target_error = 0;
     pilot.time_limit_seconds = slice;
+    // Path and bdpt render every k-th tile in their pilot (tiles strided over the whole image, as a
+    // job-array part): a pass then costs a k-th, so the pilot fits its slice with several passes, and
+    // the winner continues it (each pixel from its own count) into the one image.
+    if (entry->resumable) {
+      const int tiles = ((film.width() + 15) / 16) * ((film.height() + 15) / 16);
+      pilot.part_count = std::clamp(tiles / 16, 1, kPilotTileStride);
+      pilot.part_index = 0;
+    }
     Film pilot_film(film.width(), film.height());
     RenderStats stats = render(scene, pilot_settings, pilot_film, pilot);
     PilotRun run;

@@ -20,6 +20,7 @@
 namespace candela {
 
 inline constexpr double kPilotSeconds = 1.0;
+inline constexpr int kPilotTileStride = 8;  // path and bdpt pilots render every 8th tile (at least 16 tiles)
 
 struct PilotRun {
   const IntegratorEntry* integrator = nullptr;
