@@ -801,7 +801,7 @@ int main(int argc, char** argv) {
   for (const IntegratorEntry& entry : integrators())
     integrator_help += fmt::format(" {} ({}){}", entry.name, entry.description, &entry == &integrators().back() ? "" : ";");
   integrator_help += "; auto (short pilots of each measure which reaches the lowest error in the budget: "
-                     "--time-limit, --target-error, or the path tracer's time for --spp; the pilots take about 10%)";
+                     "--time-limit, --target-error, or the path tracer's time for --spp; the pilots aim at 10%)";
   render_cmd->add_option("--integrator", cmd.integrator, integrator_help);
   render_cmd->add_option("--bdpt-strategies", cmd.bdpt_strategies,
                          "bdpt: also write each strategy's contribution (depth <= 5) to "

@@ -7,7 +7,7 @@
 // continuing its pilot where it can (path, bdpt) and starting afresh where it cannot (mlt, whose
 // set-up, the bootstrap and normalisation, then counts twice and is priced in).
 //
-// The pilots take about 10% of the budget together: with a time limit T each of n gets 0.1 T / n;
+// The pilots aim at 10% of the budget together: with a time limit T each of n gets 0.1 T / n;
 // with an error target or spp, each gets kPilotSeconds (a pilot ends after a whole pass or round, so it
 // can take a little longer). MLT's pilot bootstraps with a hundredth of the paths (its set-up would
 // otherwise take more than the slice on deep scenes) and its full set-up time is extrapolated.
