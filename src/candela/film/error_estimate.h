@@ -14,12 +14,13 @@
 //
 // One pixel's (A - B)^2 is a single draw (one degree of freedom), but the image's relMSE averages
 // thousands of them. The truth in the denominator is not known either; error_estimate.cpp takes the
-// pixel's mean, capped against fireflies by its brightest neighbour, floored by its lesser half,
-// less half its variance. The 95% interval combines the spread of the pixels' draws (each pixel's
+// pixel's mean, capped against fireflies by its neighbourhood (the median of the neighbours' means
+// or the largest of their lesser halves), floored by its own lesser half, less at most half its
+// variance (error_estimate.cpp says why each). The 95% interval combines the spread of the pixels' draws (each pixel's
 // actual squared error and its estimate as independent one-degree-of-freedom draws of the same
 // variance, exact for Gaussian halves: variance sum 4/3 e_i^2 / N^2) with a systematic 30% for
-// the denominators, the largest miss measured against converged references.
-// docs/error-estimates.md measures how well this holds against converged references.
+// the denominators, the largest miss measured against converged references
+// (docs/error-estimates.md).
 #include <cstdint>
 #include <string>
 #include <vector>
