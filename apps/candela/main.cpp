@@ -27,6 +27,7 @@
 #include "candela/render/checkpoint.h"
 #include "candela/render/cluster.h"
 #include "candela/render/film_part.h"
+#include "candela/render/render_request.h"
 #include "candela/integrators/auto_integrator.h"
 #include "candela/integrators/bdpt.h"
 #include "candela/integrators/integrator.h"
@@ -84,14 +85,6 @@ void install_signal_handlers() {
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
 }
-constexpr int kMaxResolution = 65536;
-constexpr int kTargetErrorMaxSpp = 65536;
-constexpr long long kMaxPixels = 1LL << 28;
-
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
 // An error every rank of the job has agreed on (the lowest failing rank's): the root prints it once
 // and every rank exits with kExitBadInput.
 struct AgreedError : std::runtime_error {
@@ -114,168 +107,13 @@ void on_every_rank(Cluster& cluster, Step&& step) {
   if (!error.empty()) throw AgreedError(error);
 }
 
-struct RenderCommand {
+// The render subcommand: the request (render/render_request.h) and what only the command line does.
+struct RenderCommand : RenderRequest {
   std::string scene_file;  // empty = built-in scene
-  std::string output;
-  std::optional<int> spp, threads, max_depth;
-  std::optional<uint64_t> seed;
-  std::string resolution;
-  std::string integrator;
-  std::string sampler, filter, direction_sampling, light_selection, spp_map, bvh, transport;
-  std::optional<int> shadow_rays, max_spp, adaptive_batch, adaptive_spp;
-  std::optional<float> adaptive_threshold;
-  bool no_mis = false;
-  bool quiet = false;
+  std::string output, spp_map;
   std::string checkpoint, resume, pixel, part;
   std::optional<double> checkpoint_every;
-  std::string time_limit;
-  std::optional<double> target_error;
-  bool estimate_error = false;
-  std::optional<float> clamp;
-  std::string bdpt_strategies;
-  bool bdpt_unweighted = false;
-  std::optional<int> mlt_bootstrap, mlt_chains;
-  std::optional<float> mlt_sigma, mlt_large_step, mlt_lens, mlt_caustic;
 };
-
-template <typename Enum>
-Enum parse_choice(const std::string& option, const std::string& value,
-                  std::initializer_list<std::pair<const char*, Enum>> choices) {
-  std::string names;
-  for (const auto& [name, e] : choices) {
-    if (value == name) return e;
-    names += (names.empty() ? "" : ", ") + std::string(name);
-  }
-  throw UsageError(fmt::format("{}: unknown value '{}' (expected one of: {})", option, value, names));
-}
-
-// The chosen integrator must read every selective setting the command line gives
-// (integrators/integrator.h); what the scene file sets for another integrator gets a note.
-void check_integrator_flags(const RenderCommand& cmd, const SceneDesc& scene) {
-  if (scene.settings.integrator == "auto") {
-    // Every candidate must read what the scene and the flags set.
-    if (auto_candidates(scene.settings).empty())
-      throw UsageError("--integrator auto: no integrator reads every setting given (see --help for who reads what)");
-    if (!cmd.bdpt_strategies.empty()) throw UsageError("--bdpt-strategies needs --integrator bdpt, not auto");
-    return;
-  }
-  const IntegratorEntry* integrator = find_integrator(scene.settings.integrator);
-  if (!integrator)
-    throw UsageError(fmt::format("unknown integrator '{}' (known: {}, auto)", scene.settings.integrator, integrator_names()));
-  struct SelectiveFlag {
-    const char* flag;
-    std::string_view key;
-    bool given;
-  };
-  const SelectiveFlag flags[] = {
-      {"--direction-sampling", "direction_sampling", !cmd.direction_sampling.empty()},
-      {"--no-mis", "mis", cmd.no_mis},
-      {"--shadow-rays", "shadow_rays", cmd.shadow_rays.has_value()},
-      {"--light-selection paper", "light_selection=paper", cmd.light_selection == "paper"},
-      {"--adaptive-threshold", "adaptive", cmd.adaptive_threshold.has_value()},
-      {"--adaptive-spp", "adaptive", cmd.adaptive_spp.has_value()},
-      {"--adaptive-batch", "adaptive", cmd.adaptive_batch.has_value()},
-      {"--max-spp", "adaptive", cmd.max_spp.has_value()},
-      {"--mlt-bootstrap", "mlt", cmd.mlt_bootstrap.has_value()},
-      {"--mlt-chains", "mlt", cmd.mlt_chains.has_value()},
-      {"--mlt-sigma", "mlt", cmd.mlt_sigma.has_value()},
-      {"--mlt-large-step", "mlt", cmd.mlt_large_step.has_value()},
-      {"--mlt-lens", "mlt", cmd.mlt_lens.has_value()},
-      {"--mlt-caustic", "mlt", cmd.mlt_caustic.has_value()},
-  };
-  for (const SelectiveFlag& f : flags)
-    if (f.given && !integrator->reads_setting(f.key))
-      throw UsageError(fmt::format("{}: {}", f.flag, unread_setting_message(*integrator, f.key)));
-  if (!cmd.bdpt_strategies.empty() && !integrator->strategy_images)
-    throw UsageError(fmt::format("--bdpt-strategies: the {} integrator writes no strategy images (bdpt does)",
-                                 integrator->name));
-  if (!cmd.integrator.empty() && !cmd.quiet)
-    for (std::string_view key : set_but_unread(*integrator, scene.settings))
-      fmt::print(stderr, "note: the scene sets {}, which --integrator {} does not read\n", key, integrator->name);
-}
-
-void apply_overrides(const RenderCommand& cmd, SceneDesc& scene) {
-  if (cmd.spp) scene.settings.spp = *cmd.spp;
-  if (cmd.max_depth) scene.settings.max_depth = *cmd.max_depth;
-  if (cmd.seed) scene.settings.seed = *cmd.seed;
-  if (!cmd.integrator.empty()) scene.settings.integrator = cmd.integrator;
-  RenderSettings& rs = scene.settings;
-  if (!cmd.sampler.empty())
-    rs.sampler.type = parse_choice<SamplerType>("--sampler", cmd.sampler,
-                                                {{"random", SamplerType::Independent},
-                                                 {"independent", SamplerType::Independent},
-                                                 {"stratified", SamplerType::Stratified},
-                                                 {"poisson", SamplerType::Poisson},
-                                                 {"zsobol", SamplerType::ZSobol}});
-  if (!cmd.filter.empty())
-    rs.filter = default_filter(parse_choice<FilterType>(
-        "--filter", cmd.filter,
-        {{"box", FilterType::Box}, {"tent", FilterType::Tent}, {"gaussian", FilterType::Gaussian},
-         {"mitchell", FilterType::Mitchell}}));
-  if (!cmd.direction_sampling.empty())
-    rs.path.direction_sampling = parse_choice<DirectionSampling>(
-        "--direction-sampling", cmd.direction_sampling,
-        {{"bsdf", DirectionSampling::Bsdf}, {"cosine", DirectionSampling::Cosine},
-         {"uniform", DirectionSampling::Uniform}});
-  if (!cmd.bvh.empty())
-    rs.bvh = parse_choice<BvhLayout>("--bvh", cmd.bvh, {{"fast", BvhLayout::Fast}, {"compact", BvhLayout::Compact}});
-  if (!cmd.light_selection.empty())
-    rs.light_selection = parse_choice<LightSelection>("--light-selection", cmd.light_selection,
-                                                      {{"power", LightSelection::Power},
-                                                       {"paper", LightSelection::Paper},
-                                                       {"uniform", LightSelection::Uniform}});
-  if (cmd.no_mis) rs.path.mis = false;
-  // An error estimate needs two independent halves of every pixel's samples; with a target the
-  // spp is the most a pixel may get (--spp, or 65536).
-  if (cmd.estimate_error || cmd.target_error || rs.integrator == "auto") rs.sampler.replicas = true;
-  // --integrator auto: the pilots and the winner share one sampler setup (spp sets its sets), so the
-  // winner can continue its pilot; the scene's or the given spp is then the budget, not the count.
-  if (rs.integrator == "auto" && !cmd.target_error) rs.spp = kTargetErrorMaxSpp;
-  if (cmd.target_error) rs.spp = cmd.spp.value_or(kTargetErrorMaxSpp);
-  if (!cmd.transport.empty())
-    rs.spectral = parse_choice<bool>("--transport", cmd.transport, {{"rgb", false}, {"spectral", true}});
-  if (cmd.mlt_bootstrap) rs.mlt.bootstrap = *cmd.mlt_bootstrap;
-  if (cmd.mlt_chains) rs.mlt.chains = *cmd.mlt_chains;
-  if (cmd.mlt_sigma) rs.mlt.sigma = *cmd.mlt_sigma;
-  if (cmd.mlt_large_step) rs.mlt.large_step = *cmd.mlt_large_step;
-  if (cmd.mlt_lens) rs.mlt.lens = *cmd.mlt_lens;
-  if (cmd.mlt_caustic) rs.mlt.caustic = *cmd.mlt_caustic;
-  if (std::string problem = rs.mlt.problem(); !problem.empty())
-    throw UsageError("--mlt-large-step, --mlt-lens, --mlt-caustic: " + problem);
-  if (cmd.shadow_rays) rs.path.shadow_rays = *cmd.shadow_rays;
-  if (cmd.adaptive_threshold) rs.adaptive_threshold = *cmd.adaptive_threshold;
-  if (cmd.adaptive_spp) rs.adaptive_spp = *cmd.adaptive_spp;
-  if (cmd.adaptive_batch) rs.adaptive_batch = *cmd.adaptive_batch;
-  if (cmd.max_spp) rs.adaptive_max_spp = *cmd.max_spp;
-  if (rs.adaptive() && (rs.adaptive_batch & (rs.adaptive_batch - 1)) != 0)
-    throw UsageError(fmt::format("--adaptive-batch: must be a power of two, got {}", rs.adaptive_batch));
-  if (rs.adaptive_spp > 0 && rs.adaptive_spp < rs.adaptive_batch)
-    throw UsageError(fmt::format("--adaptive-spp ({}) must be at least the batch size ({})", rs.adaptive_spp,
-                                 rs.adaptive_batch));
-  if (rs.adaptive_spp > 0 && rs.adaptive_max_spp > 0 && rs.adaptive_max_spp < rs.adaptive_spp)
-    throw UsageError(fmt::format("--max-spp ({}) must be at least --adaptive-spp ({})", rs.adaptive_max_spp,
-                                 rs.adaptive_spp));
-  if (!cmd.spp_map.empty() && !is_supported_output(cmd.spp_map))
-    throw UsageError(fmt::format("--spp-map '{}': unsupported image format (use .exr, .png or .pfm)", cmd.spp_map));
-  if (!cmd.resolution.empty()) {
-    std::smatch m;
-    static const std::regex pattern(R"((\d{1,9})[xX](\d{1,9}))");
-    if (!std::regex_match(cmd.resolution, m, pattern))
-      throw UsageError(fmt::format("--resolution: expected WIDTHxHEIGHT such as 640x480, got '{}'", cmd.resolution));
-    scene.film.width = std::stoi(m[1]);
-    scene.film.height = std::stoi(m[2]);
-  }
-  const auto& f = scene.film;
-  if (f.width < 1 || f.height < 1 || f.width > kMaxResolution || f.height > kMaxResolution ||
-      (long long)f.width * f.height > kMaxPixels)
-    throw UsageError(fmt::format("resolution {}x{} is out of range (each side 1..{}, at most {} pixels)", f.width,
-                                 f.height, kMaxResolution, kMaxPixels));
-  if (cmd.target_error && rs.adaptive())
-    throw UsageError("--target-error: adaptive sampling (--adaptive-threshold, --adaptive-spp) has its own stopping "
-                     "rule; use one or the other");
-  check_integrator_flags(cmd, scene);
-  if (cmd.bdpt_unweighted && cmd.bdpt_strategies.empty()) throw UsageError("--bdpt-unweighted needs --bdpt-strategies DIR");
-}
 
 // The files to write: -o wins, then the scene's own film name, then <scene name>.exr. The built-in
 // scene writes both cornell-box.png and cornell-box.exr.
@@ -360,25 +198,6 @@ std::string read_bytes(const fs::path& file) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-// Seconds from "90", "2.5", "90s", "10m", "2h" or "1h30m" (each part a number with a unit, largest first).
-double parse_duration(const std::string& option, const std::string& text) {
-  static const std::regex plain(R"(\d{1,9}(\.\d{0,9})?)");
-  static const std::regex parts(R"((\d{1,9}(?:\.\d{0,9})?h)?(\d{1,9}(?:\.\d{0,9})?m)?(\d{1,9}(?:\.\d{0,9})?s)?)");
-  double seconds = 0;
-  std::smatch m;
-  if (std::regex_match(text, plain)) {
-    seconds = std::stod(text);
-  } else if (!text.empty() && std::regex_match(text, m, parts)) {
-    const double unit[] = {3600, 60, 1};
-    for (int i = 0; i < 3; ++i)
-      if (m[i + 1].matched) seconds += std::stod(m[i + 1].str()) * unit[i];
-  } else {
-    throw UsageError(fmt::format("{}: expected seconds or a duration such as 90s, 10m, 2h or 1h30m, got '{}'", option, text));
-  }
-  if (!(seconds > 0)) throw UsageError(fmt::format("{}: must be more than 0, got '{}'", option, text));
-  return seconds;
-}
-
 // What the ranks of a job must all have read alike: the scene file's bytes and every mesh.
 uint64_t scene_content_hash(const std::string& scene_bytes, const SceneDesc& desc) {
   uint64_t hash = fnv1a64(scene_bytes.data(), scene_bytes.size());
@@ -396,7 +215,6 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   const bool pixel_mode = !cmd.pixel.empty();
   int px = -1, py = -1;
   int part_index = 0, part_count = 1;
-  double time_limit_seconds = 0;
   int auto_budget_spp = 0;
   std::vector<fs::path> outputs;
   std::string scene_bytes;
@@ -408,10 +226,13 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
     if (cluster.distributed() || !cmd.checkpoint.empty() || !cmd.resume.empty() || !cmd.part.empty())
       scene_bytes = cmd.scene_file.empty() ? std::string(builtin_scene_json()) : read_bytes(cmd.scene_file);
     auto_budget_spp = cmd.spp.value_or(desc.settings.spp);
-    apply_overrides(cmd, desc);
+    apply_request(cmd, desc);
+    if (!cmd.spp_map.empty() && !is_supported_output(cmd.spp_map))
+      throw UsageError(fmt::format("--spp-map '{}': unsupported image format (use .exr, .png or .pfm)", cmd.spp_map));
     adaptive = desc.settings.adaptive();
     if (cmd.checkpoint_every && cmd.checkpoint.empty()) throw UsageError("--checkpoint-every needs --checkpoint FILE");
-    if (!cmd.time_limit.empty()) time_limit_seconds = parse_duration("--time-limit", cmd.time_limit);
+    if (cmd.checkpoint_every && !(*cmd.checkpoint_every > 0))
+      throw UsageError(fmt::format("--checkpoint-every: must be a positive number, got {}", *cmd.checkpoint_every));
     if (adaptive && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
       throw UsageError("--checkpoint and --resume are not supported with adaptive sampling (--adaptive-threshold, --adaptive-spp)");
     if (pixel_mode && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
@@ -524,13 +345,10 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   if (!cmd.bdpt_strategies.empty()) {
     strategy_images.assign(size_t(BdptIntegrator::strategy_count(strategy_depth)), SplatImage(film.width(), film.height()));
   }
-  RenderOptions options;
+  RenderOptions options = request_options(cmd);
   options.threads = cmd.threads.value_or(cluster.default_threads());
   options.progress = !cmd.quiet && cluster.is_root();
   options.cancel = &g_stop;
-  options.time_limit_seconds = time_limit_seconds;
-  options.target_error = cmd.target_error.value_or(0.0);
-  options.clamp = clamp;
   options.cluster = &cluster;
   options.part_index = part_index;
   options.part_count = part_count;
@@ -574,19 +392,10 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
       last_checkpoint = std::chrono::steady_clock::now();
     };
   g_phase.store(kRendering);
-  // --integrator auto: pilots of each integrator measure which reaches the lowest error in the budget.
-  std::optional<AutoChoice> choice;
-  if (desc.settings.integrator == "auto") {
-    choice = choose_integrator(scene, desc.settings, film, options, auto_budget_spp);
-    desc.settings.integrator = std::string(choice->integrator->name);
-    if (cluster.is_root()) std::printf("auto: %s\n", choice->summary().c_str());
-    // The rest of the budget; a cancelled pilot leaves none.
-    if (choice->budget_seconds > 0)
-      options.time_limit_seconds = std::max(choice->budget_seconds - choice->pilot_seconds, 1e-3);
-  }
-  const IntegratorEntry& integrator = *find_integrator(desc.settings.integrator);
-  RenderStats stats = render(scene, desc.settings, film, options);
-  if (choice) stats.seconds += choice->pilot_seconds;
+  RenderOutcome outcome = render_requested(scene, desc.settings, film, options, auto_budget_spp, [&](const std::string& summary) {
+    if (cluster.is_root()) std::printf("auto: %s\n", summary.c_str());
+  });
+  const RenderStats& stats = outcome.stats;
   g_phase.store(kWriting);  // a signal from here on lets the (complete or partial) images be written
   const uint64_t non_finite = earlier_non_finite + stats.non_finite_samples;
   const bool stopped = stats.cancelled || stats.time_limited;
@@ -620,49 +429,11 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   for (const Cluster::Traffic& t : traffic) most_sent = std::max(most_sent, t.bytes_sent);
   if (!cluster.is_root()) return stats.cancelled ? kExitInterrupted : 0;
 
-  const double pixels = double(film.width()) * film.height();
-  const uint64_t min_spp = film.min_samples(), max_spp = film.max_samples();
-  const double mean_spp = double(film.total_samples()) / pixels;
-  std::string spp_text;
-  const char* spp_unit = " spp";  // appended in messages where spp_text is a bare count
-  if (integrator.samples_are_mutations) {
-    spp_text = fmt::format("{:.2f} mutations per pixel", double(stats.samples) / pixels);
-    spp_unit = "";
-  } else if (adaptive && !stopped) {
-    spp_text = fmt::format("adaptive, {:.2f} spp on average", mean_spp);
-    spp_unit = "";
-  } else if (min_spp == max_spp)
-    spp_text = std::to_string(min_spp);
-  else
-    spp_text = fmt::format("min {}, mean {:.2f}", min_spp, mean_spp);
-  std::map<std::string, std::string> metadata = {
-      {"candela:scene", cmd.scene_file.empty() ? "<built-in cornell-box.json>" : cmd.scene_file},
-      {"candela:spp", spp_text},
-      {"candela:spp_min", std::to_string(min_spp)},
-      {"candela:spp_mean", fmt::format("{:.4f}", mean_spp)},
-      {"candela:render_time_seconds", fmt::format("{:.3f}", stats.seconds)},
-      {"candela:integrator", desc.settings.integrator},
-      {"candela:transport", desc.settings.spectral ? "spectral" : "rgb"},
-      {"candela:max_depth", std::to_string(desc.settings.max_depth)},
-      {"candela:seed", std::to_string(desc.settings.seed)},
-      {"candela:ranks", std::to_string(cluster.size())},
-      {"Software", "candela " CANDELA_VERSION}};
-  if (stats.cancelled) metadata["candela:interrupted"] = "true";
-  if (stats.time_limited) metadata["candela:time-limited"] = "true";
-  // How good the image is, from its own two halves (film/error_estimate.h).
-  const ErrorEstimate error = estimate_error(film, stats.mlt_normalization_relative_error);
-  if (error.valid) {
-    metadata["candela:relmse_estimate"] = fmt::format("{:.6g}", error.relmse);
-    metadata["candela:relmse_interval95"] = fmt::format("{:.6g} {:.6g}", error.low, error.high);
-  }
-  if (options.target_error > 0) {
-    metadata["candela:target_error"] = fmt::format("{}", options.target_error);
-    metadata["candela:target_reached"] = stats.reached_target ? "true" : "false";
-  }
-  if (clamp > 0) metadata["candela:clamp"] = fmt::format("{}", clamp);
-  if (non_finite > 0) metadata["candela:non_finite_samples"] = std::to_string(non_finite);
-  if (integrator.reads_setting("mlt")) metadata["candela:mlt"] = desc.settings.mlt.describe();
-  if (choice) metadata["candela:auto"] = choice->summary();
+  const auto [spp_text, spp_unit] = describe_samples(desc.settings, film, outcome);
+  const std::map<std::string, std::string> metadata =
+      image_metadata(cmd.scene_file.empty() ? "<built-in cornell-box.json>" : cmd.scene_file, desc.settings, film,
+                     outcome, options, cluster.size(), non_finite);
+  const ErrorEstimate& error = outcome.error;
   if (!cmd.part.empty()) {
     FilmPart part{part_index, part_count, render_fingerprint,
                   double(scene.camera().importance_film_pixels()), non_finite, std::move(film)};
@@ -791,11 +562,10 @@ int main(int argc, char** argv) {
   render_cmd->add_option("-o,--output", cmd.output,
                          "Output image; the extension picks the format: .exr (linear HDR, with metadata), "
                          ".png (sRGB 8-bit), .pfm (linear). Default: the scene's film file name, else SCENE.exr");
-  render_cmd->add_option("--spp", cmd.spp, "Samples per pixel (overrides the scene)")->check(CLI::Range(1, 1 << 24));
-  render_cmd->add_option("--threads", cmd.threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 4096));
+  render_cmd->add_option("--spp", cmd.spp, "Samples per pixel (overrides the scene)");
+  render_cmd->add_option("--threads", cmd.threads, "Worker threads (default: all cores)");
   render_cmd->add_option("--seed", cmd.seed, "Random seed (overrides the scene)");
-  render_cmd->add_option("--max-depth", cmd.max_depth, "Maximum number of bounces; 1 = direct light only")
-      ->check(CLI::Range(1, 100000));
+  render_cmd->add_option("--max-depth", cmd.max_depth, "Maximum number of bounces; 1 = direct light only");
   render_cmd->add_option("--resolution", cmd.resolution, "Image size WIDTHxHEIGHT (overrides the scene)");
   std::string integrator_help = "Integrator:";
   for (const IntegratorEntry& entry : integrators())
@@ -809,23 +579,17 @@ int main(int argc, char** argv) {
   render_cmd->add_flag("--bdpt-unweighted", cmd.bdpt_unweighted,
                        "bdpt: the strategy images without their MIS weights (each then estimates the whole "
                        "image of its depth on its own)");
-  render_cmd->add_option("--mlt-bootstrap", cmd.mlt_bootstrap, "mlt: bootstrap paths per depth (default 100000)")
-      ->check(CLI::Range(1, 100000000));
-  render_cmd->add_option("--mlt-chains", cmd.mlt_chains, "mlt: independent Markov chains (default 1000)")
-      ->check(CLI::Range(1, 100000000));
+  render_cmd->add_option("--mlt-bootstrap", cmd.mlt_bootstrap, "mlt: bootstrap paths per depth (default 100000)");
+  render_cmd->add_option("--mlt-chains", cmd.mlt_chains, "mlt: independent Markov chains (default 1000)");
   render_cmd->add_option("--mlt-sigma", cmd.mlt_sigma,
-                         "mlt: deviation of small steps in primary sample space (default 0.01)")
-      ->check(CLI::Range(1e-6, 1.0));
+                         "mlt: deviation of small steps in primary sample space (default 0.01)");
   render_cmd->add_option("--mlt-large-step", cmd.mlt_large_step,
-                         "mlt: probability of a large step (default 0.3)")
-      ->check(CLI::Range(0.0, 1.0));
+                         "mlt: probability of a large step (default 0.3)");
   render_cmd->add_option("--mlt-lens", cmd.mlt_lens,
-                         "mlt: probability of a lens perturbation (only the film position moves; default 0)")
-      ->check(CLI::Range(0.0, 1.0));
+                         "mlt: probability of a lens perturbation (only the film position moves; default 0)");
   render_cmd->add_option("--mlt-caustic", cmd.mlt_caustic,
                          "mlt: probability of a caustic perturbation (only the direction leaving the light moves; "
-                         "default 0)")
-      ->check(CLI::Range(0.0, 1.0));
+                         "default 0)");
   render_cmd->add_option("--sampler", cmd.sampler,
                          "Pixel sampler: random (independent), stratified (jittered, every dimension), "
                          "poisson (Poisson-disc pixel positions), zsobol (Owen-scrambled Sobol' in Morton order)");
@@ -848,21 +612,17 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--bvh", cmd.bvh,
                          "Acceleration structure: fast (the default) or compact (about half the memory per "
                          "triangle, traversal about a third slower)");
-  render_cmd->add_option("--shadow-rays", cmd.shadow_rays, "Shadow rays per path vertex")->check(CLI::Range(1, 1024));
+  render_cmd->add_option("--shadow-rays", cmd.shadow_rays, "Shadow rays per path vertex");
   render_cmd->add_option("--adaptive-threshold", cmd.adaptive_threshold,
                          "Adaptive sampling: keep adding batches to pixels whose relative standard error "
-                         "(per channel, se / sqrt(mean^2 + 0.01)) exceeds this")
-      ->check(CLI::PositiveNumber);
+                         "(per channel, se / sqrt(mean^2 + 0.01)) exceeds this");
   render_cmd->add_option("--adaptive-spp", cmd.adaptive_spp,
                          "Adaptive sampling with a budget: this many samples per pixel on average, each pixel "
-                         "getting a share proportional to its estimated relative error (lowest relMSE)")
-      ->check(CLI::Range(1, 1 << 24));
+                         "getting a share proportional to its estimated relative error (lowest relMSE)");
   render_cmd->add_option("--adaptive-batch", cmd.adaptive_batch,
-                         "Adaptive sampling: samples per batch, a power of two (default 16)")
-      ->check(CLI::Range(1, 1 << 16));
+                         "Adaptive sampling: samples per batch, a power of two (default 16)");
   render_cmd->add_option("--max-spp", cmd.max_spp,
-                         "Adaptive sampling: most samples a pixel gets (default 1024, or 8 x --adaptive-spp)")
-      ->check(CLI::Range(1, 1 << 24));
+                         "Adaptive sampling: most samples a pixel gets (default 1024, or 8 x --adaptive-spp)");
   render_cmd->add_option("--spp-map", cmd.spp_map,
                          "Also write the per-pixel sample counts: a heat map (.png) or raw counts (.exr, .pfm)");
   render_cmd->add_flag("-q,--quiet", cmd.quiet, "No progress bar");
@@ -870,8 +630,7 @@ int main(int argc, char** argv) {
                          "Write the render state to FILE (atomically) every --checkpoint-every seconds "
                          "between passes, and when interrupted or out of time");
   render_cmd->add_option("--checkpoint-every", cmd.checkpoint_every,
-                         "Seconds between checkpoints (fractions allowed); needs --checkpoint")
-      ->check(CLI::PositiveNumber);
+                         "Seconds between checkpoints (fractions allowed); needs --checkpoint");
   render_cmd->add_option("--resume", cmd.resume,
                          "Continue from a checkpoint made with the same scene file and settings; the result "
                          "equals an uninterrupted render bit for bit");
@@ -880,14 +639,12 @@ int main(int argc, char** argv) {
                          "seconds (90, 2.5) or a duration such as 90s, 10m, 2h, 1h30m");
   render_cmd->add_option("--target-error", cmd.target_error,
                          "Render until the image's estimated relMSE (eps 0.01, from two independent halves of the "
-                         "samples) is at most this, then stop; --spp (default 65536) and --time-limit cap it")
-      ->check(CLI::PositiveNumber);
+                         "samples) is at most this, then stop; --spp (default 65536) and --time-limit cap it");
   render_cmd->add_flag("--estimate-error", cmd.estimate_error,
                        "Render every pixel's samples as two independent halves and report the image's estimated "
                        "relMSE with a 95% interval (always done with the random sampler and with --target-error)");
   render_cmd->add_option("--clamp", cmd.clamp,
-                         "Scale each sample so its largest RGB component is at most VALUE (biased; off by default)")
-      ->check(CLI::PositiveNumber);
+                         "Scale each sample so its largest RGB component is at most VALUE (biased; off by default)");
   render_cmd->add_option("--part", cmd.part,
                          "Render part K of N of the image (every N-th tile; for job arrays) and write it, with "
                          "its exact sums, to the .exr output for candela merge");

@@ -1,5 +1,6 @@
 #include "candela/film/image_io.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 #include <unistd.h>
@@ -49,6 +50,30 @@ bool is_supported_output(const std::filesystem::path& file) {
   return ext == ".exr" || ext == ".png" || ext == ".pfm";
 }
 
+namespace {
+
+// An 8-bit sRGB PNG (values clipped to [0,1]) through `out`, opened as `name`.
+bool write_png(OIIO::ImageOutput& out, const std::string& name, const Image& image) {
+  OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+  spec.attribute("oiio:ColorSpace", "sRGB");
+  std::vector<uint8_t> pixels(image.rgb.size());
+  std::transform(image.rgb.begin(), image.rgb.end(), pixels.begin(), encode_srgb8);
+  return out.open(name, spec) && out.write_image(OIIO::TypeDesc::UINT8, pixels.data());
+}
+
+}  // namespace
+
+std::vector<unsigned char> encode_png(const Image& image) {
+  std::vector<unsigned char> bytes;
+  OIIO::Filesystem::IOVecOutput memory(bytes);
+  auto out = OIIO::ImageOutput::create("image.png", &memory);
+  if (!out) throw std::runtime_error("cannot create a PNG writer: " + OIIO::geterror());
+  bool ok = write_png(*out, "image.png", image);
+  std::string error = ok ? "" : out->geterror();
+  if (!out->close() || !ok) throw std::runtime_error("cannot encode PNG: " + (error.empty() ? out->geterror() : error));
+  return bytes;
+}
+
 // Writes with OpenImageIO; returns an error message, empty on success.
 std::string write_with_oiio(const std::filesystem::path& tmp, const std::string& ext, const Image& image,
                             const std::map<std::string, std::string>& metadata, const ExactChannels* extra) {
@@ -56,11 +81,7 @@ std::string write_with_oiio(const std::filesystem::path& tmp, const std::string&
   if (!out) return "cannot create image writer: " + OIIO::geterror();
   bool ok;
   if (ext == ".png") {
-    OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
-    spec.attribute("oiio:ColorSpace", "sRGB");
-    std::vector<uint8_t> pixels(image.rgb.size());
-    std::transform(image.rgb.begin(), image.rgb.end(), pixels.begin(), encode_srgb8);
-    ok = out->open(tmp.string(), spec) && out->write_image(OIIO::TypeDesc::UINT8, pixels.data());
+    ok = write_png(*out, tmp.string(), image);
   } else {
     OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::FLOAT);
     spec.attribute("oiio:ColorSpace", "Linear");

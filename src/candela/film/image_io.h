@@ -20,6 +20,10 @@ bool is_supported_output(const std::filesystem::path& file);
 void write_image(const std::filesystem::path& file, const Image& image,
                  const std::map<std::string, std::string>& metadata = {});
 
+// The bytes of an 8-bit sRGB PNG of `image` (as write_image writes a .png), e.g. to show it inline
+// in a notebook. Throws std::runtime_error.
+std::vector<unsigned char> encode_png(const Image& image);
+
 // 32-bit unsigned integer channels kept exactly beside an EXR's RGB (a render part's sums, bit for
 // bit): names.size() values per pixel in `values`, row-major.
 struct ExactChannels {

@@ -252,7 +252,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   const uint64_t pixels = uint64_t(film.width()) * uint64_t(film.height());
   const uint64_t total_mutations = uint64_t(settings.spp) * pixels;
   const uint64_t bootstrap_count = uint64_t(settings.mlt.bootstrap) * uint64_t(depths);
-  ProgressBar progress(bootstrap_count + total_mutations, options.progress);
+  ProgressBar progress(bootstrap_count + total_mutations, options.progress, options.progress_fraction);
   // The bootstrap grows with max_depth (one per depth): the bar says which phase it is in.
   progress.set_label(fmt::format("MLT bootstrap ({} depths x {})", depths, settings.mlt.bootstrap));
 

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 
@@ -17,12 +18,13 @@ std::string format_duration(double seconds) {
 
 }  // namespace
 
-ProgressBar::ProgressBar(uint64_t total_work, bool enabled)
-    : total_(total_work ? total_work : 1), enabled_(enabled && isatty(fileno(stderr))),
+ProgressBar::ProgressBar(uint64_t total_work, bool enabled, std::atomic<double>* fraction_out)
+    : total_(total_work ? total_work : 1), enabled_(enabled && isatty(fileno(stderr))), fraction_out_(fraction_out),
       start_(std::chrono::steady_clock::now()), last_draw_(start_) {}
 
 void ProgressBar::advance(uint64_t work) {
   uint64_t done = done_.fetch_add(work) + work;
+  if (fraction_out_) fraction_out_->store(std::min(1.0, double(done) / double(total_)), std::memory_order_relaxed);
   if (!enabled_) return;
   auto now = std::chrono::steady_clock::now();
   std::unique_lock lock(draw_mutex_, std::try_to_lock);
@@ -38,6 +40,7 @@ void ProgressBar::set_label(std::string label) {
 }
 
 void ProgressBar::finish() {
+  if (fraction_out_) fraction_out_->store(1.0, std::memory_order_relaxed);
   if (!enabled_) return;
   std::lock_guard lock(draw_mutex_);
   draw(total_, true);

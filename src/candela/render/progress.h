@@ -11,7 +11,8 @@ namespace candela {
 
 class ProgressBar {
  public:
-  ProgressBar(uint64_t total_work, bool enabled);
+  // `fraction_out`: also stores the fraction done there (RenderOptions::progress_fraction).
+  ProgressBar(uint64_t total_work, bool enabled, std::atomic<double>* fraction_out = nullptr);
   void advance(uint64_t work);  // thread-safe
   void finish();
   // A word on the phase under way, drawn before the bar (thread-safe).
@@ -25,6 +26,7 @@ class ProgressBar {
   std::string label_;
   uint64_t total_;
   bool enabled_;
+  std::atomic<double>* fraction_out_;
   std::atomic<uint64_t> done_{0};
   std::mutex draw_mutex_;
   std::chrono::steady_clock::time_point start_, last_draw_;

@@ -477,7 +477,7 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
                  busy_nanoseconds};
   const uint64_t samples_before = film.total_samples();
   const uint64_t expected_spp = adaptive && settings.adaptive_spp > 0 ? uint64_t(settings.adaptive_spp) : uint64_t(max_spp);
-  ProgressBar progress(pixel_count * expected_spp, options.progress);
+  ProgressBar progress(pixel_count * expected_spp, options.progress, options.progress_fraction);
   progress.advance(options.only_x >= 0 ? 0 : samples_before);
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   RenderStats stats;

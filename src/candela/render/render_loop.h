@@ -37,6 +37,9 @@ namespace candela {
 struct RenderOptions {
   int threads = 0;       // 0 = all cores
   bool progress = true;  // draw a progress bar when stderr is a terminal
+  // When set, the fraction of the work done (0 to 1) is stored here as the render advances, for a
+  // caller that shows progress its own way (the Python module polls it).
+  std::atomic<double>* progress_fraction = nullptr;
   // Set (e.g. by a signal handler) to stop: checked before every tile and between passes, so the
   // render stops within one tile. Pixels keep the samples they have; each pixel's count says how many.
   const std::atomic<bool>* cancel = nullptr;

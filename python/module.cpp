@@ -1,0 +1,372 @@
+// _candela: the compiled half of the `candela` Python package. candela/__init__.py holds the other
+// half (keyword checking, the Image type, the exception types, progress bars) and is what users
+// import; this file only crosses the language boundary. Every render goes through the library's
+// RenderRequest (render/render_request.h), as the command line's do, so the same settings give the
+// same bytes and the same refusals.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <map>
+#include <mutex>
+#include <thread>
+#include <variant>
+
+#include "candela/base/error.h"
+#include "candela/film/film.h"
+#include "candela/film/image_io.h"
+#include "candela/io/json_writer.h"
+#include "candela/io/mitsuba_reader.h"
+#include "candela/io/scene_reader.h"
+#include "candela/render/render_request.h"
+#include "candela/scene/parameters.h"
+#include "candela/scene/resource_limits.h"
+#include "candela/scene/scene.h"
+
+namespace py = pybind11;
+using namespace candela;
+
+namespace {
+
+// A loaded scene: the description every render builds from. Its files (meshes, and images through
+// the image cache while a built scene holds them) are read once, when it is loaded.
+struct PyScene {
+  SceneDesc desc;
+  std::string name;  // the file as given, or "<dict>"
+  std::mutex busy;   // one render or edit at a time
+};
+
+// The package's exception types (candela.SceneError, candela.UsageError), handed over by
+// __init__.py. Held without reference counting: they live as long as the interpreter.
+py::handle g_scene_error, g_usage_error;
+
+// render()'s keywords: the command line's flags with '_' for '-', each with the request field it sets.
+using RequestField = std::variant<std::optional<int> RenderRequest::*, std::optional<uint64_t> RenderRequest::*,
+                                  std::optional<float> RenderRequest::*, std::optional<double> RenderRequest::*,
+                                  std::string RenderRequest::*, bool RenderRequest::*>;
+const std::map<std::string, RequestField>& request_fields() {
+  static const std::map<std::string, RequestField> fields = {
+      {"spp", &RenderRequest::spp},
+      {"threads", &RenderRequest::threads},
+      {"max_depth", &RenderRequest::max_depth},
+      {"seed", &RenderRequest::seed},
+      {"resolution", &RenderRequest::resolution},
+      {"integrator", &RenderRequest::integrator},
+      {"sampler", &RenderRequest::sampler},
+      {"filter", &RenderRequest::filter},
+      {"direction_sampling", &RenderRequest::direction_sampling},
+      {"light_selection", &RenderRequest::light_selection},
+      {"bvh", &RenderRequest::bvh},
+      {"transport", &RenderRequest::transport},
+      {"shadow_rays", &RenderRequest::shadow_rays},
+      {"max_spp", &RenderRequest::max_spp},
+      {"adaptive_batch", &RenderRequest::adaptive_batch},
+      {"adaptive_spp", &RenderRequest::adaptive_spp},
+      {"adaptive_threshold", &RenderRequest::adaptive_threshold},
+      {"no_mis", &RenderRequest::no_mis},
+      {"time_limit", &RenderRequest::time_limit},
+      {"target_error", &RenderRequest::target_error},
+      {"estimate_error", &RenderRequest::estimate_error},
+      {"clamp", &RenderRequest::clamp},
+      {"mlt_bootstrap", &RenderRequest::mlt_bootstrap},
+      {"mlt_chains", &RenderRequest::mlt_chains},
+      {"mlt_sigma", &RenderRequest::mlt_sigma},
+      {"mlt_large_step", &RenderRequest::mlt_large_step},
+      {"mlt_lens", &RenderRequest::mlt_lens},
+      {"mlt_caustic", &RenderRequest::mlt_caustic},
+  };
+  return fields;
+}
+
+// The kind of each keyword, for the package's type checks: int, uint, float, str or bool.
+py::dict request_kinds() {
+  py::dict kinds;
+  for (const auto& [name, field] : request_fields()) {
+    const char* kind = std::visit(
+        [](auto member) -> const char* {
+          using T = std::remove_reference_t<decltype(std::declval<RenderRequest&>().*member)>;
+          if constexpr (std::is_same_v<T, std::optional<int>>) return "int";
+          else if constexpr (std::is_same_v<T, std::optional<uint64_t>>) return "uint";
+          else if constexpr (std::is_same_v<T, std::string>) return "str";
+          else if constexpr (std::is_same_v<T, bool>) return "bool";
+          else return "float";
+        },
+        field);
+    kinds[py::str(name)] = kind;
+  }
+  return kinds;
+}
+
+// The request from keywords the package has already checked for kind.
+RenderRequest request_from(const py::dict& keywords) {
+  RenderRequest request;
+  for (auto [key, value] : keywords) {
+    auto name = key.cast<std::string>();
+    auto found = request_fields().find(name);
+    if (found == request_fields().end()) throw py::type_error("render() got an unexpected keyword argument '" + name + "'");
+    std::visit(
+        [&](auto member) {
+          using T = std::remove_reference_t<decltype(request.*member)>;
+          if constexpr (std::is_same_v<T, std::string> || std::is_same_v<T, bool>)
+            request.*member = value.cast<T>();
+          else
+            request.*member = value.cast<typename T::value_type>();
+        },
+        found->second);
+  }
+  request.quiet = true;  // the package draws its own progress; notes would go past Python's stderr
+  return request;
+}
+
+// A float32 (height, width, 3) array that owns `image`'s pixels (no copy).
+py::array_t<float> to_array(Image&& image) {
+  auto* pixels = new std::vector<float>(std::move(image.rgb));
+  py::capsule owner(pixels, [](void* p) { delete static_cast<std::vector<float>*>(p); });
+  const auto w = py::ssize_t(image.width), h = py::ssize_t(image.height);
+  return py::array_t<float>({h, w, py::ssize_t(3)}, {w * 3 * py::ssize_t(sizeof(float)), 3 * py::ssize_t(sizeof(float)), py::ssize_t(sizeof(float))},
+                            pixels->data(), owner);
+}
+
+// An (height, width, 3) float32 C-contiguous array (the package converts) into an Image.
+Image from_array(const py::array_t<float, py::array::c_style>& array) {
+  if (array.ndim() != 3 || array.shape(2) != 3) throw py::value_error("expected an array of shape (height, width, 3)");
+  Image image(int(array.shape(1)), int(array.shape(0)));
+  std::copy_n(array.data(), image.rgb.size(), image.rgb.begin());
+  return image;
+}
+
+// The settings and film size a render changes in the description, put back when it ends: a render's
+// keywords apply to that render only.
+class RequestScope {
+ public:
+  explicit RequestScope(SceneDesc& desc) : desc_(desc), settings_(desc.settings), film_(desc.film) {}
+  ~RequestScope() {
+    desc_.settings = settings_;
+    desc_.film = film_;
+  }
+  RequestScope(const RequestScope&) = delete;
+  RequestScope& operator=(const RequestScope&) = delete;
+
+ private:
+  SceneDesc& desc_;
+  RenderSettings settings_;
+  FilmDesc film_;
+};
+
+// Renders on a worker thread while this one, with the GIL released, wakes 20 times a second to let
+// Python run its signal handlers (Ctrl-C raises KeyboardInterrupt here) and call `progress`
+// (fraction done, seconds elapsed). An interruption or an exception from `progress` cancels the
+// render, which stops within one tile, and is raised once the worker has finished.
+py::tuple render_scene(PyScene& scene, const py::dict& keywords, const py::object& progress) {
+  RenderRequest request = request_from(keywords);
+  std::unique_lock busy(scene.busy, std::try_to_lock);
+  if (!busy.owns_lock()) throw py::value_error("this scene is being rendered or edited by another thread");
+  RequestScope scope(scene.desc);
+  const int budget_spp = request.spp.value_or(scene.desc.settings.spp);
+  apply_request(request, scene.desc);
+  check_resources(scene.desc);
+  RenderOptions options = request_options(request);
+  std::atomic<bool> cancel{false};
+  std::atomic<double> fraction{0};
+  options.cancel = &cancel;
+  options.progress = false;
+  options.progress_fraction = &fraction;
+
+  Image image;
+  std::map<std::string, std::string> metadata;
+  std::exception_ptr failure;
+  std::mutex mutex;
+  std::condition_variable finished;
+  bool done = false;
+  std::thread worker([&] {
+    try {
+      Scene built(scene.desc);
+      Film film(scene.desc.film.width, scene.desc.film.height);
+      RenderOutcome outcome = render_requested(built, scene.desc.settings, film, options, budget_spp);
+      metadata = image_metadata(scene.name, scene.desc.settings, film, outcome, options, 1,
+                                outcome.stats.non_finite_samples);
+      image = film.mean_image();
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    std::lock_guard lock(mutex);
+    done = true;
+    finished.notify_one();
+  });
+
+  std::optional<py::error_already_set> python_error;
+  const auto start = std::chrono::steady_clock::now();
+  {
+    py::gil_scoped_release release;
+    std::unique_lock lock(mutex);
+    while (!finished.wait_for(lock, std::chrono::milliseconds(50), [&] { return done; })) {
+      if (python_error) continue;  // cancelled: wait for the worker
+      lock.unlock();
+      {
+        py::gil_scoped_acquire acquire;
+        try {
+          if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+          if (!progress.is_none())
+            progress(fraction.load(), std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        } catch (py::error_already_set& e) {
+          python_error = std::move(e);
+          cancel.store(true);
+        }
+      }
+      lock.lock();
+    }
+  }
+  worker.join();
+  if (python_error) throw std::move(*python_error);
+  if (failure) std::rethrow_exception(failure);
+  py::dict meta;
+  for (const auto& [key, value] : metadata) meta[py::str(key)] = value;
+  return py::make_tuple(to_array(std::move(image)), meta);
+}
+
+py::object parameter_to_python(const ParameterValue& value) {
+  if (const float* f = std::get_if<float>(&value)) return py::float_(*f);
+  if (const RGB* c = std::get_if<RGB>(&value)) return py::make_tuple(c->r, c->g, c->b);
+  const Matrix4& m = std::get<Matrix4>(value);
+  py::array_t<double> out({4, 4});
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) out.mutable_at(r, c) = m.m[size_t(r)][size_t(c)];
+  return out;
+}
+
+// A value of the kind `current` has: a number, three numbers (or one grey), or a 4x4 matrix.
+ParameterValue parameter_from_python(const std::string& name, const ParameterValue& current, const py::handle& value) {
+  auto kind_error = [&](const char* expected) {
+    return py::type_error(name + ": expected " + expected + ", got " + py::str(py::type::of(value).attr("__name__")).cast<std::string>());
+  };
+  if (py::isinstance<py::str>(value) || py::isinstance<py::bool_>(value)) throw kind_error("a number");
+  try {
+    if (std::holds_alternative<float>(current)) return py::cast<float>(value);
+    if (std::holds_alternative<RGB>(current)) {
+      if (!py::isinstance<py::sequence>(value) && !py::isinstance<py::array>(value)) {
+        float grey = py::cast<float>(value);
+        return RGB(grey);
+      }
+      auto values = py::cast<std::vector<float>>(value);
+      if (values.size() != 3) throw kind_error("three numbers (r, g, b)");
+      return RGB(values[0], values[1], values[2]);
+    }
+    auto rows = py::cast<std::vector<std::vector<double>>>(value);
+    Matrix4 m;
+    if (rows.size() != 4) throw kind_error("a 4x4 matrix");
+    for (size_t r = 0; r < 4; ++r) {
+      if (rows[r].size() != 4) throw kind_error("a 4x4 matrix");
+      for (size_t c = 0; c < 4; ++c) m.m[r][c] = rows[r][c];
+    }
+    return m;
+  } catch (const py::cast_error&) {
+    throw kind_error(std::holds_alternative<float>(current) ? "a number"
+                     : std::holds_alternative<RGB>(current) ? "three numbers (r, g, b) or one"
+                                                            : "a 4x4 matrix");
+  }
+}
+
+std::unique_ptr<PyScene> make_scene(SceneDesc&& desc, std::string name) {
+  auto scene = std::make_unique<PyScene>();
+  scene->desc = std::move(desc);
+  scene->name = std::move(name);
+  return scene;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_candela, m) {
+  m.doc() = "The compiled half of the candela package; import candela instead.";
+  m.attr("version") = CANDELA_VERSION;
+
+  m.def("set_exception_types", [](py::object scene_error, py::object usage_error) {
+    g_scene_error = scene_error.release();
+    g_usage_error = usage_error.release();
+  });
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const SceneError& e) {
+      PyErr_SetString(g_scene_error.ptr(), e.what());
+    } catch (const FileContentError& e) {
+      PyErr_SetString(g_scene_error.ptr(), e.what());
+    } catch (const UsageError& e) {
+      PyErr_SetString(g_usage_error.ptr(), e.what());
+    } catch (const std::invalid_argument& e) {  // scene parameters: an unknown name
+      PyErr_SetString(PyExc_KeyError, e.what());
+    }
+  });
+
+  py::class_<PyScene>(m, "Scene")
+      .def_property_readonly("name", [](const PyScene& s) { return s.name; })
+      .def_property_readonly("resolution", [](const PyScene& s) { return py::make_tuple(s.desc.film.width, s.desc.film.height); })
+      .def("settings",
+           [](const PyScene& s) {
+             const RenderSettings& r = s.desc.settings;
+             py::dict d;
+             d["spp"] = r.spp;
+             d["max_depth"] = r.max_depth;
+             d["seed"] = r.seed;
+             d["integrator"] = r.integrator;
+             d["transport"] = r.spectral ? "spectral" : "rgb";
+             d["resolution"] = py::make_tuple(s.desc.film.width, s.desc.film.height);
+             return d;
+           })
+      .def("parameters",
+           [](PyScene& s) {
+             std::lock_guard lock(s.busy);
+             py::list out;
+             for (const SceneParameter& p : scene_parameters(s.desc))
+               out.append(py::make_tuple(p.name, parameter_to_python(p.value), p.range));
+             return out;
+           })
+      .def("set_parameter",
+           [](PyScene& s, const std::string& name, const py::handle& value) {
+             std::unique_lock busy(s.busy, std::try_to_lock);
+             if (!busy.owns_lock()) throw py::value_error("this scene is being rendered by another thread");
+             for (const SceneParameter& p : scene_parameters(s.desc))
+               if (p.name == name) {
+                 set_scene_parameter(s.desc, name, parameter_from_python(name, p.value, value));
+                 return;
+               }
+             set_scene_parameter(s.desc, name, 0.0f);  // throws the unknown name's KeyError
+           })
+      .def("to_json", [](PyScene& s) {
+        std::lock_guard lock(s.busy);
+        return scene_to_json(s.desc);
+      });
+
+  m.def("load_file", [](const std::string& path, const std::map<std::string, std::string>& parameters) {
+    std::vector<std::string> warnings;
+    SceneDesc desc;
+    {
+      py::gil_scoped_release release;
+      if (std::filesystem::path(path).extension() == ".xml")
+        desc = read_mitsuba_scene(path, warnings, MitsubaReadOptions{parameters});
+      else
+        desc = read_scene_file(path);
+    }
+    return py::make_tuple(make_scene(std::move(desc), path), warnings);
+  });
+  m.def("load_json", [](const std::string& text, const std::string& name, const std::string& base_dir) {
+    return make_scene(read_json_scene(text, name, base_dir), name);
+  });
+  m.def("builtin_scene", [] {
+    return make_scene(read_json_scene(builtin_scene_json(), "<built-in cornell-box.json>", "."), "<built-in cornell-box.json>");
+  });
+  m.def("render_keywords", &request_kinds);
+  m.def("render", &render_scene);
+  m.def("write_image", [](const std::string& path, const py::array_t<float, py::array::c_style>& array,
+                          const std::map<std::string, std::string>& metadata) {
+    write_image(path, from_array(array), metadata);
+  });
+  m.def("read_image", [](const std::string& path) { return to_array(read_image(path)); });
+  m.def("read_image_metadata", [](const std::string& path) { return read_image_metadata(path); });
+  m.def("encode_png", [](const py::array_t<float, py::array::c_style>& array) {
+    std::vector<unsigned char> bytes = encode_png(from_array(array));
+    return py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  });
+}
