@@ -85,6 +85,19 @@ MaterialDesc material_of(const ObjMaterial& m, SceneDesc& scene, std::vector<std
   return p;
 }
 
+// A model brings no camera: one frames its meshes. Without emitters it would be black: a white sky
+// lights it (and is what the user sees around it).
+void frame_and_light(SceneDesc& scene, bool any_emitter) {
+  Point3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  for (const ShapeDesc& shape : scene.shapes)
+    for (const Point3& p : std::get<MeshShape>(shape.geometry).mesh.positions) {
+      lo = min(lo, p);
+      hi = max(hi, p);
+    }
+  scene.camera = camera_framing(lo, hi);
+  if (!any_emitter) scene.lights.push_back(SkyLight{});
+}
+
 }  // namespace
 
 SceneDesc read_obj_scene(const std::filesystem::path& file) {
@@ -101,13 +114,8 @@ SceneDesc read_obj_scene(const std::filesystem::path& file) {
     scene.places.materials.push_back({file.string(), 0, 0, "newmtl " + model.materials[i].name});
     material_index[i] = int(scene.materials.size() - 1);
   }
-  Point3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
   bool any_emitter = false;
   for (ObjModel::Part& part : model.parts) {
-    for (const Point3& p : part.mesh.positions) {
-      lo = min(lo, p);
-      hi = max(hi, p);
-    }
     ShapeDesc shape;
     shape.material = part.material >= 0 ? material_index[size_t(part.material)] : -1;
     shape.name = part.material >= 0 ? model.materials[size_t(part.material)].name : file.filename().string();
@@ -122,11 +130,20 @@ SceneDesc read_obj_scene(const std::filesystem::path& file) {
     shape.geometry = MeshShape{std::move(part.mesh)};
     scene.shapes.push_back(std::move(shape));
   }
-  scene.camera = camera_framing(lo, hi);
-  // Without emitters the model would be black: a white sky lights it (and is what the user sees
-  // around it).
-  if (!any_emitter) scene.lights.push_back(SkyLight{});
+  frame_and_light(scene, any_emitter);
   for (const std::string& w : warnings) std::fprintf(stderr, "%s\n", w.c_str());
+  return scene;
+}
+
+SceneDesc read_mesh_scene(const std::filesystem::path& file) {
+  SceneDesc scene;
+  scene.settings.sampler.type = SamplerType::ZSobol;
+  ShapeDesc shape;
+  shape.name = file.filename().string();
+  shape.where = {file.string(), 0, 0, {}};
+  shape.geometry = MeshShape{load_mesh_file(file, shape.where)};
+  scene.shapes.push_back(std::move(shape));
+  frame_and_light(scene, false);
   return scene;
 }
 

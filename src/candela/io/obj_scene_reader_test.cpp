@@ -8,6 +8,7 @@
 
 #include "candela/base/error.h"
 #include "candela/io/scene_reader.h"
+#include "candela/testing/json_reader_helpers.h"
 #include "candela/testing/render_helpers.h"
 
 namespace candela {
@@ -22,6 +23,21 @@ const ShapeDesc& shape_named(const SceneDesc& scene, const std::string& name) {
     if (s.name == name) return s;
   ADD_FAILURE() << "no shape " << name;
   return scene.shapes.front();
+}
+
+TEST(ObjScene, APlyMeshIsASceneFramedAndLitByASky) {
+  SceneDesc scene = read_scene_file(fs::path(CANDELA_SHARED_DIR) / "meshes/ply-tests/cube.ply");
+  ASSERT_EQ(scene.shapes.size(), 1u);
+  EXPECT_EQ(std::get<MeshShape>(scene.shapes[0].geometry).mesh.indices.size(), 36u);  // 6 quads, triangulated
+  EXPECT_EQ(scene.shapes[0].material, -1);  // the default grey diffuse
+  ASSERT_EQ(scene.lights.size(), 1u);
+  EXPECT_TRUE(std::holds_alternative<SkyLight>(scene.lights[0]));
+  // The camera looks at the cube's centre from +z.
+  const Matrix4& m = scene.camera.world_from_camera.matrix();
+  EXPECT_GT(m.m[2][3], 1.0);
+  EXPECT_NEAR(m.m[2][2], -1.0, 1e-6);  // camera +z (forward) is world -z
+  EXPECT_NE(testing::json_reader::scene_file_error_of(fs::path(CANDELA_SHARED_DIR) / "meshes/ply-tests/points.ply").find("points.ply"),
+            std::string::npos);
 }
 
 TEST(ObjScene, McGuiresCornellBoxGetsItsMaterialsLightAndAFramingCamera) {

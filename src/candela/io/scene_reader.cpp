@@ -59,13 +59,15 @@ SceneDesc read_scene_file(const std::filesystem::path& file) {
     scene = read_pbrt_scene(file);
   else if (extension == ".obj")
     scene = read_obj_scene(file);
+  else if (extension == ".ply")
+    scene = read_mesh_scene(file);
   else if (extension == ".gltf" || extension == ".glb")
     scene = read_gltf_scene(file);
   else if (extension == ".xml")
     scene = read_mitsuba_scene(file);
   else
     throw_scene_error(location_of_file(file),
-                      "unsupported scene file extension {}; supported: .json, .pbrt, .xml (Mitsuba 3), .gltf, .glb, .obj",
+                      "unsupported scene file extension {}; supported: .json, .pbrt, .xml (Mitsuba 3), .gltf, .glb, .obj, .ply",
                       extension.empty() ? std::string("(none)") : "\"" + extension + "\"");
   scene.source_file = file.string();
   return scene;

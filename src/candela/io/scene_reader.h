@@ -10,7 +10,7 @@
 namespace candela {
 
 // Chooses the reader by extension: .json (candela's format), .pbrt (pbrt-v4), .xml (Mitsuba 3),
-// .gltf / .glb (glTF 2.0), .obj (with its MTL). Throws SceneError for a missing file or an unknown
+// .gltf / .glb (glTF 2.0), .obj (with its MTL), .ply (a mesh). Throws SceneError for a missing file or an unknown
 // extension.
 SceneDesc read_scene_file(const std::filesystem::path& file);
 

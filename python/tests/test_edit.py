@@ -1,0 +1,90 @@
+"""traverse(): read and change a loaded scene's parameters, render again without reloading."""
+import numpy as np
+import pytest
+
+import candela
+from conftest import SOURCE_DIR, furnace_dict
+
+SETTINGS = dict(spp=4, resolution=(32, 32), seed=7)
+
+
+def test_doubling_the_light_doubles_the_image():
+    scene = candela.load_file(SOURCE_DIR / "scenes/cornell-box.json")
+    params = candela.traverse(scene)
+    before = candela.render(scene, **SETTINGS)
+    params["shapes.light.emission"] = tuple(2 * c for c in params["shapes.light.emission"])
+    after = candela.render(scene, **SETTINGS)
+    # Every sample's radiance scales with the one light; the sampling decisions do not change.
+    assert np.allclose(after, 2 * before, rtol=1e-5, atol=1e-7)
+    assert before.max() > 0
+
+
+def test_a_point_lights_intensity_scales_its_image():
+    scene_dict = furnace_dict()
+    scene_dict["lights"] = [{"type": "point", "position": [0, 3, 3], "intensity": [10, 10, 10]}]
+    scene = candela.load_dict(scene_dict)
+    before = candela.render(scene, **SETTINGS)
+    candela.traverse(scene)["lights.0.intensity"] = 20
+    assert np.allclose(candela.render(scene, **SETTINGS), 2 * before, rtol=1e-5, atol=1e-7)
+
+
+def test_material_camera_and_transform_edits_change_the_image_as_a_reloaded_edited_file_does():
+    edited = furnace_dict()
+    edited["materials"]["grey"]["reflectance"] = [0.2, 0.4, 0.6]
+    edited["camera"]["fov"] = 25
+    edited["shapes"][0]["transform"] = [{"translate": [0.5, 0, 0]}]
+    scene = candela.load_dict(furnace_dict())
+    params = candela.traverse(scene)
+    params["materials.grey.reflectance"] = (0.2, 0.4, 0.6)
+    params["camera.fov"] = 25
+    matrix = np.eye(4)
+    matrix[0, 3] = 0.5
+    params["shapes.ball.to_world"] = matrix
+    assert np.array_equal(params["shapes.ball.to_world"], matrix)
+    assert candela.render(scene, **SETTINGS).tobytes() == candela.render(candela.load_dict(edited), **SETTINGS).tobytes()
+
+
+def test_roughness_and_the_listing():
+    scene = candela.load_dict({
+        "materials": {"metal": {"type": "conductor", "roughness": 0.1}, "glass": {"type": "dielectric", "ior": 1.5}},
+        "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "metal"},
+                   {"type": "sphere", "center": [3, 0, 0], "radius": 1, "material": "glass"}],
+        "lights": [{"type": "sky", "radiance": 1}]})
+    params = candela.traverse(scene)
+    assert params["materials.metal.roughness"] == pytest.approx(0.1)
+    params["materials.metal.roughness"] = 0.3
+    params["materials.glass.ior"] = 1.33
+    assert params["materials.metal.roughness"] == pytest.approx(0.3)
+    assert params["materials.glass.ior"] == pytest.approx(1.33)
+    listing = repr(params)
+    for name in params:
+        assert name in listing
+    assert params.range("camera.fov") == "0 < fov < 180"
+    assert len(params) == len(list(params.keys()))
+
+
+def test_bad_edits_are_refused_and_change_nothing():
+    scene = candela.load_dict(furnace_dict())
+    params = candela.traverse(scene)
+    before = scene.to_json()
+    with pytest.raises(KeyError, match="materials.grey.reflectance"):
+        params["materials.gray.reflectance"] = 0.5  # a typo: the message names the near ones
+    with pytest.raises(ValueError, match="outside its range"):
+        params["camera.fov"] = 190
+    with pytest.raises(ValueError, match="outside its range"):
+        params["materials.grey.reflectance"] = (0.5, -0.1, 0.5)
+    with pytest.raises(ValueError, match="outside its range"):
+        params["materials.grey.reflectance"] = float("nan")
+    with pytest.raises(TypeError, match="expected a number"):
+        params["camera.fov"] = "wide"
+    with pytest.raises(TypeError, match="three numbers"):
+        params["materials.grey.reflectance"] = (0.5, 0.5)
+    with pytest.raises(ValueError, match="singular"):
+        params["shapes.ball.to_world"] = np.zeros((4, 4))
+    with pytest.raises(TypeError, match="4x4"):
+        params["shapes.ball.to_world"] = np.eye(3)
+    with pytest.raises(TypeError):
+        del params["camera.fov"]
+    with pytest.raises(KeyError):
+        params["no.such.parameter"]
+    assert scene.to_json() == before
