@@ -1,7 +1,7 @@
 // _candela: the compiled half of the `candela` Python package. candela/__init__.py holds the other
 // half (keyword checking, the Image type, the exception types, progress bars) and is what users
 // import; this file only crosses the language boundary. Every render goes through the library's
-// RenderRequest (render/render_request.h), as the command line's do, so the same settings give the
+// RenderRequest (integrators/render_request.h), as the command line's do, so the same settings give the
 // same bytes and the same refusals.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -19,9 +19,8 @@
 #include "candela/film/film.h"
 #include "candela/film/image_io.h"
 #include "candela/io/json_writer.h"
-#include "candela/io/mitsuba_reader.h"
 #include "candela/io/scene_reader.h"
-#include "candela/render/render_request.h"
+#include "candela/integrators/render_request.h"
 #include "candela/scene/parameters.h"
 #include "candela/scene/resource_limits.h"
 #include "candela/scene/scene.h"
@@ -31,11 +30,13 @@ using namespace candela;
 
 namespace {
 
-// A loaded scene: the description every render builds from. Its files (meshes, and images through
-// the image cache while a built scene holds them) are read once, when it is loaded.
+// A loaded scene: the description every render builds from. Its files are read once, when it is
+// loaded: the meshes are in the description, and the images (textures, environment maps) are held
+// here, so that each render's build finds them in read_image_shared's cache.
 struct PyScene {
   SceneDesc desc;
   std::string name;  // the file as given, or "<dict>"
+  std::vector<std::shared_ptr<const Image>> images;
   std::mutex busy;   // one render or edit at a time
 };
 
@@ -273,6 +274,19 @@ std::unique_ptr<PyScene> make_scene(SceneDesc&& desc, std::string name) {
   auto scene = std::make_unique<PyScene>();
   scene->desc = std::move(desc);
   scene->name = std::move(name);
+  // Read the images now, as the scene's build will (a file that cannot be read is left to the build
+  // to report, with the place in the scene that names it).
+  auto hold = [&](const std::string& file, IntegerEncoding encoding) {
+    try {
+      scene->images.push_back(read_image_shared(file, encoding));
+    } catch (const std::exception&) {
+    }
+  };
+  for (const TextureDesc& texture : scene->desc.textures)
+    if (const auto* image = std::get_if<ImageTexture>(&texture))
+      hold(image->filename, image->encoding == ColorEncoding::Linear ? IntegerEncoding::Linear : IntegerEncoding::SRGB);
+  for (const LightDesc& light : scene->desc.lights)
+    if (const auto* map = std::get_if<EnvironmentMap>(&light)) hold(map->filename, IntegerEncoding::SRGB);
   return scene;
 }
 
@@ -344,10 +358,8 @@ PYBIND11_MODULE(_candela, m) {
     SceneDesc desc;
     {
       py::gil_scoped_release release;
-      if (std::filesystem::path(path).extension() == ".xml")
-        desc = read_mitsuba_scene(path, warnings, MitsubaReadOptions{parameters});
-      else
-        desc = read_scene_file(path);
+      // Mitsuba's warnings come back to the package, which warns with them.
+      desc = read_scene_file(path, SceneReadOptions{parameters, &warnings});
     }
     return py::make_tuple(make_scene(std::move(desc), path), warnings);
   });

@@ -166,6 +166,11 @@ TEST_F(CommandLine, RenderControlOptionsAreChecked) {
   expect_failure("render " + scene + " -o " + out() + " --pixel 99,1", "outside");
   for (const char* bad : {"10x", "m", "1m30", "0", "0s", "-5", "2h1h"})
     expect_failure("render " + scene + " -o " + out() + " --time-limit " + bad, "--time-limit: (expected seconds or a duration|must be more than 0)");
+  // Values out of range, refused before the scene is read (the file need not exist).
+  expect_failure("render none.json --spp 0", "--spp: 0 is out of range \\(1 to 16777216\\)");
+  expect_failure("render none.json --mlt-sigma 2", "--mlt-sigma: 2 is out of range");
+  expect_failure("render none.json --clamp nan", "--clamp: must be a positive number");
+  expect_failure("render none.json --checkpoint-every -1", "--checkpoint-every: must be a positive number");
   // Durations: a limit far beyond the render does not cut it short.
   for (const char* limit : {"90", "2.5", "90s", "10m", "2h", "1h30m", "1m0.5s"}) {
     RunResult r = run_cli("render " + scene + " -o " + out() + " --spp 2 -q --time-limit " + limit);

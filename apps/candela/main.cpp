@@ -27,7 +27,7 @@
 #include "candela/render/checkpoint.h"
 #include "candela/render/cluster.h"
 #include "candela/render/film_part.h"
-#include "candela/render/render_request.h"
+#include "candela/integrators/render_request.h"
 #include "candela/integrators/auto_integrator.h"
 #include "candela/integrators/bdpt.h"
 #include "candela/integrators/integrator.h"
@@ -107,7 +107,7 @@ void on_every_rank(Cluster& cluster, Step&& step) {
   if (!error.empty()) throw AgreedError(error);
 }
 
-// The render subcommand: the request (render/render_request.h) and what only the command line does.
+// The render subcommand: the request (integrators/render_request.h) and what only the command line does.
 struct RenderCommand : RenderRequest {
   std::string scene_file;  // empty = built-in scene
   std::string output, spp_map;
@@ -219,6 +219,10 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   std::vector<fs::path> outputs;
   std::string scene_bytes;
   on_every_rank(cluster, [&] {
+    // A value out of range is said before a big scene is read.
+    check_request_values(cmd);
+    if (cmd.checkpoint_every && !(*cmd.checkpoint_every > 0))
+      throw UsageError(fmt::format("--checkpoint-every: must be a positive number, got {}", *cmd.checkpoint_every));
     desc = cmd.scene_file.empty() ? read_json_scene(builtin_scene_json(), "<built-in cornell-box.json>", ".")
                                   : read_scene_file(cmd.scene_file);
     // The scene file's bytes again, for what must know they are the same: the ranks of a job, a
@@ -231,8 +235,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
       throw UsageError(fmt::format("--spp-map '{}': unsupported image format (use .exr, .png or .pfm)", cmd.spp_map));
     adaptive = desc.settings.adaptive();
     if (cmd.checkpoint_every && cmd.checkpoint.empty()) throw UsageError("--checkpoint-every needs --checkpoint FILE");
-    if (cmd.checkpoint_every && !(*cmd.checkpoint_every > 0))
-      throw UsageError(fmt::format("--checkpoint-every: must be a positive number, got {}", *cmd.checkpoint_every));
+
     if (adaptive && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
       throw UsageError("--checkpoint and --resume are not supported with adaptive sampling (--adaptive-threshold, --adaptive-spp)");
     if (pixel_mode && (!cmd.checkpoint.empty() || !cmd.resume.empty()))

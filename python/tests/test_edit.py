@@ -88,3 +88,23 @@ def test_bad_edits_are_refused_and_change_nothing():
     with pytest.raises(KeyError):
         params["no.such.parameter"]
     assert scene.to_json() == before
+
+
+def test_renders_after_an_edit_read_no_file_again(tmp_path):
+    # The texture and the environment map are read when the scene is loaded: removing the files
+    # afterwards changes nothing, through edits and any number of renders.
+    for name in ("checker.ppm", "sky.hdr"):
+        (tmp_path / name).write_bytes((SOURCE_DIR / "tests/data/textures" / name).read_bytes())
+    scene = candela.load_dict({
+        "textures": {"checker": {"type": "image", "filename": "checker.ppm"}},
+        "materials": {"m": {"type": "diffuse", "reflectance": "checker"}},
+        "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
+        "lights": [{"type": "environment", "filename": "sky.hdr"}]}, base_dir=tmp_path)
+    before = candela.render(scene, **SETTINGS)
+    for name in ("checker.ppm", "sky.hdr"):
+        (tmp_path / name).unlink()
+    params = candela.traverse(scene)
+    params["lights.0.scale"] = 2
+    assert np.allclose(candela.render(scene, **SETTINGS), 2 * before, rtol=1e-5, atol=1e-7)
+    params["lights.0.scale"] = 1
+    assert candela.render(scene, **SETTINGS).tobytes() == before.tobytes()

@@ -100,18 +100,6 @@ def test_bad_dicts_raise_scene_error_with_the_json_pointer():
     assert issubclass(candela.SceneError, ValueError)
 
 
-def test_a_texture_removed_after_loading_raises_when_the_scene_is_built(tmp_path):
-    texture = tmp_path / "checker.ppm"
-    texture.write_bytes((SOURCE_DIR / "tests/data/textures/checker.ppm").read_bytes())
-    scene = candela.load_dict({"textures": {"t": {"type": "image", "filename": "checker.ppm"}},
-                               "materials": {"m": {"type": "diffuse", "reflectance": "t"}},
-                               "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]}, base_dir=tmp_path)
-    assert candela.render(scene, spp=1, resolution=(8, 8)).shape == (8, 8, 3)
-    texture.unlink()
-    with pytest.raises((candela.SceneError, RuntimeError), match="checker.ppm"):
-        candela.render(scene, spp=1, resolution=(8, 8))
-
-
 def test_writing_to_a_missing_directory_raises_and_writes_nothing(tmp_path):
     image = candela.render(candela.load_dict(furnace_dict()), spp=1)
     with pytest.raises(RuntimeError, match="cannot write image"):

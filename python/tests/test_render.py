@@ -95,3 +95,21 @@ def test_the_builtin_scene_renders():
     image = candela.render(candela.builtin_scene(), spp=1, resolution=(32, 32))
     assert image.metadata["candela:scene"] == "<built-in cornell-box.json>"
     assert 0.02 < float(image.mean()) < 1
+
+
+def test_other_python_threads_run_while_a_render_holds_no_gil():
+    import threading
+    import time
+    scene = candela.load_dict(furnace_dict())
+    done = threading.Event()
+    worker = threading.Thread(target=lambda: (candela.render(scene, spp=128, resolution=(256, 256), progress=False),
+                                              done.set()))
+    worker.start()
+    time.sleep(0.05)
+    count, start = 0, time.monotonic()
+    while time.monotonic() - start < 0.2:
+        count += 1
+    still_rendering = not done.is_set()
+    worker.join()
+    assert still_rendering, "the render should take longer than this test's counting"
+    assert count > 10000

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <cmath>
 #include <cstdint>
+#include <mutex>
 #include <stdexcept>
 #include <vector>
 
@@ -230,6 +231,28 @@ std::map<std::string, std::string> read_image_metadata(const std::filesystem::pa
   for (const auto& attr : in->spec().extra_attribs) result[attr.name().string()] = attr.get_string();
   in->close();
   return result;
+}
+
+std::shared_ptr<const Image> read_image_shared(const std::filesystem::path& file, IntegerEncoding encoding) {
+  struct Entry {
+    std::weak_ptr<const Image> image;
+    std::uintmax_t size;
+    std::filesystem::file_time_type modified;
+  };
+  static std::mutex mutex;
+  static std::map<std::pair<std::string, IntegerEncoding>, Entry> images;
+  std::error_code ec;
+  const std::string path = std::filesystem::absolute(file, ec).string();
+  const std::uintmax_t size = std::filesystem::file_size(file, ec);
+  const std::filesystem::file_time_type modified = std::filesystem::last_write_time(file, ec);
+  std::lock_guard lock(mutex);
+  Entry& entry = images[{path, encoding}];
+  // The image held: unless the file has changed since (a file removed since is not read again).
+  if (auto live = entry.image.lock(); live && (ec || (entry.size == size && entry.modified == modified))) return live;
+  auto image = std::make_shared<const Image>(read_image(file, encoding));
+  entry = {image, size, modified};
+  std::erase_if(images, [](const auto& e) { return e.second.image.expired(); });
+  return image;
 }
 
 }  // namespace candela

@@ -3,6 +3,7 @@
 // metadata), .pfm (linear float), .png (sRGB-encoded 8-bit, values clipped to [0,1]).
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -48,6 +49,13 @@ enum class IntegerEncoding { SRGB, Linear };
 Image read_image(const std::filesystem::path& file, IntegerEncoding encoding);
 // The same with 8- and 16-bit data sRGB-decoded.
 Image read_image(const std::filesystem::path& file);
+
+// read_image, shared: while anything holds the image of a file (the same path and encoding), reading
+// it again returns that image instead of reading the file, unless the file has changed since (its
+// size or modification time; a file removed since is not read again). A scene built
+// again from the same description (the Python module builds one per render) then reads no image
+// file again while its loaded scene keeps the images (python/module.cpp).
+std::shared_ptr<const Image> read_image_shared(const std::filesystem::path& file, IntegerEncoding encoding);
 
 // The metadata attributes of an image file (for tests and tools).
 std::map<std::string, std::string> read_image_metadata(const std::filesystem::path& file);

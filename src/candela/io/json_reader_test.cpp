@@ -756,6 +756,15 @@ TEST(JsonReader, SceneFileWithUnknownExtensionIsAnError) {
   EXPECT_NE(scene_file_error_of(kSharedDir / "README.md").find("\".md\""), std::string::npos);
 }
 
+TEST(JsonReader, MitsubaParametersForAnotherFormatAreAnError) {
+  try {
+    read_scene_file(kSourceDir / "scenes/cornell-box.json", SceneReadOptions{{{"spp", "4"}}, nullptr});
+    FAIL() << "no error";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("$spp is a Mitsuba scene parameter"), std::string::npos) << e.what();
+  }
+}
+
 TEST(JsonReader, MissingSceneFileIsAnError) {
   std::string message = scene_file_error_of("/tmp/candela-no-such-scene.json");
   EXPECT_NE(message.find("/tmp/candela-no-such-scene.json"), std::string::npos) << message;

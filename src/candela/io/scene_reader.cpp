@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -49,9 +50,12 @@ std::string read_text_file(const fs::path& file) {
 
 }  // namespace
 
-SceneDesc read_scene_file(const std::filesystem::path& file) {
+SceneDesc read_scene_file(const std::filesystem::path& file, const SceneReadOptions& options) {
   check_is_readable_file(file);
   std::string extension = lowercase_extension(file);
+  if (!options.parameters.empty() && extension != ".xml")
+    throw_scene_error(location_of_file(file), "${} is a Mitsuba scene parameter, and this is not a Mitsuba .xml file",
+                      options.parameters.begin()->first);
   SceneDesc scene;
   if (extension == ".json")
     scene = read_json_scene(read_text_file(file), file.string(), file.parent_path());
@@ -63,8 +67,20 @@ SceneDesc read_scene_file(const std::filesystem::path& file) {
     scene = read_mesh_scene(file);
   else if (extension == ".gltf" || extension == ".glb")
     scene = read_gltf_scene(file);
-  else if (extension == ".xml")
-    scene = read_mitsuba_scene(file);
+  else if (extension == ".xml") {
+    std::vector<std::string> printed;
+    std::vector<std::string>& warnings = options.warnings ? *options.warnings : printed;
+    auto print = [&] {
+      for (const std::string& w : printed) std::fprintf(stderr, "%s\n", w.c_str());
+    };
+    try {
+      scene = read_mitsuba_scene(file, warnings, MitsubaReadOptions{options.parameters});
+    } catch (...) {
+      print();  // what came before the error may explain it
+      throw;
+    }
+    print();
+  }
   else
     throw_scene_error(location_of_file(file),
                       "unsupported scene file extension {}; supported: .json, .pbrt, .xml (Mitsuba 3), .gltf, .glb, .obj, .ply",

@@ -2,8 +2,10 @@
 // Entry points of the scene readers. Each returns a complete SceneDesc (meshes loaded, includes
 // resolved) or throws SceneError naming the file and place of the first problem.
 #include <filesystem>
+#include <map>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "candela/scene/description.h"
 
@@ -12,7 +14,14 @@ namespace candela {
 // Chooses the reader by extension: .json (candela's format), .pbrt (pbrt-v4), .xml (Mitsuba 3),
 // .gltf / .glb (glTF 2.0), .obj (with its MTL), .ply (a mesh). Throws SceneError for a missing file or an unknown
 // extension.
-SceneDesc read_scene_file(const std::filesystem::path& file);
+struct SceneReadOptions {
+  // A Mitsuba scene's $parameters, over its <default> tags (Mitsuba's -D name=value); the other
+  // formats have none, and giving one for them is a SceneError.
+  std::map<std::string, std::string> parameters;
+  // Where the Mitsuba reader's warnings go, one line each; null: printed to stderr.
+  std::vector<std::string>* warnings = nullptr;
+};
+SceneDesc read_scene_file(const std::filesystem::path& file, const SceneReadOptions& options = {});
 
 // The native JSON format (docs/scene-format.md). `file_name` is used in messages; relative mesh
 // paths are resolved against `base_dir`.

@@ -274,15 +274,15 @@ float EnvironmentLight::power() const {
 float EnvironmentLight::importance(const LightSampleContext&) const { return kPi * data_->average_luminance; }
 
 EnvironmentLight make_environment_light(const EnvironmentMap& desc, float scene_radius) {
-  Image image;
+  std::shared_ptr<const Image> image;
   try {
-    image = read_image(desc.filename);
+    image = read_image_shared(desc.filename, IntegerEncoding::SRGB);
   } catch (const std::exception& e) {
     // read_image's message names the file already.
     throw SceneError(fmt::format("environment map: {}", e.what()));
   }
   try {
-    return EnvironmentLight(image, desc.mapping, desc.scale, desc.to_world, scene_radius, desc.mis_compensation);
+    return EnvironmentLight(*image, desc.mapping, desc.scale, desc.to_world, scene_radius, desc.mis_compensation);
   } catch (const SceneError& e) {
     throw SceneError(fmt::format("{}: {}", desc.filename, e.what()));
   }

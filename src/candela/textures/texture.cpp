@@ -163,12 +163,12 @@ TextureSet::TextureSet(const std::vector<TextureDesc>& descs, const EntryPlace& 
           desc->encoding == ColorEncoding::Linear ? IntegerEncoding::Linear : IntegerEncoding::SRGB;
       auto& image = images[{desc->filename, encoding}];
       if (!image) {
-        std::error_code ec;
-        if (!std::filesystem::exists(desc->filename, ec))
-          throw SceneError(fmt::format("{}: image file \"{}\" not found", name(i), desc->filename));
         try {
-          image = std::make_shared<const Image>(read_image(desc->filename, encoding));
+          image = read_image_shared(desc->filename, encoding);
         } catch (const std::exception& e) {
+          std::error_code ec;
+          if (!std::filesystem::exists(desc->filename, ec))
+            throw SceneError(fmt::format("{}: image file \"{}\" not found", name(i), desc->filename));
           // read_image's message already names the file.
           throw SceneError(fmt::format("{}: {}", name(i), e.what()));
         }

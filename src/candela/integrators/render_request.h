@@ -48,7 +48,10 @@ struct RenderRequest {
   bool quiet = false;  // no progress bar, no notes
 };
 
-// Checks every value's range, applies the request to `scene` (its settings and film size) and
+// Checks each value on its own (ranges, the time limit's form), before a scene is read. Throws UsageError.
+void check_request_values(const RenderRequest& request);
+
+// Checks every value (check_request_values), applies the request to `scene` (its settings and film size) and
 // checks the result: the integrator exists and reads every selective setting given, adaptive
 // sampling's batch and budget agree, the resolution and MLT probabilities are valid. Throws
 // UsageError. Prints a note (unless quiet) for a scene setting the chosen integrator ignores.

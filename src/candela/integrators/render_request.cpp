@@ -1,4 +1,4 @@
-#include "candela/render/render_request.h"
+#include "candela/integrators/render_request.h"
 
 #include <fmt/format.h>
 
@@ -35,7 +35,9 @@ void check_positive(const char* option, const std::optional<T>& value) {
     throw UsageError(fmt::format("{}: must be a positive number, got {}", option, *value));
 }
 
-void check_ranges(const RenderRequest& r) {
+}  // namespace
+
+void check_request_values(const RenderRequest& r) {
   check_range("--spp", r.spp, 1, 1 << 24);
   check_range("--threads", r.threads, 1, 4096);
   check_range("--max-depth", r.max_depth, 1, 100000);
@@ -52,7 +54,10 @@ void check_ranges(const RenderRequest& r) {
   check_range("--max-spp", r.max_spp, 1, 1 << 24);
   check_positive("--target-error", r.target_error);
   check_positive("--clamp", r.clamp);
+  if (!r.time_limit.empty()) parse_duration("--time-limit", r.time_limit);
 }
+
+namespace {
 
 // The chosen integrator must read every selective setting the request gives
 // (integrators/integrator.h); what the scene file sets for another integrator gets a note.
@@ -102,7 +107,7 @@ void check_integrator_flags(const RenderRequest& request, const SceneDesc& scene
 }  // namespace
 
 void apply_request(const RenderRequest& request, SceneDesc& scene) {
-  check_ranges(request);
+  check_request_values(request);
   if (request.spp) scene.settings.spp = *request.spp;
   if (request.max_depth) scene.settings.max_depth = *request.max_depth;
   if (request.seed) scene.settings.seed = *request.seed;
@@ -179,7 +184,6 @@ void apply_request(const RenderRequest& request, SceneDesc& scene) {
   if (request.target_error && rs.adaptive())
     throw UsageError("--target-error: adaptive sampling (--adaptive-threshold, --adaptive-spp) has its own stopping "
                      "rule; use one or the other");
-  if (!request.time_limit.empty()) parse_duration("--time-limit", request.time_limit);
   check_integrator_flags(request, scene);
   if (request.bdpt_unweighted && request.bdpt_strategies.empty())
     throw UsageError("--bdpt-unweighted needs --bdpt-strategies DIR");
