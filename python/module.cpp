@@ -24,6 +24,7 @@
 #include "candela/scene/parameters.h"
 #include "candela/scene/resource_limits.h"
 #include "candela/scene/scene.h"
+#include "candela/textures/texture.h"
 
 namespace py = pybind11;
 using namespace candela;
@@ -276,17 +277,17 @@ std::unique_ptr<PyScene> make_scene(SceneDesc&& desc, std::string name) {
   scene->name = std::move(name);
   // Read the images now, as the scene's build will (a file that cannot be read is left to the build
   // to report, with the place in the scene that names it).
-  auto hold = [&](const std::string& file, IntegerEncoding encoding) {
+  auto hold = [&](auto read) {
     try {
-      scene->images.push_back(read_image_shared(file, encoding));
+      scene->images.push_back(read());
     } catch (const std::exception&) {
     }
   };
   for (const TextureDesc& texture : scene->desc.textures)
-    if (const auto* image = std::get_if<ImageTexture>(&texture))
-      hold(image->filename, image->encoding == ColorEncoding::Linear ? IntegerEncoding::Linear : IntegerEncoding::SRGB);
+    if (const auto* image = std::get_if<ImageTexture>(&texture)) hold([&] { return read_texture_image(*image); });
   for (const LightDesc& light : scene->desc.lights)
-    if (const auto* map = std::get_if<EnvironmentMap>(&light)) hold(map->filename, IntegerEncoding::SRGB);
+    if (const auto* map = std::get_if<EnvironmentMap>(&light))
+      hold([&] { return read_image_shared(map->filename, IntegerEncoding::SRGB); });
   return scene;
 }
 
@@ -337,16 +338,16 @@ PYBIND11_MODULE(_candela, m) {
                out.append(py::make_tuple(p.name, parameter_to_python(p.value), p.range));
              return out;
            })
+      .def("parameter",
+           [](PyScene& s, const std::string& name) {
+             std::lock_guard lock(s.busy);
+             return parameter_to_python(scene_parameter(s.desc, name));
+           })
       .def("set_parameter",
            [](PyScene& s, const std::string& name, const py::handle& value) {
              std::unique_lock busy(s.busy, std::try_to_lock);
              if (!busy.owns_lock()) throw py::value_error("this scene is being rendered by another thread");
-             for (const SceneParameter& p : scene_parameters(s.desc))
-               if (p.name == name) {
-                 set_scene_parameter(s.desc, name, parameter_from_python(name, p.value, value));
-                 return;
-               }
-             set_scene_parameter(s.desc, name, 0.0f);  // throws the unknown name's KeyError
+             set_scene_parameter(s.desc, name, parameter_from_python(name, scene_parameter(s.desc, name), value));
            })
       .def("to_json", [](PyScene& s) {
         std::lock_guard lock(s.busy);

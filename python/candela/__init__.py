@@ -121,10 +121,7 @@ class SceneParameters(collections.abc.MutableMapping):
         return self._scene._native.parameters()
 
     def __getitem__(self, name: str):
-        for entry_name, value, _ in self._entries():
-            if entry_name == name:
-                return value
-        raise KeyError(f"no scene parameter {name!r} (see candela.traverse(scene).keys())")
+        return self._scene._native.parameter(name)  # KeyError naming the nearest names
 
     def __setitem__(self, name: str, value) -> None:
         if isinstance(value, np.ndarray):

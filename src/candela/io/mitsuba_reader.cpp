@@ -49,10 +49,10 @@ SceneDesc read_mitsuba_scene(const std::filesystem::path& file, std::vector<std:
   return read(text.str(), file.string(), dir, warnings, options);
 }
 
-SceneDesc read_mitsuba_scene(const std::filesystem::path& file) {
+SceneDesc read_mitsuba_scene(const std::filesystem::path& file, const MitsubaReadOptions& options) {
   std::vector<std::string> warnings;
   try {
-    SceneDesc scene = read_mitsuba_scene(file, warnings);
+    SceneDesc scene = read_mitsuba_scene(file, warnings, options);
     for (const std::string& w : warnings) std::cerr << w << "\n";
     return scene;
   } catch (...) {

@@ -27,7 +27,7 @@ SceneDesc read_mitsuba_scene_text(std::string_view xml, const std::string& file_
                                   const std::filesystem::path& base_dir, std::vector<std::string>& warnings,
                                   const MitsubaReadOptions& options = {});
 
-// read_mitsuba_scene printing its warnings to stderr.
-SceneDesc read_mitsuba_scene(const std::filesystem::path& file);
+// read_mitsuba_scene printing its warnings to stderr (also those before an error).
+SceneDesc read_mitsuba_scene(const std::filesystem::path& file, const MitsubaReadOptions& options = {});
 
 }  // namespace candela

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
-#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -67,20 +66,9 @@ SceneDesc read_scene_file(const std::filesystem::path& file, const SceneReadOpti
     scene = read_mesh_scene(file);
   else if (extension == ".gltf" || extension == ".glb")
     scene = read_gltf_scene(file);
-  else if (extension == ".xml") {
-    std::vector<std::string> printed;
-    std::vector<std::string>& warnings = options.warnings ? *options.warnings : printed;
-    auto print = [&] {
-      for (const std::string& w : printed) std::fprintf(stderr, "%s\n", w.c_str());
-    };
-    try {
-      scene = read_mitsuba_scene(file, warnings, MitsubaReadOptions{options.parameters});
-    } catch (...) {
-      print();  // what came before the error may explain it
-      throw;
-    }
-    print();
-  }
+  else if (extension == ".xml")
+    scene = options.warnings ? read_mitsuba_scene(file, *options.warnings, MitsubaReadOptions{options.parameters})
+                             : read_mitsuba_scene(file, MitsubaReadOptions{options.parameters});
   else
     throw_scene_error(location_of_file(file),
                       "unsupported scene file extension {}; supported: .json, .pbrt, .xml (Mitsuba 3), .gltf, .glb, .obj, .ply",

@@ -200,17 +200,8 @@ const char* kind_name(const ParameterValue& v) {
   return std::holds_alternative<float>(v) ? "a number" : std::holds_alternative<RGB>(v) ? "a colour" : "a 4x4 matrix";
 }
 
-}  // namespace
-
-std::vector<SceneParameter> scene_parameters(const SceneDesc& scene) {
-  std::vector<SceneParameter> out;
-  for (const Slot& slot : slots(const_cast<SceneDesc&>(scene)))  // read only
-    out.push_back({slot.name, value_of(slot), slot.range()});
-  return out;
-}
-
-void set_scene_parameter(SceneDesc& scene, const std::string& name, const ParameterValue& value) {
-  std::vector<Slot> all = slots(scene);
+// The slot named `name` among `all`; an unknown name throws, naming the nearest ones.
+const Slot& find_slot(const std::vector<Slot>& all, const std::string& name) {
   const Slot* slot = nullptr;
   for (const Slot& s : all)
     if (s.name == name) slot = &s;
@@ -226,6 +217,26 @@ void set_scene_parameter(SceneDesc& scene, const std::string& name, const Parame
     }
     throw std::invalid_argument(fmt::format("no scene parameter '{}'{}", name, near.empty() ? "" : "; did you mean one of: " + near));
   }
+  return *slot;
+}
+
+}  // namespace
+
+std::vector<SceneParameter> scene_parameters(const SceneDesc& scene) {
+  std::vector<SceneParameter> out;
+  for (const Slot& slot : slots(const_cast<SceneDesc&>(scene)))  // read only
+    out.push_back({slot.name, value_of(slot), slot.range()});
+  return out;
+}
+
+ParameterValue scene_parameter(const SceneDesc& scene, const std::string& name) {
+  std::vector<Slot> all = slots(const_cast<SceneDesc&>(scene));  // read only
+  return value_of(find_slot(all, name));
+}
+
+void set_scene_parameter(SceneDesc& scene, const std::string& name, const ParameterValue& value) {
+  std::vector<Slot> all = slots(scene);
+  const Slot* slot = &find_slot(all, name);
   const ParameterValue current = value_of(*slot);
   if (value.index() != current.index())
     throw std::domain_error(fmt::format("{}: expected {}, got {}", name, kind_name(current), kind_name(value)));

@@ -31,6 +31,9 @@ struct SceneParameter {
 // Every editable parameter of `scene`, in a stable order (camera, materials, lights, shapes, instances).
 std::vector<SceneParameter> scene_parameters(const SceneDesc& scene);
 
+// The named parameter's value. Throws std::invalid_argument for an unknown name (with the closest names).
+ParameterValue scene_parameter(const SceneDesc& scene, const std::string& name);
+
 // Sets the named parameter. Throws std::invalid_argument for an unknown name (with
 // the closest names), std::domain_error for a value of the wrong kind or outside its range, which
 // leaves the scene unchanged.

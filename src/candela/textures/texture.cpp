@@ -7,7 +7,6 @@
 #include <cstdint>
 #include <exception>
 #include <filesystem>
-#include <map>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -141,10 +140,13 @@ std::pair<int, int> TextureSet::resolution(int index) const {
                     textures_[size_t(index)]);
 }
 
+std::shared_ptr<const Image> read_texture_image(const ImageTexture& texture) {
+  return read_image_shared(texture.filename,
+                           texture.encoding == ColorEncoding::Linear ? IntegerEncoding::Linear : IntegerEncoding::SRGB);
+}
+
 TextureSet::TextureSet(const std::vector<TextureDesc>& descs, const EntryPlace& place_of) {
   auto name = [&](size_t i) { return place_of ? fmt::format("{}: texture {}", place_of(i), i) : fmt::format("texture {}", i); };
-  // Keyed by the effective decoding, so Auto and SRGB on the same file share one image.
-  std::map<std::pair<std::string, IntegerEncoding>, std::shared_ptr<const Image>> images;
   textures_.reserve(descs.size());
   for (size_t i = 0; i < descs.size(); ++i) {
     for_each_reference(descs[i], [&](int ref) {
@@ -159,19 +161,16 @@ TextureSet::TextureSet(const std::vector<TextureDesc>& descs, const EntryPlace& 
     });
 
     if (const auto* desc = std::get_if<ImageTexture>(&descs[i])) {
-      IntegerEncoding encoding =
-          desc->encoding == ColorEncoding::Linear ? IntegerEncoding::Linear : IntegerEncoding::SRGB;
-      auto& image = images[{desc->filename, encoding}];
-      if (!image) {
-        try {
-          image = read_image_shared(desc->filename, encoding);
-        } catch (const std::exception& e) {
-          std::error_code ec;
-          if (!std::filesystem::exists(desc->filename, ec))
-            throw SceneError(fmt::format("{}: image file \"{}\" not found", name(i), desc->filename));
-          // read_image's message already names the file.
-          throw SceneError(fmt::format("{}: {}", name(i), e.what()));
-        }
+      // Textures of the same file with the same decoding (Auto and SRGB alike) share one image.
+      std::shared_ptr<const Image> image;
+      try {
+        image = read_texture_image(*desc);
+      } catch (const std::exception& e) {
+        std::error_code ec;
+        if (!std::filesystem::exists(desc->filename, ec))
+          throw SceneError(fmt::format("{}: image file \"{}\" not found", name(i), desc->filename));
+        // read_image's message already names the file.
+        throw SceneError(fmt::format("{}: {}", name(i), e.what()));
       }
       textures_.emplace_back(ImageLookup{image, desc->wrap, desc->bilinear, desc->scale, desc->invert, desc->luminance, desc->mapping});
     } else {
