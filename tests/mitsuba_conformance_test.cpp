@@ -103,7 +103,7 @@ TEST_P(MitsubaConformance, PassesMitsubasRenderTest) {
     // bidirectional render splats part of its samples elsewhere: its pixel sums do not hold the
     // variance, and only the magnitude is used.)
     Image substitute = absolute;
-    if (desc.settings.integrator == "path") {
+    if (desc.settings.integrator == "path" || desc.settings.integrator == "volpath") {
       SceneDesc independent = desc;
       independent.settings.sampler.type = SamplerType::Independent;
       independent.settings.seed = 2;
@@ -126,7 +126,7 @@ TEST_P(MitsubaConformance, PassesMitsubasRenderTest) {
   }
 }
 
-// The 26 scenes, with what each sampler achieves in this checkout; docs/conformance.md explains each.
+// The 33 scenes, with what each sampler achieves in this checkout; docs/conformance.md explains each.
 const ConformanceCase kCases[] = {
     {"bsdf_spheres", "test_arealight_path", Expect::PassWithNegativeVarianceReplaced, Expect::PassWithNegativeVarianceReplaced},
     {"bsdf_spheres", "test_bumpmap_path", Expect::Pass, Expect::Pass},
@@ -149,6 +149,13 @@ const ConformanceCase kCases[] = {
     {"mesh_attributes", "test_mesh_attributes_3_face_direct", Expect::Pass, Expect::PassWithNegativeVarianceReplaced},
     {"mesh_attributes", "test_mesh_attributes_3_vertex_direct", Expect::Pass, Expect::PassWithNegativeVarianceReplaced},
     {"orthographic_sensor", "test_orthographic_path", Expect::Pass, Expect::Pass},
+    {"participating_media", "test_hetero_sigmat_volpath", Expect::Pass, Expect::Pass},
+    {"participating_media", "test_homo_area_light_volpath", Expect::Pass, Expect::Pass},
+    {"participating_media", "test_homo_dielectric_envmap_volpath", Expect::Pass, Expect::Pass},
+    {"participating_media", "test_homo_null_envmap_volpath", Expect::Pass, Expect::Pass},
+    {"participating_media", "test_homo_obj_inside_medium_volpath", Expect::Pass, Expect::Pass},
+    {"participating_media", "test_homo_roughdielectric_spot_volpath", Expect::Pass, Expect::Pass},
+    {"participating_media", "test_surf_area_light_volpath", Expect::Pass, Expect::Pass},
     {"projector", "test_projector_constant_direct", Expect::Pass, Expect::Pass},
     {"projector", "test_projector_textured_direct", Expect::Pass, Expect::PassWithNegativeVarianceReplaced},
     {"spot_light", "test_spot_direct", Expect::PassWithNegativeVarianceReplaced, Expect::PassWithNegativeVarianceReplaced},

@@ -11,10 +11,12 @@
 
 namespace candela {
 
-std::vector<const IntegratorEntry*> auto_candidates(const RenderSettings& settings) {
+std::vector<const IntegratorEntry*> auto_candidates(const RenderSettings& settings, bool has_media) {
   std::vector<const IntegratorEntry*> candidates;
+  // With media only the integrators that render them apply; without, volpath is the path tracer
+  // with one shadow ray and adds nothing to compare.
   for (const IntegratorEntry& entry : integrators())
-    if (set_but_unread(entry, settings).empty()) candidates.push_back(&entry);
+    if (set_but_unread(entry, settings).empty() && entry.participating_media == has_media) candidates.push_back(&entry);
   return candidates;
 }
 
@@ -42,7 +44,7 @@ AutoChoice choose_integrator(const Scene& scene, const RenderSettings& settings,
   if (!settings.sampler.replicas) throw std::logic_error("choose_integrator: the pilots need the sampler's replicas");
   Cluster& cluster = options.cluster ? *options.cluster : local_cluster();
   AutoChoice choice;
-  const std::vector<const IntegratorEntry*> candidates = auto_candidates(settings);
+  const std::vector<const IntegratorEntry*> candidates = auto_candidates(settings, scene.has_media());
   if (candidates.empty()) throw std::invalid_argument("--integrator auto: no integrator reads every setting the scene sets");
   const double time_limit = options.time_limit_seconds;
   const double slice = time_limit > 0 ? 0.1 * time_limit / double(candidates.size()) : kPilotSeconds;

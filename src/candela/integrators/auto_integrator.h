@@ -41,7 +41,7 @@ struct AutoChoice {
 };
 
 // The integrators that read every selective setting `settings` sets (integrator.h).
-std::vector<const IntegratorEntry*> auto_candidates(const RenderSettings& settings);
+std::vector<const IntegratorEntry*> auto_candidates(const RenderSettings& settings, bool has_media);
 
 // Runs the pilots (settings.integrator is ignored; settings.sampler.replicas must be on) under
 // `options` (its time limit or target error is the budget; the film must be empty) and chooses.

@@ -8,6 +8,7 @@
 #include "candela/integrators/bdpt.h"
 #include "candela/integrators/mlt.h"
 #include "candela/integrators/path_integrator.h"
+#include "candela/integrators/volpath.h"
 
 namespace candela {
 
@@ -25,6 +26,10 @@ const std::vector<IntegratorEntry>& integrators() {
        {"mlt"},
        /*resumable=*/false, /*single_pixel=*/false, /*strategy_images=*/false, /*samples_are_mutations=*/true,
        render_mlt},
+      {"volpath", "volumetric path tracing: participating media by delta and ratio tracking, spectral MIS, NEE",
+       {"rr_start_depth", "adaptive"},
+       /*resumable=*/true, /*single_pixel=*/true, /*strategy_images=*/false, /*samples_are_mutations=*/false,
+       render_volpath, /*participating_media=*/true},
   };
   return table;
 }
@@ -80,6 +85,10 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
     throw std::invalid_argument(fmt::format("unknown integrator '{}' (known: {})", settings.integrator, integrator_names()));
   if (settings.adaptive() && !integrator->reads_setting("adaptive"))
     throw std::invalid_argument(fmt::format("adaptive sampling does not apply to the {} integrator", integrator->name));
+  if (scene.has_media() && !integrator->participating_media)
+    throw std::invalid_argument(fmt::format(
+        "the scene has participating media, which the {} integrator does not render: use --integrator volpath",
+        integrator->name));
   if (options.only_x >= 0 && !integrator->single_pixel)
     throw std::invalid_argument(fmt::format("the {} integrator cannot render a single pixel", integrator->name));
   const bool started = film.total_samples() > 0 ||

@@ -43,6 +43,7 @@ struct IntegratorEntry {
   bool strategy_images = false;  // writes per-strategy images (--bdpt-strategies)
   bool samples_are_mutations = false;  // RenderSettings::spp counts Markov chain mutations per pixel
   RenderStats (*render)(const Scene&, const RenderSettings&, Film&, const RenderOptions&) = nullptr;
+  bool participating_media = false;  // renders scenes with participating media
 
   bool reads_setting(std::string_view key) const;
 };

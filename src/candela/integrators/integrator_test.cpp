@@ -15,7 +15,7 @@ namespace {
 using Keys = std::vector<std::string_view>;
 
 TEST(IntegratorRegistry, NamesComeFromTheTable) {
-  EXPECT_EQ(integrator_names(), "path, bdpt, mlt");
+  EXPECT_EQ(integrator_names(), "path, bdpt, mlt, volpath");
   for (const IntegratorEntry& entry : integrators()) {
     EXPECT_EQ(find_integrator(entry.name), &entry);
     EXPECT_NE(entry.render, nullptr) << entry.name;
@@ -39,7 +39,7 @@ TEST(IntegratorRegistry, SetButUnreadListsWhatDiffersFromTheDefaultsAndTheIntegr
   EXPECT_EQ(set_but_unread(*find_integrator("bdpt"), settings), (Keys{"mis", "light_selection=paper", "mlt"}));
   EXPECT_EQ(set_but_unread(*find_integrator("mlt"), settings), (Keys{"mis", "light_selection=paper", "adaptive"}));
   EXPECT_EQ(unread_setting_message(*find_integrator("mlt"), "adaptive"),
-            "the mlt integrator does not read adaptive (adaptive sampling; read by: path, bdpt)");
+            "the mlt integrator does not read adaptive (adaptive sampling; read by: path, bdpt, volpath)");
 }
 
 TEST(IntegratorRegistry, RenderRefusesWhatTheIntegratorCannotDo) {

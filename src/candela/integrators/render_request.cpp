@@ -64,7 +64,7 @@ namespace {
 void check_integrator_flags(const RenderRequest& request, const SceneDesc& scene) {
   if (scene.settings.integrator == "auto") {
     // Every candidate must read what the scene and the flags set.
-    if (auto_candidates(scene.settings).empty())
+    if (auto_candidates(scene.settings, !scene.media.empty()).empty())
       throw UsageError("--integrator auto: no integrator reads every setting given (see --help for who reads what)");
     if (!request.bdpt_strategies.empty()) throw UsageError("--bdpt-strategies needs --integrator bdpt, not auto");
     return;

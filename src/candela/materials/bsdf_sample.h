@@ -12,6 +12,10 @@ struct BsdfSample {
                     // probability of the chosen event (only used to skip MIS)
   bool is_delta = false;
   float eta = 1;    // relative index of refraction crossed (1 for reflection); for Russian roulette
+  // Continues straight on without scattering (wi = -wo: a mask's absent part, a thin sheet's
+  // transmission): Mitsuba's "null" events, which its volumetric path tracer does not count as a
+  // bounce and which shadow rays see through.
+  bool passes_through = false;
 };
 
 inline float cos_theta(const Vec3& w) { return w.z; }

@@ -32,9 +32,16 @@ struct DielectricBsdf {
   RGB reflectance{1.0f};
   RGB transmittance{1.0f};
   Microfacet distribution;  // GGX or Beckmann
+  // A thin sheet (Mitsuba's thindielectric): smooth, reflects with the probability of the sheet's
+  // two faces and their internal reflections, else lets light through without bending it.
+  bool thin = false;
 
   // An index-matched interface does not refract, whatever its roughness.
-  bool is_smooth() const { return eta == 1 || distribution.effectively_smooth(); }
+  bool is_smooth() const { return thin || eta == 1 || distribution.effectively_smooth(); }
+
+  // The fraction a thin sheet lets straight through at incidence cos_theta: 1 - R', with
+  // R' = R + T^2 R / (1 - R^2) summing the light reflected back and forth inside it.
+  RGB thin_transmission(float cos_theta) const { return transmittance * (1 - thin_reflectance(cos_theta)); }
 
   RGB eval(const Vec3& wo, const Vec3& wi) const {
     HalfVector h;
@@ -57,6 +64,11 @@ struct DielectricBsdf {
   }
 
   std::optional<BsdfSample> sample(const Vec3& wo, float u_lobe, Vec2 u) const {
+    if (thin) {
+      float r = thin_reflectance(wo.z);
+      if (u_lobe < r) return BsdfSample{reflect_local(wo), reflectance, r, true, 1};
+      return BsdfSample{-wo, transmittance, 1 - r, true, 1, true};
+    }
     if (is_smooth()) return sample_smooth(wo, u_lobe);
     if (wo.z == 0) return std::nullopt;
     const Microfacet& d = distribution;
@@ -87,6 +99,11 @@ struct DielectricBsdf {
   float non_delta_probability(const Vec3& /*wo*/) const { return is_smooth() ? 0.0f : 1.0f; }
 
  private:
+  float thin_reflectance(float cos_theta) const {
+    float r = fresnel_dielectric(std::abs(cos_theta), eta);
+    return r < 1 ? r + (1 - r) * (1 - r) * r / (1 - r * r) : 1.0f;
+  }
+
   struct HalfVector {
     Vec3 wm;
     float etap = 1;

@@ -93,8 +93,13 @@ MaterialTable::MaterialTable(const std::vector<MaterialDesc>& descs, const Textu
     : textures_(&textures) {
   auto name = [&](size_t i) { return place_of ? fmt::format("{}: material {}", place_of(i), i) : fmt::format("material {}", i); };
   entries_.reserve(descs.size() + 1);
-  for (const auto& d : descs) entries_.push_back({d, std::nullopt, std::holds_alternative<InterfaceMaterial>(d), {}});
-  entries_.push_back({DiffuseMaterial{RGB(0.5f)}, std::nullopt, false, {}});
+  for (const auto& d : descs) {
+    const auto* dielectric = std::get_if<DielectricMaterial>(&d);
+    bool interface = std::holds_alternative<InterfaceMaterial>(d);
+    bool passes = interface || std::holds_alternative<MaskMaterial>(d) || (dielectric && dielectric->thin);
+    entries_.push_back({d, std::nullopt, interface, passes, {}});
+  }
+  entries_.push_back({DiffuseMaterial{RGB(0.5f)}, std::nullopt, false, false, {}});
   // Wrappers refer to materials before them, so one pass in order sees every nested material done.
   std::vector<int> leaves(entries_.size(), 1);
   std::vector<bool> constant(entries_.size(), true);
@@ -113,6 +118,7 @@ MaterialTable::MaterialTable(const std::vector<MaterialDesc>& descs, const Textu
     for (int n : nested) {
       if (n < 0 || size_t(n) >= i)
         throw SceneError(fmt::format("{}: wraps material {}, which is not a material before it", name(i), n));
+      e.may_pass_through = e.may_pass_through || entries_[size_t(n)].may_pass_through;
       if (std::holds_alternative<TwoSidedMaterial>(entries_[size_t(n)].desc))
         throw SceneError(fmt::format("{}: wraps material {}, which has two sides; a two-sided material must be "
                                      "the outermost (it is chosen per hit by the side seen)", name(i), n));
@@ -274,7 +280,7 @@ Bsdf MaterialTable::build(const Entry& entry, const TextureEvalContext& ctx) con
         } else if constexpr (std::is_same_v<T, MirrorMaterial>) {
           return MirrorBsdf{albedo(m.reflectance)};
         } else if constexpr (std::is_same_v<T, DielectricMaterial>) {
-          return DielectricBsdf{m.ior, albedo(m.reflectance), albedo(m.transmittance), distribution(m.roughness)};
+          return DielectricBsdf{m.ior, albedo(m.reflectance), albedo(m.transmittance), distribution(m.roughness), m.thin};
         } else if constexpr (std::is_same_v<T, ConductorMaterial>) {
           RGB eta = color(m.eta), k = color(m.k);
           if (m.reflectance) {

@@ -52,6 +52,9 @@ class MaterialTable {
   bool perturbs_normals(uint32_t material) const { return !entries_[material].perturbations.empty(); }
   // An interface material has no surface: rays pass through it (pbrt-v4's "interface").
   bool is_interface(uint32_t material) const { return entries_[material].interface; }
+  // Whether some light may pass the surface straight on (interfaces, masks, thin sheets): where
+  // shadow rays may see through it (SurfaceBsdf::pass_through says how much).
+  bool may_pass_through(uint32_t material) const { return entries_[material].may_pass_through; }
   // Whether the BSDF is black whatever the hit (pure emitters, light blockers): paths end there.
   size_t size() const { return entries_.size(); }
   uint32_t default_material() const { return uint32_t(entries_.size() - 1); }
@@ -61,6 +64,7 @@ class MaterialTable {
     MaterialDesc desc;
     std::optional<SurfaceBsdf> constant;
     bool interface = false;
+    bool may_pass_through = false;
     std::vector<int> perturbations;  // the normal / bump map materials that apply, outermost first
     std::shared_ptr<const RoughCoatTable> coat_table;  // for a tabulated coated diffuse
   };

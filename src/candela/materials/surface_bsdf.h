@@ -150,7 +150,20 @@ struct SurfaceBsdf {
       }
     }
     if (!(null_weight > 0)) return std::nullopt;
-    return BsdfSample{-wo, RGB(1.0f), null_weight / t, true, 1};
+    return BsdfSample{-wo, RGB(1.0f), null_weight / t, true, 1, true};
+  }
+
+  // What passes straight through towards -wo without scattering (the null part, and the
+  // transmission of thin sheets): the factor a shadow ray that crosses the surface carries, where
+  // an integrator lets shadow rays see through (Mitsuba's eval_null_transmission).
+  RGB pass_through(const Vec3& wo) const {
+    RGB sum(null_weight);
+    for (int k = 0; k < count; ++k) {
+      const Component& c = components[size_t(k)];
+      if (const auto* d = std::get_if<DielectricBsdf>(&c.bsdf); d && d->thin && c.weight > 0 && !c.one_sided)
+        sum += d->thin_transmission(wo.z) * c.weight;
+    }
+    return sum / total();
   }
 
   bool has_non_delta() const {

@@ -377,6 +377,12 @@ struct ShapeDesc {
   // Independently of this, a to_world that swaps handedness keeps normals equal to the object-space
   // normals transformed as normals (pbrt-v4's convention).
   bool reverse_orientation = false;
+  // The participating media on either side (indices into SceneDesc::media; -1 = vacuum): interior on
+  // the side opposite the surface normal. A ray crossing a shape whose two differ enters the one on
+  // the side it goes to; where they are equal the ray keeps the medium it has (pbrt-v4's
+  // MediumInterface, Mitsuba's interior/exterior).
+  int interior_medium = -1, exterior_medium = -1;
+  bool is_medium_transition() const { return interior_medium != exterior_medium; }
   std::string name;      // for messages
   SourceLocation where;  // where the scene file declares it (file empty = unknown), for messages
 };
@@ -396,6 +402,52 @@ struct InstanceDesc {
   std::optional<Transform> to_world_end;  // moving instance, as ShapeDesc::to_world_end
   SourceLocation where;
 };
+
+// ---------------------------------------------------------------- participating media
+
+// A quantity that varies over space (Mitsuba's volume plugins): a constant, or samples on a grid over
+// the unit cube [0,1]^3 of its own space, which to_world places in the scene. Sample (i, j, k) sits at
+// the voxel centre ((i + 0.5) / nx, (j + 0.5) / ny, (k + 0.5) / nz); values in between are trilinear,
+// and between the outermost centres and the cube's faces they are clamped (Mitsuba's gridvolume with
+// its default wrap mode "clamp") or fade to zero (pbrt-v4's grids, whose samples beyond the grid are 0).
+enum class VolumeBorder { Clamp, Zero };
+struct VolumeDesc {
+  RGB constant{1.0f};  // the value everywhere when there is no grid
+  std::array<int, 3> resolution{0, 0, 0};
+  int channels = 1;  // 1 (a scalar) or 3 (RGB)
+  // nx ny nz channels floats, a sample's channels together, x fastest, then y, then z; null = constant.
+  std::shared_ptr<const std::vector<float>> values;
+  Transform to_world;    // the grid's unit cube to world space
+  VolumeBorder border = VolumeBorder::Clamp;
+  std::string filename;  // where it was read from, for messages (empty: made in memory)
+  bool is_constant() const { return !values; }
+};
+
+// A participating medium (pbrt-v4's homogeneous and uniformgrid, Mitsuba 3's homogeneous and
+// heterogeneous): extinction sigma_t(p) = scale * sigma_t * density(p), of which the fraction
+// albedo(p) scatters (sigma_s = albedo sigma_t) and the rest is absorbed (sigma_a = sigma_t - sigma_s).
+// A medium whose density is a grid has no density outside the grid's cube (Mitsuba bounds a
+// heterogeneous medium by its volume's box). It emits radiance `emission` in proportion to absorption
+// (the source term sigma_a Le, as pbrt-v4 defines Le). Light scatters by Henyey-Greenstein's phase
+// function with mean cosine g in (-1, 1) (0: isotropic).
+struct MediumDesc {
+  RGB sigma_t{1.0f};    // per unit length, times density and scale
+  VolumeDesc density;   // a scalar; constant 1 = homogeneous
+  VolumeDesc albedo;    // RGB in [0, 1]
+  float scale = 1;
+  RGB emission{0.0f};
+  float g = 0;
+  std::string name;      // for messages
+  SourceLocation where;  // where the scene file declares it
+  bool is_homogeneous() const { return density.is_constant() && albedo.is_constant(); }
+};
+
+// pbrt-v4's and JSON's way of giving a medium: absorption and scattering coefficients.
+inline void set_sigma_a_sigma_s(MediumDesc& m, const RGB& sigma_a, const RGB& sigma_s) {
+  m.sigma_t = sigma_a + sigma_s;
+  m.albedo.constant = {m.sigma_t.r > 0 ? sigma_s.r / m.sigma_t.r : 0.0f, m.sigma_t.g > 0 ? sigma_s.g / m.sigma_t.g : 0.0f,
+                       m.sigma_t.b > 0 ? sigma_s.b / m.sigma_t.b : 0.0f};
+}
 
 // ---------------------------------------------------------------- lights (those that are not shapes)
 
@@ -498,6 +550,8 @@ struct CameraDesc {
   float focus_distance = 1e6f;
   // Each camera path gets a time uniformly in [shutter_open, shutter_close] (motion blur).
   float shutter_open = 0, shutter_close = 1;
+  // The participating medium the camera sits in (index into SceneDesc::media; -1 = vacuum).
+  int medium = -1;
 };
 
 // For models that bring no camera (OBJ, glTF): a perspective camera looking along -z at the box
@@ -664,6 +718,7 @@ struct SceneDesc {
   std::vector<ObjectDesc> objects;
   std::vector<InstanceDesc> instances;
   std::vector<LightDesc> lights;
+  std::vector<MediumDesc> media;  // referred to by shapes' interior/exterior and the camera
   // The times at which ShapeDesc::to_world and to_world_end hold (pbrt's TransformTimes).
   float transform_start_time = 0, transform_end_time = 1;
   std::string source_file;  // the file it was read from, for messages and image metadata

@@ -95,6 +95,17 @@ void Scene::build(const SceneDesc& desc, SceneDesc* take_meshes) {
   textures_ = TextureSet(desc.textures, [&](size_t i) { return place(place_in(desc.places.textures, i)); });
   materials_ = MaterialTable(desc.materials, textures_,
                              [&](size_t i) { return place(place_in(desc.places.materials, i)); });
+  for (const MediumDesc& m : desc.media) {
+    with_place(m.where, [&] {
+      if (std::string problem = medium_problem(m); !problem.empty())
+        throw SceneError(fmt::format("medium \"{}\": {}", m.name, problem));
+      return 0;
+    });
+    media_.emplace_back(m);
+  }
+  camera_medium_ = desc.camera.medium;
+  if (camera_medium_ < -1 || camera_medium_ >= int(media_.size()))
+    throw SceneError(fmt::format("{}: the camera is in medium {}, which does not exist", source_file_, camera_medium_));
   for (size_t i = 0; i < desc.shapes.size(); ++i)
     add_shape(desc.shapes[i], i, -1, take_meshes ? mesh_to_take(take_meshes, take_meshes->shapes, i) : nullptr);
   add_objects_and_instances(desc, take_meshes);
@@ -206,6 +217,11 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int object, TriangleM
   rec.material = desc.material >= 0 && size_t(desc.material) < materials_.size() - 1 ? uint32_t(desc.material)
                                                                                     : materials_.default_material();
   rec.flip_normal = desc.reverse_orientation;
+  rec.interior_medium = desc.interior_medium;
+  rec.exterior_medium = desc.exterior_medium;
+  for (int m : {desc.interior_medium, desc.exterior_medium})
+    if (m < -1 || m >= int(media_.size()))
+      throw SceneError(fmt::format("{}: refers to medium {}, which does not exist", rec.name, m));
   const Transform& T = desc.to_world;
   const Transform* T_end = moving_end_transform(desc);
   // Lights are sampled at fixed positions, so emitters stay put.

@@ -10,6 +10,7 @@
 #include "candela/geometry/surface_hit.h"
 #include "candela/lights/light.h"
 #include "candela/materials/material.h"
+#include "candela/media/medium.h"
 #include "candela/sampling/distribution1d.h"
 #include "candela/scene/description.h"
 #include "candela/textures/texture.h"
@@ -25,6 +26,8 @@ struct ShapeRecord {
   RGB radiance;          // emitted radiance when emissive
   bool two_sided_emission = false;
   int emission_texture = -1;  // textured emitters: index into the scene's textures
+  // The media on the side opposite the oriented normal and on its side (SceneDesc::media; -1 = vacuum).
+  int interior_medium = -1, exterior_medium = -1;
   bool flip_normal = false;  // spheres, planes, disks, cylinders and SDF grids: reverse orientation
   bool winding_swapped = false;  // triangles: indices 1 and 2 swapped to orient the normal
   // Triangles, in world space, winding baked so cross(p1-p0, p2-p0) is the oriented normal.
@@ -79,6 +82,22 @@ class Scene {
   TextureEvalContext texture_context(const SurfaceHit& hit) const;
   // Whether the surface hit is an interface without a surface of its own (rays pass through).
   bool is_interface(const SurfaceHit& hit) const { return materials_.is_interface(shapes_[hit.shape].material); }
+  // Whether light may pass the hit's surface straight on (interfaces, masks, thin sheets).
+  bool may_pass_through(const SurfaceHit& hit) const { return materials_.may_pass_through(shapes_[hit.shape].material); }
+
+  // Participating media (SceneDesc::media), indexed as there.
+  const std::vector<Medium>& media() const { return media_; }
+  bool has_media() const { return !media_.empty(); }
+  // The medium camera rays start in (-1 = vacuum).
+  int camera_medium() const { return camera_medium_; }
+  // The medium a ray that leaves the hit along `dir` travels in, given the one it arrived in
+  // (`current`): the shape's interior or exterior by the side `dir` goes to where the two differ.
+  int medium_after(const SurfaceHit& hit, const Vec3& dir, int current) const {
+    const ShapeRecord& rec = shapes_[hit.shape];
+    if (rec.interior_medium == rec.exterior_medium) return current;
+    return dot(dir, hit.ng) > 0 ? rec.exterior_medium : rec.interior_medium;
+  }
+
   // Radiance emitted from the hit point towards wo (zero for non-emitters and their back faces).
   RGB emitted(const SurfaceHit& hit, const Vec3& wo) const;
   // The light of an emissive hit, or -1.
@@ -148,6 +167,8 @@ class Scene {
   std::vector<Light> lights_;
   Distribution1D light_distribution_;
   std::vector<uint32_t> infinite_lights_;
+  std::vector<Medium> media_;
+  int camera_medium_ = -1;
   PerspectiveCamera camera_;
   Bounds3 bounds_;
   SceneSphere bounding_sphere_;

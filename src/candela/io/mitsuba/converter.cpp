@@ -40,7 +40,7 @@ SceneDesc Converter::convert(const Object& scene) {
       shape(*o, nullptr);
     } else if (o->tag == "emitter") {
       emitter(*o);
-    } else if (o->tag == "bsdf" || o->tag == "texture") {
+    } else if (o->tag == "bsdf" || o->tag == "texture" || o->tag == "medium") {
       continue;  // used where referenced
     } else {
       throw_scene_error(o->where.loc(), "<{}> cannot occur directly inside <scene>", o->tag);

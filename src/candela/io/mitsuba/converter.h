@@ -131,6 +131,16 @@ class Converter {
 
   std::pair<int, int> texture_size(int index);
 
+  // ------------------------------------------------ participating media (media.cpp)
+
+  // The medium `m` (memoised: shapes refer to one medium by id), as an index into SceneDesc::media.
+  int medium(const Object& m);
+  // A medium parameter given as a colour or a float, or as a nested volume.
+  VolumeDesc volume_parameter(const Object& m, std::string_view name, RGB fallback);
+  float phase_g(const Object& m);
+  // A shape's or the sensor's nested medium references: interior/exterior, or (sensor) the medium.
+  void shape_media(const Object& s, ShapeDesc& out);
+
   // ------------------------------------------------ sensor, film, sampler, integrator
 
   static FilterDesc gaussian_filter(float stddev);
@@ -154,6 +164,7 @@ class Converter {
   std::map<std::pair<const Object*, TextureLookup>, int> texture_memo_;
   std::map<std::pair<const Object*, bool>, int> bsdf_memo_;
   std::map<const Object*, int> group_memo_;
+  std::map<const Object*, int> medium_memo_;
   int default_material_ = -1;
 };
 

@@ -38,6 +38,9 @@ void Converter::sensor(const Object& s) {
   for (const char* name : {"principal_point_offset_x", "principal_point_offset_y"})
     if (get_float(s, name, 0) != 0)
       throw_scene_error(s.where.loc(), "{}: {} is not supported", s.describe(), name);
+  auto media = nested(s, "medium");
+  if (media.size() > 1) throw_scene_error(media[1].first->where.loc(), "{}: more than one medium", s.describe());
+  if (!media.empty()) cam.medium = medium(*media[0].second);
   ignore(s, "shutter_open");
   ignore(s, "shutter_close");
   ignore(s, "srf", nullptr);
@@ -173,15 +176,14 @@ void Converter::integrator(const Object& i) {
   if (i.type == "path" || i.type == "ptracer" || i.type == "volpath" || i.type == "volpathmis") {
     // A particle tracer's strength, paths from the lights connected to the camera, is BDPT's
     // t = 1 strategy: BDPT renders ptracer scenes with it (and the other strategies, under MIS).
-    rs.integrator = i.type == "ptracer" ? "bdpt" : "path";
+    // volpath and volpathmis (the same expectation; candela's volpath always does spectral MIS).
+    rs.integrator = i.type == "ptracer" ? "bdpt" : i.type == "path" ? "path" : "volpath";
     rs.max_depth = candela_depth(get_int(i, "max_depth", -1));
     int rr = get_int(i, "rr_depth", 5);
     rs.rr_start_depth = std::max(1, rr - 1);
     rs.hide_emitters = get_bool(i, "hide_emitters", false);
     if (i.type == "ptracer")
       warn(i.where, "integrator \"ptracer\": rendering with candela's bidirectional path tracer (the same expectation)");
-    if (i.type != "path" && i.type != "ptracer")
-      warn(i.where, "integrator \"{}\": rendering with candela's path tracer (no participating media)", i.type);
     ignore(i, "samples_per_pass");
   } else if (i.type == "direct") {
     rs.integrator = "path";
@@ -192,7 +194,7 @@ void Converter::integrator(const Object& i) {
       warn(i.where, "integrator \"direct\": emitter_samples/bsdf_samples are ignored (one of each, with MIS)");
     rs.hide_emitters = get_bool(i, "hide_emitters", false);
   } else {
-    throw_scene_error(i.where.loc(), "unknown integrator type \"{}\" (supported: path, direct, ptracer, moment)",
+    throw_scene_error(i.where.loc(), "unknown integrator type \"{}\" (supported: path, volpath, volpathmis, direct, ptracer, moment)",
                       i.type);
   }
   check_all_used(i);

@@ -120,6 +120,7 @@ void Converter::shape(const Object& s, ObjectDesc* group) {
                       type);
   }
   out.reverse_orientation = get_bool(s, "flip_normals", false);
+  shape_media(s, out);
   auto bsdfs = nested(s, "bsdf");
   if (bsdfs.size() > 1) throw_scene_error(bsdfs[1].first->where.loc(), "a shape can have only one bsdf");
   out.material = bsdfs.empty() ? default_material() : bsdf(*bsdfs[0].second, false);

@@ -290,8 +290,6 @@ class XmlParser {
     if (is_object_tag(tag)) {
       if (tag == "scene") throw_scene_error(where.loc(), "<scene> can only be the root element");
       check_attributes(doc, node, {"type", "id", "name", "version"});
-      if (tag == "medium" || tag == "phase" || tag == "volume")
-        throw_scene_error(where.loc(), "<{}>: participating media are not supported", tag);
       Object* o = new_object(tag, required(doc, node, "type"), where);
       if (pugi::xml_attribute id = node.attribute("id")) {
         o->id = id.value();

@@ -1,0 +1,432 @@
+#include "candela/integrators/volpath.h"
+
+#include <bit>
+#include <cmath>
+#include <limits>
+
+#include "candela/materials/spectral_bsdf.h"
+#include "candela/render/camera_sample_tiles.h"
+#include "candela/sampling/rng.h"
+#include "candela/sampling/samplers.h"
+
+namespace candela {
+
+namespace {
+
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
+// exp(-sigma dt) per channel; 1 where sigma is 0, also over an infinite distance.
+RGB exp_neg(const RGB& sigma, float dt) {
+  auto e = [dt](float s) { return s > 0 ? std::exp(-s * dt) : 1.0f; };
+  return {e(sigma.r), e(sigma.g), e(sigma.b)};
+}
+
+RGB clamp_zero(const RGB& c) { return {std::max(c.r, 0.0f), std::max(c.g, 0.0f), std::max(c.b, 0.0f)}; }
+
+// A medium's coefficients at a path's wavelengths (RGB when there are none).
+struct MediumValues {
+  const Medium& medium;
+  const Wavelengths* wl;
+  RGB sigma_t, albedo, emission;
+  MediumValues(const Medium& m, const Wavelengths* w)
+      : medium(m),
+        wl(w),
+        sigma_t(w ? unbounded_at(m.sigma_t(), *w) : m.sigma_t()),
+        albedo(w ? reflectance_at(m.albedo(Point3(0.0f)), *w) : m.albedo(Point3(0.0f))),
+        emission(illuminant_at(m.emission(), w)) {}
+  MediumPoint at(const Point3& p) const {
+    RGB st = sigma_t * medium.density(p);
+    RGB a = albedo;
+    if (medium.has_albedo_grid()) a = wl ? reflectance_at(medium.albedo(p), *wl) : medium.albedo(p);
+    RGB ss = st * a;
+    return {clamp_zero(st - ss), ss};
+  }
+};
+
+// Delta tracking against the majorant along `ray` (unit direction) over [t_min, t_max) (pbrt-v4's
+// SampleT_maj): tentative collisions are drawn with the hero channel's majorant; at each,
+// event(p, point, sigma_maj, T_maj) gets the majorant transmittance since the previous one, and
+// returns whether to go on. Returns the majorant transmittance from the last collision to t_max
+// (1 when an event stopped the walk).
+template <typename Event>
+RGB sample_majorant(const MediumValues& mv, const Ray& ray, float t_min, float t_max, int hero, Rng& rng,
+                    Event&& event) {
+  RGB T_maj(1.0f);
+  bool stopped = false;
+  mv.medium.for_each_majorant(ray, t_min, t_max, [&](float t0, float t1, float density_bound) {
+    const RGB sigma_maj = mv.sigma_t * density_bound;
+    if (!(sigma_maj[hero] > 0)) {
+      T_maj *= exp_neg(sigma_maj, t1 - t0);
+      return true;
+    }
+    for (float t = t0;;) {
+      float dt = -std::log1p(-rng.next_float()) / sigma_maj[hero];
+      if (!(t + dt < t1)) {
+        T_maj *= exp_neg(sigma_maj, t1 - t);
+        return true;
+      }
+      t += dt;
+      T_maj *= exp_neg(sigma_maj, dt);
+      const Point3 p = ray.at(t);
+      if (!event(p, mv.at(p), sigma_maj, T_maj)) {
+        stopped = true;
+        return false;
+      }
+      T_maj = RGB(1.0f);
+    }
+  });
+  return stopped ? RGB(1.0f) : T_maj;
+}
+
+// A fresh random stream for a medium walk from two sampler dimensions (pbrt-v4 does the same), so
+// that the unbounded number of collisions does not consume sampler dimensions.
+template <typename Sampler>
+Rng walk_rng(Sampler& sampler) {
+  uint64_t a = std::bit_cast<uint32_t>(sampler.get_1d()), b = std::bit_cast<uint32_t>(sampler.get_1d());
+  return Rng(hash_values(a, b), hash_values(b, a, 7));
+}
+
+}  // namespace
+
+struct VolPathIntegrator::ScatterPoint {
+  LightSampleContext ctx;  // the point, and the gathering side's normal (zero in media)
+  Normal3 ng;              // surfaces: the geometric normal (ray offsets); zero in media
+  const SurfaceHit* hit = nullptr;
+  const SurfaceBsdf* bsdf = nullptr;  // surfaces
+  const Frame* frame = nullptr;
+  Vec3 wo_local;
+  const HenyeyGreenstein* phase = nullptr;  // media
+  Vec3 wo;                                  // world space, towards the previous vertex
+  int medium = -1;                          // the medium the path is in at this point
+  float time = 0;
+  const Wavelengths* wl = nullptr;
+};
+
+VolPathIntegrator::VolPathIntegrator(const Scene& scene, const RenderSettings& settings)
+    : scene_(scene),
+      max_depth_(settings.max_depth),
+      rr_start_depth_(settings.rr_start_depth),
+      hide_emitters_(settings.hide_emitters) {}
+
+template <typename Sampler>
+RGB VolPathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, const Wavelengths* wl) const {
+  // Distances in media are measured in world units.
+  const float length_scale = length(ray.direction);
+  ray.direction = ray.direction / length_scale;
+  ray.t_min *= length_scale;
+
+  RGB L(0.0f), beta(1.0f), r_u(1.0f), r_l(1.0f);
+  const int hero = std::min(int(sampler.get_1d() * 3), 2);
+  bool specular_bounce = false;
+  float eta_scale = 1;
+  LightSampleContext prev_ctx;
+  int medium = scene_.camera_medium();
+  int depth = 0;
+  ++counts.camera;
+
+  // Possibly terminate the path with Russian roulette (after a real scattering event); survivors
+  // are reweighted so that the estimate stays unbiased.
+  auto survives_roulette = [&]() {
+    RGB rr_beta = beta * (eta_scale / r_u.average());
+    float u = sampler.get_1d();
+    if (depth > rr_start_depth_ && rr_beta.max_component() < 1) {
+      float q = std::max(0.0f, 1 - rr_beta.max_component());
+      if (u < q) return false;
+      beta = beta / (1 - q);
+    }
+    return true;
+  };
+
+  // Light found by the path (an emitter hit or the sky): MIS-weighted against light sampling from
+  // the previous real scattering point unless nothing else could have found it.
+  auto add_emitted = [&](const RGB& Le, uint32_t light, const Point3& p, const Normal3& n) {
+    if (depth == 0 || specular_bounce) {
+      L += beta * Le / r_u.average();
+      return;
+    }
+    float light_pdf = scene_.light_distribution().pmf(light) *
+                      light_pdf_li(scene_.lights()[light], prev_ctx, ray.direction, p, n);
+    L += beta * Le / (r_u + r_l * light_pdf).average();
+  };
+
+  for (;;) {
+    SurfaceHit hit;
+    const bool found = scene_.intersect(ray, hit);
+
+    // Sample the medium the ray travels in, up to the surface: absorption, real scattering (then
+    // the path continues from the scattering point), or null collisions that walk on.
+    if (medium >= 0) {
+      bool scattered = false, terminated = false;
+      Ray scattered_ray;  // the continuation after a real scattering event
+      const Medium& m = scene_.media()[size_t(medium)];
+      const MediumValues mv(m, wl);
+      Rng rng = walk_rng(sampler);
+      RGB T_maj = sample_majorant(
+          mv, ray, ray.t_min, found ? hit.t : kInfinity, hero, rng,
+          [&](const Point3& p, const MediumPoint& mp, const RGB& sigma_maj, const RGB& T) {
+            // Add the medium's emission (source term sigma_a Le) at every tentative collision.
+            if (depth < max_depth_ && m.is_emissive()) {
+              float pdf = sigma_maj[hero] * T[hero];
+              RGB r_e = r_u * sigma_maj * T / pdf;
+              if (!r_e.is_black()) L += beta * T / pdf * mp.sigma_a * mv.emission / r_e.average();
+            }
+            // A real collision (with probability sigma_t over the majorant) scatters, its weight
+            // the albedo: absorption is taken as a weight, not by ending paths (as Mitsuba's
+            // volpath does), which keeps colour noise down in chromatic media; Russian roulette
+            // ends the paths whose weight has become small.
+            const RGB sigma_t = mp.sigma_a + mp.sigma_s;
+            if (rng.next_float() < sigma_t[hero] / sigma_maj[hero]) {
+              // Real scattering: estimate direct light, then continue along a phase-function sample.
+              if (depth++ >= max_depth_) {
+                terminated = true;
+                return false;
+              }
+              float pdf = T[hero] * sigma_t[hero];
+              beta *= T * mp.sigma_s / pdf;
+              r_u *= T * sigma_t / pdf;
+              if (beta.is_black() || r_u.is_black()) {
+                terminated = true;
+                return false;
+              }
+              ScatterPoint at;
+              at.ctx = {p, Normal3(0.0f)};
+              at.phase = &m.phase();
+              at.wo = -ray.direction;
+              at.medium = medium;
+              at.time = ray.time;
+              at.wl = wl;
+              if (!scene_.lights().empty()) L += sample_direct(at, sampler, beta, r_u, hero, counts);
+              PhaseSample ps = m.phase().sample(at.wo, sampler.get_2d());
+              if (!(ps.pdf > 0)) {
+                terminated = true;
+                return false;
+              }
+              // HG is sampled exactly: the weight p / pdf is 1.
+              r_l = r_u / ps.pdf;
+              prev_ctx = at.ctx;
+              specular_bounce = false;
+              scattered_ray = Ray{p, ps.wi, kInfinity, ray.time};
+              scattered = true;
+              if (!survives_roulette()) terminated = true;
+              return false;
+            }
+            // A null collision: walk on, carrying sigma_n over the hero's density.
+            RGB sigma_n = clamp_zero(sigma_maj - mp.sigma_a - mp.sigma_s);
+            float pdf = T[hero] * sigma_n[hero];
+            if (!(pdf > 0)) {
+              beta = RGB(0.0f);
+              return false;
+            }
+            beta *= T * sigma_n / pdf;
+            r_u *= T * sigma_n / pdf;
+            r_l *= T * sigma_maj / pdf;
+            return !beta.is_black() && !r_u.is_black();
+          });
+      if (terminated || beta.is_black() || r_u.is_black()) return L;
+      if (scattered) {
+        ray = scattered_ray;
+        ++counts.bounce;
+        continue;
+      }
+      // Reached the surface (or infinity): the hero's majorant transmittance was sampled, the
+      // others' are ratios.
+      if (!(T_maj[hero] > 0)) return L;
+      beta *= T_maj / T_maj[hero];
+      r_u *= T_maj / T_maj[hero];
+      r_l *= T_maj / T_maj[hero];
+    }
+
+    if (!found) {
+      // The ray escapes: the lights at infinity.
+      if (!(depth == 0 && hide_emitters_))
+        for (uint32_t li : scene_.infinite_lights()) {
+          RGB Le = illuminant_at(scene_.escaped_radiance(li, ray.direction), wl);
+          if (!Le.is_black()) add_emitted(Le, li, {}, {});
+        }
+      break;
+    }
+
+    // Light emitted by the surface hit.
+    const Vec3 wo = -ray.direction;
+    if (!(depth == 0 && hide_emitters_)) {
+      RGB Le = illuminant_at(scene_.emitted(hit, wo), wl);
+      if (!Le.is_black()) add_emitted(Le, uint32_t(scene_.light_index(hit)), hit.p, hit.ng);
+    }
+
+    // An interface has no surface: continue beyond it in the medium on its other side.
+    if (scene_.is_interface(hit)) {
+      medium = scene_.medium_after(hit, ray.direction, medium);
+      ray = Ray{offset_ray_origin(hit.p, hit.ng, ray.direction), ray.direction, kInfinity, ray.time};
+      continue;
+    }
+
+    Shading shading = scene_.shading(hit, wo);
+    bsdf_at_wavelengths(shading.bsdf, wl);
+    const SurfaceBsdf& bsdf = shading.bsdf;
+    if (bsdf.is_black()) break;
+    const Frame& frame = shading.frame;
+    const Vec3 wo_local = frame.to_local(wo);
+    if (wo_local.z == 0) break;
+
+    // Sample direct illumination where the BSDF is not purely specular, if one more scattering
+    // event is allowed.
+    const bool may_scatter = depth < max_depth_;
+    const Normal3 gather_n = bsdf.has_non_delta_transmission() ? Normal3(0.0f) : wo_local.z > 0 ? frame.n : -frame.n;
+    const LightSampleContext ctx{hit.p, gather_n};
+    if (may_scatter && bsdf.has_non_delta() && !scene_.lights().empty()) {
+      ScatterPoint at;
+      at.ctx = ctx;
+      at.ng = hit.ng;
+      at.hit = &hit;
+      at.bsdf = &bsdf;
+      at.frame = &frame;
+      at.wo_local = wo_local;
+      at.wo = wo;
+      at.medium = medium;
+      at.time = ray.time;
+      at.wl = wl;
+      L += sample_direct(at, sampler, beta, r_u, hero, counts);
+    }
+
+    // Sample the BSDF for the next direction.
+    float u_lobe = sampler.get_1d();
+    Vec2 u = sampler.get_2d();
+    auto bs = bsdf.sample(wo_local, u_lobe, u);
+    if (!bs || bs->weight.is_black()) break;
+    const Vec3 wi = normalize(frame.to_world(bs->wi));
+    beta *= bs->weight;
+    medium = scene_.medium_after(hit, wi, medium);
+    ray = Ray{offset_ray_origin(hit.p, hit.ng, wi), wi, kInfinity, ray.time};
+    // Light passing straight on is not a bounce: the MIS state of the last real scattering holds.
+    if (bs->passes_through) continue;
+    if (!may_scatter) break;
+    ++depth;
+    r_l = bs->is_delta ? r_u : r_u / bs->pdf;
+    specular_bounce = bs->is_delta;
+    prev_ctx = ctx;
+    if (bs->eta != 1) eta_scale *= bs->eta * bs->eta;
+    if (!survives_roulette()) break;
+    ++counts.bounce;
+  }
+  return L;
+}
+
+template <typename Sampler>
+RGB VolPathIntegrator::sample_direct(const ScatterPoint& at, Sampler& sampler, const RGB& beta, const RGB& r_p,
+                                     int hero, RayCounts& counts) const {
+  // Choose a light and a point on it.
+  const Distribution1D& choice = scene_.light_distribution();
+  const size_t li = choice.sample(sampler.get_1d());
+  const Vec2 u = sampler.get_2d();
+  Rng rng = walk_rng(sampler);
+  const float pmf = choice.pmf(li);
+  if (!(pmf > 0)) return RGB(0.0f);
+  const Light& light = scene_.lights()[li];
+  const LightSample ls = light_sample_li(light, at.ctx, u);
+  if (!(ls.pdf > 0) || ls.radiance.is_black()) return RGB(0.0f);
+
+  // What the scattering point does with light from there.
+  RGB f_hat;
+  float scatter_pdf;
+  Point3 origin = at.ctx.p;
+  int medium = at.medium;
+  if (at.bsdf) {
+    Vec3 wi_local = at.frame->to_local(ls.wi);
+    f_hat = at.bsdf->eval(at.wo_local, wi_local) * std::abs(wi_local.z);
+    scatter_pdf = at.bsdf->pdf(at.wo_local, wi_local);
+    origin = offset_ray_origin(at.ctx.p, at.ng, ls.wi);
+    medium = scene_.medium_after(*at.hit, ls.wi, medium);
+  } else {
+    f_hat = RGB(at.phase->p(at.wo, ls.wi));
+    scatter_pdf = at.phase->pdf(at.wo, ls.wi);
+  }
+  if (f_hat.is_black()) return RGB(0.0f);
+
+  // The shadow ray's transmittance, and the two strategies' path densities along it.
+  float t_max = kInfinity;
+  if (!std::isinf(ls.distance)) t_max = length(ls.p_light - origin) * (1 - 1e-4f);
+  RGB r_u(1.0f), r_l(1.0f);
+  uint64_t seed = hash_values(rng.next_u32(), rng.next_u32());
+  RGB T_ray = trace_transmittance(origin, ls.wi, t_max, medium, hero, seed, at.time, at.wl, r_u, r_l, counts);
+  if (T_ray.is_black()) return RGB(0.0f);
+
+  const RGB Le = illuminant_at(ls.radiance, at.wl);
+  r_l *= r_p * (pmf * ls.pdf);
+  if (ls.is_delta) return beta * f_hat * T_ray * Le / r_l.average();
+  r_u *= r_p * scatter_pdf;
+  return beta * f_hat * T_ray * Le / (r_l + r_u).average();
+}
+
+RGB VolPathIntegrator::trace_transmittance(Point3 origin, const Vec3& dir, float t_max, int medium, int hero,
+                                           uint64_t seed, float time, const Wavelengths* wl, RGB& r_u, RGB& r_l,
+                                           RayCounts& counts) const {
+  Rng rng(seed, hash_values(seed));
+  RGB T_ray(1.0f);
+  for (float remaining = t_max;;) {
+    Ray ray{origin, dir, remaining, time};
+    SurfaceHit hit;
+    ++counts.shadow;
+    const bool found = scene_.intersect(ray, hit);
+    if (found && !scene_.may_pass_through(hit)) return RGB(0.0f);
+    if (medium >= 0) {
+      // Ratio tracking: every tentative collision multiplies by sigma_n over the majorant.
+      const MediumValues mv(scene_.media()[size_t(medium)], wl);
+      RGB T_maj = sample_majorant(mv, ray, 0, found ? hit.t : remaining, hero, rng,
+                                  [&](const Point3&, const MediumPoint& mp, const RGB& sigma_maj, const RGB& T) {
+                                    RGB sigma_n = clamp_zero(sigma_maj - mp.sigma_a - mp.sigma_s);
+                                    float pdf = T[hero] * sigma_maj[hero];
+                                    T_ray *= T * sigma_n / pdf;
+                                    r_l *= T * sigma_maj / pdf;
+                                    r_u *= T * sigma_n / pdf;
+                                    // Russian roulette where little light gets through.
+                                    RGB Tr = T_ray / (r_l + r_u).average();
+                                    if (Tr.max_component() < 0.05f) {
+                                      if (rng.next_float() < 0.75f)
+                                        T_ray = RGB(0.0f);
+                                      else
+                                        T_ray = T_ray / 0.25f;
+                                    }
+                                    return !T_ray.is_black();
+                                  });
+      if (!(T_maj[hero] > 0)) return RGB(0.0f);
+      T_ray *= T_maj / T_maj[hero];
+      r_l *= T_maj / T_maj[hero];
+      r_u *= T_maj / T_maj[hero];
+    }
+    if (T_ray.is_black() || !found) return T_ray;
+    // Cross the surface: all of an interface's light, a mask's or a thin sheet's straight share.
+    if (!scene_.is_interface(hit)) {
+      Shading shading = scene_.shading(hit, -dir);
+      bsdf_at_wavelengths(shading.bsdf, wl);
+      T_ray *= shading.bsdf.pass_through(shading.frame.to_local(-dir));
+      if (T_ray.is_black()) return T_ray;
+    }
+    medium = scene_.medium_after(hit, dir, medium);
+    origin = offset_ray_origin(hit.p, hit.ng, dir);
+    remaining -= hit.t;
+    if (!(remaining > 0)) return T_ray;
+  }
+}
+
+RGB VolPathIntegrator::transmittance(const Point3& from, const Point3& to, int medium, int hero, uint64_t seed,
+                                     float time, const Wavelengths* wl) const {
+  RGB r_u(1.0f), r_l(1.0f);
+  RayCounts counts;
+  float d = length(to - from);
+  RGB T = trace_transmittance(from, (to - from) / d, d, medium, hero, seed, time, wl, r_u, r_l, counts);
+  return T / r_l.average();
+}
+
+RenderStats render_volpath(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options) {
+  const VolPathIntegrator volpath(scene, settings);
+  CameraSampleTiles tiles([&volpath](const Ray& ray, auto& sampler, RayCounts& counts, const PixelSample&,
+                                     const Wavelengths* wl) { return volpath.radiance(ray, sampler, counts, wl); });
+  return render_tiles(scene, settings, film, options, tiles);
+}
+
+#define CANDELA_INSTANTIATE(S) \
+  template RGB VolPathIntegrator::radiance<S>(Ray, S&, RayCounts&, const Wavelengths*) const;
+CANDELA_FOR_EACH_SAMPLER(CANDELA_INSTANTIATE)
+#undef CANDELA_INSTANTIATE
+
+}  // namespace candela
