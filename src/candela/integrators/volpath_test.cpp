@@ -1,0 +1,269 @@
+// The volumetric path tracer against analytic answers: transmittance through a chromatic slab,
+// furnaces of media in closed enclosures (albedo 1 inside an emitter; an emitting, absorbing medium;
+// Kirchhoff's equilibrium of emitting walls and an emitting, scattering medium), a heterogeneous
+// grid's transmittance by ratio tracking and by delta tracking against quadrature, and the refusal
+// of scenes with media by integrators that do not render them. Each render is repeated over seeds;
+// tolerances are 5 standard errors of the mean over seeds (Student's t, 7 degrees of freedom).
+#include "candela/integrators/volpath.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "candela/integrators/integrator.h"
+#include "candela/sampling/rng.h"
+#include "candela/testing/render_helpers.h"
+
+namespace candela {
+namespace {
+
+using testing::look_at_camera;
+
+constexpr int kSeeds = 8;
+
+// Mean over seeds of each channel's image mean, and its standard error.
+struct ChannelMeans {
+  RGB mean, standard_error;
+};
+
+ChannelMeans render_means(const SceneDesc& desc) {
+  const Scene scene(desc);
+  double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
+  for (uint64_t seed = 1; seed <= kSeeds; ++seed) {
+    RenderSettings settings = desc.settings;
+    settings.seed = seed;
+    Film film(desc.film.width, desc.film.height);
+    RenderOptions options;
+    options.progress = false;
+    render(scene, settings, film, options);
+    Image image = film.mean_image();
+    for (int c = 0; c < 3; ++c) {
+      double m = testing::region_mean(image, c, [](int, int) { return true; }).mean;
+      sum[c] += m;
+      sum2[c] += m * m;
+    }
+  }
+  ChannelMeans out;
+  for (int c = 0; c < 3; ++c) {
+    double m = sum[c] / kSeeds, v = std::max(0.0, (sum2[c] - kSeeds * m * m) / (kSeeds - 1));
+    out.mean[c] = float(m);
+    out.standard_error[c] = float(std::sqrt(v / kSeeds));
+  }
+  return out;
+}
+
+void expect_channels(const ChannelMeans& got, const RGB& expected, const char* what, float floor = 1e-4f) {
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(got.mean[c], expected[c], 5 * got.standard_error[c] + floor * expected[c])
+        << what << ", channel " << c << ": standard error " << got.standard_error[c];
+}
+
+SceneDesc volpath_scene(int size, int spp) {
+  SceneDesc d;
+  d.film = {size, size, ""};
+  d.settings.integrator = "volpath";
+  d.settings.spp = spp;
+  d.settings.max_depth = 1000;
+  return d;
+}
+
+// A sphere of radius 2 at the origin bounding `medium` (the medium inside, vacuum outside), black,
+// optionally emitting `wall` on both sides; the camera at its centre, in the medium.
+SceneDesc medium_in_sphere(const MediumDesc& medium, const RGB& wall) {
+  SceneDesc d = volpath_scene(8, 16);
+  d.camera = look_at_camera({0, 0, 0}, {0.3f, 0.2f, 1}, 90);
+  d.camera.medium = 0;
+  d.media = {medium};
+  d.materials = {BlackMaterial{}};
+  ShapeDesc s;
+  s.geometry = SphereShape{{0, 0, 0}, 2};
+  s.material = 0;
+  s.interior_medium = 0;
+  if (!wall.is_black()) s.emission = AreaEmission{wall, true};
+  d.shapes = {s};
+  return d;
+}
+
+TEST(VolPath, ChromaticSlabTransmitsExpOfMinusSigmaTTimesThickness) {
+  // An absorbing slab 0.8 thick between an orthographic camera and a white sky: exp(-sigma_t d)
+  // per channel, however unlike the channels' coefficients are (the hero channel drives sampling).
+  SceneDesc d = volpath_scene(8, 64);
+  d.camera.projection = Projection::Orthographic;
+  d.camera.world_from_camera = Transform::look_at_right_handed({0, 0, -3}, {0, 0, 0}, {0, 1, 0});
+  MediumDesc fog;
+  fog.sigma_t = {0.2f, 1.0f, 4.0f};
+  fog.albedo.constant = RGB(0.0f);
+  d.media = {fog};
+  d.materials = {InterfaceMaterial{}};
+  ShapeDesc slab;
+  slab.geometry = BoxShape{{-5, -5, -0.4f}, {5, 5, 0.4f}};
+  slab.material = 0;
+  slab.interior_medium = 0;
+  d.shapes = {slab};
+  d.lights = {SkyLight{RGB(1.0f), RGB(1.0f), RGB(1.0f), {0, 1, 0}}};
+  expect_channels(render_means(d), {std::exp(-0.16f), std::exp(-0.8f), std::exp(-3.2f)}, "slab");
+}
+
+TEST(VolPath, AnEnclosureThatEmitsLeFilledWithAnAlbedoOneMediumRendersLe) {
+  for (float sigma : {0.3f, 4.0f}) {
+    MediumDesc medium;
+    medium.sigma_t = RGB(sigma);
+    medium.albedo.constant = RGB(1.0f);
+    medium.g = 0.4f;
+    expect_channels(render_means(medium_in_sphere(medium, {1.0f, 2.0f, 0.5f})), {1.0f, 2.0f, 0.5f}, "albedo 1");
+  }
+}
+
+TEST(VolPath, AnEmittingAbsorbingMediumGivesLeTimesOneMinusItsTransmittance) {
+  // From the centre every ray travels 2 to the black wall: L = Le (1 - exp(-2 sigma_t)).
+  MediumDesc medium;
+  medium.sigma_t = {0.1f, 0.5f, 2.0f};
+  medium.albedo.constant = RGB(0.0f);
+  medium.emission = {3.0f, 1.0f, 2.0f};
+  RGB expected;
+  for (int c = 0; c < 3; ++c) expected[c] = medium.emission[c] * (1 - std::exp(-2 * medium.sigma_t[c]));
+  expect_channels(render_means(medium_in_sphere(medium, RGB(0.0f))), expected, "emitting absorber");
+}
+
+TEST(VolPath, EmittingWallsAndAnEmittingScatteringMediumAreInEquilibrium) {
+  // Kirchhoff: walls and medium at the same "temperature" (both emit Le where they absorb) give Le
+  // everywhere, whatever the albedo, the extinction's colour and the phase function.
+  MediumDesc medium;
+  medium.sigma_t = {0.4f, 1.5f, 3.0f};
+  medium.albedo.constant = {0.6f, 0.3f, 0.9f};
+  medium.g = -0.3f;
+  medium.emission = {0.7f, 1.2f, 2.0f};
+  expect_channels(render_means(medium_in_sphere(medium, medium.emission)), medium.emission, "equilibrium");
+}
+
+// A scene of one heterogeneous medium (a random 6^3 grid over [-1, 1]^3) bounded by an interface box.
+SceneDesc grid_scene() {
+  SceneDesc d = volpath_scene(4, 1);
+  MediumDesc m;
+  m.sigma_t = {0.5f, 1.0f, 2.0f};
+  m.scale = 1.5f;
+  m.density.resolution = {6, 6, 6};
+  std::vector<float> values(216);
+  Rng rng(5, 6);
+  for (float& v : values) v = rng.next_float() < 0.3f ? 0.0f : 3 * rng.next_float();
+  m.density.values = std::make_shared<const std::vector<float>>(values);
+  m.density.to_world = Transform::translate({-1, -1, -1}) * Transform::scale({2, 2, 2});
+  d.media = {m};
+  d.materials = {InterfaceMaterial{}};
+  ShapeDesc box;
+  box.geometry = BoxShape{{-1.5f, -1.5f, -1.5f}, {1.5f, 1.5f, 1.5f}};
+  box.material = 0;
+  box.interior_medium = 0;
+  d.shapes = {box};
+  return d;
+}
+
+TEST(VolPath, GridTransmittanceByRatioAndDeltaTrackingMatchesQuadrature) {
+  const SceneDesc desc = grid_scene();
+  const Scene scene(desc);
+  const Medium& medium = scene.media()[0];
+  const VolPathIntegrator volpath(scene, desc.settings);
+  const Point3 from(-1.3f, -0.4f, 0.2f), to(1.2f, 0.5f, -0.3f);
+  const Vec3 dir = normalize(to - from);
+  const float length_ = length(to - from);
+  // The optical depth by the midpoint rule.
+  double depth = 0;
+  const int steps = 200000;
+  for (int i = 0; i < steps; ++i)
+    depth += double(medium.density(from + dir * (length_ * (float(i) + 0.5f) / float(steps)))) * length_ / steps;
+  ASSERT_GT(depth, 0.5);  // the segment does cross the medium
+  const int n = 40000;
+  Rng rng(11, 12);
+  for (int c = 0; c < 3; ++c) {
+    const double expected = std::exp(-double(medium.sigma_t()[c]) * depth);
+    // Ratio tracking, as the integrator's shadow rays do it (the hero channel chosen uniformly).
+    double sum = 0, sum2 = 0;
+    for (int i = 0; i < n; ++i) {
+      double t = volpath.transmittance(from, to, 0, int(rng.next_u32() % 3), rng.next_u32(), 0)[c];
+      sum += t;
+      sum2 += t * t;
+    }
+    double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / n);
+    EXPECT_NEAR(mean, expected, 5 * se + 1e-4) << "ratio tracking, channel " << c;
+    // Delta tracking with the majorant pieces: the fraction of walks that reach the end.
+    const float sigma = medium.sigma_t()[c];
+    int reached = 0;
+    for (int i = 0; i < n; ++i) {
+      bool collided = false;
+      medium.for_each_majorant(Ray{from, dir}, 0, length_, [&](float t0, float t1, float bound) {
+        for (float t = t0;;) {
+          t += -std::log1p(-rng.next_float()) / (sigma * bound);
+          if (t >= t1) return true;
+          if (rng.next_float() * bound < medium.density(from + dir * t)) {
+            collided = true;
+            return false;
+          }
+        }
+      });
+      reached += !collided;
+    }
+    double p = double(reached) / n;
+    EXPECT_NEAR(p, expected, 5 * std::sqrt(expected * (1 - expected) / n) + 1e-4) << "delta tracking, channel " << c;
+  }
+}
+
+TEST(VolPath, WithoutMediaItAgreesWithThePathTracer) {
+  // A diffuse sphere under a sky, and a thin dielectric sheet in front of it.
+  SceneDesc d = testing::sphere_under_sky(DiffuseMaterial{RGB(0.7f, 0.5f, 0.3f)}, RGB(1.0f), 8, 20, 32, 8);
+  DielectricMaterial sheet;
+  sheet.thin = true;
+  sheet.ior = 1.5f;
+  d.materials.push_back(sheet);
+  ShapeDesc s;
+  s.geometry = RectangleShape{{-1.5f, -1.5f, -2}, {3, 0, 0}, {0, 3, 0}};
+  s.material = 1;
+  d.shapes.push_back(s);
+  ChannelMeans path = render_means(d);
+  d.settings.integrator = "volpath";
+  ChannelMeans volpath = render_means(d);
+  for (int c = 0; c < 3; ++c) {
+    float se = std::hypot(path.standard_error[c], volpath.standard_error[c]);
+    EXPECT_NEAR(volpath.mean[c], path.mean[c], 5 * se + 1e-4f) << "channel " << c;
+  }
+}
+
+TEST(VolPath, IntegratorsThatDoNotRenderMediaRefuseScenesWithThem) {
+  MediumDesc medium;
+  SceneDesc d = medium_in_sphere(medium, RGB(1.0f));
+  const Scene scene(d);
+  for (const char* name : {"path", "bdpt", "mlt"}) {
+    RenderSettings settings = d.settings;
+    settings.integrator = name;
+    Film film(d.film.width, d.film.height);
+    RenderOptions options;
+    options.progress = false;
+    try {
+      render(scene, settings, film, options);
+      ADD_FAILURE() << name << " rendered a scene with media";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("use --integrator volpath"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(VolPath, AShapeOrCameraReferringToAMissingMediumIsASceneError) {
+  MediumDesc medium;
+  SceneDesc d = medium_in_sphere(medium, RGB(1.0f));
+  d.shapes[0].interior_medium = 3;
+  EXPECT_THROW(Scene{d}, SceneError);
+  d = medium_in_sphere(medium, RGB(1.0f));
+  d.camera.medium = 1;
+  EXPECT_THROW(Scene{d}, SceneError);
+  d = medium_in_sphere(medium, RGB(1.0f));
+  d.media[0].g = -1.5f;
+  try {
+    Scene scene(d);
+    ADD_FAILURE() << "accepted g = -1.5";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("g = -1.5 must be within (-1, 1)"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace candela
