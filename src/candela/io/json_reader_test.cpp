@@ -98,7 +98,7 @@ TEST(JsonReader, ReadsCameraAndRenderSettings) {
 // integrator and those that read it (integrators/integrator.h); an unknown integrator is an error.
 TEST(JsonReader, ARenderKeyTheIntegratorDoesNotReadIsAnError) {
   expect_error_containing(R"({"render": {"integrator": "whitted"}})",
-                          "at /render/integrator: unknown integrator \"whitted\" (known: path, bdpt, mlt)");
+                          "at /render/integrator: unknown integrator \"whitted\" (known: path, bdpt, mlt, volpath)");
   const std::pair<const char*, const char*> cases[] = {
       {R"({"render": {"integrator": "bdpt", "mis": false}})", "at /render/mis: the bdpt integrator does not read mis"},
       {R"({"render": {"integrator": "bdpt", "direction_sampling": "cosine"}})",
@@ -110,7 +110,7 @@ TEST(JsonReader, ARenderKeyTheIntegratorDoesNotReadIsAnError) {
       {R"({"render": {"integrator": "mlt", "rr_start_depth": 2}})",
        "at /render/rr_start_depth: the mlt integrator does not read rr_start_depth"},
       {R"({"render": {"integrator": "mlt", "adaptive": {"threshold": 0.1}}})",
-       "at /render/adaptive: the mlt integrator does not read adaptive (adaptive sampling; read by: path, bdpt)"},
+       "at /render/adaptive: the mlt integrator does not read adaptive (adaptive sampling; read by: path, bdpt, volpath)"},
       {R"({"render": {"mlt": {"chains": 10}}})", "at /render/mlt: the path integrator does not read mlt"},
   };
   for (const auto& [text, message] : cases) EXPECT_NE(error_of(text).find(message), std::string::npos) << text;
@@ -450,7 +450,7 @@ TEST(JsonReader, UnknownKeyNamesItsJsonPointer) {
       "  {\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"radiuss\": 2}]}");
   EXPECT_EQ(message,
             "test.json:3:56: at /shapes/1/radiuss: unknown key; expected one of: type, center, radius, "
-            "material, emission, transform, transform_end, name, reverse_orientation");
+            "material, emission, transform, transform_end, name, reverse_orientation, interior, exterior");
   expect_error_containing(R"({"camera": {"fov": 40, "zoom": 2}})", "at /camera/zoom: unknown key");
   expect_error_containing(R"({"scene": {}})", "at /scene: unknown key");
   expect_error_containing(R"({"render": {"samples": 4}})", "at /render/samples: unknown key");

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <stdexcept>
 #include <system_error>
 
@@ -260,7 +261,49 @@ Json geometry_json(const ShapeGeometry& geometry) {
       geometry);
 }
 
-Json shape_json(const ShapeDesc& shape) {
+// The names media are written under: their own where they are unique (as every reader makes them),
+// numbered otherwise.
+std::vector<std::string> medium_names(const std::vector<MediumDesc>& media) {
+  std::set<std::string> used{"_comment"};  // the reader skips that key
+  std::vector<std::string> names;
+  for (size_t i = 0; i < media.size(); ++i) {
+    const std::string base = media[i].name.empty() ? fmt::format("medium{:05}", i) : media[i].name;
+    std::string name = base;
+    for (int k = 2; !used.insert(name).second; ++k) name = fmt::format("{} {}", base, k);
+    names.push_back(std::move(name));
+  }
+  return names;
+}
+
+// A grid from a file is written as its file name, one made in memory (pbrt's uniformgrid, an inline
+// grid) with its samples.
+Json volume_json(const VolumeDesc& v) {
+  Json j = Json::object();
+  if (!v.filename.empty()) {
+    j["filename"] = absolute(v.filename);
+  } else {
+    j["resolution"] = v.resolution;
+    if (v.channels != 1) j["channels"] = v.channels;
+    j["values"] = v.values ? *v.values : std::vector<float>{};
+  }
+  if (!v.to_world.is_identity()) j["transform"] = matrix(v.to_world);
+  if (v.border == VolumeBorder::Zero) j["border"] = "zero";
+  return j;
+}
+
+// sigma_t and albedo as the description holds them (sigma_a and sigma_s would not round-trip exactly).
+Json medium_json(const MediumDesc& m) {
+  const bool homogeneous = m.is_homogeneous() && m.density.constant == RGB(1.0f);
+  Json j{{"type", homogeneous ? "homogeneous" : "grid"}, {"sigma_t", rgb(m.sigma_t)}};
+  j["albedo"] = m.albedo.is_constant() ? rgb(m.albedo.constant) : volume_json(m.albedo);
+  if (!homogeneous) j["density"] = m.density.is_constant() ? Json(m.density.constant.r) : volume_json(m.density);
+  if (m.scale != 1) j["scale"] = m.scale;
+  if (m.g != 0) j["g"] = m.g;
+  if (!m.emission.is_black()) j["emission"] = rgb(m.emission);
+  return j;
+}
+
+Json shape_json(const ShapeDesc& shape, const std::vector<std::string>& media) {
   Json j = geometry_json(shape.geometry);
   if (shape.material >= 0) j["material"] = material_name(shape.material);
   if (shape.emission) {
@@ -272,6 +315,8 @@ Json shape_json(const ShapeDesc& shape) {
   if (shape.to_world_end) j["transform_end"] = matrix(*shape.to_world_end);
   if (!shape.name.empty()) j["name"] = shape.name;
   if (shape.reverse_orientation) j["reverse_orientation"] = true;
+  if (shape.interior_medium >= 0) j["interior"] = media[size_t(shape.interior_medium)];
+  if (shape.exterior_medium >= 0) j["exterior"] = media[size_t(shape.exterior_medium)];
   return j;
 }
 
@@ -323,7 +368,7 @@ Json light_json(const LightDesc& light) {
       light);
 }
 
-Json camera_json(const SceneDesc& scene) {
+Json camera_json(const SceneDesc& scene, const std::vector<std::string>& media) {
   const CameraDesc& c = scene.camera;
   static const char* kAxis[] = {"x", "y", "smaller", "larger", "diagonal"};
   Json j{{"transform", matrix(c.world_from_camera)}, {"fov", c.fov_degrees}, {"fov_axis", kAxis[int(c.fov_axis)]}};
@@ -336,6 +381,7 @@ Json camera_json(const SceneDesc& scene) {
     j["focus_distance"] = c.focus_distance;
   }
   j["shutter"] = Json::array({c.shutter_open, c.shutter_close});
+  if (c.medium >= 0) j["medium"] = media[size_t(c.medium)];
   return j;
 }
 
@@ -389,7 +435,13 @@ Json render_json(const SceneDesc& scene) {
 std::string scene_to_json(const SceneDesc& scene) {
   Json root;
   if (!scene.source_file.empty()) root["_comment"] = fmt::format("converted by candela from {}", scene.source_file);
-  root["camera"] = camera_json(scene);
+  const std::vector<std::string> media = medium_names(scene.media);
+  if (!scene.media.empty()) {
+    Json named = Json::object();
+    for (size_t i = 0; i < scene.media.size(); ++i) named[media[i]] = medium_json(scene.media[i]);
+    root["media"] = std::move(named);
+  }
+  root["camera"] = camera_json(scene, media);
   root["render"] = render_json(scene);
   Json textures = Json::object();
   for (size_t i = 0; i < scene.textures.size(); ++i) textures[texture_name(int(i))] = texture_json(scene.textures[i]);
@@ -401,12 +453,12 @@ std::string scene_to_json(const SceneDesc& scene) {
   Json objects = Json::object();
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     Json shapes = Json::array();
-    for (const ShapeDesc& shape : scene.objects[i].shapes) shapes.push_back(shape_json(shape));
+    for (const ShapeDesc& shape : scene.objects[i].shapes) shapes.push_back(shape_json(shape, media));
     objects[object_name(int(i))] = Json{{"shapes", std::move(shapes)}};
   }
   if (!scene.objects.empty()) root["objects"] = std::move(objects);
   Json shapes = Json::array();
-  for (const ShapeDesc& shape : scene.shapes) shapes.push_back(shape_json(shape));
+  for (const ShapeDesc& shape : scene.shapes) shapes.push_back(shape_json(shape, media));
   for (const InstanceDesc& instance : scene.instances) {
     Json j{{"type", "instance"}, {"object", object_name(instance.object)}};
     if (!instance.to_world.is_identity()) j["transform"] = matrix(instance.to_world);

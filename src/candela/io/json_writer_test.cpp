@@ -7,6 +7,8 @@
 #include <string>
 
 #include "candela/base/error.h"
+#include "candela/geometry/sdf_grid.h"
+#include "candela/io/pbrt_reader.h"
 #include "candela/io/scene_reader.h"
 #include "candela/testing/render_helpers.h"
 
@@ -109,6 +111,132 @@ TEST(ConvertJson, WrappersAndNewShapesRoundTrip) {
   const auto& sides = std::get<TwoSidedMaterial>(back.materials[size_t(back.shapes[1].material)]);
   EXPECT_TRUE(std::holds_alternative<MaskMaterial>(back.materials[size_t(sides.front)]));
   EXPECT_TRUE(std::holds_alternative<DiffuseMaterial>(back.materials[size_t(sides.back)]));
+}
+
+void expect_same_volume(const VolumeDesc& back, const VolumeDesc& original) {
+  EXPECT_EQ(back.is_constant(), original.is_constant());
+  EXPECT_EQ(back.constant, original.constant);
+  if (original.is_constant()) return;
+  EXPECT_EQ(back.resolution, original.resolution);
+  EXPECT_EQ(back.channels, original.channels);
+  EXPECT_EQ(*back.values, *original.values);
+  EXPECT_EQ(back.to_world.matrix(), original.to_world.matrix());
+  EXPECT_EQ(back.border, original.border);
+  EXPECT_EQ(back.filename, original.filename);
+}
+
+void expect_same_media(const SceneDesc& back, const SceneDesc& original) {
+  ASSERT_EQ(back.media.size(), original.media.size());
+  for (size_t i = 0; i < original.media.size(); ++i) {
+    const MediumDesc &b = back.media[i], &o = original.media[i];
+    EXPECT_EQ(b.sigma_t, o.sigma_t) << i;
+    EXPECT_EQ(b.scale, o.scale) << i;
+    EXPECT_EQ(b.g, o.g) << i;
+    EXPECT_EQ(b.emission, o.emission) << i;
+    expect_same_volume(b.density, o.density);
+    expect_same_volume(b.albedo, o.albedo);
+  }
+}
+
+// Media, with grids inline and from files, and the names shapes, objects and the camera refer to
+// them by.
+TEST(ConvertJson, MediaRoundTrip) {
+  const fs::path albedo_file = fs::temp_directory_path() / "candela_convert_media_albedo.vol";
+  VolumeGrid albedo_grid;
+  albedo_grid.resolution = {1, 2, 1};
+  albedo_grid.channels = 3;
+  albedo_grid.values = {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f};
+  write_volume_grid(albedo_file, albedo_grid);
+
+  SceneDesc scene;
+  MediumDesc fog;
+  set_sigma_a_sigma_s(fog, RGB(0.1f, 0.2f, 0.3f), RGB(0.7f, 0.3f, 0.1f));
+  fog.scale = 2.5f;
+  fog.g = 0.3f;
+  fog.emission = RGB(1, 0.5f, 0.25f);
+  fog.name = "fog";
+  scene.media.push_back(fog);
+  MediumDesc smoke;
+  smoke.sigma_t = RGB(3, 2, 1);
+  smoke.density.resolution = {2, 1, 1};
+  smoke.density.values = std::make_shared<const std::vector<float>>(std::vector<float>{0.5f, 1.25f});
+  smoke.density.to_world = Transform::translate({1, 2, 3}) * Transform::scale({2, 2, 0.5f});
+  smoke.density.border = VolumeBorder::Zero;
+  smoke.albedo.resolution = albedo_grid.resolution;
+  smoke.albedo.channels = 3;
+  smoke.albedo.values = std::make_shared<const std::vector<float>>(albedo_grid.values);
+  smoke.albedo.filename = albedo_file.string();
+  smoke.name = "smoke";
+  scene.media.push_back(smoke);
+  MediumDesc thin;  // a constant density other than 1, and a name already taken
+  thin.density.constant = RGB(0.5f);
+  thin.name = "fog";
+  scene.media.push_back(thin);
+  scene.media.push_back(MediumDesc{});  // no name
+
+  scene.camera.medium = 1;
+  ShapeDesc ball;
+  ball.geometry = SphereShape{};
+  ball.interior_medium = 0;
+  ball.exterior_medium = 2;
+  scene.shapes.push_back(ball);
+  ShapeDesc plain;
+  plain.geometry = SphereShape{};
+  scene.shapes.push_back(plain);
+  ObjectDesc object;
+  ShapeDesc drop;
+  drop.geometry = SphereShape{};
+  drop.interior_medium = 3;
+  object.shapes.push_back(drop);
+  scene.objects.push_back(object);
+  scene.instances.push_back(InstanceDesc{});
+
+  const std::string text = scene_to_json(scene);
+  SceneDesc back = read_json_scene(text, "converted.json", fs::temp_directory_path());
+  expect_same_media(back, scene);
+  ASSERT_EQ(back.media.size(), 4u);
+  EXPECT_EQ(back.media[0].name, "fog");
+  EXPECT_EQ(back.media[1].name, "smoke");
+  EXPECT_EQ(back.media[2].name, "fog 2");
+  EXPECT_EQ(back.media[3].name, "medium00003");
+  EXPECT_NE(text.find(albedo_file.string()), std::string::npos);  // the file, not its samples
+  EXPECT_EQ(back.camera.medium, 1);
+  ASSERT_EQ(back.shapes.size(), 2u);
+  EXPECT_EQ(back.shapes[0].interior_medium, 0);
+  EXPECT_EQ(back.shapes[0].exterior_medium, 2);
+  EXPECT_EQ(back.shapes[1].interior_medium, -1);
+  EXPECT_EQ(back.shapes[1].exterior_medium, -1);
+  EXPECT_EQ(back.objects.at(0).shapes.at(0).interior_medium, 3);
+  fs::remove(albedo_file);
+
+  SceneDesc empty = read_json_scene(scene_to_json(SceneDesc{}), "converted.json", fs::temp_directory_path());
+  EXPECT_TRUE(empty.media.empty());
+  EXPECT_EQ(empty.camera.medium, -1);
+}
+
+// pbrt's media convert too: a uniformgrid's samples are written inline.
+TEST(ConvertJson, PbrtMediaRoundTrip) {
+  std::vector<std::string> warnings;
+  SceneDesc pbrt = read_pbrt_string(
+      "MakeNamedMedium \"air\" \"string type\" \"homogeneous\" \"rgb sigma_s\" [ 0.01 0.02 0.03 ] \"float g\" 0.2\n"
+      "MediumInterface \"\" \"air\"\n"
+      "Camera \"perspective\"\n"
+      "WorldBegin\n"
+      "Rotate 30 0 1 0\n"
+      "MakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\" \"integer nx\" 2 \"integer nz\" 2\n"
+      "  \"float density\" [ 0 0.25 0.5 1 ] \"point3 p0\" [ -1 -1 -1 ] \"point3 p1\" [ 1 1 1 ]\n"
+      "MediumInterface \"smoke\" \"air\"\n"
+      "Material \"interface\"\n"
+      "Shape \"sphere\"\n",
+      "media.pbrt", fs::temp_directory_path(), warnings);
+  SceneDesc back = read_json_scene(scene_to_json(pbrt), "converted.json", fs::temp_directory_path());
+  expect_same_media(back, pbrt);
+  EXPECT_EQ(back.media.at(1).name, "smoke");
+  EXPECT_EQ(back.media.at(1).density.border, VolumeBorder::Zero);
+  EXPECT_EQ(back.camera.medium, pbrt.camera.medium);
+  ASSERT_EQ(back.shapes.size(), 1u);
+  EXPECT_EQ(back.shapes[0].interior_medium, 1);
+  EXPECT_EQ(back.shapes[0].exterior_medium, 0);
 }
 
 }  // namespace

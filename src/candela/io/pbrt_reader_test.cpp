@@ -958,9 +958,9 @@ TEST(PbrtReader, BdptAndMltAreCandelasOwn) {
   EXPECT_THROW(read_lines({"Integrator \"mlt\" \"integer chains\" 0", "WorldBegin"}), SceneError);
 }
 
-TEST(PbrtReader, OtherPbrtIntegratorsAreRenderedWithThePathIntegrator) {
+TEST(PbrtReader, OtherPbrtIntegratorsAreRenderedWithOneThatConvergesToTheSameImage) {
   EXPECT_TRUE(read_warned({"Integrator \"path\" \"integer maxdepth\" 9", "WorldBegin"}).warnings.empty());
-  for (std::string type : {"sppm", "lightpath", "randomwalk", "simplepath", "simplevolpath"}) {
+  for (std::string type : {"sppm", "lightpath", "randomwalk", "simplepath"}) {
     SCOPED_TRACE(type);
     std::vector<std::string> lines = {"Integrator \"" + type + "\" \"integer maxdepth\" 9", "WorldBegin"};
     expect_warning(lines, 1, "\"" + type + "\"",
@@ -969,8 +969,13 @@ TEST(PbrtReader, OtherPbrtIntegratorsAreRenderedWithThePathIntegrator) {
     EXPECT_EQ(scene.settings.integrator, "path");
     EXPECT_EQ(scene.settings.max_depth, 9);
   }
-  expect_warning({"Integrator \"volpath\"", "WorldBegin"}, 1, "\"volpath\"",
-                 "without participating media (which candela does not render) it is the same integrator");
+  Warned volpath = read_warned({"Integrator \"volpath\" \"integer maxdepth\" 7", "WorldBegin"});
+  EXPECT_TRUE(volpath.warnings.empty()) << joined(volpath.warnings);
+  EXPECT_EQ(volpath.scene.settings.integrator, "volpath");
+  EXPECT_EQ(volpath.scene.settings.max_depth, 7);
+  expect_warning({"Integrator \"simplevolpath\"", "WorldBegin"}, 1, "\"simplevolpath\"",
+                 "Integrator \"simplevolpath\": using candela's volpath integrator with maxdepth 5");
+  EXPECT_EQ(read_lines({"Integrator \"simplevolpath\"", "WorldBegin"}).settings.integrator, "volpath");
   EXPECT_THROW(read_lines({"Integrator \"ambientocclusion\"", "WorldBegin"}), SceneError);
   Warned sppm = read_warned({"Integrator \"sppm\" \"integer photonsperiteration\" 1000 \"float radius\" 0.1",
                              "WorldBegin"});

@@ -334,24 +334,6 @@ TEST(PbrtReader, AttributeSetsDefaultParametersForABlock) {
                "Attribute: unknown target \"camera\"");
   expect_error({"WorldBegin", "Attribute \"shape\" \"string radius\" \"big\"", "Shape \"sphere\""}, 2,
                "\"string radius\"", "parameter \"radius\" must be of type \"float\", not \"string\"");
-  expect_warning({"WorldBegin", "Attribute \"medium\" \"rgb sigma_a\" [ 1 1 1 ]"}, 2, "Attribute",
-                 "Attribute \"medium\" is ignored");
-}
-
-TEST(PbrtReader, MediaAreIgnoredWithWarnings) {
-  Warned read = read_warned({"MediumInterface \"\" \"fog\"",
-                             "WorldBegin",
-                             "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [ 1 1 1 ]",
-                             "MediumInterface \"\"",
-                             "MediumInterface \"fog\" \"\"",
-                             "Shape \"sphere\""});
-  EXPECT_EQ(read.scene.shapes.size(), 1u);
-  ASSERT_EQ(read.warnings.size(), 3u) << joined(read.warnings);
-  EXPECT_NE(read.warnings[0].find(":1:1: warning: MediumInterface \"\" \"fog\": participating media are not supported"),
-            std::string::npos);
-  EXPECT_NE(read.warnings[1].find(":3:1: warning: MakeNamedMedium \"fog\": participating media are not supported"),
-            std::string::npos);
-  EXPECT_NE(read.warnings[2].find(":5:1: warning: MediumInterface \"fog\" \"\""), std::string::npos);
 }
 
 TEST(PbrtReader, PrintedWarningsAreCappedPerKind) {

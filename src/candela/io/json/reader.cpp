@@ -8,6 +8,7 @@ SceneDesc JsonSceneReader::read() {
   reject_duplicate_keys();
   CheckedObject root(report_, document, "");
   const Json empty = Json::object();  // absent sections still get their defaults
+  if (const Json* media = root.find("media")) read_media(*media, root.pointer_of("media"));
   const Json* camera = root.find("camera");
   read_camera(camera ? *camera : empty, root.pointer_of("camera"));
   const Json* render = root.find("render");
@@ -42,6 +43,7 @@ void JsonSceneReader::locate_places() {
     for (ShapeDesc& shape : object.shapes) add(shape.where);
   }
   for (InstanceDesc& instance : scene_.instances) add(instance.where);
+  for (MediumDesc& medium : scene_.media) add(medium.where);
   report_.locate(places);
 }
 

@@ -2,8 +2,8 @@
 // The reader of candela's JSON scene format (docs/scene-format.md): one JsonSceneReader per file,
 // its sections read by the functions of reader.cpp (the document), settings.cpp (camera and render
 // settings), textures.cpp, materials.cpp, shapes.cpp (shapes, objects and instances, meshes,
-// transforms) and lights.cpp. Each reader of a kind of entry (texture, material, shape, light)
-// dispatches on a table of type names, from which its "unknown ... type" message lists the names.
+// transforms), lights.cpp and media.cpp. Each reader of a kind of entry (texture, material, shape,
+// light) dispatches on a table of type names, from which its "unknown ... type" message lists the names.
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -193,6 +193,13 @@ class JsonSceneReader {
   static Transform rotation_between(Vec3 from, Vec3 to);
   void check_rotation(const Transform& transform, const std::string& pointer) const;
 
+  // ---- participating media (media.cpp): read before the camera and the shapes that name them
+  void read_media(const Json& value, const std::string& pointer);
+  MediumDesc read_medium(const Json& value, const std::string& pointer);
+  VolumeDesc read_volume(const Json& value, const std::string& pointer, std::string_view what) const;
+  int medium_by_name(const std::string& name, const std::string& pointer) const;
+  int medium_reference(CheckedObject& object, std::string_view key) const;
+
   std::string_view text_;
   ErrorReporter report_;
   fs::path base_dir_;
@@ -202,6 +209,7 @@ class JsonSceneReader {
   int texture_depth_ = 0;                   // textures being read, named or inline
   NamedEntries named_materials_;
   std::map<std::string, int> object_index_;
+  std::map<std::string, int> medium_index_;
   std::optional<int> black_material_;
 };
 

@@ -38,6 +38,7 @@ void JsonSceneReader::read_camera(const Json& value, const std::string& pointer)
   scene_.film.width = camera.integer_or("width", scene_.film.width, 1, kMaxResolution);
   scene_.film.height = camera.integer_or("height", scene_.film.height, 1, kMaxResolution);
   read_lens_and_shutter(camera);
+  scene_.camera.medium = medium_reference(camera, "medium");
   camera.finish();
   if (int64_t(scene_.film.width) * scene_.film.height > kMaxPixels)
     report_.fail(pointer, "{} x {} pixels exceeds the limit of 2^28 pixels", scene_.film.width, scene_.film.height);

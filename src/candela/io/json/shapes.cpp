@@ -30,6 +30,8 @@ ShapeDesc JsonSceneReader::read_shape(const Json& value, const std::string& poin
   if (const Json* end = s.find("transform_end")) shape.to_world_end = read_moving_transform(*end, s, shape);
   shape.name = s.string_or("name", "");
   shape.reverse_orientation = s.boolean_or("reverse_orientation", false);
+  shape.interior_medium = medium_reference(s, "interior");
+  shape.exterior_medium = medium_reference(s, "exterior");
   s.finish();
   return shape;
 }

@@ -1,7 +1,7 @@
 #pragma once
 // pbrt's graphics state: what the directives of an attribute block set for the shapes, lights and
-// materials that follow (the CTMs, the material, the area light, the orientation, Attribute
-// defaults), and the open blocks that restore it.
+// materials that follow (the CTMs, the material, the area light, the orientation, the medium
+// interface, Attribute defaults), and the open blocks that restore it.
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -43,6 +43,9 @@ struct GraphicsState {
   int material = -1;  // -1: pbrt's default material, diffuse 0.5
   std::optional<AreaLightSpec> area_light;
   bool reverse_orientation = false;
+  // MediumInterface: the media inside and outside the shapes that follow (indices into
+  // SceneDesc::media, -1 = vacuum); the camera sits in the outside one.
+  int inside_medium = -1, outside_medium = -1;
   std::vector<Param> attributes[kAttributeTargets];
 };
 

@@ -48,6 +48,7 @@ void SceneParser::camera(const Token& d) {
   camera.focus_distance = focus_distance;
   camera.shutter_open = shutter_open;
   camera.shutter_close = shutter_close;
+  camera.medium = state_.outside_medium;  // pbrt-v4's CameraMedium
   coordinate_systems_["camera"] = {camera.world_from_camera, camera.world_from_camera};
 }
 
@@ -126,8 +127,9 @@ void SceneParser::sampler(const Token& d) {
   if (params.has("seed")) options_.seed = static_cast<uint64_t>(seed);
 }
 
-// Every pbrt-v4 integrator is rendered with candela's path tracer at the scene's "maxdepth"; the
-// parameters the others have are accepted with a warning that they are ignored.
+// pbrt-v4's path, volpath, bdpt and mlt are rendered with candela's integrator of that name; the
+// others with the one that converges to the same image (volpath for simplevolpath, path for the rest),
+// at the scene's "maxdepth". Parameters candela has no use for are accepted with a warning.
 void SceneParser::integrator(const Token& d) {
   require_options(d);
   Token type = expect_string(d, "the integrator type");
@@ -182,17 +184,16 @@ void SceneParser::integrator(const Token& d) {
     options_.spp = mutations;
     options_.mlt = RenderDirectives::Metropolis{bootstrap, chains, large_step, sigma};
   } else {
+    if (type.text == "volpath" || type.text == "simplevolpath") integrator = "volpath";
     for (std::string_view name : known->second)
-      ignore_param(params, name, "candela's path integrator has no such setting");
+      ignore_param(params, name, fmt::format("candela's {} integrator has no such setting", integrator));
   }
   params.reject_unused();
-  if (type.text == "volpath")
-    warn(at(type), "Integrator \"volpath\": using candela's path integrator; without participating media (which "
-         "candela does not render) it is the same integrator");
-  else if (integrator == "path" && type.text != "path")
-    warn(at(type), "Integrator \"{}\": using candela's path integrator with maxdepth {} (it converges to the "
-         "same image, with different noise)", type.text, max_depth);
+  if (type.text != integrator)
+    warn(at(type), "Integrator \"{}\": using candela's {} integrator with maxdepth {} (it converges to the "
+         "same image, with different noise)", type.text, integrator, max_depth);
   options_.integrator = integrator;
+  options_.integrator_given = true;
   options_.max_depth = max_depth;
 }
 
@@ -271,7 +272,9 @@ void SceneParser::write_render_settings(RenderSettings& settings) const {
   if (options_.seed) settings.seed = *options_.seed;
   settings.filter = options_.filter;
   settings.max_depth = options_.max_depth;
-  settings.integrator = options_.integrator;
+  // pbrt-v4's default integrator is volpath; candela's path tracer is the same for scenes without
+  // media, and faster.
+  settings.integrator = !options_.integrator_given && !scene_.media.empty() ? "volpath" : options_.integrator;
   settings.spectral = true;  // pbrt-v4 renders spectrally; RGB parameters become spectra as there
   if (options_.light_sampler_given) settings.light_selection = LightSelection::Power;
   if (options_.mlt) {

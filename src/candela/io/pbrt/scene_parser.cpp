@@ -100,6 +100,7 @@ void SceneParser::start(const std::string& source, const fs::path& top_directory
 
 SceneDesc SceneParser::finish(const SourceLocation& end) {
   check_end_of_scene(end);
+  check_media_defined();
   write_render_settings(scene_.settings);
   return std::move(scene_);
 }
@@ -372,8 +373,6 @@ void SceneParser::attribute(const Token& d) {
     throw_scene_error(at(target), "Attribute: unknown target \"{}\" (expected \"shape\", \"light\", \"material\", "
                       "\"medium\" or \"texture\")", target.text);
   std::vector<Param> params = read_parameter_list(*tokens_, fmt::format("Attribute \"{}\"", target.text));
-  if (index == kMediumAttributes && !params.empty())
-    warn(at(d), "Attribute \"medium\" is ignored: participating media are not supported");
   std::vector<Param>& defaults = state_.attributes[index];
   for (Param& param : params) {
     auto same = std::find_if(defaults.begin(), defaults.end(), [&](const Param& p) { return p.name == param.name; });
@@ -396,23 +395,6 @@ void SceneParser::world_begin(const Token& d) {
   state_.ctm = {};
   state_.active_transforms = kAllTransforms;
   coordinate_systems_["world"] = {};
-}
-
-// ---------------------------------------------------------------- participating media
-
-void SceneParser::make_named_medium(const Token& d) {
-  Token name = expect_string(d, "the medium name");
-  ParamList params = read_params(d, fmt::format("MakeNamedMedium \"{}\"", name.text), kMediumAttributes);
-  warn(at(d), "MakeNamedMedium \"{}\": participating media are not supported; the medium is ignored", name.text);
-}
-
-void SceneParser::medium_interface(const Token& d) {
-  Token inside = expect_string(d, "the inside medium's name");
-  std::string outside = inside.text;  // one name means the same medium on both sides
-  if (tokens_->peek().kind == TokenKind::String) outside = tokens_->next().text;
-  if (!inside.text.empty() || !outside.empty())
-    warn(at(d), "MediumInterface \"{}\" \"{}\": participating media are not supported; everything is in vacuum",
-         inside.text, outside);
 }
 
 // ---------------------------------------------------------------- other files

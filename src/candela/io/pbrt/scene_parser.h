@@ -8,6 +8,7 @@
 //   materials.cpp       Material, MakeNamedMaterial, NamedMaterial
 //   lights.cpp          LightSource, AreaLightSource
 //   shapes.cpp          Shape and object instancing
+//   media.cpp           MakeNamedMedium, MediumInterface
 // Every problem is one SceneError naming file:line:column. What candela reads but cannot reproduce
 // exactly (a sampler or integrator it replaces, a parameter it ignores) is a warning naming
 // file:line:column; what would change the image materially is an error.
@@ -53,6 +54,15 @@ struct BuiltGeometry {
   float object_area = 0;
 };
 
+// A medium name as MediumInterface and MakeNamedMedium use it. Its slot in SceneDesc::media is
+// reserved when it is first named, so that (as in pbrt-v4) an interface may name a medium that is
+// defined further on.
+struct NamedMedium {
+  int index = -1;  // into SceneDesc::media
+  bool defined = false;
+  SourceLocation first_reference;  // for the error when the scene never defines it
+};
+
 struct NamedTexture {
   int index = -1;  // into SceneDesc::textures; -1 for a "constant" texture
   ColorInput color;
@@ -68,6 +78,7 @@ struct RenderDirectives {
   int spp = 16;  // pixel samples, or an "mlt" integrator's mutations per pixel
   std::optional<uint64_t> seed;
   std::string integrator = "path";
+  bool integrator_given = false;  // else pbrt-v4's default, volpath, which is path without media
   int max_depth = 5;
   FilterDesc filter = default_filter(FilterType::Gaussian);
   bool light_sampler_given = false;  // an integrator that reads "lightsampler" was named
@@ -185,6 +196,7 @@ class SceneParser {
   std::optional<ColorInput> read_color(ParamList& params, std::string_view name, pbrt_spectra::Role role);
   std::optional<FloatInput> read_float_texture(ParamList& params, std::string_view name);
   std::optional<RGB> read_emission(ParamList& params, std::string_view name);
+  std::optional<RGB> read_spectrum(ParamList& params, std::string_view name, pbrt_spectra::Role role);
   std::optional<float> read_ior(ParamList& params, std::string_view name);
   Roughness read_roughness(ParamList& params);
   void ignore_shading_params(ParamList& params);
@@ -210,6 +222,14 @@ class SceneParser {
   void add_emissive_shape(ShapeDesc shape, const BuiltGeometry& built, const Token& directive);
   void add_shape(ShapeDesc shape, const Token& directive);
 
+  // participating media
+  int medium_index(const Token& name);
+  void check_media_defined() const;
+  void read_scattering(ParamList& params, MediumDesc& medium, std::optional<RGB> sigma_a, std::optional<RGB> sigma_s);
+  RGB read_medium_emission(ParamList& params, float scale);
+  MediumDesc make_homogeneous_medium(ParamList& params);
+  MediumDesc make_grid_medium(ParamList& params);
+
   std::vector<std::string>& warnings_;
   SceneDesc scene_;
   RenderDirectives options_;
@@ -223,6 +243,7 @@ class SceneParser {
   std::map<std::string, NamedTexture> spectrum_textures_, float_textures_;
   std::optional<ObjectDefinition> open_object_;
   std::map<std::string, ObjectDefinition> objects_;
+  std::map<std::string, NamedMedium> media_;
   Tokenizer* tokens_ = nullptr;
   fs::path directory_;  // of the file being read: relative names are looked up there first
   // Canonical paths of the files being read, to catch include cycles (empty for text not read from

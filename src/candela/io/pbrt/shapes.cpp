@@ -337,6 +337,8 @@ void SceneParser::shape(const Token& d) {
   }
   desc.material = state_.material;
   desc.reverse_orientation = state_.reverse_orientation;
+  desc.interior_medium = state_.inside_medium;
+  desc.exterior_medium = state_.outside_medium;
   desc.name = fmt::format("{} at {}", type.text, at(d).to_string());
   desc.where = at(d);
   if (state_.area_light)

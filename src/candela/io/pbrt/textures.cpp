@@ -107,6 +107,13 @@ std::optional<RGB> SceneParser::read_emission(ParamList& params, std::string_vie
   return pbrt_spectra::blackbody_rgb(static_cast<float>(kelvin));
 }
 
+// A constant spectrum that cannot be textured (a medium's coefficients): "rgb" or "spectrum".
+std::optional<RGB> SceneParser::read_spectrum(ParamList& params, std::string_view name, Role role) {
+  const Param* p = params.take(name, {"rgb", "spectrum"});
+  if (!p) return std::nullopt;
+  return p->type == "rgb" ? params.checked_rgb(*p, role == Role::Reflectance) : spectrum_rgb(*p, params, role);
+}
+
 // A dielectric's index of refraction: "float", or a "spectrum" (a named glass or pairs) taken at
 // 550 nm, since candela does not disperse light.
 std::optional<float> SceneParser::read_ior(ParamList& params, std::string_view name) {

@@ -1,0 +1,283 @@
+// Participating media: MakeNamedMedium ("homogeneous" and "uniformgrid"), MediumInterface, and the
+// media the shapes and the camera get from it.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+
+#include "candela/io/pbrt/scene_parser.h"
+#include "candela/media/medium.h"
+
+namespace candela::pbrt {
+
+using pbrt_spectra::Role;
+
+namespace {
+
+// pbrt-v4's named scattering coefficients ("string preset"), in mm^-1 as measured (pbrt converts no
+// units; "scale" does): the first twelve from Jensen et al. 2001, "A Practical Model for Subsurface
+// Light Transport", the others from Narasimhan et al. 2006, "Acquiring Scattering Properties of
+// Participating Media by Dilution". The measured scattering is the reduced coefficient
+// sigma_s' = sigma_s (1 - g); pbrt-v4 uses it as sigma_s, and so does candela.
+struct ScatteringPreset {
+  std::string_view name;
+  RGB sigma_s, sigma_a;
+};
+
+constexpr ScatteringPreset kScatteringPresets[] = {
+    {"Apple", {2.29f, 2.39f, 1.97f}, {0.0030f, 0.0034f, 0.046f}},
+    {"Chicken1", {0.15f, 0.21f, 0.38f}, {0.015f, 0.077f, 0.19f}},
+    {"Chicken2", {0.19f, 0.25f, 0.32f}, {0.018f, 0.088f, 0.20f}},
+    {"Cream", {7.38f, 5.47f, 3.15f}, {0.0002f, 0.0028f, 0.0163f}},
+    {"Ketchup", {0.18f, 0.07f, 0.03f}, {0.061f, 0.97f, 1.45f}},
+    {"Marble", {2.19f, 2.62f, 3.00f}, {0.0021f, 0.0041f, 0.0071f}},
+    {"Potato", {0.68f, 0.70f, 0.55f}, {0.0024f, 0.0090f, 0.12f}},
+    {"Skimmilk", {0.70f, 1.22f, 1.90f}, {0.0014f, 0.0025f, 0.0142f}},
+    {"Skin1", {0.74f, 0.88f, 1.01f}, {0.032f, 0.17f, 0.48f}},
+    {"Skin2", {1.09f, 1.59f, 1.79f}, {0.013f, 0.070f, 0.145f}},
+    {"Spectralon", {11.6f, 20.4f, 14.9f}, {0.00f, 0.00f, 0.00f}},
+    {"Wholemilk", {2.55f, 3.21f, 3.77f}, {0.0011f, 0.0024f, 0.014f}},
+    {"Lowfat Milk", {0.89187f, 1.5136f, 2.532f}, {0.002875f, 0.00575f, 0.0115f}},
+    {"Reduced Milk", {2.4858f, 3.1669f, 4.5214f}, {0.0025556f, 0.0051111f, 0.012778f}},
+    {"Regular Milk", {4.5513f, 5.8294f, 7.136f}, {0.0015333f, 0.0046f, 0.019933f}},
+    {"Espresso", {0.72378f, 0.84557f, 1.0247f}, {4.7984f, 6.5751f, 8.8493f}},
+    {"Mint Mocha Coffee", {0.31602f, 0.38538f, 0.48131f}, {3.772f, 5.8228f, 7.82f}},
+    {"Lowfat Soy Milk", {0.30576f, 0.34233f, 0.61664f}, {0.0014375f, 0.0071875f, 0.035937f}},
+    {"Regular Soy Milk", {0.59223f, 0.73866f, 1.4693f}, {0.0019167f, 0.0095833f, 0.065167f}},
+    {"Lowfat Chocolate Milk", {0.64925f, 0.83916f, 1.1057f}, {0.0115f, 0.0368f, 0.1564f}},
+    {"Regular Chocolate Milk", {1.4585f, 2.1289f, 2.9527f}, {0.010063f, 0.043125f, 0.14375f}},
+    {"Coke", {8.9053e-05f, 8.372e-05f, 0.0f}, {0.10014f, 0.16503f, 0.2468f}},
+    {"Pepsi", {6.1697e-05f, 4.2564e-05f, 0.0f}, {0.091641f, 0.14158f, 0.20729f}},
+    {"Sprite", {6.0306e-06f, 6.4139e-06f, 6.5504e-06f}, {0.001886f, 0.0018308f, 0.0020025f}},
+    {"Gatorade", {0.0024574f, 0.003007f, 0.0037325f}, {0.024794f, 0.019289f, 0.008878f}},
+    {"Chardonnay", {1.7982e-05f, 1.3758e-05f, 1.2023e-05f}, {0.010782f, 0.011855f, 0.023997f}},
+    {"White Zinfandel", {1.7501e-05f, 1.9069e-05f, 1.288e-05f}, {0.012072f, 0.016184f, 0.019843f}},
+    {"Merlot", {2.1129e-05f, 0.0f, 0.0f}, {0.11632f, 0.25191f, 0.29434f}},
+    {"Budweiser Beer", {2.4356e-05f, 2.4079e-05f, 1.0564e-05f}, {0.011492f, 0.024911f, 0.057786f}},
+    {"Coors Light Beer", {5.0922e-05f, 4.301e-05f, 0.0f}, {0.006164f, 0.013984f, 0.034983f}},
+    {"Clorox", {0.0024035f, 0.0031373f, 0.003991f}, {0.0033542f, 0.014892f, 0.026297f}},
+    {"Apple Juice", {0.00013612f, 0.00015836f, 0.000227f}, {0.012957f, 0.023741f, 0.052184f}},
+    {"Cranberry Juice", {0.00010402f, 0.00011646f, 7.8139e-05f}, {0.039437f, 0.094223f, 0.12426f}},
+    {"Grape Juice", {5.382e-05f, 0.0f, 0.0f}, {0.10404f, 0.23958f, 0.29325f}},
+    {"Ruby Grapefruit Juice", {0.011002f, 0.010927f, 0.011036f}, {0.085867f, 0.18314f, 0.25262f}},
+    {"White Grapefruit Juice", {0.22826f, 0.23998f, 0.32748f}, {0.0138f, 0.018831f, 0.056781f}},
+    {"Shampoo", {0.0007176f, 0.0008303f, 0.0009016f}, {0.014107f, 0.045693f, 0.061717f}},
+    {"Strawberry Shampoo", {0.00015671f, 0.00015947f, 1.518e-05f}, {0.01449f, 0.05796f, 0.075823f}},
+    {"Head & Shoulders Shampoo", {0.023805f, 0.028804f, 0.034306f}, {0.084621f, 0.15688f, 0.20365f}},
+    {"Lemon Tea Powder", {0.040224f, 0.045264f, 0.051081f}, {2.4288f, 4.5757f, 7.2127f}},
+    {"Orange Powder", {0.00015617f, 0.00017482f, 0.0001762f}, {0.001449f, 0.003441f, 0.007863f}},
+    {"Pink Lemonade Powder", {0.00012103f, 0.00013073f, 0.00012528f}, {0.001165f, 0.002366f, 0.003195f}},
+    {"Cappuccino Powder", {1.8436f, 2.5851f, 2.1662f}, {35.844f, 49.547f, 61.084f}},
+    {"Salt Powder", {0.027333f, 0.032451f, 0.031979f}, {0.28415f, 0.3257f, 0.34148f}},
+    {"Sugar Powder", {0.00022272f, 0.00025513f, 0.000271f}, {0.012638f, 0.031051f, 0.050124f}},
+    {"Suisse Mocha Powder", {2.7979f, 3.5452f, 4.3365f}, {17.502f, 27.004f, 35.433f}},
+    {"Pacific Ocean Surface Water", {0.0001764f, 0.00032095f, 0.00019617f}, {0.031845f, 0.031324f, 0.030147f}},
+};
+
+const ScatteringPreset* find_scattering_preset(std::string_view name) {
+  for (const ScatteringPreset& preset : kScatteringPresets)
+    if (preset.name == name) return &preset;
+  return nullptr;
+}
+
+std::string scattering_preset_names() {
+  std::string names;
+  for (const ScatteringPreset& preset : kScatteringPresets)
+    names += fmt::format("{}\"{}\"", names.empty() ? "" : ", ", preset.name);
+  return names;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------- names
+
+// The index in SceneDesc::media of the medium `name` refers to (-1 for "", the vacuum). As in
+// pbrt-v4, a medium may be defined after the MediumInterface that names it: its slot is reserved at
+// the first reference and filled by MakeNamedMedium; check_media_defined() reports a name the scene
+// never defines.
+int SceneParser::medium_index(const Token& name) {
+  if (name.text.empty()) return -1;
+  auto [named, first_reference] = media_.try_emplace(name.text);
+  if (first_reference) {
+    named->second = NamedMedium{static_cast<int>(scene_.media.size()), false, at(name)};
+    MediumDesc placeholder;
+    placeholder.name = name.text;
+    placeholder.where = at(name);
+    scene_.media.push_back(std::move(placeholder));
+  }
+  return named->second.index;
+}
+
+void SceneParser::check_media_defined() const {
+  const std::pair<const std::string, NamedMedium>* first_undefined = nullptr;
+  for (const auto& entry : media_)
+    if (!entry.second.defined && (!first_undefined || entry.second.index < first_undefined->second.index))
+      first_undefined = &entry;
+  if (first_undefined)
+    throw_scene_error(first_undefined->second.first_reference,
+                      "MediumInterface: no medium named \"{}\" is defined (MakeNamedMedium defines it, anywhere in "
+                      "the scene)",
+                      first_undefined->first);
+}
+
+// ---------------------------------------------------------------- directives
+
+// MediumInterface "inside" ["outside"]: one name means the same medium on both sides; "" is the
+// vacuum. The shapes that follow get the two (ShapeDesc::interior_medium, exterior_medium), and a
+// Camera the outside one (pbrt-v4's CameraMedium); lights take nothing from it.
+void SceneParser::medium_interface(const Token& d) {
+  Token inside = expect_string(d, "the inside medium's name");
+  Token outside = inside;
+  if (tokens_->peek().kind == TokenKind::String) outside = tokens_->next();
+  state_.inside_medium = medium_index(inside);
+  state_.outside_medium = medium_index(outside);
+}
+
+void SceneParser::make_named_medium(const Token& d) {
+  Token name = expect_string(d, "the medium name");
+  ParamList params = read_params(d, fmt::format("MakeNamedMedium \"{}\"", name.text), kMediumAttributes);
+  if (name.text.empty())
+    throw_scene_error(at(name), "MakeNamedMedium: the name must not be empty (\"\" stands for the vacuum in "
+                      "MediumInterface)");
+  if (auto earlier = media_.find(name.text); earlier != media_.end() && earlier->second.defined)
+    throw_scene_error(at(name), "MakeNamedMedium: medium \"{}\" is already defined at {}", name.text,
+                      scene_.media[earlier->second.index].where.to_string());
+
+  const Param* type = params.take("type", {"string"});
+  if (!type)
+    throw_scene_error(at(d), "{}: \"string type\" is required (\"homogeneous\" or \"uniformgrid\")", params.owner());
+  params.expect_count(*type, 1);
+  MediumDesc medium;
+  if (type->strings[0] == "homogeneous") {
+    medium = make_homogeneous_medium(params);
+  } else if (type->strings[0] == "uniformgrid") {
+    medium = make_grid_medium(params);
+  } else {
+    const std::string& t = type->strings[0];
+    reject_type(type->where, "medium", t, {"homogeneous", "uniformgrid"}, {"rgbgrid", "cloud", "nanovdb"},
+                t == "nanovdb" ? "NanoVDB and OpenVDB grids are not read yet"
+                : t == "rgbgrid" ? "grids of RGB coefficients are not supported yet"
+                                 : "pbrt's procedural clouds are not supported yet");
+  }
+  params.reject_unused();
+  medium.name = name.text;
+  medium.where = at(d);
+  // The parameters were checked one by one above; this is the renderer's own account of what it can
+  // render, so that the two cannot drift apart.
+  if (std::string problem = medium_problem(medium); !problem.empty())
+    throw_scene_error(at(d), "{}: {}", params.owner(), problem);
+
+  int index = medium_index(name);
+  scene_.media[index] = std::move(medium);
+  media_[name.text].defined = true;
+}
+
+// ---------------------------------------------------------------- the medium types
+
+// sigma_a, sigma_s (pbrt-v4's defaults: 1 each), "scale" and "g", which every medium type reads.
+void SceneParser::read_scattering(ParamList& params, MediumDesc& medium, std::optional<RGB> sigma_a,
+                                  std::optional<RGB> sigma_s) {
+  if (!sigma_a) sigma_a = read_spectrum(params, "sigma_a", Role::Unbounded);
+  if (!sigma_s) sigma_s = read_spectrum(params, "sigma_s", Role::Unbounded);
+  set_sigma_a_sigma_s(medium, sigma_a.value_or(RGB(1.0f)), sigma_s.value_or(RGB(1.0f)));
+  medium.scale = params.get_float("scale", 1);
+  if (!(medium.scale >= 0)) params.fail("scale", "must not be negative, got {}", medium.scale);
+  medium.g = params.get_float("g", 0);
+  if (!(medium.g > -1 && medium.g < 1))
+    params.fail("g", "(Henyey-Greenstein's mean cosine) must be between -1 and 1, exclusive, got {}", medium.g);
+}
+
+// "Le", an emission spectrum normalised as lights' are (read_emission), times `scale` ("Lescale").
+RGB SceneParser::read_medium_emission(ParamList& params, float scale) {
+  if (!(scale >= 0)) params.fail("Lescale", "must not be negative, got {}", scale);
+  return read_emission(params, "Le").value_or(RGB(0.0f)) * scale;
+}
+
+// The same coefficients everywhere: pbrt-v4's HomogeneousMedium. Its CTM does not matter.
+MediumDesc SceneParser::make_homogeneous_medium(ParamList& params) {
+  std::optional<RGB> sigma_a, sigma_s;
+  if (const Param* preset = params.take("preset", {"string"})) {
+    params.expect_count(*preset, 1);
+    const ScatteringPreset* found = find_scattering_preset(preset->strings[0]);
+    // pbrt-v4 warns and falls back to sigma_a and sigma_s; a misspelt preset changes the image
+    // entirely, so it is an error here.
+    if (!found)
+      params.fail("preset", "names no scattering preset: \"{}\" (the presets are {})", preset->strings[0],
+                  scattering_preset_names());
+    sigma_a = found->sigma_a;  // and "sigma_a" and "sigma_s" stay unread: an unused-parameter error
+    sigma_s = found->sigma_s;
+  }
+  MediumDesc medium;
+  read_scattering(params, medium, sigma_a, sigma_s);
+  medium.emission = read_medium_emission(params, params.get_float("Lescale", 1));
+  return medium;
+}
+
+// A grid of nx ny nz densities over the box from p0 to p1 in the medium's space (pbrt-v4's
+// GridMedium): extinction (sigma_a + sigma_s) scale density(p), the samples at the voxel centres, and
+// zero beyond them (pbrt's SampledGrid), so the density fades to zero over the outer half voxel.
+MediumDesc SceneParser::make_grid_medium(ParamList& params) {
+  if (params.has("temperature"))
+    params.fail("temperature", "is not supported yet: the emission of a grid medium must be a constant \"Le\"");
+  // Read by pbrt-v4 whether or not there is a temperature grid; without one they change nothing.
+  for (std::string_view unused : {"temperaturescale", "temperatureoffset", "temperaturecutoff"})
+    params.get_float(unused, 0);
+
+  int resolution[3];
+  for (int axis = 0; axis < 3; ++axis) {
+    const char* name = axis == 0 ? "nx" : axis == 1 ? "ny" : "nz";
+    resolution[axis] = params.get_int(name, 1);
+    if (resolution[axis] < 1) params.fail(name, "must be at least 1, got {}", resolution[axis]);
+  }
+  const int64_t voxels = int64_t{resolution[0]} * resolution[1] * resolution[2];
+  const Param* density = params.take("density", {"float"});
+  if (!density)
+    throw_scene_error(params.directive(), "{}: a \"uniformgrid\" medium needs \"float density\" (nx ny nz values)",
+                      params.owner());
+  if (int64_t(density->count()) != voxels)
+    throw_scene_error(density->where, "{}: {} has {} values; nx ny nz = {} x {} x {} needs {}", params.owner(),
+                      density->declaration(), density->count(), resolution[0], resolution[1], resolution[2], voxels);
+  std::vector<float> values(density->numbers.size());
+  for (size_t i = 0; i < values.size(); ++i) {
+    values[i] = static_cast<float>(density->numbers[i]);
+    if (!(values[i] >= 0) || !std::isfinite(values[i]))
+      throw_scene_error(density->where, "{}: {}: value {} (number {}, x fastest) must be finite and not negative",
+                        params.owner(), density->declaration(), density->numbers[i], i + 1);
+  }
+
+  // Bounds3f(p0, p1) in pbrt: the box between the two corners, whichever way round.
+  Point3 p0 = params.get_point3("p0", Point3(0.0f)), p1 = params.get_point3("p1", Point3(1.0f));
+  Point3 lo(std::min(p0.x, p1.x), std::min(p0.y, p1.y), std::min(p0.z, p1.z));
+  Point3 hi(std::max(p0.x, p1.x), std::max(p0.y, p1.y), std::max(p0.z, p1.z));
+  for (int axis = 0; axis < 3; ++axis)
+    if (!(hi[axis] > lo[axis]))
+      params.fail("p1", "must differ from \"p0\" on every axis (the grid's box has no volume), got {} {} {} and "
+                  "{} {} {}", p0.x, p0.y, p0.z, p1.x, p1.y, p1.z);
+
+  MediumDesc medium;
+  read_scattering(params, medium, std::nullopt, std::nullopt);
+  medium.density.resolution = {resolution[0], resolution[1], resolution[2]};
+  medium.density.channels = 1;
+  medium.density.values = std::make_shared<const std::vector<float>>(std::move(values));
+  medium.density.to_world = state_.ctm.start * Transform::translate(lo) * Transform::scale(hi - lo);
+  medium.density.border = VolumeBorder::Zero;
+
+  // pbrt-v4 reads "Lescale" as a grid of nx ny nz values, or of one value for a one-voxel grid.
+  float le_scale = 1;
+  if (const Param* scale = params.take("Lescale", {"float"})) {
+    if (scale->count() != 1 && int64_t(scale->count()) == voxels)
+      throw_scene_error(scale->where, "{}: {} is not supported yet as a grid (a value per voxel); give one value",
+                        params.owner(), scale->declaration());
+    params.expect_count(*scale, 1);
+    le_scale = static_cast<float>(scale->numbers[0]);
+  }
+  medium.emission = read_medium_emission(params, le_scale);
+  // pbrt-v4 looks its constant "Lescale" up in a grid of one sample, which fades towards the box's
+  // faces as the density does (a trilinear tent with its peak at the centre); candela's is uniform.
+  if (!medium.emission.is_black())
+    warn(params.where("Le"), "{}: the emission is the same everywhere in the grid's box; pbrt-v4's fades from the "
+         "box's centre towards its faces", params.owner());
+  return medium;
+}
+
+}  // namespace candela::pbrt
