@@ -281,12 +281,15 @@ Json volume_json(const VolumeDesc& v) {
   Json j = Json::object();
   if (!v.filename.empty()) {
     j["filename"] = absolute(v.filename);
+    if (!v.grid_name.empty()) j["grid"] = v.grid_name;
   } else {
     j["resolution"] = v.resolution;
     if (v.channels != 1) j["channels"] = v.channels;
     j["values"] = v.values ? *v.values : std::vector<float>{};
   }
-  if (!v.to_world.is_identity()) j["transform"] = matrix(v.to_world);
+  // The scene's own placement; a VDB file brings its own.
+  const Transform placement = v.to_world * v.file_to_world.inverse();
+  if (!placement.is_identity()) j["transform"] = matrix(placement);
   if (v.border == VolumeBorder::Zero) j["border"] = "zero";
   return j;
 }
@@ -299,6 +302,8 @@ Json medium_json(const MediumDesc& m) {
   if (!homogeneous) j["density"] = m.density.is_constant() ? Json(m.density.constant.r) : volume_json(m.density);
   if (m.scale != 1) j["scale"] = m.scale;
   if (m.g != 0) j["g"] = m.g;
+  if (!homogeneous && m.majorant_cell_samples != MediumDesc{}.majorant_cell_samples)
+    j["majorant_cell_samples"] = m.majorant_cell_samples;
   if (!m.emission.is_black()) j["emission"] = rgb(m.emission);
   return j;
 }

@@ -252,10 +252,9 @@ TEST(PbrtMedia, TypeErrors) {
   expect_error({"WorldBegin", "MakeNamedMedium \"m\" \"rgb sigma_a\" [ 1 1 1 ]"}, 2, "MakeNamedMedium",
                "MakeNamedMedium \"m\": \"string type\" is required");
   expect_error({"WorldBegin", "MakeNamedMedium \"m\" \"string type\" \"fog\""}, 2, "\"string type\"",
-               "unknown medium type \"fog\" (supported: \"homogeneous\", \"uniformgrid\")");
+               "unknown medium type \"fog\" (supported: \"homogeneous\", \"uniformgrid\", \"nanovdb\")");
   expect_error({"WorldBegin", "MakeNamedMedium \"m\" \"string type\" \"nanovdb\" \"string filename\" \"a.nvdb\""}, 2,
-               "\"string type\"",
-               "medium type \"nanovdb\" is not supported: NanoVDB and OpenVDB grids are not read yet");
+               "\"string filename\"", "a.nvdb");
   expect_error({"WorldBegin", "MakeNamedMedium \"m\" \"string type\" \"rgbgrid\""}, 2, "\"string type\"",
                "medium type \"rgbgrid\" is not supported: grids of RGB coefficients are not supported yet");
   expect_error({"WorldBegin", "MakeNamedMedium \"m\" \"string type\" \"cloud\""}, 2, "\"string type\"",

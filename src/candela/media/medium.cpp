@@ -44,6 +44,7 @@ std::string medium_problem(const MediumDesc& m) {
   if (!std::isfinite(m.scale) || m.scale < 0) return fmt::format("scale {} must be finite and >= 0", m.scale);
   if (!valid_rgb(m.emission)) return fmt::format("emission ({}, {}, {}) must be finite and >= 0", m.emission.r, m.emission.g, m.emission.b);
   if (!(m.g > -1 && m.g < 1)) return fmt::format("g = {} must be within (-1, 1)", m.g);
+  if (m.majorant_cell_samples < 0) return fmt::format("majorant_cell_samples {} must be >= 0", m.majorant_cell_samples);
   constexpr float kHuge = std::numeric_limits<float>::max();
   if (std::string p = volume_problem(m.density, "density", true, kHuge); !p.empty()) return p;
   return volume_problem(m.albedo, "albedo", false, 1.0f);
@@ -119,10 +120,12 @@ Medium::Medium(const MediumDesc& desc)
       emission_(desc.emission),
       phase_{desc.g} {
   if (density_.is_constant()) return;
-  // The majorant grid: a cell per 4^3 samples of the density, at most 64 per axis and at least one
-  // (pbrt-v4 uses a fixed 16^3; scaling with the grid keeps empty space skippable in large clouds).
+  // The majorant grid: a cell per majorant_cell_samples^3 samples of the density (4 by default), at
+  // most 64 per axis and at least one (pbrt-v4 uses a fixed 16^3; scaling with the grid keeps empty
+  // space skippable in large clouds).
+  const int k = desc.majorant_cell_samples;
   for (int a = 0; a < 3; ++a)
-    majorant_resolution_[a] = std::clamp((density_.resolution()[a] + 3) / 4, 1, 64);
+    majorant_resolution_[a] = k > 0 ? std::clamp((density_.resolution()[a] + k - 1) / k, 1, 64) : 1;
   const auto& r = majorant_resolution_;
   majorant_.resize(size_t(r[0]) * size_t(r[1]) * size_t(r[2]));
   for (int z = 0; z < r[2]; ++z)

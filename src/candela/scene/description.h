@@ -420,6 +420,10 @@ struct VolumeDesc {
   Transform to_world;    // the grid's unit cube to world space
   VolumeBorder border = VolumeBorder::Clamp;
   std::string filename;  // where it was read from, for messages (empty: made in memory)
+  std::string grid_name;  // the grid within an OpenVDB or NanoVDB file
+  // The part of to_world that the file itself gives (a VDB grid's voxel placement; identity for .vol
+  // files and inline grids): to_world = the scene's own placement x file_to_world.
+  Transform file_to_world;
   bool is_constant() const { return !values; }
 };
 
@@ -437,6 +441,10 @@ struct MediumDesc {
   float scale = 1;
   RGB emission{0.0f};
   float g = 0;
+  // A density grid's majorant: the largest density over cells of this many samples along each axis
+  // (at most 64 cells per axis), traversed cell by cell; 0 = one majorant for the whole grid (what
+  // Mitsuba does by default, majorant_resolution_factor = 0). Changes the noise, not the expectation.
+  int majorant_cell_samples = 4;
   std::string name;      // for messages
   SourceLocation where;  // where the scene file declares it
   bool is_homogeneous() const { return density.is_constant() && albedo.is_constant(); }

@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "candela/geometry/sdf_grid.h"
+#include "candela/io/grid_files.h"
 #include "candela/io/json/reader.h"
 #include "candela/media/medium.h"
 
@@ -69,6 +70,7 @@ MediumDesc JsonSceneReader::read_medium(const Json& value, const std::string& po
     else
       medium.density.constant = RGB(check_bound(report_, read_float(report_, density, m.pointer_of("density")),
                                                 Bound::NonNegative, m.pointer_of("density")));
+    medium.majorant_cell_samples = m.integer_or("majorant_cell_samples", medium.majorant_cell_samples, 0, 1 << 20);
   }
   m.finish();
   // The keys were checked one by one above; this is the renderer's own account of what it can render,
@@ -98,11 +100,16 @@ VolumeDesc JsonSceneReader::read_volume(const Json& value, const std::string& po
   if (from_file) {
     values_pointer = v.pointer_of("filename");
     volume.filename = existing_file(v, "filename", "volume grid");
-    VolumeGrid file = read_volume_grid(volume.filename, report_.location(values_pointer));
+    // OpenVDB and NanoVDB files hold named grids; a .vol file is one grid.
+    VolumeDesc file = read_grid_file(volume.filename, v.string_or("grid", std::string(what)),
+                                     report_.location(values_pointer));
+    volume.grid_name = file.grid_name;
     volume.resolution = file.resolution;
     volume.channels = file.channels;
+    volume.file_to_world = file.file_to_world;
+    volume.border = file.border;
     check_channels(volume.channels, values_pointer, fmt::format("volume grid '{}'", volume.filename));
-    values = std::move(file.values);
+    values = *file.values;
   } else {
     const Json& resolution = v.require("resolution");
     const std::string resolution_pointer = v.pointer_of("resolution");
@@ -135,7 +142,7 @@ VolumeDesc JsonSceneReader::read_volume(const Json& value, const std::string& po
       report_.fail(from_file ? values_pointer : child_pointer(values_pointer, k), "{} value {} (number {}{}) must be {}",
                    what, values[k], k, in_file, is_density ? "finite and >= 0" : "in [0, 1]");
   volume.values = std::make_shared<const std::vector<float>>(std::move(values));
-  volume.to_world = read_transform_key(v);
+  volume.to_world = read_transform_key(v) * volume.file_to_world;
   if (const Json* border = v.find("border"))
     volume.border = read_name<VolumeBorder>(report_, *border, v.pointer_of("border"), "grid border",
                                             {{"clamp", VolumeBorder::Clamp}, {"zero", VolumeBorder::Zero}});

@@ -95,7 +95,9 @@ int Converter::medium(const Object& m) {
   out.g = phase_g(m);
   if (!get_bool(m, "sample_emitters", true))
     warn(m.where, "{}: sample_emitters = false is ignored: candela samples emitters from every medium", m.describe());
-  ignore(m, "majorant_resolution_factor", nullptr);  // candela always uses a majorant grid
+  // Mitsuba's default is one global majorant; candela's majorant grid gives the same expectation
+  // with less noise, so only a factor the scene gives is taken over.
+  if (find(m, "majorant_resolution_factor")) out.majorant_cell_samples = get_int(m, "majorant_resolution_factor", 0);
   ignore(m, "majorant_factor", nullptr);
   check_all_used(m);
   if (std::string problem = medium_problem(out); !problem.empty())

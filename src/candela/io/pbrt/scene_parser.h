@@ -229,6 +229,7 @@ class SceneParser {
   RGB read_medium_emission(ParamList& params, float scale);
   MediumDesc make_homogeneous_medium(ParamList& params);
   MediumDesc make_grid_medium(ParamList& params);
+  MediumDesc make_nanovdb_medium(ParamList& params);
 
   std::vector<std::string>& warnings_;
   SceneDesc scene_;
