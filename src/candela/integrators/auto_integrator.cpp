@@ -7,6 +7,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "candela/integrators/volpath.h"
 #include "candela/render/cluster.h"
 
 namespace candela {
@@ -15,8 +16,10 @@ std::vector<const IntegratorEntry*> auto_candidates(const RenderSettings& settin
   std::vector<const IntegratorEntry*> candidates;
   // With media only the integrators that render them apply; without, volpath is the path tracer
   // with one shadow ray and adds nothing to compare.
-  for (const IntegratorEntry& entry : integrators())
-    if (set_but_unread(entry, settings).empty() && entry.participating_media == has_media) candidates.push_back(&entry);
+  for (const IntegratorEntry& entry : integrators()) {
+    if (has_media ? !entry.participating_media : entry.render == render_volpath) continue;
+    if (set_but_unread(entry, settings).empty()) candidates.push_back(&entry);
+  }
   return candidates;
 }
 

@@ -1,5 +1,9 @@
 #include "candela/integrators/bdpt.h"
 
+#include <bit>
+#include <cmath>
+#include <stdexcept>
+
 #include "candela/integrators/mlt_sampler.h"
 #include "candela/materials/spectral_bsdf.h"
 #include "candela/render/camera_sample_tiles.h"
@@ -43,13 +47,88 @@ class Restore {
   T saved_{};
 };
 
+// A fresh random stream for walks through media, from two sampler dimensions (drawn only where
+// there are media, so scenes without keep their samples).
+template <typename Sampler>
+Rng media_rng(Sampler& sampler) {
+  uint64_t a = std::bit_cast<uint32_t>(sampler.get_1d()), b = std::bit_cast<uint32_t>(sampler.get_1d());
+  return Rng(hash_values(a, b, 11), hash_values(b, a, 13));
+}
+
+// Delta tracking along `ray` (unit direction) over [0, t_max) with extinction sigma per unit density:
+// the distance of the first real collision, or infinity.
+float sample_collision(const Medium& m, float sigma, const Ray& ray, float t_max, Rng& rng) {
+  float collision = std::numeric_limits<float>::infinity();
+  m.for_each_majorant(ray, ray.t_min, t_max, [&](float t0, float t1, float bound) {
+    const float sigma_maj = sigma * bound;
+    if (!(sigma_maj > 0)) return true;
+    for (float t = t0;;) {
+      t += -std::log1p(-rng.next_float()) / sigma_maj;
+      if (!(t < t1)) return true;
+      if (rng.next_float() * bound < m.density(ray.at(t))) {
+        collision = t;
+        return false;
+      }
+    }
+  });
+  return collision;
+}
+
+// The transmittance over [0, t_max) of `ray`: exact in homogeneous media, by ratio tracking (with
+// Russian roulette where little gets through) in grids.
+float segment_transmittance(const Medium& m, float sigma, const Ray& ray, float t_max, Rng& rng) {
+  if (m.is_homogeneous()) {
+    const float sigma_t = sigma * m.density(ray.origin);
+    return sigma_t > 0 ? std::exp(-sigma_t * t_max) : 1.0f;
+  }
+  float T = 1;
+  m.for_each_majorant(ray, 0, t_max, [&](float t0, float t1, float bound) {
+    const float sigma_maj = sigma * bound;
+    if (!(sigma_maj > 0)) return true;
+    for (float t = t0;;) {
+      t += -std::log1p(-rng.next_float()) / sigma_maj;
+      if (!(t < t1)) return true;
+      T *= std::max(0.0f, 1 - m.density(ray.at(t)) / bound);
+      if (T < 0.05f) {
+        if (rng.next_float() < 0.75f) T = 0;
+        else T /= 0.25f;
+      }
+      if (!(T > 0)) return false;
+    }
+  });
+  return T;
+}
+
 }  // namespace
+
+float BdptIntegrator::path_sigma_t(int medium, int hero, const Wavelengths* wl) const {
+  const RGB& sigma = scene_.media()[size_t(medium)].sigma_t();
+  if (hero < 0) return sigma.r;
+  return wl ? unbounded_at(sigma, *wl)[hero] : sigma[hero];
+}
+
+int BdptIntegrator::outgoing_medium(const BdptVertex& v, const Vec3& dir) const {
+  switch (v.kind) {
+    case Kind::Camera: return scene_.camera_medium();
+    case Kind::Surface: return scene_.medium_after(v.hit, dir, v.medium);
+    case Kind::Light:
+    case Kind::Medium: return v.medium;
+  }
+  return -1;
+}
 
 BdptIntegrator::BdptIntegrator(const Scene& scene, const RenderSettings& settings)
     : scene_(scene),
       max_depth_(settings.max_depth),
       rr_start_depth_(settings.rr_start_depth),
-      hide_emitters_(settings.hide_emitters) {}
+      hide_emitters_(settings.hide_emitters) {
+  for (const Medium& m : scene.media()) {
+    if (m.is_emissive())
+      throw std::invalid_argument("the scene has an emissive medium, which only the volpath integrator renders");
+    const RGB& sigma = m.sigma_t();
+    chromatic_media_ = chromatic_media_ || sigma.r != sigma.g || sigma.g != sigma.b;
+  }
+}
 
 // ------------------------------------------------------------------------------------------ subpaths
 
@@ -78,17 +157,26 @@ int BdptIntegrator::camera_subpath(const Ray& ray, Sampler& sampler, RayCounts& 
   // An orthographic camera's directions are a delta: no strategy connects to it (t = 1), and MIS
   // leaves that strategy out as it leaves out connections to delta lights.
   camera.delta = scene_.camera().is_delta_direction();
+  // Media whose extinction differs between the channels are sampled by one channel per path, which
+  // then counts for three.
+  if (scene_.has_media() && (wl || chromatic_media_)) {
+    camera.hero = int8_t(std::min(int(sampler.get_1d() * 3), 2));
+    camera.beta = RGB(0.0f);
+    camera.beta[camera.hero] = 3;
+  }
   ++counts.camera;
   Ray r = ray;
-  r.direction = normalize(r.direction);
+  const float length_scale = length(r.direction);
+  r.direction = r.direction / length_scale;
+  r.t_min *= length_scale;
   float pdf_dir = scene_.camera().pdf_importance(r.origin, r.direction).dir;
-  return random_walk(r, sampler, counts, RGB(1.0f), pdf_dir, max_vertices, Transport::Radiance, path,
-                     crossed_emission, wl);
+  return random_walk(r, sampler, counts, camera.beta, pdf_dir, max_vertices, Transport::Radiance, path,
+                     crossed_emission, wl, scene_.camera_medium(), camera.hero);
 }
 
 template <typename Sampler>
 int BdptIntegrator::light_subpath(Sampler& sampler, RayCounts& counts, int max_vertices, float time,
-                                  BdptVertex* path, const Wavelengths* wl) const {
+                                  BdptVertex* path, const Wavelengths* wl, int hero) const {
   if (max_vertices == 0 || scene_.lights().empty()) return 0;
   // Choose a light by power, then a ray leaving it.
   float u_light = sampler.get_1d();
@@ -113,8 +201,14 @@ int BdptIntegrator::light_subpath(Sampler& sampler, RayCounts& counts, int max_v
   float cos_light = v.on_surface() ? std::abs(dot(e.n, e.w)) : 1.0f;
   RGB beta = e.radiance * (cos_light / (pmf * e.pdf_pos * e.pdf_dir));
   Point3 origin = v.on_surface() ? offset_ray_origin(e.p, e.n, e.w) : e.p;
+  // The medium the light shines into (lights carry none of their own). Light from infinity cannot
+  // cross fog that fills all space.
+  if (scene_.has_media()) {
+    if (v.at_infinity && scene_.ambient_medium() >= 0) return 0;
+    v.medium = v.at_infinity ? -1 : scene_.medium_at(origin, time);
+  }
   int n = random_walk(Ray{origin, e.w, std::numeric_limits<float>::infinity(), time}, sampler, counts, beta,
-                      e.pdf_dir, max_vertices, Transport::Importance, path, nullptr, wl);
+                      e.pdf_dir, max_vertices, Transport::Importance, path, nullptr, wl, v.medium, hero);
 
   // Lights at infinity: the first vertex's density is the disk's per-area density projected onto
   // it, and the light's own "position" is its direction, with the density all lights at infinity
@@ -132,16 +226,60 @@ int BdptIntegrator::light_subpath(Sampler& sampler, RayCounts& counts, int max_v
 template <typename Sampler>
 int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RGB beta, float pdf,
                                 int max_vertices, Transport mode, BdptVertex* path, RGB* crossed_emission,
-                                const Wavelengths* wl) const {
+                                const Wavelengths* wl, int medium, int hero) const {
   int n = 1;
   float pdf_fwd = pdf;
   float eta_scale = 1;
   // Russian roulette looks at the throughput relative to the subpath's start (light subpaths start
   // with the light's power, not with 1).
   const float start = std::max(beta.max_component(), 1e-30f);
+  // Russian roulette, after a vertex that scattered (false: the subpath ends here).
+  auto survives_roulette = [&]() {
+    int depth = n - 1;
+    float rr = (beta * eta_scale).max_component() / start;
+    if (depth > rr_start_depth_ && rr < 1) {
+      float q = std::max(0.0f, 1 - rr);
+      if (sampler.get_1d() < q) return false;
+      beta = beta / (1 - q);
+    }
+    ++counts.bounce;  // counted once the ray is sure to be traced
+    return true;
+  };
   while (n < max_vertices) {
     SurfaceHit hit;
-    if (!scene_.intersect(ray, hit)) {
+    const bool found = scene_.intersect(ray, hit);
+    // In a medium, the subpath may scatter before it reaches the surface.
+    if (medium >= 0) {
+      const Medium& m = scene_.media()[size_t(medium)];
+      Rng rng = media_rng(sampler);
+      const float t = sample_collision(m, path_sigma_t(medium, hero, wl), ray,
+                                       found ? hit.t : std::numeric_limits<float>::infinity(), rng);
+      if (t < std::numeric_limits<float>::infinity()) {
+        BdptVertex& v = path[n];
+        BdptVertex& prev = path[n - 1];
+        v = BdptVertex{};
+        v.kind = Kind::Medium;
+        v.p = ray.at(t);
+        v.wo = -ray.direction;
+        v.medium = medium;
+        v.g = m.phase().g;
+        // Distances were sampled by the extinction: what scatters of it is the albedo.
+        RGB albedo = m.albedo(v.p);
+        beta *= wl ? reflectance_at(albedo, *wl) : albedo;
+        v.beta = beta;
+        v.pdf_fwd = convert_density(pdf_fwd, prev, v);
+        ++n;
+        if (n >= max_vertices || beta.is_black()) break;
+        PhaseSample ps = m.phase().sample(v.wo, sampler.get_2d());
+        if (!(ps.pdf > 0)) break;
+        pdf_fwd = ps.pdf;
+        prev.pdf_rev = convert_density(m.phase().pdf(ps.wi, v.wo), v, prev);
+        ray = Ray{v.p, ps.wi, std::numeric_limits<float>::infinity(), ray.time};
+        if (!survives_roulette()) break;
+        continue;
+      }
+    }
+    if (!found) {
       // A camera ray that escapes ends on the lights at infinity (a vertex even when there are none,
       // as the s = 0 strategy's end point).
       if (mode == Transport::Radiance) {
@@ -166,14 +304,17 @@ int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RG
         v.pdf_fwd = convert_density(pdf_fwd, path[n - 1], v);
         crossed_emission[n + 1] += connect<Sampler>(nullptr, path, 0, n + 1, sampler, counts, ray.time, wl).L;
       }
+      medium = scene_.medium_after(hit, ray.direction, medium);
       ray.origin = offset_ray_origin(hit.p, hit.ng, ray.direction);
       ray.t_max = std::numeric_limits<float>::infinity();
+      ray.t_min = 0;
       continue;
     }
 
     BdptVertex& v = path[n];
     BdptVertex& prev = path[n - 1];
     v = surface_vertex(hit, ray, beta);
+    v.medium = medium;
     v.pdf_fwd = convert_density(pdf_fwd, prev, v);
     Shading shading = scene_.shading(hit, v.wo);
     bsdf_at_wavelengths(shading.bsdf, wl);
@@ -207,18 +348,12 @@ int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RG
       pdf_fwd = pdf_rev = 0;
     }
     prev.pdf_rev = convert_density(pdf_rev, v, prev);
+    medium = scene_.medium_after(hit, wi, medium);
     ray = Ray{offset_ray_origin(hit.p, hit.ng, wi), wi, std::numeric_limits<float>::infinity(), ray.time};
 
     // Possibly terminate the subpath with Russian roulette. The MIS densities ignore it: the
     // weights stay a partition of unity, so the estimate stays unbiased.
-    int depth = n - 1;
-    float rr = (beta * eta_scale).max_component() / start;
-    if (depth > rr_start_depth_ && rr < 1) {
-      float q = std::max(0.0f, 1 - rr);
-      if (sampler.get_1d() < q) break;
-      beta = beta / (1 - q);
-    }
-    ++counts.bounce;  // counted once the ray is sure to be traced
+    if (!survives_roulette()) break;
   }
   return n;
 }
@@ -243,6 +378,8 @@ float BdptIntegrator::vertex_pdf(const BdptVertex* prev, const BdptVertex& v, co
   float pdf;
   if (v.kind == Kind::Camera) {
     pdf = scene_.camera().pdf_importance(v.p, wn).dir;
+  } else if (v.kind == Kind::Medium) {
+    pdf = HenyeyGreenstein{v.g}.pdf(normalize(prev->p - v.p), wn);
   } else {
     Vec3 wp = normalize(prev->p - v.p);
     pdf = bsdf_pdf(v.bsdf, v.frame.to_local(wp), v.frame.to_local(wn));
@@ -346,6 +483,7 @@ RGB BdptIntegrator::scatter(const BdptVertex& v, const BdptVertex& next, Transpo
   Vec3 wi = next.p - v.p;
   if (length_squared(wi) == 0) return RGB(0.0f);
   wi = normalize(wi);
+  if (v.kind == Kind::Medium) return RGB(HenyeyGreenstein{v.g}.p(v.wo, wi));  // symmetric: the same both ways
   Vec3 wo_local = v.frame.to_local(v.wo), wi_local = v.frame.to_local(wi);
   if (mode == Transport::Importance)
     return bsdf_eval_adjoint(v.bsdf, wo_local, wi_local) * shading_normal_correction(v, v.wo, wi);
@@ -359,6 +497,7 @@ bool BdptIntegrator::is_connectible(const BdptVertex& v) const {
       // (a light of a single direction cannot be reached from another point)
       return v.light >= 0 && !has(light_flags(scene_.lights()[size_t(v.light)]), LightFlags::DeltaDirection);
     case Kind::Surface: return bsdf_has_non_delta(v.bsdf);
+    case Kind::Medium: return true;
   }
   return false;
 }
@@ -367,12 +506,15 @@ bool BdptIntegrator::is_delta_light(const BdptVertex& v) const {
   return v.kind == Kind::Light && v.light >= 0 && light_is_delta(scene_.lights()[size_t(v.light)]);
 }
 
-bool BdptIntegrator::unoccluded(const BdptVertex& a, const BdptVertex& b, float time, RayCounts& counts) const {
+RGB BdptIntegrator::visibility(const BdptVertex& a, const BdptVertex& b, float time, RayCounts& counts, Rng& rng,
+                               int hero, const Wavelengths* wl) const {
   Ray ray;
   ray.time = time;
+  const BdptVertex* from = &a;
   if (a.at_infinity || b.at_infinity) {
     const BdptVertex& finite = a.at_infinity ? b : a;
     const BdptVertex& far = a.at_infinity ? a : b;
+    from = &finite;
     ray.direction = normalize(far.p - finite.p);
     ray.origin = finite.on_surface() ? offset_ray_origin(finite.p, finite.ng, ray.direction) : finite.p;
     ray.t_max = std::numeric_limits<float>::infinity();
@@ -382,24 +524,39 @@ bool BdptIntegrator::unoccluded(const BdptVertex& a, const BdptVertex& b, float 
     Point3 to = b.on_surface() ? offset_ray_origin(b.p, b.ng, -d) : b.p;
     Vec3 segment = to - ray.origin;
     float len = length(segment);
-    if (!(len > 0)) return true;
+    if (!(len > 0)) return RGB(1.0f);
     ray.direction = segment / len;
     ray.t_max = len * (1 - 1e-4f);
   }
   ++counts.shadow;
-  if (!scene_.has_interfaces()) return !scene_.occluded(ray);
-  // Look past interfaces (surfaces without a material of their own).
+  if (!scene_.has_interfaces() && !scene_.has_media()) return RGB(scene_.occluded(ray) ? 0.0f : 1.0f);
+  // Look past interfaces (surfaces without a material of their own), through the media between.
+  int medium = scene_.has_media() ? outgoing_medium(*from, ray.direction) : -1;
+  const Point3 end = ray.at(std::isfinite(ray.t_max) ? ray.t_max : 0.0f);
+  float T = 1;
   for (int crossed = 0; crossed < 256; ++crossed) {
     SurfaceHit hit;
-    if (!scene_.intersect(ray, hit)) return true;
-    if (!scene_.is_interface(hit)) return false;
-    Point3 next = offset_ray_origin(hit.p, hit.ng, ray.direction);
-    ray.t_max -= length(next - ray.origin);
-    ray.origin = next;
-    if (!(ray.t_max > 0)) return true;
+    const bool found = scene_.intersect(ray, hit);
+    if (found && !scene_.is_interface(hit)) return RGB(0.0f);
+    if (medium >= 0) {
+      T *= segment_transmittance(scene_.media()[size_t(medium)], path_sigma_t(medium, hero, wl), ray,
+                                 found ? hit.t : ray.t_max, rng);
+      if (!(T > 0)) return RGB(0.0f);
+    }
+    if (!found) return RGB(T);
+    medium = scene_.medium_after(hit, ray.direction, medium);
+    ray.origin = offset_ray_origin(hit.p, hit.ng, ray.direction);
+    // Aim at the same end point again (the offset origin is off the original line).
+    if (std::isfinite(ray.t_max)) {
+      const Vec3 rest = end - ray.origin;
+      const float len = length(rest);
+      if (!(len > 0) || dot(rest, ray.direction) <= 0) return RGB(T);
+      ray.direction = rest / len;
+      ray.t_max = len;
+    }
     ++counts.shadow;
   }
-  return false;
+  return RGB(0.0f);
 }
 
 float BdptIntegrator::geometry_term(const BdptVertex& a, const BdptVertex& b) const {
@@ -420,6 +577,9 @@ BdptIntegrator::Connection BdptIntegrator::connect(BdptVertex* light, BdptVertex
   if (t > 1 && s != 0 && camera[t - 1].kind == Kind::Light) return c;
   RGB L(0.0f);
   BdptVertex sampled;
+  Rng rng;
+  if (scene_.has_media() && s > 0) rng = media_rng(sampler);
+  const int hero = camera[0].hero;
   if (s == 0) {
     // The camera subpath hit a light.
     const BdptVertex& pt = camera[t - 1];
@@ -439,7 +599,12 @@ BdptIntegrator::Connection BdptIntegrator::connect(BdptVertex* light, BdptVertex
     // Visibility up to the near clipping plane only (the lens point itself without one).
     BdptVertex visible = sampled;
     visible.p = lens->p_visible;
-    if (L.is_black() || !unoccluded(qs, visible, time, counts)) return c;
+    if (L.is_black()) return c;
+    // The lens point counts once, as the camera vertex of the camera subpath does: with a hero
+    // channel, three times that channel alone.
+    if (hero >= 0) L *= camera[0].beta;
+    L *= visibility(qs, visible, time, counts, rng, hero, wl);
+    if (L.is_black()) return c;
     c.raster = lens->raster;
   } else if (s == 1) {
     // Next-event estimation: a point on a light chosen by power, seen from the camera vertex.
@@ -452,7 +617,9 @@ BdptIntegrator::Connection BdptIntegrator::connect(BdptVertex* light, BdptVertex
     float pmf = choice.pmf(li);
     const Light& lt = scene_.lights()[li];
     Vec3 wo_local = pt.frame.to_local(pt.wo);
-    Normal3 gather = bsdf_has_non_delta_transmission(pt.bsdf) ? Normal3(0.0f) : wo_local.z > 0 ? pt.ns : -pt.ns;
+    Normal3 gather = pt.kind == Kind::Medium || bsdf_has_non_delta_transmission(pt.bsdf) ? Normal3(0.0f)
+                     : wo_local.z > 0                                                   ? pt.ns
+                                                                                        : -pt.ns;
     LightSample ls = light_sample_li(lt, LightSampleContext{pt.p, gather}, u);
     if (!(ls.pdf > 0) || ls.radiance.is_black() || pmf <= 0) return c;
     sampled.kind = Kind::Light;
@@ -462,8 +629,10 @@ BdptIntegrator::Connection BdptIntegrator::connect(BdptVertex* light, BdptVertex
     sampled.ng = sampled.ns = sampled.at_infinity ? Normal3(0.0f) : ls.n_light;
     sampled.beta = illuminant_at(ls.radiance, wl) / (ls.pdf * pmf);
     sampled.pdf_fwd = light_origin_pdf(sampled, pt);
-    L = pt.beta * scatter(pt, sampled, Transport::Radiance) * sampled.beta * std::abs(dot(ls.wi, pt.ns));
-    if (L.is_black() || !unoccluded(pt, sampled, time, counts)) return c;
+    L = pt.beta * scatter(pt, sampled, Transport::Radiance) * sampled.beta;
+    if (pt.on_surface()) L *= std::abs(dot(ls.wi, pt.ns));
+    if (L.is_black()) return c;
+    L *= visibility(pt, sampled, time, counts, rng, hero, wl);
   } else {
     // Join the two subpaths' end vertices with a shadow ray.
     const BdptVertex& qs = light[s - 1];
@@ -472,7 +641,8 @@ BdptIntegrator::Connection BdptIntegrator::connect(BdptVertex* light, BdptVertex
     L = qs.beta * scatter(qs, pt, Transport::Importance) * scatter(pt, qs, Transport::Radiance) * pt.beta;
     if (L.is_black()) return c;
     L *= geometry_term(qs, pt);
-    if (L.is_black() || !unoccluded(qs, pt, time, counts)) return c;
+    if (L.is_black()) return c;
+    L *= visibility(qs, pt, time, counts, rng, hero, wl);
   }
   if (L.is_black()) return c;
   c.unweighted = L;
@@ -494,7 +664,7 @@ RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts
   thread_local std::vector<RGB> crossed;
   crossed.assign(size_t(max_depth_) + 3, RGB(0.0f));
   int nc = camera_subpath(ray, sampler, counts, max_depth_ + 2, cv, crossed.data(), wl);
-  int nl = light_subpath(sampler, counts, max_depth_ + 1, ray.time, lv, wl);
+  int nl = light_subpath(sampler, counts, max_depth_ + 1, ray.time, lv, wl, nc > 0 ? cv[0].hero : -1);
   // What reaches an image directly (splats, strategy images) is RGB.
   auto to_rgb = [wl](const RGB& v) { return wavelengths_to_rgb(v, wl); };
 
@@ -559,7 +729,8 @@ RenderStats render_bdpt(const Scene& scene, const RenderSettings& settings, Film
                                            const Wavelengths*) const;                                           \
   template int BdptIntegrator::camera_subpath<S>(const Ray&, S&, RayCounts&, int, BdptVertex*, RGB*,            \
                                                  const Wavelengths*) const;                                     \
-  template int BdptIntegrator::light_subpath<S>(S&, RayCounts&, int, float, BdptVertex*, const Wavelengths*) const; \
+  template int BdptIntegrator::light_subpath<S>(S&, RayCounts&, int, float, BdptVertex*, const Wavelengths*, int) \
+      const;                                                                                                    \
   template BdptIntegrator::Connection BdptIntegrator::connect<S>(BdptVertex*, BdptVertex*, int, int, S&,       \
                                                                  RayCounts&, float, const Wavelengths*) const;
 CANDELA_FOR_EACH_SAMPLER(CANDELA_INSTANTIATE)

@@ -14,6 +14,16 @@
 // Light subpaths carry importance, so they use the adjoint BSDF: no 1/eta^2 at refractions and
 // the shading-normal correction of Veach's sec. 5.3.
 //
+// Participating media: subpaths scatter in media (delta tracking against the majorant grid gives the
+// distance; a medium vertex scatters by its phase function and connects like a surface vertex), and
+// connections carry the transmittance between their ends (exact in homogeneous media, ratio tracking
+// in grids) across interfaces. Every sampling decision uses one extinction per path: where media are
+// chromatic (or the render spectral), a hero channel chosen per camera sample, whose value then counts
+// three times (the others zero): unbiased for every channel, with more colour noise than volpath's
+// spectral MIS. The MIS densities leave out transmittance and the distance-sampling densities, as
+// pbrt-v3 does: the weights still sum to one over the strategies, so the estimate stays unbiased.
+// Emissive media are volpath's alone.
+//
 // The subpath and connection routines are templates over the sampler, shared with Metropolis light
 // transport (mlt.h), which drives them with its primary-sample-space sampler.
 #include <vector>
@@ -24,6 +34,7 @@
 #include "candela/integrators/path_integrator.h"
 #include "candela/materials/bsdf.h"
 #include "candela/math/frame.h"
+#include "candela/sampling/rng.h"
 #include "candela/scene/scene.h"
 #include "candela/spectral/wavelengths.h"
 
@@ -32,7 +43,7 @@ namespace candela {
 enum class Transport : uint8_t { Radiance, Importance };
 
 struct BdptVertex {
-  enum class Kind : uint8_t { Camera, Light, Surface };
+  enum class Kind : uint8_t { Camera, Light, Surface, Medium };
   Kind kind = Kind::Surface;
   Point3 p;
   Normal3 ng;  // geometric normal; zero where there is no surface (point lights, lights at infinity)
@@ -46,6 +57,9 @@ struct BdptVertex {
                       // for vertices at infinity)
   float pdf_rev = 0;  // density of this vertex when sampled from its successor (the reverse direction)
   int light = -1;     // light vertices: the light; surfaces: the light of an emitter that was hit, or -1
+  int medium = -1;    // surfaces: the medium the subpath arrived in; medium vertices and lights: the one they are in
+  float g = 0;        // medium vertices: the phase function's mean cosine
+  int8_t hero = -1;   // camera vertices: the colour channel that drives sampling in media (-1: all alike)
   bool delta = false;        // scattered by a delta lobe
   bool at_infinity = false;  // a light at infinity (then p is a point along its direction), or an escaped ray
 
@@ -83,9 +97,10 @@ class BdptIntegrator {
   int camera_subpath(const Ray& ray, Sampler& sampler, RayCounts& counts, int max_vertices, BdptVertex* path,
                      RGB* crossed_emission = nullptr, const Wavelengths* wl = nullptr) const;
   // A light subpath of at most max_vertices vertices, starting on a light chosen by power.
+  // `hero`: the camera subpath's (path[0].hero of camera_subpath), so both sample media alike.
   template <typename Sampler>
   int light_subpath(Sampler& sampler, RayCounts& counts, int max_vertices, float time, BdptVertex* path,
-                    const Wavelengths* wl = nullptr) const;
+                    const Wavelengths* wl = nullptr, int hero = -1) const;
   struct Connection {
     RGB L;                // the MIS-weighted contribution
     RGB unweighted;       // the same without the weight
@@ -109,7 +124,13 @@ class BdptIntegrator {
  private:
   template <typename Sampler>
   int random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RGB beta, float pdf, int max_vertices,
-                  Transport mode, BdptVertex* path, RGB* crossed_emission, const Wavelengths* wl) const;
+                  Transport mode, BdptVertex* path, RGB* crossed_emission, const Wavelengths* wl, int medium,
+                  int hero) const;
+
+  // The extinction per unit density that sampling uses in `medium` (one value: see above).
+  float path_sigma_t(int medium, int hero, const Wavelengths* wl) const;
+  // The medium a connection leaving v along dir starts in.
+  int outgoing_medium(const BdptVertex& v, const Vec3& dir) const;
 
   // A surface vertex reached by `ray` (its BSDF, frame and densities are the caller's).
   BdptVertex surface_vertex(const SurfaceHit& hit, const Ray& ray, const RGB& beta) const;
@@ -129,14 +150,17 @@ class BdptIntegrator {
   bool is_connectible(const BdptVertex& v) const;
   bool is_light(const BdptVertex& v) const { return v.kind == BdptVertex::Kind::Light || v.light >= 0; }
   bool is_delta_light(const BdptVertex& v) const;
-  // Whether nothing but interfaces lies between two vertices.
-  bool unoccluded(const BdptVertex& a, const BdptVertex& b, float time, RayCounts& counts) const;
+  // What gets from a to b: 0 when a surface (other than interfaces) lies between, else the
+  // transmittance of the media on the way (1 without media). `rng` drives ratio tracking in grids.
+  RGB visibility(const BdptVertex& a, const BdptVertex& b, float time, RayCounts& counts, Rng& rng, int hero,
+                 const Wavelengths* wl) const;
   float geometry_term(const BdptVertex& a, const BdptVertex& b) const;
 
   const Scene& scene_;
   int max_depth_;
   int rr_start_depth_;
   bool hide_emitters_;  // no depth-0 strategies: emitters seen directly are not shown
+  bool chromatic_media_ = false;  // some medium's extinction differs between the colour channels
 };
 
 // Integrator "bdpt": renders `film` through the shared tile loop, one light subpath per camera

@@ -1,4 +1,5 @@
 #include "candela/integrators/mlt.h"
+#include "candela/integrators/volpath.h"
 
 #include <fmt/format.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -73,7 +74,7 @@ class MltPathSampler {
     PathState state{RGB(0.0f), raster, s, t};
     if (bdpt_.camera_subpath(ray, sampler, counts, t, camera_path.data(), nullptr, wl) != t) return state;
     sampler.start_stream(MltSampler::kLightStream);
-    if (bdpt_.light_subpath(sampler, counts, s, time, light_path.data(), wl) != s) return state;
+    if (bdpt_.light_subpath(sampler, counts, s, time, light_path.data(), wl, camera_path[0].hero) != s) return state;
     sampler.start_stream(MltSampler::kConnectionStream);
     BdptIntegrator::Connection c =
         bdpt_.connect(light_path.data(), camera_path.data(), s, t, sampler, counts, time, wl);
@@ -162,7 +163,8 @@ Normalization estimate_normalization(const Scene& scene, const BdptIntegrator& b
         Ray ray = camera.generate_ray(raster, lens, time);
         crossed.assign(size_t(max_depth) + 3, RGB(0.0f));
         int nc = bdpt.camera_subpath(ray, sampler, counts, max_depth + 2, camera_path.data(), crossed.data(), wl);
-        int nl = bdpt.light_subpath(sampler, counts, max_depth + 1, time, light_path.data(), wl);
+        int nl = bdpt.light_subpath(sampler, counts, max_depth + 1, time, light_path.data(), wl,
+                                    nc > 0 ? camera_path[0].hero : -1);
         by_depth.assign(depths, 0.0);
         for (int t = 1; t <= nc; ++t)
           for (int s = 0; s <= nl; ++s) {
@@ -220,7 +222,9 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   emission_options.time_limit_seconds = 0;
   emission_options.target_error = 0;
   emission_options.bdpt_strategies = nullptr;
-  RenderStats stats = render_path(scene, emission, film, emission_options);
+  // (Through media, the volumetric path tracer, which attenuates what the camera sees.)
+  RenderStats stats = scene.has_media() ? render_volpath(scene, emission, film, emission_options)
+                                        : render_path(scene, emission, film, emission_options);
   stats.samples = 0;
   film.enable_splats();
   film.set_splat_scale(0);

@@ -362,8 +362,14 @@ RGB VolPathIntegrator::trace_transmittance(Point3 origin, const Vec3& dir, float
                                            RayCounts& counts) const {
   Rng rng(seed, hash_values(seed));
   RGB T_ray(1.0f);
+  // Each segment aims at the same end point: a crossing's offset origin, moved off the surface along
+  // its normal, would otherwise shift the line, which then meets the light's plane early (by the
+  // offset over the cosine, millimetres for grazing rays) and is taken for blocked.
+  const bool finite = std::isfinite(t_max);
+  const Point3 end = finite ? origin + dir * t_max : origin;
+  Vec3 direction = dir;
   for (float remaining = t_max;;) {
-    Ray ray{origin, dir, remaining, time};
+    Ray ray{origin, direction, remaining, time};
     SurfaceHit hit;
     ++counts.shadow;
     const bool found = scene_.intersect(ray, hit);
@@ -396,15 +402,19 @@ RGB VolPathIntegrator::trace_transmittance(Point3 origin, const Vec3& dir, float
     if (T_ray.is_black() || !found) return T_ray;
     // Cross the surface: all of an interface's light, a mask's or a thin sheet's straight share.
     if (!scene_.is_interface(hit)) {
-      Shading shading = scene_.shading(hit, -dir);
+      Shading shading = scene_.shading(hit, -direction);
       bsdf_at_wavelengths(shading.bsdf, wl);
-      T_ray *= shading.bsdf.pass_through(shading.frame.to_local(-dir));
+      T_ray *= shading.bsdf.pass_through(shading.frame.to_local(-direction));
       if (T_ray.is_black()) return T_ray;
     }
-    medium = scene_.medium_after(hit, dir, medium);
-    origin = offset_ray_origin(hit.p, hit.ng, dir);
-    remaining -= hit.t;
-    if (!(remaining > 0)) return T_ray;
+    medium = scene_.medium_after(hit, direction, medium);
+    origin = offset_ray_origin(hit.p, hit.ng, direction);
+    if (finite) {
+      const Vec3 rest = end - origin;
+      remaining = length(rest);
+      if (!(remaining > 0) || dot(rest, direction) <= 0) return T_ray;
+      direction = rest / remaining;
+    }
   }
 }
 

@@ -161,6 +161,27 @@ void Scene::build(const SceneDesc& desc, SceneDesc* take_meshes) {
     has_motion_ = has_motion_ || rec.is_moving();
   }
   for (const auto& inst : instances_) has_motion_ = has_motion_ || inst.to_world_end.has_value();
+  // Fog everywhere: a camera medium that no boundary around the camera accounts for.
+  if (camera_medium_ >= 0 && medium_at(desc.camera.world_from_camera.point({0, 0, 0}), desc.camera.shutter_open) < 0)
+    ambient_medium_ = camera_medium_;
+}
+
+int Scene::medium_at(const Point3& p, float time) const {
+  if (media_.empty()) return -1;
+  // Any direction will do for consistent boundaries; an irrational-looking one avoids grazing
+  // axis-aligned geometry.
+  const Vec3 dir = normalize(Vec3(0.5412f, 0.6180f, 0.5703f));
+  Ray ray{p, dir, std::numeric_limits<float>::infinity(), time};
+  for (int crossed = 0; crossed < 256; ++crossed) {
+    SurfaceHit hit;
+    if (!intersect(ray, hit)) break;
+    const ShapeRecord& rec = shapes_[hit.shape];
+    // Leaving along the normal means p is inside.
+    if (rec.interior_medium != rec.exterior_medium)
+      return dot(dir, hit.ng) > 0 ? rec.interior_medium : rec.exterior_medium;
+    ray.origin = offset_ray_origin(hit.p, hit.ng, dir);
+  }
+  return ambient_medium_;
 }
 
 void Scene::add_objects_and_instances(const SceneDesc& desc, SceneDesc* take_meshes) {

@@ -98,6 +98,13 @@ class Scene {
     return dot(dir, hit.ng) > 0 ? rec.exterior_medium : rec.interior_medium;
   }
 
+  // The medium at point p: the side facing p of the first medium boundary a ray from p meets, or
+  // the ambient medium where none is met (for lights, which carry no medium of their own).
+  int medium_at(const Point3& p, float time) const;
+  // The medium of everything outside every medium boundary: the camera's when the camera sits in
+  // a medium that no boundary encloses (fog everywhere), else -1 (vacuum).
+  int ambient_medium() const { return ambient_medium_; }
+
   // Radiance emitted from the hit point towards wo (zero for non-emitters and their back faces).
   RGB emitted(const SurfaceHit& hit, const Vec3& wo) const;
   // The light of an emissive hit, or -1.
@@ -169,6 +176,7 @@ class Scene {
   std::vector<uint32_t> infinite_lights_;
   std::vector<Medium> media_;
   int camera_medium_ = -1;
+  int ambient_medium_ = -1;
   PerspectiveCamera camera_;
   Bounds3 bounds_;
   SceneSphere bounding_sphere_;
