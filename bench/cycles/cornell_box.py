@@ -4,7 +4,11 @@ clamping, box pixel filter of width 1, 16 bounces of every kind, a fixed thread 
 float EXR output. Prints "cycles render seconds: S" (the render alone, scene set-up excluded).
 
 Usage: blender -b --factory-startup --python bench/cycles/cornell_box.py -- \
-           --spp 256 --threads 2 --seed 1 --resolution 512 --out cornell-cycles.exr
+           --spp 256 --threads 2 --seed 1 --resolution 512 --out cornell-cycles.exr [--fog SS,SA,G]
+
+--fog fills the box with a homogeneous grey medium (a cube just inside the walls whose material has only a
+volume: Volume Scatter of density SS with Henyey-Greenstein anisotropy G, plus Volume Absorption of
+density SA, per millimetre), as bench/cycles_fog_vs_candela.py builds the same fog for candela.
 """
 import argparse
 import sys
@@ -122,6 +126,36 @@ def build_scene(resolution):
     return scene
 
 
+def add_fog(scene, sigma_s, sigma_a, g):
+    """The fog's box [1, 555] x [1, 547] x [1, 558] (SPEC coordinates), a volume-only material."""
+    m = bpy.data.materials.new("fog")
+    m.use_nodes = True
+    m.cycles.homogeneous_volume = True
+    nodes = m.node_tree.nodes
+    nodes.clear()
+    scatter = nodes.new("ShaderNodeVolumeScatter")
+    scatter.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    scatter.inputs["Density"].default_value = sigma_s
+    scatter.inputs["Anisotropy"].default_value = g
+    absorb = nodes.new("ShaderNodeVolumeAbsorption")
+    absorb.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)  # absorbs density x (1 - colour)
+    absorb.inputs["Density"].default_value = sigma_a
+    add = nodes.new("ShaderNodeAddShader")
+    out = nodes.new("ShaderNodeOutputMaterial")
+    m.node_tree.links.new(scatter.outputs["Volume"], add.inputs[0])
+    m.node_tree.links.new(absorb.outputs["Volume"], add.inputs[1])
+    m.node_tree.links.new(add.outputs["Shader"], out.inputs["Volume"])
+    lo, hi = (1, 1, 1), (555, 547, 558)
+    corners = [(x, y, z) for z in (lo[2], hi[2]) for y in (lo[1], hi[1]) for x in (lo[0], hi[0])]
+    # Wound so that the normals point out of the box (Cycles tells inside from outside by them).
+    faces = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+    mesh = bpy.data.meshes.new("fog")
+    mesh.from_pydata([to_blender(p) for p in corners], [], faces)
+    mesh.materials.append(m)
+    obj = bpy.data.objects.new("fog", mesh)
+    scene.collection.objects.link(obj)
+
+
 def main():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     p = argparse.ArgumentParser()
@@ -130,8 +164,11 @@ def main():
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--resolution", type=int, default=512)
     p.add_argument("--out", required=True)
+    p.add_argument("--fog", help="SIGMA_S,SIGMA_A,G: fill the box with homogeneous fog")
     a = p.parse_args(argv)
     scene = build_scene(a.resolution)
+    if a.fog:
+        add_fog(scene, *[float(v) for v in a.fog.split(",")])
     scene.cycles.samples = a.spp
     scene.cycles.seed = a.seed
     scene.render.threads_mode = "FIXED"

@@ -74,10 +74,10 @@ float sample_collision(const Medium& m, float sigma, const Ray& ray, float t_max
   return collision;
 }
 
-// The transmittance over [0, t_max) of `ray`: exact in homogeneous media, by ratio tracking (with
+// The transmittance over [0, t_max) of `ray`: exact where the density is constant, by ratio tracking (with
 // Russian roulette where little gets through) in grids.
 float segment_transmittance(const Medium& m, float sigma, const Ray& ray, float t_max, Rng& rng) {
-  if (m.is_homogeneous()) {
+  if (m.has_constant_density()) {
     const float sigma_t = sigma * m.density(ray.origin);
     return sigma_t > 0 ? std::exp(-sigma_t * t_max) : 1.0f;
   }

@@ -374,7 +374,18 @@ RGB VolPathIntegrator::trace_transmittance(Point3 origin, const Vec3& dir, float
     ++counts.shadow;
     const bool found = scene_.intersect(ray, hit);
     if (found && !scene_.may_pass_through(hit)) return RGB(0.0f);
-    if (medium >= 0) {
+    if (medium >= 0 && scene_.media()[size_t(medium)].has_constant_density()) {
+      // A constant extinction is its own majorant: ratio tracking would be all or nothing (no null
+      // collisions), and its expectation is known. The transmittance itself, with the densities of
+      // the walk that met no collision, is that expectation (the same MIS weights, less noise).
+      const Medium& m = scene_.media()[size_t(medium)];
+      const MediumValues mv(m, wl);
+      const RGB T_maj = exp_neg(mv.sigma_t * m.density(origin), found ? hit.t : remaining);
+      if (!(T_maj[hero] > 0)) return RGB(0.0f);
+      T_ray *= T_maj;
+      r_l *= T_maj / T_maj[hero];
+      r_u *= T_maj / T_maj[hero];
+    } else if (medium >= 0) {
       // Ratio tracking: every tentative collision multiplies by sigma_n over the majorant.
       const MediumValues mv(scene_.media()[size_t(medium)], wl);
       RGB T_maj = sample_majorant(mv, ray, 0, found ? hit.t : remaining, hero, rng,

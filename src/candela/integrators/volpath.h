@@ -13,8 +13,9 @@
 //     has no colour bias and does not blow up where one channel's coefficient is small. The same
 //     average weighs light sampling against the unidirectional strategy (the balance heuristic).
 //   - Next-event estimation at surfaces and in media, its shadow rays carrying transmittance by ratio
-//     tracking through every medium and pass-through surface (interfaces, masks, thin sheets) they
-//     cross, combined by MIS with the phase function or BSDF sampled continuation.
+//     tracking (in media of constant extinction: the exact transmittance, ratio tracking's expectation)
+//     through every medium and pass-through surface (interfaces, masks, thin sheets) they cross,
+//     combined by MIS with the phase function or BSDF sampled continuation.
 //   - Media emit (source term sigma_a Le) where their emission is non-zero.
 //   - Russian roulette on the throughput over the unidirectional density.
 // Surfaces that let light pass straight on (interfaces; a mask's absent part; a thin sheet's

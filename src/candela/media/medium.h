@@ -74,6 +74,8 @@ class Medium {
   bool is_emissive() const { return !emission_.is_black(); }
   const HenyeyGreenstein& phase() const { return phase_; }
   bool is_homogeneous() const { return density_.is_constant() && albedo_.is_constant(); }
+  // The extinction is the same everywhere (the albedo may still vary).
+  bool has_constant_density() const { return density_.is_constant(); }
 
   // Visits the majorant along `ray` over [t_min, t_max): visit(t0, t1, density_bound) for
   // consecutive pieces in order, where the density stays at most density_bound (the majorant of
