@@ -55,50 +55,6 @@ Rng media_rng(Sampler& sampler) {
   return Rng(hash_values(a, b, 11), hash_values(b, a, 13));
 }
 
-// Delta tracking along `ray` (unit direction) over [0, t_max) with extinction sigma per unit density:
-// the distance of the first real collision, or infinity.
-float sample_collision(const Medium& m, float sigma, const Ray& ray, float t_max, Rng& rng) {
-  float collision = std::numeric_limits<float>::infinity();
-  m.for_each_majorant(ray, ray.t_min, t_max, [&](float t0, float t1, float bound) {
-    const float sigma_maj = sigma * bound;
-    if (!(sigma_maj > 0)) return true;
-    for (float t = t0;;) {
-      t += -std::log1p(-rng.next_float()) / sigma_maj;
-      if (!(t < t1)) return true;
-      if (rng.next_float() * bound < m.density(ray.at(t))) {
-        collision = t;
-        return false;
-      }
-    }
-  });
-  return collision;
-}
-
-// The transmittance over [0, t_max) of `ray`: exact where the density is constant, by ratio tracking (with
-// Russian roulette where little gets through) in grids.
-float segment_transmittance(const Medium& m, float sigma, const Ray& ray, float t_max, Rng& rng) {
-  if (m.has_constant_density()) {
-    const float sigma_t = sigma * m.density(ray.origin);
-    return sigma_t > 0 ? std::exp(-sigma_t * t_max) : 1.0f;
-  }
-  float T = 1;
-  m.for_each_majorant(ray, 0, t_max, [&](float t0, float t1, float bound) {
-    const float sigma_maj = sigma * bound;
-    if (!(sigma_maj > 0)) return true;
-    for (float t = t0;;) {
-      t += -std::log1p(-rng.next_float()) / sigma_maj;
-      if (!(t < t1)) return true;
-      T *= std::max(0.0f, 1 - m.density(ray.at(t)) / bound);
-      if (T < 0.05f) {
-        if (rng.next_float() < 0.75f) T = 0;
-        else T /= 0.25f;
-      }
-      if (!(T > 0)) return false;
-    }
-  });
-  return T;
-}
-
 }  // namespace
 
 float BdptIntegrator::path_sigma_t(int medium, int hero, const Wavelengths* wl) const {
@@ -539,7 +495,7 @@ RGB BdptIntegrator::visibility(const BdptVertex& a, const BdptVertex& b, float t
     const bool found = scene_.intersect(ray, hit);
     if (found && !scene_.is_interface(hit)) return RGB(0.0f);
     if (medium >= 0) {
-      T *= segment_transmittance(scene_.media()[size_t(medium)], path_sigma_t(medium, hero, wl), ray,
+      T *= estimate_transmittance(scene_.media()[size_t(medium)], path_sigma_t(medium, hero, wl), ray,
                                  found ? hit.t : ray.t_max, rng);
       if (!(T > 0)) return RGB(0.0f);
     }

@@ -190,23 +190,19 @@ TEST(VolPath, GridTransmittanceByRatioAndDeltaTrackingMatchesQuadrature) {
     }
     double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / n);
     EXPECT_NEAR(mean, expected, 5 * se + 1e-4) << "ratio tracking, channel " << c;
-    // Delta tracking with the majorant pieces: the fraction of walks that reach the end.
+    // Delta tracking (media/medium.h, as BDPT walks): the fraction of walks that reach the end.
     const float sigma = medium.sigma_t()[c];
     int reached = 0;
+    for (int i = 0; i < n; ++i) reached += std::isinf(sample_collision(medium, sigma, Ray{from, dir}, length_, rng));
+    // The scalar ratio tracking BDPT's connections use.
+    double ratio_sum = 0, ratio_sum2 = 0;
     for (int i = 0; i < n; ++i) {
-      bool collided = false;
-      medium.for_each_majorant(Ray{from, dir}, 0, length_, [&](float t0, float t1, float bound) {
-        for (float t = t0;;) {
-          t += -std::log1p(-rng.next_float()) / (sigma * bound);
-          if (t >= t1) return true;
-          if (rng.next_float() * bound < medium.density(from + dir * t)) {
-            collided = true;
-            return false;
-          }
-        }
-      });
-      reached += !collided;
+      double t = estimate_transmittance(medium, sigma, Ray{from, dir}, length_, rng);
+      ratio_sum += t;
+      ratio_sum2 += t * t;
     }
+    double ratio_mean = ratio_sum / n, ratio_se = std::sqrt((ratio_sum2 / n - ratio_mean * ratio_mean) / n);
+    EXPECT_NEAR(ratio_mean, expected, 5 * ratio_se + 1e-4) << "scalar ratio tracking, channel " << c;
     double p = double(reached) / n;
     EXPECT_NEAR(p, expected, 5 * std::sqrt(expected * (1 - expected) / n) + 1e-4) << "delta tracking, channel " << c;
   }

@@ -145,4 +145,45 @@ float Medium::density(const Point3& p) const {
   return density_.scalar_at(p);
 }
 
+float sample_collision(const Medium& m, float sigma, const Ray& ray, float t_max, Rng& rng) {
+  float collision = std::numeric_limits<float>::infinity();
+  m.for_each_majorant(ray, ray.t_min, t_max, [&](float t0, float t1, float bound) {
+    const float sigma_maj = sigma * bound;
+    if (!(sigma_maj > 0)) return true;
+    for (float t = t0;;) {
+      t += -std::log1p(-rng.next_float()) / sigma_maj;
+      if (!(t < t1)) return true;
+      // A real collision with probability density / bound; else a null one, and on.
+      if (rng.next_float() * bound < m.density(ray.at(t))) {
+        collision = t;
+        return false;
+      }
+    }
+  });
+  return collision;
+}
+
+float estimate_transmittance(const Medium& m, float sigma, const Ray& ray, float t_max, Rng& rng) {
+  if (m.has_constant_density()) {
+    const float sigma_t = sigma * m.density(ray.origin);
+    return sigma_t > 0 ? std::exp(-sigma_t * t_max) : 1.0f;
+  }
+  float T = 1;
+  m.for_each_majorant(ray, 0, t_max, [&](float t0, float t1, float bound) {
+    const float sigma_maj = sigma * bound;
+    if (!(sigma_maj > 0)) return true;
+    for (float t = t0;;) {
+      t += -std::log1p(-rng.next_float()) / sigma_maj;
+      if (!(t < t1)) return true;
+      T *= std::max(0.0f, 1 - m.density(ray.at(t)) / bound);
+      if (T < 0.05f) {
+        if (rng.next_float() < 0.75f) T = 0;
+        else T /= 0.25f;
+      }
+      if (!(T > 0)) return false;
+    }
+  });
+  return T;
+}
+
 }  // namespace candela

@@ -15,6 +15,7 @@
 #include "candela/math/color.h"
 #include "candela/math/transform.h"
 #include "candela/media/phase.h"
+#include "candela/sampling/rng.h"
 #include "candela/scene/description.h"
 
 namespace candela {
@@ -95,6 +96,20 @@ class Medium {
   std::array<int, 3> majorant_resolution_{1, 1, 1};
   std::vector<float> majorant_;
 };
+
+// ---------------------------------------------------------------- walks with one extinction
+
+// Distance sampling and transmittance where one extinction per unit density holds for every channel
+// (a grey medium, or one colour channel chosen for the whole path): what BDPT and MLT walk media with.
+// (volpath carries every channel at once, with its own tracking in integrators/volpath.cpp.)
+
+// Delta tracking along `ray` (unit direction) over [ray.t_min, t_max), extinction sigma x density:
+// the distance of the first real collision, or infinity.
+float sample_collision(const Medium& m, float sigma, const Ray& ray, float t_max, Rng& rng);
+
+// The transmittance over [0, t_max) of `ray`: exact where the density is constant, else ratio
+// tracking's unbiased estimate (with Russian roulette where little gets through).
+float estimate_transmittance(const Medium& m, float sigma, const Ray& ray, float t_max, Rng& rng);
 
 // ---------------------------------------------------------------- implementation of the traversal
 
