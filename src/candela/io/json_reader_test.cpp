@@ -823,6 +823,9 @@ TEST(JsonReader, EveryShippedSceneReads) {
   for (const char* folder : {"scenes", "bench/scenes"})
     for (const auto& entry : fs::directory_iterator(kSourceDir / folder)) {
       if (entry.path().extension() != ".json") continue;
+      // cloud.json reads the grid scenes/make_cloud.py writes (not shipped): VolPath.TheMediaExampleScenesRender
+      // generates it and renders the scene.
+      if (entry.path().filename() == "cloud.json") continue;
       EXPECT_NO_THROW(read_scene_file(entry.path())) << entry.path();
       ++scenes;
     }
