@@ -108,3 +108,33 @@ def test_renders_after_an_edit_read_no_file_again(tmp_path):
     assert np.allclose(candela.render(scene, **SETTINGS), 2 * before, rtol=1e-5, atol=1e-7)
     params["lights.0.scale"] = 1
     assert candela.render(scene, **SETTINGS).tobytes() == before.tobytes()
+
+
+def fog_dict(sigma_t, albedo, g, emission, scale):
+    """The furnace's sphere inside a fog-filled box (the camera outside), rendered by volpath."""
+    d = furnace_dict()
+    d["render"]["integrator"] = "volpath"
+    d["media"] = {"fog": {"type": "homogeneous", "sigma_t": sigma_t, "albedo": albedo, "g": g,
+                          "emission": emission, "scale": scale}}
+    d["materials"]["boundary"] = {"type": "interface"}
+    d["shapes"].append({"type": "box", "min": [-2, -2, -2], "max": [2, 2, 2], "material": "boundary",
+                        "interior": "fog"})
+    return d
+
+
+def test_medium_edits_render_as_the_edited_file_does():
+    scene = candela.load_dict(fog_dict([0.5, 0.25, 0.5], 0.5, 0, 0, 1))
+    params = candela.traverse(scene)
+    assert params["media.fog.g"] == 0
+    params["media.fog.sigma_t"] = (0.25, 0.5, 0.75)
+    params["media.fog.albedo"] = (0.5, 0.75, 0.25)
+    params["media.fog.g"] = 0.5
+    params["media.fog.emission"] = (1, 2, 3)
+    params["media.fog.scale"] = 2
+    edited = candela.load_dict(fog_dict([0.25, 0.5, 0.75], [0.5, 0.75, 0.25], 0.5, [1, 2, 3], 2))
+    assert candela.render(scene, **SETTINGS).tobytes() == candela.render(edited, **SETTINGS).tobytes()
+    with pytest.raises(ValueError, match="outside its range"):
+        params["media.fog.albedo"] = (0.5, 1.2, 0.5)
+    with pytest.raises(ValueError, match="outside its range"):
+        params["media.fog.g"] = 1
+    assert params["media.fog.g"] == 0.5

@@ -47,14 +47,6 @@ class Restore {
   T saved_{};
 };
 
-// A fresh random stream for walks through media, from two sampler dimensions (drawn only where
-// there are media, so scenes without keep their samples).
-template <typename Sampler>
-Rng media_rng(Sampler& sampler) {
-  uint64_t a = std::bit_cast<uint32_t>(sampler.get_1d()), b = std::bit_cast<uint32_t>(sampler.get_1d());
-  return Rng(hash_values(a, b, 11), hash_values(b, a, 13));
-}
-
 }  // namespace
 
 float BdptIntegrator::path_sigma_t(int medium, int hero, const Wavelengths* wl) const {
@@ -79,8 +71,6 @@ BdptIntegrator::BdptIntegrator(const Scene& scene, const RenderSettings& setting
       rr_start_depth_(settings.rr_start_depth),
       hide_emitters_(settings.hide_emitters) {
   for (const Medium& m : scene.media()) {
-    if (m.is_emissive())
-      throw std::invalid_argument("the scene has an emissive medium, which only the volpath integrator renders");
     const RGB& sigma = m.sigma_t();
     chromatic_media_ = chromatic_media_ || sigma.r != sigma.g || sigma.g != sigma.b;
   }
@@ -207,7 +197,7 @@ int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RG
     // In a medium, the subpath may scatter before it reaches the surface.
     if (medium >= 0) {
       const Medium& m = scene_.media()[size_t(medium)];
-      Rng rng = media_rng(sampler);
+      Rng rng = medium_walk_rng(sampler);
       const float t = sample_collision(m, path_sigma_t(medium, hero, wl), ray,
                                        found ? hit.t : std::numeric_limits<float>::infinity(), rng);
       if (t < std::numeric_limits<float>::infinity()) {
@@ -221,7 +211,14 @@ int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RG
         v.g = m.phase().g;
         // Distances were sampled by the extinction: what scatters of it is the albedo.
         RGB albedo = m.albedo(v.p);
-        beta *= wl ? reflectance_at(albedo, *wl) : albedo;
+        if (wl) albedo = reflectance_at(albedo, *wl);
+        // An emissive medium: the s = 0 path that ends here, by the collision estimator (sigma_a Le
+        // over the sigma_t that chose this distance). No other strategy samples points of a medium
+        // as light vertices, so its MIS weight is 1. A path of depth n - 1, as volpath counts it
+        // (there, at every tentative collision of a segment).
+        if (crossed_emission && m.is_emissive() && n - 1 <= max_depth_)
+          crossed_emission[n + 1] += beta * (RGB(1.0f) - albedo) * illuminant_at(m.emission(), wl);
+        beta *= albedo;
         v.beta = beta;
         v.pdf_fwd = convert_density(pdf_fwd, prev, v);
         ++n;
@@ -253,7 +250,7 @@ int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RG
     // An interface has no surface: continue beyond it. If it emits (pbrt's area lights of material
     // "interface"), the s = 0 strategy's path ends on it: weigh that now, as if it were the next vertex.
     if (scene_.is_interface(hit)) {
-      if (crossed_emission && scene_.light_index(hit) >= 0) {
+      if (crossed_emission && scene_.light_index(hit) >= 0 && !(n == 1 && hide_emitters_)) {
         BdptVertex& v = path[n];
         v = surface_vertex(hit, ray, beta);
         v.bsdf = SurfaceBsdf(BlackBsdf{});
@@ -534,7 +531,7 @@ BdptIntegrator::Connection BdptIntegrator::connect(BdptVertex* light, BdptVertex
   RGB L(0.0f);
   BdptVertex sampled;
   Rng rng;
-  if (scene_.has_media() && s > 0) rng = media_rng(sampler);
+  if (scene_.has_media() && s > 0) rng = medium_walk_rng(sampler);
   const int hero = camera[0].hero;
   if (s == 0) {
     // The camera subpath hit a light.
@@ -630,7 +627,7 @@ RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts
   const float camera_part_scale = float(camera.width()) * float(camera.height()) / camera.importance_film_pixels();
   RGB L(0.0f);
   for (int t = 2; t <= max_depth_ + 2; ++t) {
-    if (crossed[size_t(t)].is_black() || (t == 2 && hide_emitters_)) continue;
+    if (crossed[size_t(t)].is_black()) continue;
     L += crossed[size_t(t)];
     if (target.strategies && strategy_index(0, t) < int(target.strategies->size()) && !target.unweighted)
       (*target.strategies)[size_t(strategy_index(0, t))].add_to_pixel(

@@ -22,7 +22,8 @@
 // three times (the others zero): unbiased for every channel, with more colour noise than volpath's
 // spectral MIS. The MIS densities leave out transmittance and the distance-sampling densities, as
 // pbrt-v3 does: the weights still sum to one over the strategies, so the estimate stays unbiased.
-// Emissive media are volpath's alone.
+// An emissive medium's light is taken where camera subpaths scatter in it (the s = 0 strategy alone,
+// weight 1: no strategy samples light vertices in media).
 //
 // The subpath and connection routines are templates over the sampler, shared with Metropolis light
 // transport (mlt.h), which drives them with its primary-sample-space sampler.

@@ -52,6 +52,7 @@ class MltPathSampler {
 
   PathState sample(MltSampler& sampler, int depth, RayCounts& counts) const {
     thread_local std::vector<BdptVertex> camera_path, light_path;
+    thread_local std::vector<RGB> crossed;
     camera_path.resize(size_t(depth) + 2);
     light_path.resize(size_t(depth) + 1);
     sampler.start_stream(MltSampler::kCameraStream);
@@ -72,13 +73,18 @@ class MltPathSampler {
     const Wavelengths* wl = sample_wavelengths_if(spectral_, sampler, storage);
     Ray ray = camera.generate_ray(raster, lens, time);
     PathState state{RGB(0.0f), raster, s, t};
-    if (bdpt_.camera_subpath(ray, sampler, counts, t, camera_path.data(), nullptr, wl) != t) return state;
+    // The s = 0 strategy also takes the light the camera subpath meets without a vertex of its own
+    // (emissive interfaces, emissive media): BdptIntegrator::camera_subpath's crossed emission.
+    crossed.assign(size_t(t) + 1, RGB(0.0f));
+    if (bdpt_.camera_subpath(ray, sampler, counts, t, camera_path.data(), s == 0 ? crossed.data() : nullptr, wl) != t)
+      return state;
     sampler.start_stream(MltSampler::kLightStream);
     if (bdpt_.light_subpath(sampler, counts, s, time, light_path.data(), wl, camera_path[0].hero) != s) return state;
     sampler.start_stream(MltSampler::kConnectionStream);
     BdptIntegrator::Connection c =
         bdpt_.connect(light_path.data(), camera_path.data(), s, t, sampler, counts, time, wl);
     if (t == 1) state.raster = c.raster;
+    if (s == 0) c.L += crossed[size_t(t)];
     state.L = wavelengths_to_rgb(c.L, wl) * float(strategies);
     if (!state.L.is_finite() || !(state.luminance() > 0)) state.L = RGB(0.0f);
     return state;
@@ -139,6 +145,9 @@ Normalization estimate_normalization(const Scene& scene, const BdptIntegrator& b
   const size_t per_block = depths + 2;
   std::vector<double> block_sums(blocks * per_block, 0.0);
   std::vector<uint8_t> mine = run_shared(cluster, arena, blocks, [&](uint64_t block) {
+      // Once cancelled, the remaining blocks (hundreds of thousands at a deep max_depth) are passed
+      // over without a clock reading each.
+      if (cancelled()) return;
       BusyTimer busy(busy_nanoseconds);
       thread_local std::vector<BdptVertex> camera_path, light_path;
       thread_local std::vector<RGB> crossed;
@@ -166,13 +175,16 @@ Normalization estimate_normalization(const Scene& scene, const BdptIntegrator& b
         int nl = bdpt.light_subpath(sampler, counts, max_depth + 1, time, light_path.data(), wl,
                                     nc > 0 ? camera_path[0].hero : -1);
         by_depth.assign(depths, 0.0);
-        for (int t = 1; t <= nc; ++t)
+        for (int t = 1; t <= nc; ++t) {
+          // A deep path has nc x nl connections, seconds of work: answer a signal between them.
+          if (cancelled()) return;
           for (int s = 0; s <= nl; ++s) {
             int depth = s + t - 2;
             if ((s == 1 && t == 1) || depth < 0 || depth > max_depth) continue;
             RGB L = bdpt.connect(light_path.data(), camera_path.data(), s, t, sampler, counts, time, wl).L;
             if (L.is_finite()) by_depth[size_t(depth)] += luminance_of(L);
           }
+        }
         for (size_t t = 2; t < crossed.size(); ++t)
           if (t - 2 <= size_t(max_depth) && crossed[t].is_finite()) by_depth[t - 2] += luminance_of(crossed[t]);
         double v = 0;
@@ -268,6 +280,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   std::vector<uint8_t> bootstrap_mine = run_shared(
       cluster, arena, bootstrap_blocks,
       [&](uint64_t block) {
+        if (cancelled()) return;  // as in the normalisation
         BusyTimer busy(busy_nanoseconds);
         RayCounts& counts = ray_counts.local();
         const uint64_t end = std::min(bootstrap_count, (block + 1) * kBootstrapBlock);

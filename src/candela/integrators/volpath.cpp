@@ -32,7 +32,8 @@ struct MediumValues {
       : medium(m),
         wl(w),
         sigma_t(w ? unbounded_at(m.sigma_t(), *w) : m.sigma_t()),
-        albedo(w ? reflectance_at(m.albedo(Point3(0.0f)), *w) : m.albedo(Point3(0.0f))),
+        albedo(m.has_albedo_grid() ? RGB(0.0f)  // looked up per point instead
+                                   : w ? reflectance_at(m.albedo(Point3(0.0f)), *w) : m.albedo(Point3(0.0f))),
         emission(illuminant_at(m.emission(), w)) {}
   MediumPoint at(const Point3& p) const {
     RGB st = sigma_t * medium.density(p);
@@ -76,14 +77,6 @@ RGB sample_majorant(const MediumValues& mv, const Ray& ray, float t_min, float t
     }
   });
   return stopped ? RGB(1.0f) : T_maj;
-}
-
-// A fresh random stream for a medium walk from two sampler dimensions (pbrt-v4 does the same), so
-// that the unbounded number of collisions does not consume sampler dimensions.
-template <typename Sampler>
-Rng walk_rng(Sampler& sampler) {
-  uint64_t a = std::bit_cast<uint32_t>(sampler.get_1d()), b = std::bit_cast<uint32_t>(sampler.get_1d());
-  return Rng(hash_values(a, b), hash_values(b, a, 7));
 }
 
 }  // namespace
@@ -160,12 +153,14 @@ RGB VolPathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, co
       Ray scattered_ray;  // the continuation after a real scattering event
       const Medium& m = scene_.media()[size_t(medium)];
       const MediumValues mv(m, wl);
-      Rng rng = walk_rng(sampler);
+      Rng rng = medium_walk_rng(sampler);
       RGB T_maj = sample_majorant(
           mv, ray, ray.t_min, found ? hit.t : kInfinity, hero, rng,
           [&](const Point3& p, const MediumPoint& mp, const RGB& sigma_maj, const RGB& T) {
-            // Add the medium's emission (source term sigma_a Le) at every tentative collision.
-            if (depth < max_depth_ && m.is_emissive()) {
+            // Add the medium's emission (source term sigma_a Le) at every tentative collision. Light
+            // emitted on the segment after `depth` scattering events is a path of that depth, as a
+            // surface's light found there is (pbrt-v4 leaves out depth == max_depth for media only).
+            if (depth <= max_depth_ && m.is_emissive()) {
               float pdf = sigma_maj[hero] * T[hero];
               RGB r_e = r_u * sigma_maj * T / pdf;
               if (!r_e.is_black()) L += beta * T / pdf * mp.sigma_a * mv.emission / r_e.average();
@@ -318,7 +313,7 @@ RGB VolPathIntegrator::sample_direct(const ScatterPoint& at, Sampler& sampler, c
   const Distribution1D& choice = scene_.light_distribution();
   const size_t li = choice.sample(sampler.get_1d());
   const Vec2 u = sampler.get_2d();
-  Rng rng = walk_rng(sampler);
+  Rng rng = medium_walk_rng(sampler);
   const float pmf = choice.pmf(li);
   if (!(pmf > 0)) return RGB(0.0f);
   const Light& light = scene_.lights()[li];

@@ -16,7 +16,8 @@
 //     tracking (in media of constant extinction: the exact transmittance, ratio tracking's expectation)
 //     through every medium and pass-through surface (interfaces, masks, thin sheets) they cross,
 //     combined by MIS with the phase function or BSDF sampled continuation.
-//   - Media emit (source term sigma_a Le) where their emission is non-zero.
+//   - Media emit (source term sigma_a Le) where their emission is non-zero; light emitted on a
+//     segment after k scattering events is a path of depth k, counted while k <= max_depth.
 //   - Russian roulette on the throughput over the unidirectional density.
 // Surfaces that let light pass straight on (interfaces; a mask's absent part; a thin sheet's
 // transmission) do not count as bounces, as in Mitsuba 3's volpath. Without media the result

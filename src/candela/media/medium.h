@@ -7,6 +7,8 @@
 //
 // Everything here is in RGB; the integrator converts to a spectral path's wavelengths.
 #include <array>
+#include <bit>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -102,6 +104,15 @@ class Medium {
 // Distance sampling and transmittance where one extinction per unit density holds for every channel
 // (a grey medium, or one colour channel chosen for the whole path): what BDPT and MLT walk media with.
 // (volpath carries every channel at once, with its own tracking in integrators/volpath.cpp.)
+
+// A fresh random stream for one walk through a medium, from two sampler dimensions (pbrt-v4 does the
+// same), so that the unbounded number of collisions does not consume sampler dimensions. Drawn only
+// where there are media, so scenes without keep their samples.
+template <typename Sampler>
+Rng medium_walk_rng(Sampler& sampler) {
+  uint64_t a = std::bit_cast<uint32_t>(sampler.get_1d()), b = std::bit_cast<uint32_t>(sampler.get_1d());
+  return Rng(hash_values(a, b, 11), hash_values(b, a, 13));
+}
 
 // Delta tracking along `ray` (unit direction) over [ray.t_min, t_max), extinction sigma x density:
 // the distance of the first real collision, or infinity.

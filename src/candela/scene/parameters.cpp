@@ -25,7 +25,7 @@ struct Slot {
   bool lo_open = false, hi_open = false;
 
   std::string range() const {
-    if (color) return "each component finite and >= 0";
+    if (color) return hi < kInf ? fmt::format("each component within [0, {}]", hi) : "each component finite and >= 0";
     if (transform) return "an invertible 4x4 matrix";
     std::string text = fmt::format("{} {} {}", lo, lo_open ? "<" : "<=", name.substr(name.rfind('.') + 1));
     if (hi < kInf) text += fmt::format(" {} {}", hi_open ? "<" : "<=", hi);
@@ -42,7 +42,9 @@ class Slots {
   void number(const std::string& name, FloatInput& input, float lo = 0, float hi = kInf) {
     if (input.texture < 0) number(name, input.value, lo, hi);
   }
-  void color(std::string name, RGB& value) { out_.push_back(Slot{std::move(name), nullptr, nullptr, &value}); }
+  void color(std::string name, RGB& value, float hi = kInf) {
+    out_.push_back(Slot{std::move(name), nullptr, nullptr, &value, nullptr, 0, hi});
+  }
   void color(const std::string& name, ColorInput& input) {
     if (input.texture < 0) color(name, input.value);
   }
@@ -187,6 +189,18 @@ std::vector<Slot> slots(SceneDesc& scene) {
   }
   for (size_t i = 0; i < scene.instances.size(); ++i)
     s.transform(fmt::format("instances.{}.to_world", i), scene.instances[i].to_world);
+  names.clear();
+  for (const MediumDesc& medium : scene.media) names.push_back(medium.name);
+  std::vector<std::string> medium_labels = labels(names);
+  for (size_t i = 0; i < scene.media.size(); ++i) {
+    MediumDesc& m = scene.media[i];
+    const std::string p = "media." + medium_labels[i] + ".";
+    s.color(p + "sigma_t", m.sigma_t);
+    if (m.albedo.is_constant()) s.color(p + "albedo", m.albedo.constant, 1);
+    s.number(p + "scale", m.scale);
+    s.color(p + "emission", m.emission);
+    s.number(p + "g", m.g, -1, 1, true, true);
+  }
   return out;
 }
 
@@ -251,7 +265,7 @@ void set_scene_parameter(SceneDesc& scene, const std::string& name, const Parame
   } else if (slot->color) {
     RGB c = std::get<RGB>(value);
     for (int i = 0; i < 3; ++i)
-      if (!std::isfinite(c[i]) || c[i] < 0)
+      if (!std::isfinite(c[i]) || c[i] < 0 || c[i] > slot->hi)
         throw std::domain_error(fmt::format("{}: ({}, {}, {}) is outside its range ({})", name, c.r, c.g, c.b, slot->range()));
     *slot->color = c;
   } else {

@@ -1,13 +1,14 @@
 #pragma once
 // The editable parameters of a scene description by name (Mitsuba's traverse()): the camera's pose
 // and lens, the constant (untextured) inputs of materials, lights' intensities, area emission and
-// shape and instance transforms. The Python module lists, reads and changes them between renders
+// shape and instance transforms, and media's coefficients. The Python module lists, reads and changes them between renders
 // without reading the scene's files again. Names:
 //   camera.to_world, camera.fov, camera.lens_radius, camera.focus_distance
 //   materials.<name>.<input>       e.g. materials.red.reflectance, materials.glass.roughness
 //   lights.<index>.<quantity>      e.g. lights.0.intensity, lights.1.scale
 //   shapes.<name>.to_world, shapes.<name>.emission
 //   instances.<index>.to_world
+//   media.<name>.sigma_t, .albedo (a constant one), .scale, .emission, .g
 // <name> is the material's name in the scene file (a JSON key, an OBJ newmtl) or the shape's name,
 // else its index; where two share a name, both go by their index.
 #include <string>
@@ -28,7 +29,8 @@ struct SceneParameter {
   std::string range;     // what it accepts, e.g. "0 < fov < 180", "each component >= 0"
 };
 
-// Every editable parameter of `scene`, in a stable order (camera, materials, lights, shapes, instances).
+// Every editable parameter of `scene`, in a stable order (camera, materials, lights, shapes, instances,
+// media).
 std::vector<SceneParameter> scene_parameters(const SceneDesc& scene);
 
 // The named parameter's value. Throws std::invalid_argument for an unknown name (with the closest names).

@@ -81,7 +81,8 @@ void JsonSceneReader::read_render(const Json& value, const std::string& pointer)
   settings.spp = render.integer_or("spp", settings.spp, 1, kIntMax);
   settings.max_depth = render.integer_or("max_depth", settings.max_depth, 1, kIntMax);
   if (const Json* seed = render.find("seed")) settings.seed = read_uint64(report_, *seed, render.pointer_of("seed"));
-  settings.integrator = render.string_or("integrator", settings.integrator);
+  // A scene with media renders with the volumetric path tracer unless it names another integrator.
+  settings.integrator = render.string_or("integrator", scene_.media.empty() ? settings.integrator : "volpath");
   if (settings.integrator.empty()) report_.fail(render.pointer_of("integrator"), "the integrator name is empty");
   scene_.film.filename = render.string_or("output", "");
   settings.rr_start_depth = render.integer_or("rr_start_depth", settings.rr_start_depth, 0, kIntMax);
