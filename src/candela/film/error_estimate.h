@@ -16,7 +16,8 @@
 // thousands of them. The truth in the denominator is not known either; error_estimate.cpp takes the
 // pixel's mean, capped against fireflies by its neighbourhood (the median of the neighbours' means
 // or the largest of their lesser halves), floored by its own lesser half, less at most half its
-// variance (error_estimate.cpp says why each). The 95% interval combines the spread of the pixels' draws (each pixel's
+// variance; a capped pixel's also floored by its 11 x 11 neighbourhood's mean less that
+// neighbourhood's fireflies (error_estimate.cpp says why each). The 95% interval combines the spread of the pixels' draws (each pixel's
 // actual squared error and its estimate as independent one-degree-of-freedom draws of the same
 // variance, exact for Gaussian halves: variance sum 4/3 e_i^2 / N^2) with a systematic 30% for
 // the denominators, the largest miss measured against converged references
@@ -34,6 +35,9 @@ struct ErrorEstimate {
   std::string why_not;  // when !valid: what the film lacks
   double relmse = 0;    // estimated relMSE of the film's image (epsilon kErrorEpsilon)
   double low = 0, high = 0;  // 95% interval for the image's actual relMSE
+  // The share of relmse from the splats (light paths', chains') alone, as if the pixels' own samples
+  // had no error: how an integrator's error splits between its two kinds of samples.
+  double splat_relmse = 0;
   uint64_t pixels = 0;       // pixels the estimate covers (both halves sampled)
 };
 

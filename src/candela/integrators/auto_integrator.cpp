@@ -59,10 +59,16 @@ AutoChoice choose_integrator(const Scene& scene, const RenderSettings& settings,
     // MLT's set-up (bootstrap and normalisation, in proportion to mlt.bootstrap) would take the
     // whole slice and more on a deep scene: its pilot bootstraps with a hundredth (at least 1000)
     // and its set-up time is scaled back up for the prediction.
-    double setup_scale = 1;
-    if (entry->reads_setting("mlt")) {
+    // Its depth-0 pass takes spp / 16 samples per pixel (16 to 256): the pilot's takes 16, and its
+    // time is scaled up too.
+    double bootstrap_scale = 1, direct_scale = 1;
+    const bool mlt = entry->reads_setting("mlt");
+    if (mlt) {
       pilot_settings.mlt.bootstrap = std::min(settings.mlt.bootstrap, std::max(1000, settings.mlt.bootstrap / 100));
-      setup_scale = double(settings.mlt.bootstrap) / double(pilot_settings.mlt.bootstrap);
+      bootstrap_scale = double(settings.mlt.bootstrap) / double(pilot_settings.mlt.bootstrap);
+      pilot_settings.spp = std::min(settings.spp, 256);
+      auto direct_spp = [](int spp) { return double(std::clamp(spp / 16, 16, 256)); };
+      direct_scale = direct_spp(settings.spp) / direct_spp(pilot_settings.spp);
     }
     RenderOptions pilot = options;
     pilot.progress = false;
@@ -72,10 +78,12 @@ AutoChoice choose_integrator(const Scene& scene, const RenderSettings& settings,
     // Path and bdpt render every k-th tile in their pilot (tiles strided over the whole image, as a
     // job-array part): a pass then costs a k-th, so the pilot fits its slice with several passes, and
     // the winner continues it (each pixel from its own count) into the one image.
+    double image_share = 1;
     if (entry->resumable) {
       const int tiles = ((film.width() + 15) / 16) * ((film.height() + 15) / 16);
       pilot.part_count = std::clamp(tiles / 16, 1, kPilotTileStride);
       pilot.part_index = 0;
+      image_share = double((tiles + pilot.part_count - 1) / pilot.part_count) / double(tiles);
     }
     Film pilot_film(film.width(), film.height());
     RenderStats stats = render(scene, pilot_settings, pilot_film, pilot);
@@ -84,7 +92,13 @@ AutoChoice choose_integrator(const Scene& scene, const RenderSettings& settings,
     // The root's clock, so every rank decides alike (the films, and so the estimates, are the same).
     run.seconds = cluster.from_root(stats.seconds);
     run.setup_seconds = cluster.from_root(stats.setup_seconds);
-    run.full_setup_seconds = run.setup_seconds * setup_scale;
+    run.image_share = image_share;
+    // MLT's set-up in the real render: its depth-0 pass and bootstrap scaled up; its normalisation
+    // (a ninth of a time limit, else in proportion to the mutations, part of the work) is priced
+    // below, once the remaining budget is known.
+    run.full_setup_seconds = mlt ? cluster.from_root(stats.mlt_direct_seconds) * direct_scale +
+                                       cluster.from_root(stats.mlt_bootstrap_seconds) * bootstrap_scale
+                                 : run.setup_seconds;
     run.error = estimate_error(pilot_film, stats.mlt_normalization_relative_error);
     choice.pilot_seconds += run.seconds;
     choice.pilots.push_back(run);
@@ -112,15 +126,25 @@ AutoChoice choose_integrator(const Scene& scene, const RenderSettings& settings,
       p.predicted = std::numeric_limits<double>::infinity();
       continue;
     }
-    // The pilot's own rendering time (set-up aside), the work behind its error.
+    // The pilot's own rendering time (set-up aside), the work behind its error; a pilot of every
+    // k-th tile did a k-th of the work of the whole image at its samples per pixel (its pixels stay
+    // ahead by them when it is continued).
     const double work = std::max(p.seconds - p.setup_seconds, 1e-6);
+    const double whole_image_work = work / p.image_share;
+    // BDPT's light paths splat over the whole image, but a pilot of a k-th of the tiles traces a
+    // k-th of them: their part of the pilot's error is already the whole image's at its work.
+    const double splat_part = std::min(p.error.splat_relmse, p.error.relmse);
+    const double error = p.error.relmse - splat_part + splat_part * p.image_share;
     if (options.target_error > 0) {
       // Seconds from now to the target: a continued pilot adds to its work, a restart redoes the set-up.
-      const double needed = work * p.error.relmse / options.target_error;
+      const double needed = whole_image_work * error / options.target_error;
       p.predicted = p.integrator->resumable ? std::max(0.0, needed - work) : p.full_setup_seconds + needed;
+    } else if (p.integrator->resumable) {
+      p.predicted = error * whole_image_work / (work + remaining);
     } else {
-      p.predicted = p.integrator->resumable ? p.error.relmse * work / (work + remaining)
-                                            : p.error.relmse * work / std::max(remaining - p.full_setup_seconds, 1e-6);
+      // A restart: the set-up again, and a ninth of what is left normalises MLT's chains.
+      const double setup = p.full_setup_seconds + (time_limit > 0 && p.integrator->reads_setting("mlt") ? remaining / 9 : 0);
+      p.predicted = p.error.relmse * work / std::max(remaining - setup, 1e-6);
     }
     if (p.predicted < best) {
       best = p.predicted;

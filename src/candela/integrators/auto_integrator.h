@@ -10,7 +10,9 @@
 // The pilots aim at 10% of the budget together: with a time limit T each of n gets 0.1 T / n;
 // with an error target or spp, each gets kPilotSeconds (a pilot ends after a whole pass or round, so it
 // can take a little longer). MLT's pilot bootstraps with a hundredth of the paths (its set-up would
-// otherwise take more than the slice on deep scenes) and its full set-up time is extrapolated.
+// otherwise take more than the slice on deep scenes) and renders its depth-0 pass at 16 spp; its full
+// set-up time is extrapolated part by part. Path and bdpt pilots render every k-th tile: their error
+// is scaled to the whole image's (but for bdpt's splats, which already cover it).
 #include <string>
 #include <vector>
 
@@ -26,6 +28,7 @@ struct PilotRun {
   const IntegratorEntry* integrator = nullptr;
   double seconds = 0, setup_seconds = 0;
   double full_setup_seconds = 0;  // the set-up the real render would take (mlt's pilot bootstraps less)
+  double image_share = 1;         // the share of the image's tiles the pilot rendered
   ErrorEstimate error;
   double predicted = 0;  // relMSE at the budget (time limit, spp), or seconds to the target
 };

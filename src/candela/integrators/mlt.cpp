@@ -238,6 +238,7 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   RenderStats stats = scene.has_media() ? render_volpath(scene, emission, film, emission_options)
                                         : render_path(scene, emission, film, emission_options);
   stats.samples = 0;
+  stats.mlt_direct_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   film.enable_splats();
   film.set_splat_scale(0);
   if (scene.lights().empty() || settings.max_depth == 0 || stats.cancelled) {
@@ -295,6 +296,8 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
       },
       [&](uint64_t, uint64_t count) { progress.advance(count * kBootstrapBlock); });
   if (cluster.any(cancelled())) return stop_cancelled(progress);
+  stats.mlt_bootstrap_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count() - stats.mlt_direct_seconds;
   if (cluster.distributed()) {
     weights.resize(bootstrap_blocks * kBootstrapBlock);  // whole blocks to exchange
     exchange_values(cluster, bootstrap_mine, weights, kBootstrapBlock);

@@ -95,6 +95,7 @@ struct RenderStats {
   double mlt_normalization = 0, mlt_normalization_relative_error = 0;
   uint64_t mlt_normalization_samples = 0;
   double mlt_normalization_seconds = 0;
+  double mlt_direct_seconds = 0, mlt_bootstrap_seconds = 0;  // its depth-0 pass and bootstrap
   // Seconds spent before the first sample that counts towards the image could be taken, which a
   // longer render does not repeat (mlt: the direct pass, bootstrap and normalisation; else 0).
   double setup_seconds = 0;
