@@ -56,11 +56,9 @@ AutoChoice choose_integrator(const Scene& scene, const RenderSettings& settings,
   for (const IntegratorEntry* entry : candidates) {
     RenderSettings pilot_settings = settings;
     pilot_settings.integrator = std::string(entry->name);
-    // MLT's set-up (bootstrap and normalisation, in proportion to mlt.bootstrap) would take the
-    // whole slice and more on a deep scene: its pilot bootstraps with a hundredth (at least 1000)
-    // and its set-up time is scaled back up for the prediction.
-    // Its depth-0 pass takes spp / 16 samples per pixel (16 to 256): the pilot's takes 16, and its
-    // time is scaled up too.
+    // MLT's bootstrap (in proportion to mlt.bootstrap) would take the whole slice and more on a deep
+    // scene: its pilot bootstraps with a hundredth (at least 1000), and its depth-0 pass (spp / 16
+    // samples per pixel, 16 to 256) takes 16; both times are scaled back up for the prediction.
     double bootstrap_scale = 1, direct_scale = 1;
     const bool mlt = entry->reads_setting("mlt");
     if (mlt) {
