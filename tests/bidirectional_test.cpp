@@ -307,6 +307,36 @@ TEST(BidirectionalStrategies, WeightedStrategiesSumToTheImageAndThePathTracer) {
   expect_agree(full, render_image(d, "path", 64, 14), "bdpt vs path");
 }
 
+// Under the light BVH, BDPT's next-event strategy chooses lights by what they give at the camera
+// vertex while light paths start by power; the MIS weights carry the ratio of the two. Lights of
+// very different power, distance and orientation (one facing away from most of the scene) make
+// that ratio range widely: a wrong weight shows as a biased image against the path tracer's and
+// against BDPT choosing by power.
+TEST(BidirectionalStrategies, LightBvhKeepsTheEstimateUnbiased) {
+  SceneDesc d = floor_under_light();
+  d.settings.max_depth = 3;
+  d.materials.push_back(DiffuseMaterial{RGB(0.3f, 0.6f, 0.8f)});
+  ShapeDesc up_light;  // faces up, lighting only the ceiling-less sky side: most vertices cannot see it
+  up_light.geometry = RectangleShape{{1.0f, 0.8f, -1.0f}, {0, 0, 0.6f}, {0.6f, 0, 0}};  // normal +y
+  up_light.material = 1;
+  up_light.emission = AreaEmission{RGB(30.0f, 20.0f, 10.0f), false};
+  ShapeDesc wall;  // a wall above the up-facing light, so its light does reach the floor
+  wall.geometry = RectangleShape{{0.5f, 2.5f, -2}, {2, 0, 0}, {0, 0, 4}};  // normal -y
+  wall.material = 1;
+  ShapeDesc bulb{.geometry = SphereShape{{-1.2f, 0.4f, 0.6f}, 0.15f}, .material = 0,
+                 .emission = AreaEmission{RGB(2.0f, 6.0f, 3.0f), false}};
+  d.shapes.push_back(up_light);
+  d.shapes.push_back(wall);
+  d.shapes.push_back(bulb);
+  d.lights = {PointLight{{-1, 1, -1.5f}, RGB(0.5f)}, SkyLight{RGB(0.05f), RGB(0.05f), RGB(0.05f), {0, 1, 0}}};
+  SceneDesc bvh = d, power = d;
+  bvh.settings.light_selection = LightSelection::Bvh;
+  power.settings.light_selection = LightSelection::Power;
+  Image bdpt_bvh = render_image(bvh, "bdpt", 256, 31);
+  expect_agree(bdpt_bvh, render_image(power, "bdpt", 256, 32), "bdpt: light BVH vs power");
+  expect_agree(bdpt_bvh, render_image(bvh, "path", 512, 33), "light BVH: bdpt vs path");
+}
+
 TEST(BidirectionalStrategies, LightTracingAloneReproducesThePathTracer) {
   // The t = 1 strategies alone (unweighted) render every path of depth >= 1 of a diffuse scene;
   // directly seen emission (depth 0) is the (0, 2) strategy's.

@@ -288,13 +288,14 @@ TEST_F(CommandLine, AFlagTheIntegratorDoesNotReadIsAnError) {
                    flag_name + ".*: the " + c.refused_by + " integrator does not read " + c.key + " \\(.*; read by: " +
                        c.read_by + "\\)");
   }
-  // A light selection by power or uniformly shapes the light distribution every integrator samples.
-  for (std::string integrator : {"path", "bdpt", "mlt"}) {
-    RunResult r = run_cli("render " + scene + " -o " + out() + " --integrator " + integrator +
-                          " --light-selection uniform --spp 1 --max-depth 2 -q" +
-                          (integrator == "mlt" ? " --mlt-bootstrap 100" : ""));
-    EXPECT_EQ(r.exit_code, 0) << integrator << ": " << r.output;
-  }
+  // Light selection by power, uniformly or through the light BVH: every integrator reads it.
+  for (std::string integrator : {"path", "volpath", "bdpt", "mlt"})
+    for (std::string selection : {"uniform", "bvh"}) {
+      RunResult r = run_cli("render " + scene + " -o " + out() + " --integrator " + integrator +
+                            " --light-selection " + selection + " --spp 1 --max-depth 2 -q" +
+                            (integrator == "mlt" ? " --mlt-bootstrap 100" : ""));
+      EXPECT_EQ(r.exit_code, 0) << integrator << " " << selection << ": " << r.output;
+    }
 }
 
 TEST_F(CommandLine, ConvertWritesJsonThatRendersTheSameImage) {

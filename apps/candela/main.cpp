@@ -610,8 +610,10 @@ int main(int argc, char** argv) {
                        "Turn off multiple importance sampling: direct light from shadow rays only");
   render_cmd->add_option("--light-selection", cmd.light_selection,
                          "How shadow rays pick lights: power (each ray one light, chosen by power), uniform "
-                         "(each ray one emitter, all equally likely, as Mitsuba), paper (every light a share "
-                         "proportional to power x projected solid angle)");
+                         "(each ray one emitter, all equally likely, as Mitsuba), bvh (each ray one light, "
+                         "chosen through a light BVH by power, distance and orientation: for many lights; "
+                         "pbrt-v4's default), paper (every light a share proportional to power x projected "
+                         "solid angle, O(lights) per vertex)");
   render_cmd->add_option("--bvh", cmd.bvh,
                          "Acceleration structure: fast (the default) or compact (about half the memory per "
                          "triangle, traversal about a third slower)");

@@ -116,20 +116,26 @@ int BdptIntegrator::camera_subpath(const Ray& ray, Sampler& sampler, RayCounts& 
   r.direction = r.direction / length_scale;
   r.t_min *= length_scale;
   float pdf_dir = scene_.camera().pdf_importance(r.origin, r.direction).dir;
-  return random_walk(r, sampler, counts, camera.beta, pdf_dir, max_vertices, Transport::Radiance, path,
-                     crossed_emission, wl, scene_.camera_medium(), camera.hero);
+  const int n = random_walk(r, sampler, counts, camera.beta, pdf_dir, max_vertices, Transport::Radiance, path,
+                            crossed_emission, wl, scene_.camera_medium(), camera.hero);
+  // Emitters the path found: how next-event estimation at the vertex before would have chosen them.
+  if (scene_.light_sampler().uses_bvh())
+    for (int i = 2; i < n; ++i)
+      if (path[i].light >= 0 || path[i].at_infinity) path[i].nee_ratio = nee_light_pdf_ratio(path[i], path[i - 1]);
+  return n;
 }
 
 template <typename Sampler>
 int BdptIntegrator::light_subpath(Sampler& sampler, RayCounts& counts, int max_vertices, float time,
                                   BdptVertex* path, const Wavelengths* wl, int hero) const {
   if (max_vertices == 0 || scene_.lights().empty()) return 0;
-  // Choose a light by power, then a ray leaving it.
+  // Choose a light by power (or uniformly over emitters; no point to ask a light BVH from), then a
+  // ray leaving it.
   float u_light = sampler.get_1d();
   Vec2 u_pos = sampler.get_2d(), u_dir = sampler.get_2d();
-  const Distribution1D& choice = scene_.light_distribution();
-  size_t li = choice.sample(u_light);
-  float pmf = choice.pmf(li);
+  const SampledLight chosen = scene_.light_sampler().sample_emitter(u_light);
+  const size_t li = chosen.light;
+  const float pmf = chosen.pmf;
   const Light& light = scene_.lights()[li];
   LightEmission e = light_sample_le(light, u_pos, u_dir, scene_.bounding_sphere());
   if (!(e.pdf_pos > 0) || !(e.pdf_dir > 0) || e.radiance.is_black() || pmf <= 0) return 0;
@@ -166,6 +172,7 @@ int BdptIntegrator::light_subpath(Sampler& sampler, RayCounts& counts, int max_v
     }
     v.pdf_fwd = infinite_lights_pdf(e.w);
   }
+  if (n > 1 && scene_.light_sampler().uses_bvh()) v.nee_ratio = nee_light_pdf_ratio(v, path[1]);
   return n;
 }
 
@@ -366,14 +373,40 @@ float BdptIntegrator::light_origin_pdf(const BdptVertex& lv, const BdptVertex& n
   if (lv.at_infinity) return infinite_lights_pdf(w);
   if (lv.light < 0) return 0;
   const Light& light = scene_.lights()[size_t(lv.light)];
-  return scene_.light_distribution().pmf(size_t(lv.light)) *
+  return scene_.light_sampler().emitter_pmf(size_t(lv.light)) *
          light_pdf_le(light, lv.p, lv.ng, w, scene_.bounding_sphere()).pos;
+}
+
+float BdptIntegrator::nee_light_pdf_ratio(const BdptVertex& x0, const BdptVertex& x1) const {
+  const LightSampler& choice = scene_.light_sampler();
+  // The context next-event estimation at x1 would have used: the side of x1 facing the light (the
+  // side the path arrives from wherever the path carries light) or, transmitting, both.
+  Normal3 n(0.0f);
+  if (x1.kind == Kind::Surface && !bsdf_has_non_delta_transmission(x1.bsdf))
+    n = dot(x1.ns, x0.p - x1.p) > 0 ? x1.ns : -x1.ns;
+  const LightSampleContext ctx{x1.p, n};
+  if (x0.at_infinity) {
+    // The light vertex stands for every light at infinity along its direction.
+    Vec3 w = x1.p - x0.p;
+    if (length_squared(w) == 0) return 1;
+    w = normalize(w);
+    float by_point = 0, by_power = 0;
+    for (uint32_t li : scene_.infinite_lights()) {
+      float pdf = light_pdf_le(scene_.lights()[li], {}, {}, w, scene_.bounding_sphere()).dir;
+      by_point += choice.pmf(ctx, li) * pdf;
+      by_power += choice.emitter_pmf(li) * pdf;
+    }
+    return by_power > 0 ? by_point / by_power : 1.0f;
+  }
+  if (x0.light < 0) return 1;
+  const float by_power = choice.emitter_pmf(size_t(x0.light));
+  return by_power > 0 ? choice.pmf(ctx, size_t(x0.light)) / by_power : 1.0f;
 }
 
 float BdptIntegrator::infinite_lights_pdf(const Vec3& emitted_dir) const {
   float pdf = 0;
   for (uint32_t li : scene_.infinite_lights())
-    pdf += scene_.light_distribution().pmf(li) *
+    pdf += scene_.light_sampler().emitter_pmf(li) *
            light_pdf_le(scene_.lights()[li], {}, {}, emitted_dir, scene_.bounding_sphere()).dir;
   return pdf;
 }
@@ -400,19 +433,29 @@ float BdptIntegrator::mis_weight(BdptVertex* light, BdptVertex* camera, BdptVert
   if (qs) a6 = Restore<float>(&qs->pdf_rev, vertex_pdf(pt_minus, *pt, *qs));
   if (qs_minus) a7 = Restore<float>(&qs_minus->pdf_rev, vertex_pdf(pt, *qs, *qs_minus));
 
+  // The light vertex's density in the s = 1 strategy differs from the others' by the factor
+  // nee (its light chosen at the next vertex instead of by power; 1 unless the light BVH chooses),
+  // which the subpaths and the s = 1 connection left on the light vertex.
+  const float nee = s > 0 ? light[0].nee_ratio : camera[t - 1].nee_ratio;
+  // p_other / p_this for strategy s_other, given the ratio r of their densities from the subpaths'
+  // vertices alone. (Where s = 1 made the path, nee > 0: its light was chosen with that probability.)
+  auto ratio = [&](float r, int s_other) {
+    return r * (s_other == 1 ? nee : 1.0f) / (s == 1 ? std::max(nee, 1e-30f) : 1.0f);
+  };
+
   // Sum over the other strategies of (p_other / p_this)^2, the ratios built up one vertex at a time
   // outwards from the connection on each side.
   float sum = 0;
   float r = 1;
   for (int i = t - 1; i > 0; --i) {
     r *= remap0(camera[i].pdf_rev) / remap0(camera[i].pdf_fwd);
-    if (!camera[i].delta && !camera[i - 1].delta) sum += r * r;
+    if (!camera[i].delta && !camera[i - 1].delta) sum += sqr(ratio(r, s + t - i));
   }
   r = 1;
   for (int i = s - 1; i >= 0; --i) {
     r *= remap0(light[i].pdf_rev) / remap0(light[i].pdf_fwd);
     bool delta_before = i > 0 ? light[i - 1].delta : is_delta_light(light[0]);
-    if (!light[i].delta && !delta_before) sum += r * r;
+    if (!light[i].delta && !delta_before) sum += sqr(ratio(r, i));
   }
   return 1 / (1 + sum);
 }
@@ -560,19 +603,21 @@ BdptIntegrator::Connection BdptIntegrator::connect(BdptVertex* light, BdptVertex
     if (L.is_black()) return c;
     c.raster = lens->raster;
   } else if (s == 1) {
-    // Next-event estimation: a point on a light chosen by power, seen from the camera vertex.
+    // Next-event estimation: a point on a light chosen by the scene's light sampler (the light BVH
+    // asks what each light can give at the camera vertex), seen from the camera vertex.
     const BdptVertex& pt = camera[t - 1];
     float u_light = sampler.get_1d();
     Vec2 u = sampler.get_2d();
     if (!is_connectible(pt)) return c;
-    const Distribution1D& choice = scene_.light_distribution();
-    size_t li = choice.sample(u_light);
-    float pmf = choice.pmf(li);
-    const Light& lt = scene_.lights()[li];
     Vec3 wo_local = pt.frame.to_local(pt.wo);
     Normal3 gather = pt.kind == Kind::Medium || bsdf_has_non_delta_transmission(pt.bsdf) ? Normal3(0.0f)
                      : wo_local.z > 0                                                   ? pt.ns
                                                                                         : -pt.ns;
+    const SampledLight chosen = scene_.light_sampler().sample(LightSampleContext{pt.p, gather}, u_light);
+    const size_t li = chosen.light;
+    const float pmf = chosen.pmf;
+    if (!(pmf > 0)) return c;
+    const Light& lt = scene_.lights()[li];
     LightSample ls = light_sample_li(lt, LightSampleContext{pt.p, gather}, u);
     if (!(ls.pdf > 0) || ls.radiance.is_black() || pmf <= 0) return c;
     sampled.kind = Kind::Light;
@@ -580,6 +625,13 @@ BdptIntegrator::Connection BdptIntegrator::connect(BdptVertex* light, BdptVertex
     sampled.at_infinity = std::isinf(ls.distance);
     sampled.p = sampled.at_infinity ? pt.p + ls.wi * (2 * scene_.bounding_sphere().radius) : ls.p_light;
     sampled.ng = sampled.ns = sampled.at_infinity ? Normal3(0.0f) : ls.n_light;
+    if (scene_.light_sampler().uses_bvh()) {
+      // (A light at infinity stands for all of them, as in light_origin_pdf.)
+      const float by_power = scene_.light_sampler().emitter_pmf(li);
+      sampled.nee_ratio = sampled.at_infinity ? nee_light_pdf_ratio(sampled, pt)
+                          : by_power > 0      ? pmf / by_power
+                                              : 1.0f;
+    }
     sampled.beta = illuminant_at(ls.radiance, wl) / (ls.pdf * pmf);
     sampled.pdf_fwd = light_origin_pdf(sampled, pt);
     L = pt.beta * scatter(pt, sampled, Transport::Radiance) * sampled.beta;

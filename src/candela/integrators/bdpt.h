@@ -58,6 +58,10 @@ struct BdptVertex {
                       // for vertices at infinity)
   float pdf_rev = 0;  // density of this vertex when sampled from its successor (the reverse direction)
   int light = -1;     // light vertices: the light; surfaces: the light of an emitter that was hit, or -1
+  // Light vertices and emitters hit: the probability that next-event estimation at the neighbouring
+  // vertex chooses this light over the probability that a light path starts from it (they differ
+  // under the light BVH), for MIS.
+  float nee_ratio = 1;
   int medium = -1;    // surfaces: the medium the subpath arrived in; medium vertices and lights: the one they are in
   float g = 0;        // medium vertices: the phase function's mean cosine
   int8_t hero = -1;   // camera vertices: the colour channel that drives sampling in media (-1: all alike)
@@ -142,6 +146,9 @@ class BdptIntegrator {
   float light_pdf(const BdptVertex& light_vertex, const BdptVertex& next) const;
   float light_origin_pdf(const BdptVertex& light_vertex, const BdptVertex& next) const;
   float infinite_lights_pdf(const Vec3& emitted_dir) const;
+  // The density of light vertex x0 as next-event estimation at x1 chooses its light, over its
+  // density as a light path's start (they differ under the light BVH): for MIS.
+  float nee_light_pdf_ratio(const BdptVertex& x0, const BdptVertex& x1) const;
   float mis_weight(BdptVertex* light, BdptVertex* camera, BdptVertex& sampled, int s, int t) const;
 
   // Light emitted by a light vertex (or an emitter that was hit) towards `towards`.

@@ -160,7 +160,7 @@ float PathIntegrator::total_light_importance(const LightSampleContext& ctx) cons
 }
 
 float PathIntegrator::expected_shadow_rays(size_t li, const LightSampleContext& ctx, float total_importance) const {
-  if (light_selection_ != LightSelection::Paper) return float(shadow_rays_) * scene_.light_distribution().pmf(li);
+  if (light_selection_ != LightSelection::Paper) return float(shadow_rays_) * scene_.light_sampler().pmf(ctx, li);
   // The paper's rule, mixed with a uniform share so that every light keeps a non-zero expected
   // number of rays (which keeps the estimator unbiased where the heuristic says "nothing here").
   float uniform = 1.0f / float(scene_.lights().size());
@@ -197,16 +197,17 @@ template <typename Sampler>
 RGB PathIntegrator::direct_light(const Vertex& v, Sampler& sampler, RayCounts& counts, float& total_importance) const {
   RGB sum(0.0f);
   if (light_selection_ != LightSelection::Paper) {
-    // Each shadow ray goes to one light chosen from the scene's light distribution (by power, or
-    // uniformly over emitters); with several rays, the light choices and the points on the lights
-    // are stratified.
-    const Distribution1D& choice = scene_.light_distribution();
+    // Each shadow ray goes to one light chosen by the scene's light sampler (by power, uniformly
+    // over emitters, or through the light BVH by what each light can give here); with several
+    // rays, the light choices and the points on the lights are stratified.
+    const LightSampler& choice = scene_.light_sampler();
     float rotation = shadow_rays_ > 1 ? sampler.get_1d() : 0.0f;
     for (int k = 0; k < shadow_rays_; ++k) {
       float u_choice = (float(k) + sampler.get_1d()) / float(shadow_rays_);
-      size_t li = choice.sample(std::min(u_choice, 0x1.fffffep-1f));
+      SampledLight chosen = choice.sample(v.ctx, std::min(u_choice, 0x1.fffffep-1f));
       Vec2 u = stratified_square(sampler.get_2d(), k, shadow_rays_, rotation);
-      sum += shadow_ray_estimate(v, li, u, expected_shadow_rays(li, v.ctx, 0), counts);
+      if (chosen.pmf > 0)  // (none: no light can reach this vertex)
+        sum += shadow_ray_estimate(v, chosen.light, u, float(shadow_rays_) * chosen.pmf, counts);
     }
     return sum;
   }

@@ -91,6 +91,13 @@ TEST(PathIntegratorStrategies, ShadowRayCountAndLightSelectionAgree) {
   expect_same_image(one, paper, "power vs paper's rule");
   paper.settings.path.mis = false;
   expect_same_image(one, paper, "paper's rule without MIS");
+  SceneDesc bvh = one;
+  bvh.settings.light_selection = LightSelection::Bvh;
+  expect_same_image(one, bvh, "power vs light BVH");
+  bvh.settings.path.shadow_rays = 3;
+  expect_same_image(one, bvh, "light BVH, 3 shadow rays");
+  bvh.settings.path.mis = false;
+  expect_same_image(one, bvh, "light BVH without MIS");
 }
 
 TEST(PathIntegratorStrategies, ComparisonDetectsABiasedRender) {

@@ -136,7 +136,8 @@ void apply_request(const RenderRequest& request, SceneDesc& scene) {
     rs.light_selection = parse_choice<LightSelection>("--light-selection", request.light_selection,
                                                       {{"power", LightSelection::Power},
                                                        {"paper", LightSelection::Paper},
-                                                       {"uniform", LightSelection::Uniform}});
+                                                       {"uniform", LightSelection::Uniform},
+                                                       {"bvh", LightSelection::Bvh}});
   if (request.no_mis) rs.path.mis = false;
   // An error estimate needs two independent halves of every pixel's samples; with a target the
   // spp is the most a pixel may get (--spp, or 65536).

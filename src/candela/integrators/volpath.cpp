@@ -137,7 +137,7 @@ RGB VolPathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, co
       L += beta * Le / r_u.average();
       return;
     }
-    float light_pdf = scene_.light_distribution().pmf(light) *
+    float light_pdf = scene_.light_sampler().pmf(prev_ctx, light) *
                       light_pdf_li(scene_.lights()[light], prev_ctx, ray.direction, p, n);
     L += beta * Le / (r_u + r_l * light_pdf).average();
   };
@@ -310,11 +310,11 @@ template <typename Sampler>
 RGB VolPathIntegrator::sample_direct(const ScatterPoint& at, Sampler& sampler, const RGB& beta, const RGB& r_p,
                                      int hero, RayCounts& counts) const {
   // Choose a light and a point on it.
-  const Distribution1D& choice = scene_.light_distribution();
-  const size_t li = choice.sample(sampler.get_1d());
+  const SampledLight chosen = scene_.light_sampler().sample(at.ctx, sampler.get_1d());
   const Vec2 u = sampler.get_2d();
   Rng rng = medium_walk_rng(sampler);
-  const float pmf = choice.pmf(li);
+  const float pmf = chosen.pmf;
+  const size_t li = chosen.light;
   if (!(pmf > 0)) return RGB(0.0f);
   const Light& light = scene_.lights()[li];
   const LightSample ls = light_sample_li(light, at.ctx, u);

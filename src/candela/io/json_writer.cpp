@@ -416,7 +416,7 @@ Json render_json(const SceneDesc& scene) {
   if (reads("mis")) j["mis"] = s.path.mis;
   if (s.hide_emitters) j["hide_emitters"] = true;
   if (s.spectral) j["spectral"] = true;
-  static const char* kSelection[] = {"power", "paper", "uniform"};
+  static const char* kSelection[] = {"power", "paper", "uniform", "bvh"};
   if (s.light_selection != LightSelection::Paper || reads("light_selection=paper"))
     j["light_selection"] = kSelection[int(s.light_selection)];
   if (reads("shadow_rays")) j["shadow_rays"] = s.path.shadow_rays;

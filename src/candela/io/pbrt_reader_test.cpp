@@ -141,7 +141,7 @@ TEST(PbrtReader, DefaultSamplerAndFilterArePbrtsZSobolAndGaussian) {
   EXPECT_FLOAT_EQ(scene.settings.filter.radius.x, 1.5f);
   EXPECT_FLOAT_EQ(scene.settings.filter.radius.y, 1.5f);
   EXPECT_FLOAT_EQ(scene.settings.filter.gaussian_sigma, 0.5f);
-  EXPECT_EQ(scene.settings.light_selection, LightSelection::Power);
+  EXPECT_EQ(scene.settings.light_selection, LightSelection::Bvh);  // pbrt-v4's volpath's default
 }
 
 TEST(PbrtReader, ReadsTheThreeSamplerTypes) {
@@ -223,11 +223,14 @@ TEST(PbrtReader, BadPixelFilters) {
   expect_error({"PixelFilter \"box\" \"float sigma\" 1", "WorldBegin"}, 1, "\"float sigma\"", "unused parameter");
 }
 
-TEST(PbrtReader, LightSamplerPowerAndBvhChooseLightsByPower) {
-  for (std::string name : {"power", "bvh"}) {
-    SceneDesc scene = read_lines({"Integrator \"path\" \"string lightsampler\" \"" + name + "\"", "WorldBegin"});
-    EXPECT_EQ(scene.settings.light_selection, LightSelection::Power) << name;
+TEST(PbrtReader, LightSamplerPowerAndBvh) {
+  for (auto [name, selection] : {std::pair{"power", LightSelection::Power}, {"bvh", LightSelection::Bvh}}) {
+    SceneDesc scene = read_lines({"Integrator \"path\" \"string lightsampler\" \"" + std::string(name) + "\"", "WorldBegin"});
+    EXPECT_EQ(scene.settings.light_selection, selection) << name;
   }
+  // pbrt-v4's default for the integrators that read it; its BDPT and MLT choose by power.
+  EXPECT_EQ(read_lines({"Integrator \"volpath\"", "WorldBegin"}).settings.light_selection, LightSelection::Bvh);
+  EXPECT_EQ(read_lines({"Integrator \"bdpt\"", "WorldBegin"}).settings.light_selection, LightSelection::Power);
   expect_error({"Integrator \"path\" \"string lightsampler\" \"uniform\"", "WorldBegin"}, 1,
                "\"string lightsampler\"", "\"uniform\" is not supported yet");
   expect_error({"Integrator \"path\" \"string lightsampler\" \"nearest\"", "WorldBegin"}, 1,

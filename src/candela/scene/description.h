@@ -639,9 +639,12 @@ enum class LightSelection {
   Power,   // `shadow_rays` rays, each to one light chosen with probability proportional to its power
   Paper,   // every light gets a share of `shadow_rays` proportional to power x projected solid angle
            // as seen from the vertex (stratified over rectangles), kept unbiased
-  Uniform  // as Power, but every emitter (a light, or an emissive shape with all its triangles) is
+  Uniform, // as Power, but every emitter (a light, or an emissive shape with all its triangles) is
            // equally likely, and a shape's triangles by area (Mitsuba's choice): robust where power
            // misjudges, as for a small spot beside a large sky
+  Bvh      // as Power, but each vertex chooses through a light BVH by the power, distance and
+           // orientation its lights could have there (lights/light_sampler.h; pbrt-v4's default):
+           // near lights and lights facing the vertex get the rays, O(log n) per choice
 };
 
 // Settings only the path tracer reads (integrator "path"; docs/cli.md lists the flags).
@@ -692,7 +695,7 @@ struct RenderSettings {
   // Spectral transport (spectral/wavelengths.h): each sample carries three wavelengths and RGB
   // parameters become smooth spectra, as in pbrt-v4; off = RGB transport.
   bool spectral = false;
-  // Power and uniform shape the scene's light distribution, which every integrator samples; the
+  // Power, uniform and bvh choose lights for every integrator (scene.h's light_sampler()); the
   // paper's rule is the path tracer's alone.
   LightSelection light_selection = LightSelection::Power;
   BvhLayout bvh = BvhLayout::Fast;

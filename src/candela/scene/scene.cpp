@@ -135,7 +135,8 @@ void Scene::build(const SceneDesc& desc, SceneDesc* take_meshes) {
   }
 
   // Which light a shadow ray (or a light path) starts from: by power, or (LightSelection::Uniform)
-  // every emitter equally, the triangles of an emissive mesh among themselves by power (= by area).
+  // every emitter equally, the triangles of an emissive mesh among themselves by power (= by area),
+  // or (LightSelection::Bvh) through the light BVH, light paths still by power.
   std::vector<float> power;
   for (const auto& l : lights_) power.push_back(light_power(l));
   if (desc.settings.light_selection == LightSelection::Uniform) {
@@ -149,7 +150,7 @@ void Scene::build(const SceneDesc& desc, SceneDesc* take_meshes) {
     }
     power = std::move(weight);
   }
-  light_distribution_ = Distribution1D(power);
+  light_sampler_ = LightSampler(lights_, power, desc.settings.light_selection == LightSelection::Bvh);
 
   int w = desc.film.width, h = desc.film.height;
   // Camera rays reach the filter's radius beyond the outermost pixel centres.

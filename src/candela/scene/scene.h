@@ -9,9 +9,9 @@
 #include "candela/geometry/embree_scene.h"
 #include "candela/geometry/surface_hit.h"
 #include "candela/lights/light.h"
+#include "candela/lights/light_sampler.h"
 #include "candela/materials/material.h"
 #include "candela/media/medium.h"
-#include "candela/sampling/distribution1d.h"
 #include "candela/scene/description.h"
 #include "candela/textures/texture.h"
 
@@ -111,7 +111,8 @@ class Scene {
   int light_index(const SurfaceHit& hit) const;
 
   const std::vector<Light>& lights() const { return lights_; }
-  const Distribution1D& light_distribution() const { return light_distribution_; }
+  // Which light a vertex sends its shadow ray to, and which light a light path starts from.
+  const LightSampler& light_sampler() const { return light_sampler_; }
   // The lights at infinity (sky, environment maps) that rays escaping the scene see: indices into lights().
   const std::vector<uint32_t>& infinite_lights() const { return infinite_lights_; }
   // Radiance an escaping ray travelling along `dir` receives from infinite light `light`.
@@ -172,7 +173,7 @@ class Scene {
   TextureSet textures_;
   MaterialTable materials_;  // refers to textures_
   std::vector<Light> lights_;
-  Distribution1D light_distribution_;
+  LightSampler light_sampler_;
   std::vector<uint32_t> infinite_lights_;
   std::vector<Medium> media_;
   int camera_medium_ = -1;

@@ -157,7 +157,7 @@ void SceneParser::integrator(const Token& d) {
   ParamList params = read_params(d, fmt::format("Integrator \"{}\"", type.text));
   int max_depth = params.get_int("maxdepth", 5);
   if (max_depth < 0) params.fail("maxdepth", "must not be negative, got {}", max_depth);
-  if (type.text == "path" || type.text == "volpath" || type.text == "bdpt") read_light_sampler(params);
+  if (type.text == "path" || type.text == "volpath" || type.text == "bdpt") read_light_sampler(params, type.text == "bdpt" ? "power" : "bvh");
   if (type.text == "path" || type.text == "volpath" || type.text == "bdpt" || type.text == "mlt") {
     if (params.get_bool("regularize", false))
       warn(params.where("regularize"), "Integrator \"{}\": \"regularize\" is ignored: candela does not roughen "
@@ -197,17 +197,17 @@ void SceneParser::integrator(const Token& d) {
   options_.max_depth = max_depth;
 }
 
-// pbrt's "power" chooses lights by power, as candela does. Its default "bvh" also weighs each light
-// by its distance and orientation from the shading point; candela has no light BVH and uses "power"
-// for it too, which changes only the noise.
-void SceneParser::read_light_sampler(ParamList& params) {
-  std::string light_sampler = params.get_string("lightsampler", "bvh");
+// pbrt's "power" and its default "bvh" (a light BVH weighing each light by power, distance and
+// orientation from the shading point) are candela's LightSelection::Power and ::Bvh. The default is
+// "bvh" but for pbrt-v4's BDPT ("power").
+void SceneParser::read_light_sampler(ParamList& params, const char* default_sampler) {
+  std::string light_sampler = params.get_string("lightsampler", default_sampler);
   if (light_sampler == "uniform" || light_sampler == "exhaustive")
     params.fail("lightsampler", "\"{}\" is not supported yet (supported: \"power\", \"bvh\")", light_sampler);
   if (light_sampler != "bvh" && light_sampler != "power")
     params.fail("lightsampler", "must be \"bvh\", \"power\", \"uniform\" or \"exhaustive\", got \"{}\"",
                 light_sampler);
-  options_.light_sampler_given = true;
+  options_.light_sampler = light_sampler == "bvh" ? LightSelection::Bvh : LightSelection::Power;
 }
 
 void SceneParser::pixel_filter(const Token& d) {
@@ -276,7 +276,9 @@ void SceneParser::write_render_settings(RenderSettings& settings) const {
   // media, and faster.
   settings.integrator = !options_.integrator_given && !scene_.media.empty() ? "volpath" : options_.integrator;
   settings.spectral = true;  // pbrt-v4 renders spectrally; RGB parameters become spectra as there
-  if (options_.light_sampler_given) settings.light_selection = LightSelection::Power;
+  // pbrt-v4's default integrator (volpath) chooses lights with its BVH.
+  if (options_.light_sampler) settings.light_selection = *options_.light_sampler;
+  else if (!options_.integrator_given) settings.light_selection = LightSelection::Bvh;
   if (options_.mlt) {
     settings.mlt.bootstrap = options_.mlt->bootstrap;
     settings.mlt.chains = options_.mlt->chains;

@@ -81,7 +81,7 @@ struct RenderDirectives {
   bool integrator_given = false;  // else pbrt-v4's default, volpath, which is path without media
   int max_depth = 5;
   FilterDesc filter = default_filter(FilterType::Gaussian);
-  bool light_sampler_given = false;  // an integrator that reads "lightsampler" was named
+  std::optional<LightSelection> light_sampler;  // an integrator that reads "lightsampler" was named
   struct Metropolis {
     int bootstrap = 0, chains = 0;
     float large_step = 0, sigma = 0;
@@ -169,7 +169,7 @@ class SceneParser {
   void integrator(const Token& d);
   void pixel_filter(const Token& d);
   void accelerator(const Token& d);
-  void read_light_sampler(ParamList& params);
+  void read_light_sampler(ParamList& params, const char* default_sampler);
   void option(const Token& d);
   void color_space(const Token& d);
   void world_begin(const Token& d);

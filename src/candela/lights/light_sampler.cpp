@@ -1,0 +1,367 @@
+#include "candela/lights/light_sampler.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "candela/base/overloaded.h"
+
+namespace candela {
+
+namespace {
+
+constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
+
+Bounds3 point_bounds(const Point3& p) {
+  Bounds3 b;
+  b.extend(p);
+  return b;
+}
+
+// A point or a small round emitter: light in every direction (theta_o = pi, theta_e = pi/2).
+LightBounds omnidirectional(const Bounds3& bounds, float phi) {
+  return {bounds, phi, Vec3(0, 0, 1), -1.0f, 0.0f, false};
+}
+
+// A flat diffuse emitter: normals all n, light up to pi/2 from them.
+LightBounds flat(const Bounds3& bounds, float phi, const Normal3& n, bool two_sided) {
+  return {bounds, phi, n, 1.0f, 0.0f, two_sided};
+}
+
+// cos(max(0, a - b)) and sin(max(0, a - b)) from the angles' sines and cosines, without acos.
+float cos_of_clamped_difference(float sin_a, float cos_a, float sin_b, float cos_b) {
+  return cos_a > cos_b ? 1.0f : cos_a * cos_b + sin_a * sin_b;
+}
+float sin_of_clamped_difference(float sin_a, float cos_a, float sin_b, float cos_b) {
+  return cos_a > cos_b ? 0.0f : sin_a * cos_b - cos_a * sin_b;
+}
+
+// v turned by angle theta about the unit axis k (perpendicular to v): Rodrigues' formula.
+Vec3 rotate_perpendicular(const Vec3& v, const Vec3& k, float theta) {
+  return v * std::cos(theta) + cross(k, v) * std::sin(theta);
+}
+
+float surface_area(const Bounds3& b) {
+  Vec3 d = b.diagonal();
+  return 2 * (d.x * d.y + d.y * d.z + d.z * d.x);
+}
+
+// The cost of a node with these bounds in the build's split heuristic (Conty Estevez and Kulla's
+// surface area orientation heuristic, as pbrt-v4 weighs it): power x the solid angle the emission
+// cone reaches x the box's area, penalising boxes thin along the split axis.
+float node_cost(const LightBounds& b, const Bounds3& parent_box, int axis) {
+  float theta_o = std::acos(std::clamp(b.cos_theta_o, -1.0f, 1.0f));
+  float theta_e = std::acos(std::clamp(b.cos_theta_e, -1.0f, 1.0f));
+  float theta_w = std::min(theta_o + theta_e, kPi);
+  float sin_o = safe_sqrt(1 - b.cos_theta_o * b.cos_theta_o);
+  float m_omega = 2 * kPi * (1 - b.cos_theta_o) +
+                  kPi / 2 * (2 * theta_w * sin_o - std::cos(theta_o - 2 * theta_w) - 2 * theta_o * sin_o + b.cos_theta_o);
+  Vec3 d = parent_box.diagonal();
+  float extent = d[axis] > 0 ? std::max({d.x, d.y, d.z}) / d[axis] : 1.0f;
+  return b.phi * m_omega * extent * surface_area(b.bounds);
+}
+
+}  // namespace
+
+std::optional<LightBounds> light_bounds(const Light& light) {
+  std::optional<LightBounds> b = std::visit(
+      overloaded{
+          [](const PointLightSource& l) -> std::optional<LightBounds> {
+            return omnidirectional(point_bounds(l.position), l.intensity.luminance());
+          },
+          [](const SpotLightSource& l) -> std::optional<LightBounds> {
+            // Full intensity within the inner cone, none past the outer one.
+            float theta_start = std::acos(std::clamp(l.cos_falloff_start, -1.0f, 1.0f));
+            float theta_end = std::acos(std::clamp(l.cos_falloff_end, -1.0f, 1.0f));
+            return LightBounds{point_bounds(l.position), l.intensity.luminance(), l.frame.n, l.cos_falloff_start,
+                               std::cos(std::max(0.0f, theta_end - theta_start)), false};
+          },
+          [](const ProjectorLightSource& l) -> std::optional<LightBounds> {
+            // As bright as a point light of the same power, in every direction (a loose but safe cone).
+            return omnidirectional(point_bounds(l.position), l.power() / (4 * kPi));
+          },
+          [](const TriangleLight& l) -> std::optional<LightBounds> {
+            Bounds3 b = point_bounds(l.p0);
+            b.extend(l.p1);
+            b.extend(l.p2);
+            return flat(b, l.radiance.luminance() * l.area, l.n, l.two_sided);
+          },
+          [](const RectangleLight& l) -> std::optional<LightBounds> {
+            Bounds3 b = point_bounds(l.corner);
+            b.extend(l.corner + l.edge_u);
+            b.extend(l.corner + l.edge_v);
+            b.extend(l.corner + l.edge_u + l.edge_v);
+            return flat(b, l.radiance.luminance() * l.area, l.n, l.two_sided);
+          },
+          [](const DiskLight& l) -> std::optional<LightBounds> {
+            Vec3 half(std::abs(l.axis_u.x) + std::abs(l.axis_v.x), std::abs(l.axis_u.y) + std::abs(l.axis_v.y),
+                      std::abs(l.axis_u.z) + std::abs(l.axis_v.z));
+            Bounds3 b = point_bounds(l.center - half);
+            b.extend(l.center + half);
+            return flat(b, l.radiance.luminance() * l.area, l.n, l.two_sided);
+          },
+          [](const SphereLight& l) -> std::optional<LightBounds> {
+            // Seen from anywhere outside, a disk of area pi r^2.
+            Bounds3 b = point_bounds(l.center - Vec3(l.radius));
+            b.extend(l.center + Vec3(l.radius));
+            return omnidirectional(b, l.radiance.luminance() * kPi * l.radius * l.radius);
+          },
+          [](const CylinderLight& l) -> std::optional<LightBounds> {
+            Bounds3 b = point_bounds(l.base - Vec3(l.radius));
+            b.extend(l.base + Vec3(l.radius));
+            b.extend(l.base + l.axis - Vec3(l.radius));
+            b.extend(l.base + l.axis + Vec3(l.radius));
+            float projected = 2 * l.radius * length(l.axis) + kPi * l.radius * l.radius;  // at most, from any side
+            return omnidirectional(b, l.radiance.luminance() * projected);
+          },
+          [](const auto&) -> std::optional<LightBounds> { return std::nullopt; }},  // at infinity
+      light);
+  if (!b || !(b->phi > 0) || !std::isfinite(b->phi)) return std::nullopt;
+  return b;
+}
+
+LightBounds merge(const LightBounds& a, const LightBounds& b) {
+  LightBounds m;
+  m.bounds = a.bounds;
+  m.bounds.extend(b.bounds);
+  m.phi = a.phi + b.phi;
+  m.cos_theta_e = std::min(a.cos_theta_e, b.cos_theta_e);
+  m.two_sided = a.two_sided || b.two_sided;
+  // The smallest cone holding both direction cones.
+  float theta_a = std::acos(std::clamp(a.cos_theta_o, -1.0f, 1.0f));
+  float theta_b = std::acos(std::clamp(b.cos_theta_o, -1.0f, 1.0f));
+  float theta_d = std::acos(std::clamp(dot(a.w, b.w), -1.0f, 1.0f));
+  if (std::min(theta_d + theta_b, kPi) <= theta_a) {
+    m.w = a.w, m.cos_theta_o = a.cos_theta_o;
+  } else if (std::min(theta_d + theta_a, kPi) <= theta_b) {
+    m.w = b.w, m.cos_theta_o = b.cos_theta_o;
+  } else {
+    float theta_o = (theta_a + theta_d + theta_b) / 2;
+    Vec3 axis = cross(a.w, b.w);
+    if (theta_o >= kPi || length_squared(axis) == 0) {
+      m.w = a.w, m.cos_theta_o = -1;  // the whole sphere
+    } else {
+      m.w = normalize(rotate_perpendicular(a.w, normalize(axis), theta_o - theta_a));
+      m.cos_theta_o = std::cos(theta_o);
+    }
+  }
+  return m;
+}
+
+LightImportance::LightImportance(const LightBounds& b)
+    : center(b.bounds.center()),
+      radius(0.5f * length(b.bounds.diagonal())),
+      phi(b.phi),
+      w(b.w),
+      cos_o(b.cos_theta_o),
+      sin_o(safe_sqrt(1 - b.cos_theta_o * b.cos_theta_o)),
+      cos_e(b.cos_theta_e),
+      two_sided(b.two_sided) {}
+
+float LightImportance::operator()(const LightSampleContext& ctx) const {
+  const Vec3 d = ctx.p - center;
+  const float d2_true = length_squared(d);
+  const float radius2 = radius * radius;
+  // Closer than the bounds' bounding sphere, the lights could be anywhere around: no 1/d^2 growth,
+  // and every direction may lead to one (theta_b = pi).
+  const float d2 = std::max({d2_true, radius2, 1e-12f});
+  float sin_b = 0, cos_b = -1;
+  Vec3 wi(0, 0, 1);
+  if (d2_true > radius2) {
+    const float inv_d = 1 / std::sqrt(d2_true);
+    wi = d * inv_d;
+    sin_b = radius * inv_d;
+    cos_b = safe_sqrt(1 - sin_b * sin_b);
+  }
+
+  // The smallest angle between an emission direction in the cone and a direction towards the
+  // point: theta' = max(0, theta_w - theta_o - theta_b); nothing arrives past theta_e.
+  float cos_w = dot(w, wi);
+  if (two_sided) cos_w = std::abs(cos_w);
+  const float sin_w = safe_sqrt(1 - cos_w * cos_w);
+  const float cos_x = cos_of_clamped_difference(sin_w, cos_w, sin_o, cos_o);
+  const float sin_x = sin_of_clamped_difference(sin_w, cos_w, sin_o, cos_o);
+  const float cos_p = cos_of_clamped_difference(sin_x, cos_x, sin_b, cos_b);
+  if (cos_p <= cos_e) return 0;
+  float importance = phi * cos_p / d2;
+
+  // At a surface, the largest cosine with the gathering side's normal any of the lights could make.
+  if (ctx.n != Normal3(0.0f)) {
+    const float cos_i = -dot(ctx.n, wi);
+    const float sin_i = safe_sqrt(1 - cos_i * cos_i);
+    importance *= std::max(0.0f, cos_of_clamped_difference(sin_i, cos_i, sin_b, cos_b));
+  }
+  return std::isfinite(importance) ? std::max(0.0f, importance) : 0.0f;
+}
+
+LightSampler::LightSampler(std::span<const Light> lights, std::span<const float> weights, bool bvh)
+    : emitter_choice_(weights), bvh_(bvh) {
+  if (!bvh_) return;
+  leaf_of_light_.assign(lights.size(), -1);
+  infinite_slot_.assign(lights.size(), -1);
+  std::vector<std::pair<uint32_t, LightBounds>> bounded;
+  for (size_t i = 0; i < lights.size(); ++i) {
+    if (light_is_at_infinity(lights[i])) {
+      infinite_slot_[i] = int32_t(infinite_.size());
+      infinite_.push_back(uint32_t(i));
+    } else if (std::optional<LightBounds> b = light_bounds(lights[i])) {
+      bounded.emplace_back(uint32_t(i), *b);
+    }
+  }
+  if (!bounded.empty()) {
+    nodes_.reserve(2 * bounded.size());
+    bounds_.reserve(2 * bounded.size());
+    nodes_.resize(2);
+    bounds_.resize(2);
+    build(bounded, 0, bounded.size(), 0, 0);
+  }
+}
+
+void LightSampler::build(std::vector<std::pair<uint32_t, LightBounds>>& lights, size_t begin, size_t end,
+                         uint32_t index, uint32_t parent) {
+  if (end - begin == 1) {
+    const auto& [light, bounds] = lights[begin];
+    nodes_[index] = Node{LightImportance(bounds), light, parent, true};
+    bounds_[index] = bounds;
+    leaf_of_light_[light] = int32_t(index);
+    return;
+  }
+  LightBounds all = lights[begin].second;
+  Bounds3 centroids;
+  for (size_t i = begin; i < end; ++i) {
+    if (i > begin) all = merge(all, lights[i].second);
+    centroids.extend(lights[i].second.bounds.center());
+  }
+
+  // Choose the split: among 12 buckets of centroids along each axis, the boundary of least cost.
+  constexpr int kBuckets = 12;
+  float best_cost = INFINITY;
+  int best_axis = -1, best_bucket = -1;
+  auto bucket_of = [&](const LightBounds& b, int axis) {
+    float extent = centroids.hi[axis] - centroids.lo[axis];
+    int k = int(kBuckets * (b.bounds.center()[axis] - centroids.lo[axis]) / extent);
+    return std::clamp(k, 0, kBuckets - 1);
+  };
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!(centroids.hi[axis] > centroids.lo[axis])) continue;
+    std::array<std::optional<LightBounds>, kBuckets> buckets;
+    for (size_t i = begin; i < end; ++i) {
+      auto& bucket = buckets[size_t(bucket_of(lights[i].second, axis))];
+      bucket = bucket ? merge(*bucket, lights[i].second) : lights[i].second;
+    }
+    for (int split = 0; split + 1 < kBuckets; ++split) {
+      std::optional<LightBounds> below, above;
+      for (int k = 0; k < kBuckets; ++k) {
+        if (!buckets[size_t(k)]) continue;
+        auto& side = k <= split ? below : above;
+        side = side ? merge(*side, *buckets[size_t(k)]) : *buckets[size_t(k)];
+      }
+      if (!below || !above) continue;
+      float cost = node_cost(*below, all.bounds, axis) + node_cost(*above, all.bounds, axis);
+      if (cost < best_cost) best_cost = cost, best_axis = axis, best_bucket = split;
+    }
+  }
+  size_t mid = (begin + end) / 2;
+  if (best_axis >= 0) {
+    auto it = std::partition(lights.begin() + std::ptrdiff_t(begin), lights.begin() + std::ptrdiff_t(end),
+                             [&](const auto& l) { return bucket_of(l.second, best_axis) <= best_bucket; });
+    mid = size_t(it - lights.begin());
+  }
+  if (mid == begin || mid == end) mid = (begin + end) / 2;  // all alike: halve the list
+
+  const uint32_t first = uint32_t(nodes_.size());
+  nodes_.resize(nodes_.size() + 2);
+  bounds_.resize(bounds_.size() + 2);
+  nodes_[index] = Node{LightImportance(all), first, parent, false};
+  bounds_[index] = all;
+  build(lights, begin, mid, first, index);
+  build(lights, mid, end, first + 1, index);
+}
+
+int LightSampler::bvh_depth() const {
+  int depth = 0;
+  for (size_t i = 0; i < nodes_.size(); ++i) {
+    if (!nodes_[i].leaf) continue;
+    int d = 0;
+    for (size_t n = i; n != 0; n = nodes_[n].parent) ++d;
+    depth = std::max(depth, d);
+  }
+  return depth;
+}
+
+bool LightSampler::tree_may_reach(const LightSampleContext& ctx) const {
+  if (nodes_.empty()) return false;
+  // Only lights at infinity need to know, to take the tree's share. Otherwise an interior root
+  // that cannot reach ctx shows in its children's importance, and a lone light is chosen anyway
+  // (as by power: its shadow ray finds nothing where it cannot reach).
+  if (infinite_.empty()) return true;
+  return nodes_[0].importance(ctx) > 0;
+}
+
+float LightSampler::infinite_probability(bool tree_may_reach) const {
+  if (infinite_.empty()) return 0;
+  // Where no light of the tree can reach, the lights at infinity take every ray.
+  return tree_may_reach ? float(infinite_.size()) / float(infinite_.size() + 1) : 1.0f;
+}
+
+SampledLight LightSampler::sample_emitter(float u) const {
+  if (emitter_choice_.empty()) return {};
+  size_t li = emitter_choice_.sample(u);
+  return {uint32_t(li), emitter_choice_.pmf(li)};
+}
+
+SampledLight LightSampler::sample(const LightSampleContext& ctx, float u) const {
+  if (!bvh_) return sample_emitter(u);
+  // A light at infinity, each with probability 1 / (n_infinite + 1), or the tree.
+  const bool reaches = tree_may_reach(ctx);
+  const float p_infinite = infinite_probability(reaches);
+  if (u < p_infinite) {
+    size_t k = std::min(size_t(u / p_infinite * float(infinite_.size())), infinite_.size() - 1);
+    return {infinite_[k], p_infinite / float(infinite_.size())};
+  }
+  if (!reaches) return {};
+  u = std::min((u - p_infinite) / (1 - p_infinite), kOneMinusEpsilon);
+  float pmf = 1 - p_infinite;
+  // Descend, choosing each child by the importance its bounds promise at ctx and reusing u.
+  uint32_t node = 0;
+  while (!nodes_[node].leaf) {
+    const uint32_t first = nodes_[node].child_or_light;
+    const float i0 = nodes_[first].importance(ctx);
+    const float i1 = nodes_[first + 1].importance(ctx);
+    if (!(i0 + i1 > 0)) return {};
+    const float p0 = i0 / (i0 + i1);
+    if (u < p0) {
+      node = first, pmf *= p0, u = std::min(u / p0, kOneMinusEpsilon);
+    } else {
+      node = first + 1, pmf *= 1 - p0;
+      u = std::min((u - p0) / (1 - p0), kOneMinusEpsilon);
+    }
+  }
+  if (!(pmf > 0)) return {};
+  return {nodes_[node].child_or_light, pmf};
+}
+
+float LightSampler::pmf(const LightSampleContext& ctx, size_t light) const {
+  if (!bvh_) return emitter_choice_.pmf(light);
+  const bool reaches = tree_may_reach(ctx);
+  const float p_infinite = infinite_probability(reaches);
+  if (infinite_slot_[light] >= 0) return p_infinite / float(infinite_.size());
+  int32_t leaf = leaf_of_light_[light];
+  if (leaf < 0 || !reaches) return 0;
+  // The product of the choices on the way down, gathered on the way up from the light's leaf.
+  float pmf = 1 - p_infinite;
+  uint32_t node = uint32_t(leaf);
+  while (node != 0) {
+    const uint32_t parent = nodes_[node].parent;
+    const uint32_t first = nodes_[parent].child_or_light;
+    const float i0 = nodes_[first].importance(ctx);
+    const float i1 = nodes_[first + 1].importance(ctx);
+    if (!(i0 + i1 > 0)) return 0;
+    const float p0 = i0 / (i0 + i1);
+    pmf *= node == first ? p0 : 1 - p0;
+    node = parent;
+  }
+  return pmf;
+}
+
+}  // namespace candela
