@@ -28,14 +28,6 @@ LightBounds flat(const Bounds3& bounds, float phi, const Normal3& n, bool two_si
   return {bounds, phi, n, 1.0f, 0.0f, two_sided};
 }
 
-// cos(max(0, a - b)) and sin(max(0, a - b)) from the angles' sines and cosines, without acos.
-float cos_of_clamped_difference(float sin_a, float cos_a, float sin_b, float cos_b) {
-  return cos_a > cos_b ? 1.0f : cos_a * cos_b + sin_a * sin_b;
-}
-float sin_of_clamped_difference(float sin_a, float cos_a, float sin_b, float cos_b) {
-  return cos_a > cos_b ? 0.0f : sin_a * cos_b - cos_a * sin_b;
-}
-
 // v turned by angle theta about the unit axis k (perpendicular to v): Rodrigues' formula.
 Vec3 rotate_perpendicular(const Vec3& v, const Vec3& k, float theta) {
   return v * std::cos(theta) + cross(k, v) * std::sin(theta);
@@ -175,21 +167,24 @@ float LightImportance::operator()(const LightSampleContext& ctx) const {
   }
 
   // The smallest angle between an emission direction in the cone and a direction towards the
-  // point: theta' = max(0, theta_w - theta_o - theta_b); nothing arrives past theta_e.
+  // point: theta' = max(0, theta_w - theta_o - theta_b); nothing arrives past theta_e. (Sines
+  // only where an angle difference needs them: inside a cone the clamped difference is 0.)
   float cos_w = dot(w, wi);
   if (two_sided) cos_w = std::abs(cos_w);
-  const float sin_w = safe_sqrt(1 - cos_w * cos_w);
-  const float cos_x = cos_of_clamped_difference(sin_w, cos_w, sin_o, cos_o);
-  const float sin_x = sin_of_clamped_difference(sin_w, cos_w, sin_o, cos_o);
-  const float cos_p = cos_of_clamped_difference(sin_x, cos_x, sin_b, cos_b);
+  float cos_x = 1, sin_x = 0;  // of max(0, theta_w - theta_o)
+  if (!(cos_w > cos_o)) {
+    const float sin_w = safe_sqrt(1 - cos_w * cos_w);
+    cos_x = cos_w * cos_o + sin_w * sin_o;
+    sin_x = sin_w * cos_o - cos_w * sin_o;
+  }
+  const float cos_p = cos_x > cos_b ? 1.0f : cos_x * cos_b + sin_x * sin_b;
   if (cos_p <= cos_e) return 0;
   float importance = phi * cos_p / d2;
 
   // At a surface, the largest cosine with the gathering side's normal any of the lights could make.
   if (ctx.n != Normal3(0.0f)) {
     const float cos_i = -dot(ctx.n, wi);
-    const float sin_i = safe_sqrt(1 - cos_i * cos_i);
-    importance *= std::max(0.0f, cos_of_clamped_difference(sin_i, cos_i, sin_b, cos_b));
+    if (!(cos_i > cos_b)) importance *= std::max(0.0f, cos_i * cos_b + safe_sqrt(1 - cos_i * cos_i) * sin_b);
   }
   return std::isfinite(importance) ? std::max(0.0f, importance) : 0.0f;
 }
