@@ -199,8 +199,8 @@ void JsonSceneReader::read_integrator_strategies(CheckedObject& render, RenderSe
   if (const Json* value = render.find("light_selection"))
     settings.light_selection =
         read_name<LightSelection>(report_, *value, render.pointer_of("light_selection"), "light selection",
-                                  {{"power", LightSelection::Power}, {"paper", LightSelection::Paper}, {"uniform", LightSelection::Uniform},
-                                   {"bvh", LightSelection::Bvh}});
+                                  {{"power", LightSelection::Power}, {"paper", LightSelection::Paper},
+                                   {"uniform", LightSelection::Uniform}, {"bvh", LightSelection::Bvh}});
   settings.path.shadow_rays = render.integer_or("shadow_rays", settings.path.shadow_rays, 1, std::numeric_limits<int>::max());
   if (const Json* value = render.find("bvh"))
     settings.bvh = read_name<BvhLayout>(report_, *value, render.pointer_of("bvh"), "BVH layout",

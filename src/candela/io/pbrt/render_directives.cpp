@@ -157,7 +157,8 @@ void SceneParser::integrator(const Token& d) {
   ParamList params = read_params(d, fmt::format("Integrator \"{}\"", type.text));
   int max_depth = params.get_int("maxdepth", 5);
   if (max_depth < 0) params.fail("maxdepth", "must not be negative, got {}", max_depth);
-  if (type.text == "path" || type.text == "volpath" || type.text == "bdpt") read_light_sampler(params, type.text == "bdpt" ? "power" : "bvh");
+  if (type.text == "path" || type.text == "volpath" || type.text == "bdpt")
+    read_light_sampler(params, type.text == "bdpt" ? "power" : "bvh");
   if (type.text == "path" || type.text == "volpath" || type.text == "bdpt" || type.text == "mlt") {
     if (params.get_bool("regularize", false))
       warn(params.where("regularize"), "Integrator \"{}\": \"regularize\" is ignored: candela does not roughen "
