@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
-"""Writes the meshes of scenes/city-night.json, a generated city at night lit by about 20,000 emissive
+"""Writes the meshes of scenes/city-night.json, a generated city at night lit by 23,160 emissive
 triangles: lit windows in three colours on a grid of towers, and a string of street lamps along every
-street. Most lights are hidden from any given point or far away, so choosing lights by power alone
-wastes nearly every shadow ray; the light BVH (light_selection "bvh") is made for this. Deterministic
+street. Most lights are far from any given point, face away or are hidden, so choosing lights by power
+alone spends most shadow rays on lights that give nothing; the light BVH (light_selection "bvh") is made
+for this (3.5x lower relMSE at equal samples, docs/performance.md). Deterministic
 (fixed seed); about 2 MB of OBJ, so it is generated, not committed.
 
 Usage: scenes/make_city.py [OUTPUT_DIR] [--blocks N] (N x N towers; default 14, the scene's)
