@@ -153,7 +153,7 @@ def section_loading(a, candela, tmp):
 def section_replay(a, tmp):
     replay = os.path.join(a.build, "bench", "candela_ray_replay")
     if not os.path.exists(replay):
-        print("## The limit: build/bench/candela_ray_replay is not built\n")
+        print("## The limit: build/bench/candela_ray_replay is not built (configure with -DCANDELA_BUILD_BENCH=ON)\n")
         return
     print("## The limit: candela against raw Embree on the same rays (`candela_ray_replay`)\n")
     for scene, args in [(CORNELL, ["--resolution", "256x256", "--spp", "16"]),

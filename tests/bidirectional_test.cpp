@@ -472,7 +472,7 @@ TEST(BidirectionalAgreement, GlassSphereCaustic) {
   // The path tracer finds the caustic only by hitting the small light through the glass: rare,
   // bright samples, hence its high spp.
   SceneDesc d = scene_at(kScenes + "caustic.json", 32, 24);
-  expect_integrators_agree(d, {{"path", 16384}, {"bdpt", 512}}, 0.005, "caustic");
+  expect_integrators_agree(d, {{"path", 8192}, {"bdpt", 512}}, 0.005, "caustic");
   // The caustic's focus is a narrow peak of the Metropolis target: at this budget the chains share
   // their deposits between it and the rest unevenly (4-5 standard errors by region, in both
   // directions, docs/bidirectional.md), so only the whole image is judged here.
