@@ -2,7 +2,7 @@
 """Noise per sample and per second against pbrt-v4, scene by scene (issue 28's table).
 
   bench/noise_per_sample.py [--candela build/candela] [--seeds 3 5 6] [--selections power bvh]
-                            [--threads 2] [--city] [--rows NAME ...]
+                            [--threads 2] [--city] [--road] [--rows NAME ...]
 
 Renders each row's scene at 64 spp with each light selection and seed, and prints per row and
 selection the medians over seeds of: render time, relMSE (eps 0.01) against pbrt-v4's converged
@@ -14,7 +14,8 @@ with like) and candela's efficiency under each selection relative to the first o
 
 --city adds the generated many-light scene (scenes/make_city.py, about 23,000 emissive triangles) at
 240x135, 64 spp, with its own reference (1024 spp with the light BVH, rendered once into the work
-directory).
+directory). --road adds scenes/lamp-road.json (5,200 street lamps along a 65 km road, 10,400 emissive
+triangles) the same way.
 """
 import argparse
 import pathlib
@@ -69,15 +70,16 @@ def render(candela, scene, integrator, resolution, spp, seed, selection, threads
     return float(seconds.group(1))
 
 
-def city_reference(candela, threads):
+def generated_scene(candela, threads, name, scene_file, make_args):
+    """A many-light scene whose meshes scenes/make_city.py writes, and its reference (1024 spp, light BVH)."""
     WORK.mkdir(parents=True, exist_ok=True)
-    scene = WORK / "city" / "city-night.json"
+    scene = WORK / name / scene_file
     if not scene.exists():
-        subprocess.run([sys.executable, str(ROOT / "scenes/make_city.py"), str(WORK / "city")], check=True)
-        scene.write_text((ROOT / "scenes/city-night.json").read_text())
-    reference = WORK / "city-reference.exr"
+        subprocess.run([sys.executable, str(ROOT / "scenes/make_city.py"), str(WORK / name)] + make_args, check=True)
+        scene.write_text((ROOT / "scenes" / scene_file).read_text())
+    reference = WORK / f"{name}-reference.exr"
     if not reference.exists():
-        print("rendering the city's reference (1024 spp)...", flush=True)
+        print(f"rendering the reference of {scene_file} (1024 spp)...", flush=True)
         render(candela, scene, "path", "240x135", 1024, 1, "bvh", threads, reference)
     return scene, reference
 
@@ -90,6 +92,7 @@ def main():
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--spp", type=int, default=64)
     parser.add_argument("--city", action="store_true")
+    parser.add_argument("--road", action="store_true")
     parser.add_argument("--rows", nargs="*", help="only these rows (scene or scene/integrator)")
     args = parser.parse_args()
     WORK.mkdir(parents=True, exist_ok=True)
@@ -101,8 +104,11 @@ def main():
         jobs.append((name, SHARED / scene / "scene-v4.pbrt", integrator, resolution,
                      SHARED / scene / "pbrt-v4-reference.exr", pbrt_time, pbrt_relmse))
     if args.city:
-        scene, reference = city_reference(args.candela, args.threads)
+        scene, reference = generated_scene(args.candela, args.threads, "city", "city-night.json", [])
         jobs.append(("city-night", scene, "path", "240x135", reference, None, None))
+    if args.road:
+        scene, reference = generated_scene(args.candela, args.threads, "road", "lamp-road.json", ["--road"])
+        jobs.append(("lamp-road", scene, "path", "240x135", reference, None, None))
 
     print(f"{args.spp} spp, seeds {args.seeds}, {args.threads} threads; medians over seeds")
     print(f"{'scene':<12} {'integ':<5} {'selection':<9} {'time s':>7} {'relMSE':>9} {'median err':>10} "

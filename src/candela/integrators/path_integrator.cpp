@@ -24,7 +24,6 @@ PathIntegrator::PathIntegrator(const Scene& scene, const RenderSettings& setting
       direction_sampling_(settings.path.direction_sampling),
       mis_(settings.path.mis),
       hide_emitters_(settings.hide_emitters),
-      light_selection_(settings.light_selection),
       shadow_rays_(std::max(1, settings.path.shadow_rays)) {}
 
 template <typename Sampler>
@@ -32,7 +31,7 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, const
   RGB L(0.0f), beta(1.0f);
   bool specular_bounce = false;
   float eta_scale = 1;
-  float prev_bsdf_pdf = 0, prev_total_importance = 0;
+  float prev_bsdf_pdf = 0;
   LightSampleContext prev_ctx;
   ++counts.camera;
 
@@ -50,7 +49,7 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, const
         else
           L += beta * Le *
                emitter_mis_weight(li, prev_bsdf_pdf, light_pdf_li(scene_.lights()[li], prev_ctx, ray.direction, {}, {}),
-                                  prev_ctx, prev_total_importance);
+                                  prev_ctx);
       }
       break;
     }
@@ -64,7 +63,7 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, const
       } else {
         size_t li = size_t(scene_.light_index(hit));
         float pdf_li = light_pdf_li(scene_.lights()[li], prev_ctx, ray.direction, hit.p, hit.ng);
-        L += beta * Le * emitter_mis_weight(li, prev_bsdf_pdf, pdf_li, prev_ctx, prev_total_importance);
+        L += beta * Le * emitter_mis_weight(li, prev_bsdf_pdf, pdf_li, prev_ctx);
       }
     }
 
@@ -96,9 +95,7 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, const
     Vertex vertex{hit, bsdf, frame, wo_local, {hit.p, gather_n}, ray.time, wl};
 
     // Sample direct illumination with shadow rays (next-event estimation).
-    float total_importance = 0;
-    if (bsdf_has_non_delta(bsdf) && !scene_.lights().empty())
-      L += beta * direct_light(vertex, sampler, counts, total_importance);
+    if (bsdf_has_non_delta(bsdf) && !scene_.lights().empty()) L += beta * direct_light(vertex, sampler, counts);
 
     // Choose the next direction; the material's Russian roulette over its modes happens inside
     // (the paper's d, s, t).
@@ -109,7 +106,6 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, const
     specular_bounce = bs->is_delta;
     prev_bsdf_pdf = bs->pdf;
     prev_ctx = vertex.ctx;
-    prev_total_importance = total_importance;
     if (bs->eta != 1) eta_scale *= bs->eta * bs->eta;
     ray = Ray{offset_ray_origin(hit.p, hit.ng, wi), wi, std::numeric_limits<float>::infinity(), ray.time};
 
@@ -153,27 +149,13 @@ float PathIntegrator::direction_pdf(const SurfaceBsdf& bsdf, const Vec3& wo, con
   return wo.z * wi.z > 0 ? p : 0.0f;
 }
 
-float PathIntegrator::total_light_importance(const LightSampleContext& ctx) const {
-  float total = 0;
-  for (const Light& l : scene_.lights()) total += light_importance(l, ctx);
-  return total;
+float PathIntegrator::expected_shadow_rays(size_t li, const LightSampleContext& ctx) const {
+  return float(shadow_rays_) * scene_.light_sampler().pmf(ctx, li);
 }
 
-float PathIntegrator::expected_shadow_rays(size_t li, const LightSampleContext& ctx, float total_importance) const {
-  if (light_selection_ != LightSelection::Paper) return float(shadow_rays_) * scene_.light_sampler().pmf(ctx, li);
-  // The paper's rule, mixed with a uniform share so that every light keeps a non-zero expected
-  // number of rays (which keeps the estimator unbiased where the heuristic says "nothing here").
-  float uniform = 1.0f / float(scene_.lights().size());
-  float share = total_importance > 0
-                    ? 0.9f * light_importance(scene_.lights()[li], ctx) / total_importance + 0.1f * uniform
-                    : uniform;
-  return float(shadow_rays_) * share;
-}
-
-float PathIntegrator::emitter_mis_weight(size_t li, float bsdf_pdf, float light_pdf_li, const LightSampleContext& prev,
-                                         float prev_total_importance) const {
+float PathIntegrator::emitter_mis_weight(size_t li, float bsdf_pdf, float light_pdf_li, const LightSampleContext& prev) const {
   if (!mis_) return 0;  // without MIS, light found by bounces is left to the shadow rays
-  float light_pdf = expected_shadow_rays(li, prev, prev_total_importance) * light_pdf_li;
+  float light_pdf = expected_shadow_rays(li, prev) * light_pdf_li;
   return power_heuristic(bsdf_pdf, light_pdf);
 }
 
@@ -194,33 +176,21 @@ Vec2 stratified_square(Vec2 u, int k, int n, float rotation) {
 }  // namespace
 
 template <typename Sampler>
-RGB PathIntegrator::direct_light(const Vertex& v, Sampler& sampler, RayCounts& counts, float& total_importance) const {
+RGB PathIntegrator::direct_light(const Vertex& v, Sampler& sampler, RayCounts& counts) const {
+  // Each shadow ray goes to one light chosen by the scene's light sampler: by power, uniformly over
+  // emitters, through the light BVH by what each light can give here, or by the paper's rule (its
+  // estimate of each light's irradiance here, found through the same tree); with several rays, the
+  // light choices and the points on the lights are stratified, so that a light of share p here
+  // gets p x shadow_rays of them on average (the paper's expected values, sec. 4.5).
   RGB sum(0.0f);
-  if (light_selection_ != LightSelection::Paper) {
-    // Each shadow ray goes to one light chosen by the scene's light sampler (by power, uniformly
-    // over emitters, or through the light BVH by what each light can give here); with several
-    // rays, the light choices and the points on the lights are stratified.
-    const LightSampler& choice = scene_.light_sampler();
-    float rotation = shadow_rays_ > 1 ? sampler.get_1d() : 0.0f;
-    for (int k = 0; k < shadow_rays_; ++k) {
-      float u_choice = (float(k) + sampler.get_1d()) / float(shadow_rays_);
-      SampledLight chosen = choice.sample(v.ctx, std::min(u_choice, 0x1.fffffep-1f));
-      Vec2 u = stratified_square(sampler.get_2d(), k, shadow_rays_, rotation);
-      if (chosen.pmf > 0)  // (none: no light can reach this vertex)
-        sum += shadow_ray_estimate(v, chosen.light, u, float(shadow_rays_) * chosen.pmf, counts);
-    }
-    return sum;
-  }
-  // The paper's rule: each light gets a number of rays proportional to its importance here, rounded
-  // randomly to an integer n with E[n] = x; dividing by x (not n) keeps the estimate unbiased. The
-  // n points on one light are stratified over it (the paper's stratified rectangular lights).
-  total_importance = total_light_importance(v.ctx);
-  for (size_t li = 0; li < scene_.lights().size(); ++li) {
-    float x = expected_shadow_rays(li, v.ctx, total_importance);
-    int n = int(x) + (sampler.get_1d() < x - std::floor(x) ? 1 : 0);
-    float rotation = n > 1 ? sampler.get_1d() : 0.0f;
-    for (int k = 0; k < n; ++k)
-      sum += shadow_ray_estimate(v, li, stratified_square(sampler.get_2d(), k, n, rotation), x, counts);
+  const LightSampler& choice = scene_.light_sampler();
+  float rotation = shadow_rays_ > 1 ? sampler.get_1d() : 0.0f;
+  for (int k = 0; k < shadow_rays_; ++k) {
+    float u_choice = (float(k) + sampler.get_1d()) / float(shadow_rays_);
+    SampledLight chosen = choice.sample(v.ctx, std::min(u_choice, 0x1.fffffep-1f));
+    Vec2 u = stratified_square(sampler.get_2d(), k, shadow_rays_, rotation);
+    if (chosen.pmf > 0)  // (none: no light can reach this vertex)
+      sum += shadow_ray_estimate(v, chosen.light, u, float(shadow_rays_) * chosen.pmf, counts);
   }
   return sum;
 }

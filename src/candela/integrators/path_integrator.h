@@ -30,16 +30,14 @@ class PathIntegrator {
   struct Vertex;  // what direct lighting needs to know about the current path vertex
 
   template <typename Sampler>
-  RGB direct_light(const Vertex& v, Sampler& sampler, RayCounts& counts, float& total_importance) const;
+  RGB direct_light(const Vertex& v, Sampler& sampler, RayCounts& counts) const;
   RGB shadow_ray_estimate(const Vertex& v, size_t light, const Vec2& u, float expected_rays,
                           RayCounts& counts) const;
   // Expected number of shadow rays that light `li` receives at a vertex: the light-sampling
   // strategy's sample count for MIS (Veach's multi-sample model).
-  float expected_shadow_rays(size_t li, const LightSampleContext& ctx, float total_importance) const;
-  float total_light_importance(const LightSampleContext& ctx) const;
+  float expected_shadow_rays(size_t li, const LightSampleContext& ctx) const;
   // Weight of a light found by BSDF sampling (hit or escaped to the sky), against light sampling.
-  float emitter_mis_weight(size_t li, float bsdf_pdf, float light_pdf_li, const LightSampleContext& prev,
-                           float prev_total_importance) const;
+  float emitter_mis_weight(size_t li, float bsdf_pdf, float light_pdf_li, const LightSampleContext& prev) const;
 
   template <typename Sampler>
   std::optional<BsdfSample> sample_direction(const SurfaceBsdf& bsdf, const Vec3& wo, Sampler& sampler) const;
@@ -51,7 +49,6 @@ class PathIntegrator {
   DirectionSampling direction_sampling_;
   bool mis_;
   bool hide_emitters_;
-  LightSelection light_selection_;
   int shadow_rays_;
 };
 

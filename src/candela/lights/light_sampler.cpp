@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 
 #include "candela/base/overloaded.h"
 
@@ -189,10 +190,11 @@ float LightImportance::operator()(const LightSampleContext& ctx) const {
   return std::isfinite(importance) ? std::max(0.0f, importance) : 0.0f;
 }
 
-LightSampler::LightSampler(std::span<const Light> lights, std::span<const float> weights, bool bvh)
-    : emitter_choice_(weights), bvh_(bvh) {
-  if (!bvh_) return;
-  leaf_of_light_.assign(lights.size(), -1);
+LightSampler::LightSampler(std::span<const Light> lights, std::span<const float> weights, Mode mode)
+    : emitter_choice_(weights), mode_(mode) {
+  if (mode_ == Mode::Weights) return;
+  if (mode_ == Mode::Paper) lights_ = lights;
+  slot_of_light_.assign(lights.size(), -1);
   infinite_slot_.assign(lights.size(), -1);
   std::vector<std::pair<uint32_t, LightBounds>> bounded;
   for (size_t i = 0; i < lights.size(); ++i) {
@@ -203,22 +205,23 @@ LightSampler::LightSampler(std::span<const Light> lights, std::span<const float>
       bounded.emplace_back(uint32_t(i), *b);
     }
   }
-  if (!bounded.empty()) {
-    nodes_.reserve(2 * bounded.size());
-    bounds_.reserve(2 * bounded.size());
-    nodes_.resize(2);
-    bounds_.resize(2);
-    build(bounded, 0, bounded.size(), 0, 0);
-  }
+  if (bounded.empty()) return;
+  nodes_.reserve(2 * bounded.size());
+  bounds_.reserve(2 * bounded.size());
+  nodes_.resize(1);
+  bounds_.resize(1);
+  build(bounded, 0, bounded.size(), 0, 0);
+  root_importance_ = LightImportance(bounds_[0]);
+  wide_.reserve(bounded.size());
+  build_wide(0, 0, 0);
 }
 
 void LightSampler::build(std::vector<std::pair<uint32_t, LightBounds>>& lights, size_t begin, size_t end,
                          uint32_t index, uint32_t parent) {
   if (end - begin == 1) {
     const auto& [light, bounds] = lights[begin];
-    nodes_[index] = Node{LightImportance(bounds), light, parent, true};
+    nodes_[index] = BuildNode{light, parent, 1, true};
     bounds_[index] = bounds;
-    leaf_of_light_[light] = int32_t(index);
     return;
   }
   LightBounds all = lights[begin].second;
@@ -267,10 +270,116 @@ void LightSampler::build(std::vector<std::pair<uint32_t, LightBounds>>& lights, 
   const uint32_t first = uint32_t(nodes_.size());
   nodes_.resize(nodes_.size() + 2);
   bounds_.resize(bounds_.size() + 2);
-  nodes_[index] = Node{LightImportance(all), first, parent, false};
+  nodes_[index] = BuildNode{first, parent, uint32_t(end - begin), false};
   bounds_[index] = all;
   build(lights, begin, mid, first, index);
   build(lights, mid, end, first + 1, index);
+}
+
+uint32_t LightSampler::build_wide(uint32_t binary_node, uint32_t parent, uint8_t parent_slot) {
+  // The slots: the binary node's children; then, while there is room, the interior slot of most
+  // lights replaced by its two children (the binary root alone, if it is a leaf).
+  std::vector<uint32_t> slots;
+  if (nodes_[binary_node].leaf) {
+    slots.push_back(binary_node);
+  } else {
+    slots = {nodes_[binary_node].child_or_light, nodes_[binary_node].child_or_light + 1};
+    while (slots.size() < 4) {
+      auto largest = std::max_element(slots.begin(), slots.end(), [&](uint32_t a, uint32_t b) {
+        return (nodes_[a].leaf ? 0 : nodes_[a].lights) < (nodes_[b].leaf ? 0 : nodes_[b].lights);
+      });
+      if (nodes_[*largest].leaf) break;
+      const uint32_t first = nodes_[*largest].child_or_light;
+      *largest = first;
+      slots.insert(largest + 1, first + 1);
+    }
+  }
+  const uint32_t index = uint32_t(wide_.size());
+  wide_.emplace_back();
+  {
+    WideNode& w = wide_[index];
+    w.parent = parent;
+    w.parent_slot = parent_slot;
+    for (int k = 0; k < 4; ++k) {
+      // Unused slots: nothing there (phi = 0), at the origin, a cone the math stays finite on.
+      LightImportance li;
+      if (k < int(slots.size())) li = LightImportance(bounds_[slots[size_t(k)]]);
+      w.cx[k] = li.center.x, w.cy[k] = li.center.y, w.cz[k] = li.center.z, w.radius[k] = li.radius;
+      w.phi[k] = li.phi;
+      w.wx[k] = li.w.x, w.wy[k] = li.w.y, w.wz[k] = li.w.z;
+      w.cos_o[k] = li.cos_o, w.sin_o[k] = li.sin_o, w.cos_e[k] = li.cos_e;
+      w.two_sided[k] = li.two_sided ? 1.0f : 0.0f;
+      w.child[k] = 0;
+    }
+  }
+  for (size_t k = 0; k < slots.size(); ++k) {
+    const BuildNode& b = nodes_[slots[k]];
+    if (b.leaf) {
+      wide_[index].leaf_mask |= uint8_t(1u << k);
+      wide_[index].child[k] = b.child_or_light;
+      slot_of_light_[b.child_or_light] = int32_t(4 * index + k);
+    } else {
+      const uint32_t child = build_wide(slots[k], index, uint8_t(k));  // (wide_ may move)
+      wide_[index].child[k] = child;
+    }
+  }
+  return index;
+}
+
+namespace {
+
+// Four floats, one per slot of a wide node (GCC's vector extensions: SSE on x86-64).
+using F4 = float __attribute__((vector_size(16)));
+using I4 = int __attribute__((vector_size(16)));
+
+F4 load(const float* p) {
+  F4 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+F4 splat(float x) { return F4{x, x, x, x}; }
+F4 sqrt4(F4 x) {
+  for (int k = 0; k < 4; ++k) x[k] = std::sqrt(x[k]);  // (sqrtps)
+  return x;
+}
+F4 select(I4 mask, F4 a, F4 b) { return mask ? a : b; }
+F4 max4(F4 a, F4 b) { return a > b ? a : b; }
+F4 safe_sqrt4(F4 x) { return sqrt4(max4(x, splat(0.0f))); }
+
+}  // namespace
+
+void LightSampler::importances(const WideNode& node, const LightSampleContext& ctx, float out[4]) {
+  // LightImportance::operator() for the four slots at once; see there for the steps.
+  const F4 radius = load(node.radius);
+  const F4 dx = splat(ctx.p.x) - load(node.cx), dy = splat(ctx.p.y) - load(node.cy), dz = splat(ctx.p.z) - load(node.cz);
+  const F4 d2_true = dx * dx + dy * dy + dz * dz;
+  const F4 radius2 = radius * radius;
+  const F4 d2 = max4(max4(d2_true, radius2), splat(1e-12f));
+  const I4 outside = d2_true > radius2;
+  const F4 inv_d = 1.0f / sqrt4(select(outside, d2_true, splat(1.0f)));
+  const F4 sin_b = select(outside, radius * inv_d, splat(0.0f));
+  const F4 cos_b = select(outside, safe_sqrt4(1.0f - sin_b * sin_b), splat(-1.0f));
+  const F4 wix = select(outside, dx * inv_d, splat(0.0f)), wiy = select(outside, dy * inv_d, splat(0.0f)),
+           wiz = select(outside, dz * inv_d, splat(1.0f));
+
+  F4 cos_w = load(node.wx) * wix + load(node.wy) * wiy + load(node.wz) * wiz;
+  cos_w = select(load(node.two_sided) > 0.0f, select(cos_w < 0.0f, -cos_w, cos_w), cos_w);
+  const F4 cos_o = load(node.cos_o), sin_o = load(node.sin_o);
+  const I4 in_cone = cos_w > cos_o;
+  const F4 sin_w = safe_sqrt4(1.0f - cos_w * cos_w);
+  const F4 cos_x = select(in_cone, splat(1.0f), cos_w * cos_o + sin_w * sin_o);
+  const F4 sin_x = select(in_cone, splat(0.0f), sin_w * cos_o - cos_w * sin_o);
+  const F4 cos_p = select(cos_x > cos_b, splat(1.0f), cos_x * cos_b + sin_x * sin_b);
+  F4 importance = select(cos_p <= load(node.cos_e), splat(0.0f), load(node.phi) * cos_p / d2);
+
+  if (ctx.n != Normal3(0.0f)) {
+    const F4 cos_i = -(splat(ctx.n.x) * wix + splat(ctx.n.y) * wiy + splat(ctx.n.z) * wiz);
+    const F4 bound = max4(cos_i * cos_b + safe_sqrt4(1.0f - cos_i * cos_i) * sin_b, splat(0.0f));
+    importance *= select(cos_i > cos_b, splat(1.0f), bound);
+  }
+  // Not finite (or negative): nothing (NaN fails both comparisons).
+  importance = select((importance > 0.0f) & (importance < splat(INFINITY)), importance, splat(0.0f));
+  std::memcpy(out, &importance, sizeof importance);
 }
 
 int LightSampler::bvh_depth() const {
@@ -290,7 +399,7 @@ bool LightSampler::tree_may_reach(const LightSampleContext& ctx) const {
   // that cannot reach ctx shows in its children's importance, and a lone light is chosen anyway
   // (as by power: its shadow ray finds nothing where it cannot reach).
   if (infinite_.empty()) return true;
-  return nodes_[0].importance(ctx) > 0;
+  return root_importance_(ctx) > 0;
 }
 
 float LightSampler::infinite_probability(bool tree_may_reach) const {
@@ -305,8 +414,37 @@ SampledLight LightSampler::sample_emitter(float u) const {
   return {uint32_t(li), emitter_choice_.pmf(li)};
 }
 
+// The paper's rule gives every light this share uniformly.
+constexpr float kPaperUniformShare = 0.1f;
+
 SampledLight LightSampler::sample(const LightSampleContext& ctx, float u) const {
-  if (!bvh_) return sample_emitter(u);
+  if (mode_ == Mode::Weights) return sample_emitter(u);
+  if (mode_ == Mode::Bvh) return sample_tree(ctx, u);
+  // The paper's rule: the uniform share, or the tree under the paper's estimates.
+  const size_t n = lights_.size();
+  if (u < kPaperUniformShare) {
+    size_t light = std::min(size_t(u / kPaperUniformShare * float(n)), n - 1);
+    return {uint32_t(light), pmf(ctx, light)};
+  }
+  SampledLight s = sample_tree(ctx, std::min((u - kPaperUniformShare) / (1 - kPaperUniformShare), kOneMinusEpsilon));
+  if (s.pmf > 0) s.pmf = kPaperUniformShare / float(n) + (1 - kPaperUniformShare) * s.pmf;
+  return s;
+}
+
+float LightSampler::pmf(const LightSampleContext& ctx, size_t light) const {
+  if (mode_ == Mode::Weights) return emitter_choice_.pmf(light);
+  if (mode_ == Mode::Bvh) return tree_pmf(ctx, light);
+  return kPaperUniformShare / float(lights_.size()) + (1 - kPaperUniformShare) * tree_pmf(ctx, light);
+}
+
+void LightSampler::slot_importances(const WideNode& node, const LightSampleContext& ctx, float out[4]) const {
+  importances(node, ctx, out);
+  if (mode_ != Mode::Paper || node.leaf_mask == 0) return;
+  for (int k = 0; k < 4; ++k)
+    if (node.leaf_mask & (1u << k)) out[k] = std::max(0.0f, light_importance(lights_[node.child[k]], ctx));
+}
+
+SampledLight LightSampler::sample_tree(const LightSampleContext& ctx, float u) const {
   // A light at infinity, each with probability 1 / (n_infinite + 1), or the tree.
   const bool reaches = tree_may_reach(ctx);
   const float p_infinite = infinite_probability(reaches);
@@ -317,46 +455,55 @@ SampledLight LightSampler::sample(const LightSampleContext& ctx, float u) const 
   if (!reaches) return {};
   u = std::min((u - p_infinite) / (1 - p_infinite), kOneMinusEpsilon);
   float pmf = 1 - p_infinite;
-  // Descend, choosing each child by the importance its bounds promise at ctx and reusing u.
+  // A lone light is chosen anyway, as by power (its shadow ray finds nothing where it cannot reach).
+  if (nodes_[0].leaf) return {wide_[0].child[0], pmf};
+  // Descend, choosing each slot by the importance its bounds promise at ctx and reusing u.
   uint32_t node = 0;
-  while (!nodes_[node].leaf) {
-    const uint32_t first = nodes_[node].child_or_light;
-    const float i0 = nodes_[first].importance(ctx);
-    const float i1 = nodes_[first + 1].importance(ctx);
-    if (!(i0 + i1 > 0)) return {};
-    const float p0 = i0 / (i0 + i1);
-    if (u < p0) {
-      node = first, pmf *= p0, u = std::min(u / p0, kOneMinusEpsilon);
-    } else {
-      node = first + 1, pmf *= 1 - p0;
-      u = std::min((u - p0) / (1 - p0), kOneMinusEpsilon);
+  for (;;) {
+    const WideNode& w = wide_[node];
+    float importance[4];
+    slot_importances(w, ctx, importance);
+    const float total = (importance[0] + importance[1]) + (importance[2] + importance[3]);
+    if (!(total > 0)) return {};
+    // The slot whose share of [0, total) holds u x total; the last slot with any importance takes
+    // what rounding leaves, and no slot of importance 0 is ever chosen.
+    const float target = u * total;
+    int last = 3;
+    while (importance[last] == 0) --last;
+    int k = 0;
+    float below = 0;
+    while (k < last && (importance[k] == 0 || below + importance[k] <= target)) below += importance[k++];
+    pmf *= importance[k] / total;
+    u = std::clamp((target - below) / importance[k], 0.0f, kOneMinusEpsilon);
+    if (w.leaf_mask & (1u << k)) {
+      if (!(pmf > 0)) return {};
+      return {w.child[k], pmf};
     }
+    node = w.child[k];
   }
-  if (!(pmf > 0)) return {};
-  return {nodes_[node].child_or_light, pmf};
 }
 
-float LightSampler::pmf(const LightSampleContext& ctx, size_t light) const {
-  if (!bvh_) return emitter_choice_.pmf(light);
+float LightSampler::tree_pmf(const LightSampleContext& ctx, size_t light) const {
   const bool reaches = tree_may_reach(ctx);
   const float p_infinite = infinite_probability(reaches);
   if (infinite_slot_[light] >= 0) return p_infinite / float(infinite_.size());
-  int32_t leaf = leaf_of_light_[light];
-  if (leaf < 0 || !reaches) return 0;
-  // The product of the choices on the way down, gathered on the way up from the light's leaf.
+  const int32_t slot = slot_of_light_[light];
+  if (slot < 0 || !reaches) return 0;
+  // The product of the choices on the way down, gathered on the way up from the light's slot.
   float pmf = 1 - p_infinite;
-  uint32_t node = uint32_t(leaf);
-  while (node != 0) {
-    const uint32_t parent = nodes_[node].parent;
-    const uint32_t first = nodes_[parent].child_or_light;
-    const float i0 = nodes_[first].importance(ctx);
-    const float i1 = nodes_[first + 1].importance(ctx);
-    if (!(i0 + i1 > 0)) return 0;
-    const float p0 = i0 / (i0 + i1);
-    pmf *= node == first ? p0 : 1 - p0;
-    node = parent;
+  if (nodes_[0].leaf) return pmf;  // a lone light
+  uint32_t node = uint32_t(slot) / 4, k = uint32_t(slot) % 4;
+  for (;;) {
+    const WideNode& w = wide_[node];
+    float importance[4];
+    slot_importances(w, ctx, importance);
+    const float total = (importance[0] + importance[1]) + (importance[2] + importance[3]);
+    if (!(total > 0)) return 0;
+    pmf *= importance[k] / total;
+    if (node == 0) return pmf;
+    k = w.parent_slot;
+    node = w.parent;
   }
-  return pmf;
 }
 
 }  // namespace candela

@@ -10,6 +10,12 @@
 //                                    (power / distance^2, times the cosines the direction cones
 //                                    allow at the light and at the point). O(log n) per choice, and
 //                                    lights behind the point or facing away get no rays.
+//   LightSelection::Paper            the paper's rule (sec. 4.5): each light in proportion to its
+//                                    estimated irradiance at the point (light_importance: radiance
+//                                    x projected solid angle), mixed with a uniform share of 0.1 so
+//                                    that no light the estimate misjudges is left out. Found through
+//                                    the same tree (its bounds above the lights, the estimate at
+//                                    them): O(log n) per choice, not O(n).
 //
 // Lights at infinity (sky, environment maps, distant lights) have no position to bound: the BVH
 // sampler picks each of them with probability 1 / (n_infinite + 1) and the tree with the rest, as
@@ -70,9 +76,15 @@ struct SampledLight {
 class LightSampler {
  public:
   LightSampler() = default;
-  // weights: per light, the point-independent choice (power, or uniform over emitters); with
-  // bvh, points choose through the light BVH instead.
-  LightSampler(std::span<const Light> lights, std::span<const float> weights, bool bvh);
+  enum class Mode {
+    Weights,  // every point by the weights (power, or uniform over emitters)
+    Bvh,      // points through the light BVH
+    Paper,    // points by the paper's rule, through the light BVH
+  };
+  // weights: per light, the point-independent choice (power, or uniform over emitters), which light
+  // paths use in every mode. Mode::Paper keeps `lights` (it evaluates their estimates): they must
+  // outlive the sampler and stay where they are.
+  LightSampler(std::span<const Light> lights, std::span<const float> weights, Mode mode);
 
   // A light for a point gathering light at ctx (u in [0, 1)), and the probability of choosing it.
   SampledLight sample(const LightSampleContext& ctx, float u) const;
@@ -82,33 +94,58 @@ class LightSampler {
   SampledLight sample_emitter(float u) const;
   float emitter_pmf(size_t light) const { return emitter_choice_.pmf(light); }
 
-  bool uses_bvh() const { return bvh_; }
-  // The tree's depth (0 without one): for tests and the scene's statistics.
+  bool uses_bvh() const { return mode_ != Mode::Weights; }
+  // The binary tree's depth (0 without one): for tests and the scene's statistics.
   int bvh_depth() const;
 
-  // A node as the descent reads it: one cache line, and two children side by side in two more.
-  struct alignas(64) Node {
-    LightImportance importance;
+  // The tree as built: binary, each node with its bounds (for the tests).
+  struct BuildNode {
     uint32_t child_or_light = 0;  // interior: the first of its two children (the second follows it)
     uint32_t parent = 0;
+    uint32_t lights = 1;          // in its subtree
     bool leaf = false;
   };
-  // nodes()[0] is the root; nodes()[1] is unused, so that every pair of children starts a line.
-  const std::vector<Node>& nodes() const { return nodes_; }
+  const std::vector<BuildNode>& nodes() const { return nodes_; }
   const LightBounds& node_bounds(size_t node) const { return bounds_[node]; }
 
+  // The tree as descended: up to four descendants of a binary node side by side in one node (its
+  // children, the largest of them replaced by its own two while there is room), their bounds stored
+  // lane by lane so that one pass of 4-wide SIMD evaluates all four importances. Half the levels of
+  // the binary tree, and each choice is made from the tighter bounds of the lower level.
+  struct alignas(64) WideNode {
+    float cx[4], cy[4], cz[4], radius[4];  // bounding sphere
+    float phi[4];                          // 0 in unused slots
+    float wx[4], wy[4], wz[4];             // cone axis
+    float cos_o[4], sin_o[4], cos_e[4];
+    float two_sided[4];                    // 1 or 0
+    uint32_t child[4];                     // a wide node, or a light where leaf_mask has the slot's bit
+    uint32_t parent = 0;                   // wide node and slot above (the root: itself)
+    uint8_t parent_slot = 0;
+    uint8_t leaf_mask = 0;
+  };
+
  private:
+  // The importance of each of a wide node's four slots at ctx (LightImportance, four at once).
+  static void importances(const WideNode& node, const LightSampleContext& ctx, float out[4]);
   void build(std::vector<std::pair<uint32_t, LightBounds>>& lights, size_t begin, size_t end, uint32_t index,
              uint32_t parent);
+  uint32_t build_wide(uint32_t binary_node, uint32_t parent, uint8_t parent_slot);
+  SampledLight sample_tree(const LightSampleContext& ctx, float u) const;
+  float tree_pmf(const LightSampleContext& ctx, size_t light) const;
+  // importances() of a node's slots, the paper's estimate at lights under Mode::Paper.
+  void slot_importances(const WideNode& node, const LightSampleContext& ctx, float out[4]) const;
   bool tree_may_reach(const LightSampleContext& ctx) const;
   float infinite_probability(bool tree_may_reach) const;
 
   Distribution1D emitter_choice_;
-  bool bvh_ = false;
-  std::vector<Node> nodes_;
-  std::vector<LightBounds> bounds_;  // of each node (the build's and the tests')
+  Mode mode_ = Mode::Weights;
+  std::span<const Light> lights_;  // (Mode::Paper)
+  std::vector<BuildNode> nodes_;
+  std::vector<LightBounds> bounds_;  // of each binary node
+  LightImportance root_importance_;  // of the whole tree
+  std::vector<WideNode> wide_;       // wide_[0] is the root
   std::vector<uint32_t> infinite_;           // lights at infinity, chosen uniformly beside the tree
-  std::vector<int32_t> leaf_of_light_;       // the node holding each light (-1: at infinity or dark)
+  std::vector<int32_t> slot_of_light_;       // wide node x 4 + slot holding each light (-1: at infinity or dark)
   std::vector<int32_t> infinite_slot_;       // each light's place in infinite_ (-1: not there)
 };
 

@@ -58,7 +58,7 @@ std::vector<Light> mixed_lights(int triangles) {
 LightSampler bvh_of(const std::vector<Light>& lights) {
   std::vector<float> power;
   for (const Light& l : lights) power.push_back(light_power(l));
-  return LightSampler(lights, power, true);
+  return LightSampler(lights, power, LightSampler::Mode::Bvh);
 }
 
 // Points around and among the lights, half on surfaces (a gathering normal), half in a medium.
@@ -215,28 +215,80 @@ TEST(LightBvh, OneLightIsAlwaysChosen) {
 TEST(LightBvh, WithoutTheTreeEveryPointUsesTheWeights) {
   std::vector<Light> lights = mixed_lights(20);
   std::vector<float> weights(lights.size(), 1.0f);
-  LightSampler uniform(lights, weights, false);
+  LightSampler uniform(lights, weights, LightSampler::Mode::Weights);
   EXPECT_FALSE(uniform.uses_bvh());
   for (const LightSampleContext& ctx : query_points(5))
     for (size_t i = 0; i < lights.size(); ++i) EXPECT_FLOAT_EQ(uniform.pmf(ctx, i), 1.0f / float(lights.size()));
 }
 
-// scenes/city-night.json on a smaller generated city (6 x 6 towers, about 3,000 emissive triangles),
-// rendered small with each light selection: the images agree (both unbiased), and the light BVH's
-// noise at equal samples is several times lower than choosing by power.
-TEST(LightBvh, TheCitySceneRendersWithLessNoiseThanPowerSelection) {
+// The paper's rule through the tree: every light keeps its uniform share, the probabilities with the
+// chance of no light sum to 1, sample() draws what pmf() says, and where the tree's lowest level holds
+// the lights themselves the shares are the paper's estimates exactly.
+TEST(LightBvh, ThePapersRuleGoesThroughTheTree) {
+  std::vector<Light> lights = mixed_lights(300);
+  std::vector<float> power;
+  for (const Light& l : lights) power.push_back(light_power(l));
+  LightSampler paper(lights, power, LightSampler::Mode::Paper);
+  const float uniform_share = 0.1f / float(lights.size());
+  Rng rng(4, 0);
+  for (const LightSampleContext& ctx : query_points(40)) {
+    double sum = 0;
+    for (size_t i = 0; i < lights.size(); ++i) {
+      const float pmf = paper.pmf(ctx, i);
+      EXPECT_GE(pmf, uniform_share * (1 - 1e-5f)) << "light " << i;
+      sum += pmf;
+    }
+    constexpr int kSweep = 20000;
+    int none = 0;
+    for (int k = 0; k < kSweep; ++k) none += paper.sample(ctx, (float(k) + 0.5f) / kSweep).pmf == 0;
+    EXPECT_NEAR(sum + double(none) / kSweep, 1.0, 2e-3);
+  }
+  const LightSampleContext ctx = query_points(2)[1];
+  constexpr int kDraws = 300000;
+  std::vector<double> observed(lights.size() + 1, 0.0), expected(lights.size() + 1, 0.0);
+  for (int k = 0; k < kDraws; ++k) {
+    SampledLight s = paper.sample(ctx, rng.next_float());
+    if (s.pmf == 0) {
+      observed.back() += 1;
+      continue;
+    }
+    ASSERT_NEAR(s.pmf, paper.pmf(ctx, s.light), 1e-5f * s.pmf);
+    observed[s.light] += 1;
+  }
+  double sum = 0;
+  for (size_t i = 0; i < lights.size(); ++i) sum += expected[i] = kDraws * double(paper.pmf(ctx, i));
+  expected.back() = std::max(0.0, kDraws - sum);
+  EXPECT_GT(testing::chi_square_p_value(observed, expected), testing::kChiSquareAlpha);
+
+  // Two point lights, one ten times nearer: 0.05 + 0.9 x 100/101 of the rays go to it.
+  std::vector<Light> points{PointLightSource{{1, 0, 0}, RGB(1.0f)}, PointLightSource{{10, 0, 0}, RGB(1.0f)}};
+  std::vector<float> equal{1.0f, 1.0f};
+  LightSampler two(points, equal, LightSampler::Mode::Paper);
+  LightSampleContext origin{{0, 0, 0}, Normal3(0.0f)};
+  EXPECT_NEAR(two.pmf(origin, 0), 0.05f + 0.9f * 100.0f / 101.0f, 1e-5f);
+  EXPECT_NEAR(two.pmf(origin, 1), 0.05f + 0.9f * 1.0f / 101.0f, 1e-5f);
+}
+
+// A shipped many-light scene whose meshes scenes/make_city.py writes (with `make_args`), rendered small
+// from `camera` with the light BVH and with power selection: the two image means, their variance, and
+// the ratio of the expected relMSE (eps 0.01) of power selection's image to the BVH's.
+struct ManyLightComparison {
+  double mean_bvh = 0, mean_power = 0, variance = 0, relmse_ratio = 0;
+};
+ManyLightComparison render_by_bvh_and_by_power(const std::string& scene, const std::string& make_args,
+                                                const CameraDesc& camera) {
   namespace fs = std::filesystem;
   const fs::path source = CANDELA_SOURCE_DIR;
-  const fs::path dir = fs::temp_directory_path() / ("candela-city-" + std::to_string(::getpid()));
+  const fs::path dir = fs::temp_directory_path() / ("candela-many-lights-" + std::to_string(::getpid()));
   fs::create_directories(dir);
-  fs::copy_file(source / "scenes/city-night.json", dir / "city-night.json", fs::copy_options::overwrite_existing);
-  const std::string make = "/usr/bin/python3 " + (source / "scenes/make_city.py").string() + " " + dir.string() +
-                           " --blocks 6 > /dev/null";
-  ASSERT_EQ(std::system(make.c_str()), 0) << make;
-  SceneDesc bvh = read_scene_file(dir / "city-night.json");
+  fs::copy_file(source / "scenes" / scene, dir / scene, fs::copy_options::overwrite_existing);
+  const std::string make =
+      "/usr/bin/python3 " + (source / "scenes/make_city.py").string() + " " + dir.string() + " " + make_args + " > /dev/null";
+  EXPECT_EQ(std::system(make.c_str()), 0) << make;
+  SceneDesc bvh = read_scene_file(dir / scene);
   fs::remove_all(dir);
   EXPECT_EQ(bvh.settings.light_selection, LightSelection::Bvh);
-  bvh.camera = testing::look_at_camera({1.5f, 1.7f, -35}, {-1, 9, 10}, 60);  // inside the smaller city
+  bvh.camera = camera;
   bvh.film.width = 64;
   bvh.film.height = 36;
   bvh.settings.spp = 32;
@@ -244,22 +296,41 @@ TEST(LightBvh, TheCitySceneRendersWithLessNoiseThanPowerSelection) {
   power.settings.light_selection = LightSelection::Power;
   power.settings.seed = 1;
   {
-    Scene scene(bvh);
-    std::printf("%zu lights, light BVH depth %d\n", scene.lights().size(), scene.light_sampler().bvh_depth());
+    Scene s(bvh);
+    std::printf("%s: %zu lights, light BVH depth %d\n", scene.c_str(), s.lights().size(), s.light_sampler().bvh_depth());
   }
   Film a = testing::render_description(bvh), b = testing::render_description(power);
   Image ma = a.mean_image(), mb = b.mean_image(), va = a.variance_of_mean_image(), vb = b.variance_of_mean_image();
-  double mean_a = 0, mean_b = 0, var_a = 0, var_b = 0, rel_a = 0, rel_b = 0;
+  ManyLightComparison c;
+  double rel_a = 0, rel_b = 0;
   for (size_t i = 0; i < ma.rgb.size(); ++i) {
-    mean_a += ma.rgb[i], mean_b += mb.rgb[i], var_a += va.rgb[i], var_b += vb.rgb[i];
-    // Each pixel's expected relMSE (eps 0.01), against the better-converged of the two means.
+    c.mean_bvh += ma.rgb[i], c.mean_power += mb.rgb[i], c.variance += va.rgb[i] + vb.rgb[i];
+    // Each pixel's expected relMSE, against the better-converged of the two means.
     double truth = ma.rgb[i];
     rel_a += va.rgb[i] / (truth * truth + 0.01), rel_b += vb.rgb[i] / (truth * truth + 0.01);
   }
-  // The image means agree within 4 standard errors of their difference.
-  EXPECT_NEAR(mean_a, mean_b, 4 * std::sqrt(var_a + var_b));
-  std::printf("expected relMSE, power / bvh: %.2f\n", rel_b / rel_a);
-  EXPECT_GT(rel_b / rel_a, 3.0);
+  c.relmse_ratio = rel_b / rel_a;
+  std::printf("%s: expected relMSE, power / bvh: %.2f\n", scene.c_str(), c.relmse_ratio);
+  return c;
+}
+
+// scenes/city-night.json on a smaller generated city (6 x 6 towers, about 4,200 emissive triangles):
+// the images agree (both unbiased) within 4 standard errors, and the light BVH's noise at equal
+// samples is several times lower than choosing by power.
+TEST(LightBvh, TheCitySceneRendersWithLessNoiseThanPowerSelection) {
+  ManyLightComparison c = render_by_bvh_and_by_power("city-night.json", "--blocks 6",
+                                                     testing::look_at_camera({1.5f, 1.7f, -35}, {-1, 9, 10}, 60));
+  EXPECT_NEAR(c.mean_bvh, c.mean_power, 4 * std::sqrt(c.variance));
+  EXPECT_GT(c.relmse_ratio, 3.0);
+}
+
+// scenes/lamp-road.json as shipped (5,200 lamps): power selection almost never picks a lamp near the
+// road the camera sees.
+TEST(LightBvh, TheLampRoadRendersWithFarLessNoiseThanPowerSelection) {
+  ManyLightComparison c = render_by_bvh_and_by_power("lamp-road.json", "--road",
+                                                     testing::look_at_camera({-2, 1.7f, 1000}, {1, -1, 1025}, 60));
+  EXPECT_NEAR(c.mean_bvh, c.mean_power, 4 * std::sqrt(c.variance));
+  EXPECT_GT(c.relmse_ratio, 20.0);
 }
 
 }  // namespace

@@ -136,7 +136,7 @@ void Scene::build(const SceneDesc& desc, SceneDesc* take_meshes) {
 
   // Which light a shadow ray (or a light path) starts from: by power, or (LightSelection::Uniform)
   // every emitter equally, the triangles of an emissive mesh among themselves by power (= by area),
-  // or (LightSelection::Bvh) through the light BVH, light paths still by power.
+  // or (LightSelection::Bvh, ::Paper) through the light BVH, light paths still by power.
   std::vector<float> power;
   for (const auto& l : lights_) power.push_back(light_power(l));
   if (desc.settings.light_selection == LightSelection::Uniform) {
@@ -150,7 +150,11 @@ void Scene::build(const SceneDesc& desc, SceneDesc* take_meshes) {
     }
     power = std::move(weight);
   }
-  light_sampler_ = LightSampler(lights_, power, desc.settings.light_selection == LightSelection::Bvh);
+  const LightSelection selection = desc.settings.light_selection;
+  light_sampler_ = LightSampler(lights_, power,
+                                selection == LightSelection::Bvh     ? LightSampler::Mode::Bvh
+                                : selection == LightSelection::Paper ? LightSampler::Mode::Paper
+                                                                     : LightSampler::Mode::Weights);
 
   int w = desc.film.width, h = desc.film.height;
   // Camera rays reach the filter's radius beyond the outermost pixel centres.

@@ -63,6 +63,11 @@ class Scene {
   // built, which is what bounds the peak memory of large scenes.
   enum class MeshData { Copy, Take };
   Scene(SceneDesc& desc, MeshData mesh_data);
+  // Not copied: the light sampler points into lights_ (moving keeps that array where it is).
+  Scene(const Scene&) = delete;
+  Scene& operator=(const Scene&) = delete;
+  Scene(Scene&&) = default;
+  Scene& operator=(Scene&&) = default;
 
   bool intersect(const Ray& ray, SurfaceHit& hit) const;
   bool occluded(const Ray& ray) const { return embree_.occluded(ray); }
