@@ -3,7 +3,7 @@
 triangles: lit windows in three colours on a grid of towers, and a string of street lamps along every
 street. Most lights are far from any given point, face away or are hidden, so choosing lights by power
 alone spends most shadow rays on lights that give nothing; the light BVH (light_selection "bvh") is made
-for this (3.5x lower relMSE at equal samples, docs/performance.md). Deterministic
+for this (6.5x lower relMSE at equal samples, docs/performance.md). Deterministic
 (fixed seed); about 2 MB of OBJ, so it is generated, not committed.
 
 With --road it writes instead the mesh of scenes/lamp-road.json: a straight road 65 km long with a lamp
