@@ -103,28 +103,32 @@ TEST(LightBvh, ProbabilitiesSumToOneWithTheChanceOfNoLight) {
   }
 }
 
+// Draws `draws` lights at ctx: the frequencies match pmf() by chi-square, with one cell per light and a
+// last one for "no light" (its expected count: what the pmfs leave), and every draw's pmf is pmf()'s.
+void expect_frequencies_match_the_pmf(const LightSampler& sampler, size_t lights, const LightSampleContext& ctx,
+                                      int draws, Rng& rng) {
+  std::vector<double> observed(lights + 1, 0.0), expected(lights + 1, 0.0);
+  for (int k = 0; k < draws; ++k) {
+    SampledLight s = sampler.sample(ctx, rng.next_float());
+    if (s.pmf == 0) {
+      observed.back() += 1;
+      continue;
+    }
+    ASSERT_NEAR(s.pmf, sampler.pmf(ctx, s.light), 1e-5f * s.pmf);  // what sample says is what pmf says
+    observed[s.light] += 1;
+  }
+  double sum = 0;
+  for (size_t i = 0; i < lights; ++i) sum += expected[i] = draws * double(sampler.pmf(ctx, i));
+  expected.back() = std::max(0.0, draws - sum);
+  EXPECT_GT(testing::chi_square_p_value(observed, expected), testing::kChiSquareAlpha);
+}
+
 TEST(LightBvh, SamplingFrequenciesMatchThePmf) {
   std::vector<Light> lights = mixed_lights(300);
   LightSampler sampler = bvh_of(lights);
   Rng rng(3, 0);
-  constexpr int kDraws = 400000;
-  for (const LightSampleContext& ctx : query_points(4)) {
-    // One cell per light and a last one for "no light" (its expected count: what the pmfs leave).
-    std::vector<double> observed(lights.size() + 1, 0.0), expected(lights.size() + 1, 0.0);
-    for (int k = 0; k < kDraws; ++k) {
-      SampledLight s = sampler.sample(ctx, rng.next_float());
-      if (s.pmf == 0) {
-        observed.back() += 1;
-        continue;
-      }
-      ASSERT_NEAR(s.pmf, sampler.pmf(ctx, s.light), 1e-5f * s.pmf);  // what sample says is what pmf says
-      observed[s.light] += 1;
-    }
-    double sum = 0;
-    for (size_t i = 0; i < lights.size(); ++i) sum += expected[i] = kDraws * double(sampler.pmf(ctx, i));
-    expected.back() = std::max(0.0, kDraws - sum);
-    EXPECT_GT(testing::chi_square_p_value(observed, expected), testing::kChiSquareAlpha);
-  }
+  for (const LightSampleContext& ctx : query_points(4))
+    expect_frequencies_match_the_pmf(sampler, lights.size(), ctx, 400000, rng);
 }
 
 TEST(LightBvh, BoundsHoldEveryEmitter) {
@@ -243,22 +247,7 @@ TEST(LightBvh, ThePapersRuleGoesThroughTheTree) {
     for (int k = 0; k < kSweep; ++k) none += paper.sample(ctx, (float(k) + 0.5f) / kSweep).pmf == 0;
     EXPECT_NEAR(sum + double(none) / kSweep, 1.0, 2e-3);
   }
-  const LightSampleContext ctx = query_points(2)[1];
-  constexpr int kDraws = 300000;
-  std::vector<double> observed(lights.size() + 1, 0.0), expected(lights.size() + 1, 0.0);
-  for (int k = 0; k < kDraws; ++k) {
-    SampledLight s = paper.sample(ctx, rng.next_float());
-    if (s.pmf == 0) {
-      observed.back() += 1;
-      continue;
-    }
-    ASSERT_NEAR(s.pmf, paper.pmf(ctx, s.light), 1e-5f * s.pmf);
-    observed[s.light] += 1;
-  }
-  double sum = 0;
-  for (size_t i = 0; i < lights.size(); ++i) sum += expected[i] = kDraws * double(paper.pmf(ctx, i));
-  expected.back() = std::max(0.0, kDraws - sum);
-  EXPECT_GT(testing::chi_square_p_value(observed, expected), testing::kChiSquareAlpha);
+  expect_frequencies_match_the_pmf(paper, lights.size(), query_points(2)[1], 300000, rng);
 
   // Two point lights, one ten times nearer: 0.05 + 0.9 x 100/101 of the rays go to it.
   std::vector<Light> points{PointLightSource{{1, 0, 0}, RGB(1.0f)}, PointLightSource{{10, 0, 0}, RGB(1.0f)}};
