@@ -6,7 +6,9 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -20,7 +22,11 @@
 #include <vector>
 
 #include "candela/film/error_estimate.h"
+#include "candela/film/aov_film.h"
 #include "candela/film/image_io.h"
+#include "candela/film/live_film.h"
+#include "candela/preview/preview_server.h"
+#include "candela/preview/tev_client.h"
 #include "candela/base/error.h"
 #include "candela/io/json_writer.h"
 #include "candela/io/scene_reader.h"
@@ -53,6 +59,7 @@ std::atomic<int> g_phase{kReadingScene};
 // Set by the signal handler; the render loop polls it between tiles and passes.
 std::atomic<bool> g_stop{false};
 std::atomic<int> g_signals{0};
+std::atomic<bool> g_stopped_from_page{false};  // the stop came from the preview page's button
 static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_always_lock_free);
 
 template <size_t N>
@@ -111,8 +118,12 @@ void on_every_rank(Cluster& cluster, Step&& step) {
 struct RenderCommand : RenderRequest {
   std::string scene_file;  // empty = built-in scene
   std::string output, spp_map;
+  std::string display_server;  // --display-server HOST:PORT of a tev viewer (preview/tev_client.h); empty = none
+  std::string aov;  // --aov: the AOV layers; empty = the scene's (FilmDesc::aovs)
   std::string checkpoint, resume, pixel, part;
   std::optional<double> checkpoint_every;
+  std::string preview;          // [HOST:]PORT of the browser preview; empty = none
+  bool preview_public = false;  // allow a preview address reachable from other machines
 };
 
 // The files to write: -o wins, then the scene's own film name, then <scene name>.exr. The built-in
@@ -122,6 +133,12 @@ std::vector<fs::path> output_files(const RenderCommand& cmd, const SceneDesc& sc
   if (cmd.scene_file.empty()) return {"cornell-box.png", "cornell-box.exr"};
   if (!scene.film.filename.empty()) return {scene.film.filename};
   return {fs::path(cmd.scene_file).stem().string() + ".exr"};
+}
+
+bool is_exr(const fs::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext == ".exr";
 }
 
 void check_outputs(const std::vector<fs::path>& files) {
@@ -217,10 +234,34 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   int part_index = 0, part_count = 1;
   int auto_budget_spp = 0;
   std::vector<fs::path> outputs;
+  std::vector<Aov> aov_layers;
   std::string scene_bytes;
   on_every_rank(cluster, [&] {
     // A value out of range is said before a big scene is read.
     check_request_values(cmd);
+    auto parse_aov_list = [](const std::string& list, const char* where) {
+      try {
+        return parse_aovs(list);
+      } catch (const std::invalid_argument& e) {
+        throw UsageError(fmt::format("{}: {}", where, e.what()));
+      }
+    };
+    if (!cmd.aov.empty()) aov_layers = parse_aov_list(cmd.aov, "--aov");
+    if (!cmd.preview.empty()) {
+      const PreviewAddress address = parse_preview_address(cmd.preview);
+      if (!address.loopback() && !cmd.preview_public)
+        throw UsageError(fmt::format("--preview {}: the page has no authentication, so it listens on this machine only "
+                                     "(127.0.0.1) unless --preview-public is given", cmd.preview));
+      if (pixel_mode) throw UsageError("--preview shows the whole image: it cannot be combined with --pixel");
+    }
+    if (!cmd.display_server.empty()) {
+      try {
+        parse_display_server_address(cmd.display_server);
+      } catch (const std::invalid_argument& e) {
+        throw UsageError(fmt::format("--display-server: {}", e.what()));
+      }
+      if (pixel_mode) throw UsageError("--display-server shows the whole image: it cannot be combined with --pixel");
+    }
     if (cmd.checkpoint_every && !(*cmd.checkpoint_every > 0))
       throw UsageError(fmt::format("--checkpoint-every: must be a positive number, got {}", *cmd.checkpoint_every));
     desc = cmd.scene_file.empty() ? read_json_scene(builtin_scene_json(), "<built-in cornell-box.json>", ".")
@@ -277,6 +318,25 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
         throw UsageError(fmt::format("--part: the {} integrator does not render tile by tile (path and bdpt do)", chosen.name));
     }
     outputs = output_files(cmd, desc);
+    // AOVs (film/aov_film.h): --aov, else the scene's. Checkpoints and parts do not keep them.
+    if (cmd.aov.empty() && !desc.film.aovs.empty()) {
+      aov_layers = parse_aov_list(desc.film.aovs, "the scene's aovs");
+      if (!cmd.resume.empty() || !cmd.part.empty()) {
+        if (!cmd.quiet && cluster.is_root())
+          std::fprintf(stderr, "note: the scene's AOVs are not written with %s (checkpoints and parts do not keep them)\n",
+                       cmd.resume.empty() ? "--part" : "--resume");
+        aov_layers.clear();
+      }
+    }
+    if (!cmd.aov.empty() && (!cmd.resume.empty() || !cmd.part.empty()))
+      throw UsageError(fmt::format("--aov cannot be combined with {} (checkpoints and parts do not keep the AOVs)",
+                                   cmd.resume.empty() ? "--part" : "--resume"));
+    if (!aov_layers.empty() && !pixel_mode && !cmd.quiet && cluster.is_root())
+      for (const fs::path& f : outputs)
+        if (!is_exr(f)) {
+          std::fprintf(stderr, "note: AOVs are written into .exr outputs only: '%s' gets the colour alone\n", f.string().c_str());
+          break;
+        }
     if (!cmd.part.empty() && (outputs.size() != 1 || outputs[0].extension() != ".exr"))
       throw UsageError("--part writes a part file for candela merge: give one output ending in .exr (-o part-K.exr)");
     if (!pixel_mode && cluster.is_root()) check_outputs(outputs);
@@ -355,6 +415,11 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   options.cluster = &cluster;
   options.part_index = part_index;
   options.part_count = part_count;
+  std::optional<AovFilm> aov_film;
+  if (!aov_layers.empty() && !pixel_mode) {
+    aov_film.emplace(film.width(), film.height(), aov_layers);
+    options.aovs = &*aov_film;
+  }
   if (!strategy_images.empty()) {
     options.bdpt_strategies = &strategy_images;
     options.bdpt_unweighted = cmd.bdpt_unweighted;
@@ -394,6 +459,45 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
       save_checkpoint(f, earlier_non_finite + non_finite_so_far, true);
       last_checkpoint = std::chrono::steady_clock::now();
     };
+  // Viewers of the render as it converges (the root's film: after each pass it holds every rank's tiles).
+  std::unique_ptr<LiveFilm> live;
+  std::unique_ptr<PreviewServer> preview;
+  std::unique_ptr<TevClient> tev;
+  LiveState live_end = LiveState::Stopped;
+  if (cluster.is_root() && (!cmd.preview.empty() || !cmd.display_server.empty()))
+    live = std::make_unique<LiveFilm>(film.width(), film.height());
+  if (live && !cmd.display_server.empty())
+    tev = std::make_unique<TevClient>(cmd.display_server, outputs.front().filename().string(), *live);
+  if (live && !cmd.preview.empty()) {
+    const PreviewAddress address = parse_preview_address(cmd.preview);
+    preview = std::make_unique<PreviewServer>(address, *live, [] {
+      g_stopped_from_page.store(true);
+      g_stop.store(true);
+    });
+    if (!address.loopback())
+      std::fprintf(stderr, "candela: warning: the preview at %s has no authentication: anyone who can reach this "
+                           "machine can watch the render and stop it\n", preview->url().c_str());
+    std::fprintf(stderr, "candela: preview at %s\n", preview->url().c_str());
+    std::fflush(stderr);
+  }
+  if (live) {
+    options.live = live.get();
+    if (!options.progress_fraction) options.progress_fraction = &live->progress_fraction();
+    live->start(fmt::format("{} ({})", cmd.scene_file.empty() ? "built-in cornell-box.json" : cmd.scene_file,
+                            desc.settings.integrator),
+                uint64_t(!desc.settings.adaptive()          ? desc.settings.spp
+                         : desc.settings.adaptive_spp > 0 ? desc.settings.adaptive_spp
+                                                          : std::max(desc.settings.adaptive_spp_limit(), desc.settings.adaptive_batch)),
+                desc.settings.adaptive(), options.time_limit_seconds, options.target_error);
+  }
+  // The viewers see the end once the images are written (or the command fails), before they close.
+  struct EndLive {
+    LiveFilm* live;
+    const LiveState& state;
+    ~EndLive() {
+      if (live) live->finish(state);
+    }
+  } end_live{live.get(), live_end};
   g_phase.store(kRendering);
   RenderOutcome outcome = render_requested(scene, desc.settings, film, options, auto_budget_spp, [&](const std::string& summary) {
     if (cluster.is_root()) std::printf("auto: %s\n", summary.c_str());
@@ -444,7 +548,13 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
     film = std::move(part.film);
   } else {
     Image image = film.mean_image();
-    for (const auto& f : outputs) write_image(f, image, metadata);
+    const FloatChannels aov_channels = aov_film ? exr_channels(aov_film->images(film)) : FloatChannels{};
+    for (const auto& f : outputs) {
+      if (aov_channels.names.empty() || !is_exr(f))
+        write_image(f, image, metadata);
+      else
+        write_image(f, image, metadata, aov_channels);
+    }
   }
   // One image per strategy: bdpt_d<depth>_s<s>_t<t>.exr, scaled like the light image.
   for (int depth = 0; depth <= strategy_depth && !strategy_images.empty(); ++depth)
@@ -483,10 +593,12 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
                 cluster.size(), stats.threads, 100 * busy / (double(stats.threads) * seconds), per_rank.c_str(),
                 double(most_sent) * 1e-6, double(traffic[0].bytes_sent) * 1e-6, traffic[0].collective_seconds);
   }
+  live_end = stats.cancelled ? LiveState::Stopped : LiveState::Finished;
   if (stats.time_limited)
     std::fprintf(stderr, "candela: time limit reached: wrote the image with %s%s\n", spp_text.c_str(), spp_unit);
   if (stats.cancelled) {
-    std::fprintf(stderr, "candela: interrupted: wrote the image with %s%s%s\n", spp_text.c_str(), spp_unit,
+    std::fprintf(stderr, "candela: %s: wrote the image with %s%s%s\n",
+                 g_stopped_from_page.load() ? "stopped from the preview page" : "interrupted", spp_text.c_str(), spp_unit,
                  cmd.checkpoint.empty() ? "" : fmt::format(" and checkpoint {}", cmd.checkpoint).c_str());
     return kExitInterrupted;
   }
@@ -628,8 +740,19 @@ int main(int argc, char** argv) {
                          "Adaptive sampling: samples per batch, a power of two (default 16)");
   render_cmd->add_option("--max-spp", cmd.max_spp,
                          "Adaptive sampling: most samples a pixel gets (default 1024, or 8 x --adaptive-spp)");
+  render_cmd->add_option("--preview", cmd.preview,
+                         "Serve a page showing the render as it converges at [HOST:]PORT (default host 127.0.0.1; "
+                         "port 0 = any free port, printed); open it in a browser (docs/preview.md)");
+  render_cmd->add_flag("--preview-public", cmd.preview_public,
+                       "Allow --preview on an address other machines can reach (the page has no authentication)");
   render_cmd->add_option("--spp-map", cmd.spp_map,
                          "Also write the per-pixel sample counts: a heat map (.png) or raw counts (.exr, .pfm)");
+  render_cmd->add_option("--display-server", cmd.display_server,
+                         "Show the image as it renders in the tev viewer listening at HOST:PORT (tev's default: "
+                         "127.0.0.1:14158); reconnects if tev is not there yet or restarts");
+  render_cmd->add_option("--aov", cmd.aov,
+                         "Also write AOV layers into the .exr output, comma-separated: albedo, normal, depth, "
+                         "position, spp, variance, or all (docs/cli.md)");
   render_cmd->add_flag("-q,--quiet", cmd.quiet, "No progress bar");
   render_cmd->add_option("--checkpoint", cmd.checkpoint,
                          "Write the render state to FILE (atomically) every --checkpoint-every seconds "

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <bit>
 #include <cerrno>
+#include <cstddef>
 #include <cstdio>
 #include <cstring>
 #include <cmath>
@@ -75,9 +76,19 @@ std::vector<unsigned char> encode_png(const Image& image) {
   return bytes;
 }
 
+namespace {
+
+// Channels after R, G, B, every value 4 bytes (float or uint32): names->size() per pixel, row-major.
+struct ExtraChannels {
+  const std::vector<std::string>* names = nullptr;
+  OIIO::TypeDesc format = OIIO::TypeDesc::FLOAT;
+  const void* values = nullptr;
+  bool empty() const { return !names || names->empty(); }
+};
+
 // Writes with OpenImageIO; returns an error message, empty on success.
 std::string write_with_oiio(const std::filesystem::path& tmp, const std::string& ext, const Image& image,
-                            const std::map<std::string, std::string>& metadata, const ExactChannels* extra) {
+                            const std::map<std::string, std::string>& metadata, const ExtraChannels& extra) {
   auto out = OIIO::ImageOutput::create(tmp.string());
   if (!out) return "cannot create image writer: " + OIIO::geterror();
   bool ok;
@@ -88,20 +99,22 @@ std::string write_with_oiio(const std::filesystem::path& tmp, const std::string&
     spec.attribute("oiio:ColorSpace", "Linear");
     spec.attribute("compression", "zip");
     for (const auto& [key, value] : metadata) spec.attribute(key, value);
-    if (!extra || extra->names.empty()) {
+    if (extra.empty()) {
       ok = out->open(tmp.string(), spec) && out->write_image(OIIO::TypeDesc::FLOAT, image.rgb.data());
     } else {
-      // R, G, B as float, then the exact channels as uint, interleaved per pixel (all 4 bytes).
-      const size_t n = extra->names.size(), per_pixel = 3 + n;
+      // R, G, B as float, then the extra channels in their format, interleaved per pixel (all 4 bytes).
+      static_assert(sizeof(float) == sizeof(uint32_t));
+      const size_t n = extra.names->size(), per_pixel = 3 + n;
       spec.nchannels = int(per_pixel);
       spec.channelformats.assign(3, OIIO::TypeDesc::FLOAT);
-      spec.channelformats.resize(per_pixel, OIIO::TypeDesc::UINT32);
+      spec.channelformats.resize(per_pixel, extra.format);
       spec.channelnames = {"R", "G", "B"};
-      spec.channelnames.insert(spec.channelnames.end(), extra->names.begin(), extra->names.end());
+      spec.channelnames.insert(spec.channelnames.end(), extra.names->begin(), extra.names->end());
       std::vector<uint32_t> pixels(size_t(image.width) * size_t(image.height) * per_pixel);
+      const auto* values = static_cast<const std::byte*>(extra.values);
       for (size_t i = 0; i < size_t(image.width) * size_t(image.height); ++i) {
         std::memcpy(&pixels[i * per_pixel], &image.rgb[i * 3], 3 * sizeof(float));
-        std::copy_n(&extra->values[i * n], n, &pixels[i * per_pixel + 3]);
+        std::memcpy(&pixels[i * per_pixel + 3], values + i * n * sizeof(uint32_t), n * sizeof(uint32_t));
       }
       ok = out->open(tmp.string(), spec) && out->write_image(OIIO::TypeDesc::UNKNOWN, pixels.data());
     }
@@ -111,15 +124,10 @@ std::string write_with_oiio(const std::filesystem::path& tmp, const std::string&
   return ok && error.empty() ? "" : (error.empty() ? "write failed" : error);
 }
 
-void write_image(const std::filesystem::path& file, const Image& image,
-                 const std::map<std::string, std::string>& metadata) {
-  write_image(file, image, metadata, ExactChannels{});
-}
-
-void write_image(const std::filesystem::path& file, const Image& image, const std::map<std::string, std::string>& metadata,
-                 const ExactChannels& extra) {
-  if (!extra.names.empty() && lower_extension(file) != ".exr")
-    throw std::runtime_error(fmt::format("{}: only .exr files keep exact channels", file.string()));
+void write_image_with(const std::filesystem::path& file, const Image& image,
+                      const std::map<std::string, std::string>& metadata, const ExtraChannels& extra) {
+  if (!extra.empty() && lower_extension(file) != ".exr")
+    throw std::runtime_error(fmt::format("{}: only .exr files keep extra channels", file.string()));
   if (!is_supported_output(file))
     throw std::runtime_error(fmt::format("{}: unsupported image format (use .exr, .png or .pfm)", file.string()));
   std::string ext = lower_extension(file);
@@ -127,7 +135,7 @@ void write_image(const std::filesystem::path& file, const Image& image, const st
   std::filesystem::path tmp = dir / fmt::format(".{}.{}.tmp{}", file.stem().string(), getpid(), ext);
 
   std::string error = ext == ".pfm" ? (write_pfm(tmp, image) ? "" : std::string(std::strerror(errno)))
-                                    : write_with_oiio(tmp, ext, image, metadata, &extra);
+                                    : write_with_oiio(tmp, ext, image, metadata, extra);
   std::error_code ec;
   if (error.empty()) {
     std::filesystem::rename(tmp, file, ec);
@@ -137,6 +145,52 @@ void write_image(const std::filesystem::path& file, const Image& image, const st
     std::filesystem::remove(tmp, ec);
     throw std::runtime_error(fmt::format("{}: cannot write image: {}", file.string(), error));
   }
+}
+
+// The channels of `file` whose names start with `prefix` (together), each checked by `check`
+// (which throws) and read as `format` into `values`.
+template <typename T, typename Check>
+std::vector<std::string> read_channels(const std::filesystem::path& file, const std::string& prefix,
+                                       OIIO::TypeDesc format, Check check, std::vector<T>& values) {
+  auto in = OIIO::ImageInput::open(file.string());
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
+  const OIIO::ImageSpec& spec = in->spec();
+  std::vector<std::string> names;
+  int first = -1, last = -1;
+  for (int c = 0; c < spec.nchannels; ++c)
+    if (spec.channelnames[size_t(c)].rfind(prefix, 0) == 0) {
+      if (first >= 0 && c != last + 1)
+        throw std::runtime_error(fmt::format("{}: the {}* channels are not together", file.string(), prefix));
+      check(spec, c);
+      if (first < 0) first = c;
+      last = c;
+      names.push_back(spec.channelnames[size_t(c)]);
+    }
+  values.clear();
+  if (first >= 0) {
+    values.resize(size_t(spec.width) * size_t(spec.height) * names.size());
+    if (!in->read_image(0, 0, first, last + 1, format, values.data()))
+      throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), in->geterror()));
+  }
+  in->close();
+  return names;
+}
+
+}  // namespace
+
+void write_image(const std::filesystem::path& file, const Image& image,
+                 const std::map<std::string, std::string>& metadata) {
+  write_image_with(file, image, metadata, ExtraChannels{});
+}
+
+void write_image(const std::filesystem::path& file, const Image& image, const std::map<std::string, std::string>& metadata,
+                 const ExactChannels& extra) {
+  write_image_with(file, image, metadata, {&extra.names, OIIO::TypeDesc::UINT32, extra.values.data()});
+}
+
+void write_image(const std::filesystem::path& file, const Image& image, const std::map<std::string, std::string>& metadata,
+                 const FloatChannels& extra) {
+  write_image_with(file, image, metadata, {&extra.names, OIIO::TypeDesc::FLOAT, extra.values.data()});
 }
 
 namespace {
@@ -199,29 +253,30 @@ Image read_image(const std::filesystem::path& file, IntegerEncoding encoding) {
 Image read_image(const std::filesystem::path& file) { return read_image(file, IntegerEncoding::SRGB); }
 
 ExactChannels read_exact_channels(const std::filesystem::path& file, const std::string& prefix) {
+  ExactChannels result;
+  result.names = read_channels(
+      file, prefix, OIIO::TypeDesc::UINT32,
+      [&](const OIIO::ImageSpec& spec, int c) {
+        if (spec.channelformat(c) != OIIO::TypeDesc::UINT32)
+          throw std::runtime_error(fmt::format("{}: channel {} is not 32-bit unsigned integer", file.string(),
+                                               spec.channelnames[size_t(c)]));
+      },
+      result.values);
+  return result;
+}
+
+FloatChannels read_float_channels(const std::filesystem::path& file, const std::string& prefix) {
+  FloatChannels result;
+  result.names = read_channels(file, prefix, OIIO::TypeDesc::FLOAT, [](const OIIO::ImageSpec&, int) {}, result.values);
+  return result;
+}
+
+std::vector<std::string> read_channel_names(const std::filesystem::path& file) {
   auto in = OIIO::ImageInput::open(file.string());
   if (!in) throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
-  const OIIO::ImageSpec& spec = in->spec();
-  ExactChannels result;
-  int first = -1, last = -1;
-  for (int c = 0; c < spec.nchannels; ++c)
-    if (spec.channelnames[size_t(c)].rfind(prefix, 0) == 0) {
-      if (first >= 0 && c != last + 1)
-        throw std::runtime_error(fmt::format("{}: the {}* channels are not together", file.string(), prefix));
-      if (spec.channelformat(c) != OIIO::TypeDesc::UINT32)
-        throw std::runtime_error(fmt::format("{}: channel {} is not 32-bit unsigned integer", file.string(),
-                                             spec.channelnames[size_t(c)]));
-      if (first < 0) first = c;
-      last = c;
-      result.names.push_back(spec.channelnames[size_t(c)]);
-    }
-  if (first >= 0) {
-    result.values.resize(size_t(spec.width) * size_t(spec.height) * result.names.size());
-    if (!in->read_image(0, 0, first, last + 1, OIIO::TypeDesc::UINT32, result.values.data()))
-      throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), in->geterror()));
-  }
+  std::vector<std::string> names = in->spec().channelnames;
   in->close();
-  return result;
+  return names;
 }
 
 std::map<std::string, std::string> read_image_metadata(const std::filesystem::path& file) {

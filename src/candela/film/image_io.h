@@ -38,6 +38,21 @@ void write_image(const std::filesystem::path& file, const Image& image, const st
 // (an empty ExactChannels when there are none). Throws std::runtime_error naming the file.
 ExactChannels read_exact_channels(const std::filesystem::path& file, const std::string& prefix);
 
+// 32-bit float channels beside an EXR's RGB, named as layers ("Albedo.R", "Depth.Z": film/aov_film.h):
+// names.size() values per pixel in `values`, row-major.
+struct FloatChannels {
+  std::vector<std::string> names;
+  std::vector<float> values;
+};
+// write_image for an .exr with `extra` after its R, G, B channels.
+void write_image(const std::filesystem::path& file, const Image& image, const std::map<std::string, std::string>& metadata,
+                 const FloatChannels& extra);
+// The channels of `file` whose names start with `prefix`, read as 32-bit floats (an empty
+// FloatChannels when there are none). Throws std::runtime_error naming the file.
+FloatChannels read_float_channels(const std::filesystem::path& file, const std::string& prefix);
+// The names of all channels of `file`, in the order the reader gives them.
+std::vector<std::string> read_channel_names(const std::filesystem::path& file);
+
 // How 8- and 16-bit pixel values become linear: the exact sRGB decoding curve, or value / max.
 // Float pixels (EXR, HDR, PFM) are linear either way, as in pbrt-v4 and Mitsuba, whose encoding
 // options also only apply to integer images.

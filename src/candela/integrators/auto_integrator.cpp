@@ -71,6 +71,8 @@ AutoChoice choose_integrator(const Scene& scene, const RenderSettings& settings,
     RenderOptions pilot = options;
     pilot.progress = false;
     pilot.after_pass = nullptr;
+    pilot.live = nullptr;  // viewers and AOVs describe the image, not the pilots
+    pilot.aovs = nullptr;
     pilot.target_error = 0;
     pilot.time_limit_seconds = slice;
     // Path and bdpt render every k-th tile in their pilot (tiles strided over the whole image, as a

@@ -9,6 +9,7 @@
 #include "candela/integrators/mlt.h"
 #include "candela/integrators/path_integrator.h"
 #include "candela/integrators/volpath.h"
+#include "candela/render/first_hit_aovs.h"
 
 namespace candela {
 
@@ -96,7 +97,12 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
                                                          [](int64_t v) { return v != 0; }));
   if (started && !integrator->resumable)
     throw std::invalid_argument(fmt::format("the {} integrator cannot continue a partly rendered film", integrator->name));
-  return integrator->render(scene, settings, film, options);
+  RenderStats stats = integrator->render(scene, settings, film, options);
+  // Every integrator here traces its camera samples (MLT: its depth-0 pass) through CameraSampleTiles,
+  // which adds the AOVs; one that does not leaves them empty, and they get a pass of their own.
+  if (options.aovs && options.aovs->has_sample_layers() && options.aovs->empty() && !stats.cancelled)
+    render_aovs(scene, settings, *options.aovs, options);
+  return stats;
 }
 
 }  // namespace candela

@@ -502,6 +502,11 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
     progress.advance(steps * (chains - my_chains.size()));  // the other ranks' chains
     first_round = false;
     mutations_per_chain += steps;
+    // Viewers see the chains' image so far (in one process: across ranks each holds its own splats).
+    if (options.live && !cluster.distributed()) {
+      film.set_splat_scale(splat_scale(mutations_per_chain));
+      options.live->pass_done(film);
+    }
     // The root's clock sets the rounds' length and the time limit for every rank.
     double round_seconds =
         cluster.from_root(std::chrono::duration<double>(std::chrono::steady_clock::now() - round_start).count());

@@ -394,6 +394,7 @@ Json render_json(const SceneDesc& scene) {
   const RenderSettings& s = scene.settings;
   Json j{{"spp", s.spp}, {"max_depth", s.max_depth}, {"seed", s.seed}, {"integrator", s.integrator}};
   if (!scene.film.filename.empty()) j["output"] = scene.film.filename;
+  if (!scene.film.aovs.empty()) j["aovs"] = scene.film.aovs;
   // Only the selective settings the integrator reads: the reader rejects the others.
   const IntegratorEntry* integrator = find_integrator(s.integrator);
   auto reads = [&](std::string_view key) { return integrator && integrator->reads_setting(key); };

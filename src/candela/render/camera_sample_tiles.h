@@ -7,6 +7,8 @@
 #include <utility>
 #include <variant>
 
+#include "candela/film/aov_film.h"
+#include "candela/render/first_hit_aovs.h"
 #include "candela/render/render_loop.h"
 #include "candela/spectral/wavelengths.h"
 
@@ -19,6 +21,7 @@ struct PixelSample {
   bool first_half = true;  // which of the film's two independent halves the sample belongs to
 };
 
+// With TileContext::aovs set, each sample's camera ray also gives its AOVs (render/first_hit_aovs.h).
 // Radiance: a callable (const Ray&, auto& sampler, RayCounts&, const PixelSample&, const Wavelengths*)
 // returning the radiance along the camera ray (at the wavelengths, when given).
 template <typename Radiance>
@@ -77,6 +80,11 @@ class CameraSampleTiles final : public TileIntegrator {
         if (m > context.clamp) L *= context.clamp / m;
       }
       context.film.add_sample(x, y, L, fs.weight, first_half);
+      // The AOV layers of the same camera ray, with the same filter weight (their random numbers
+      // are their own: the sampler above is untouched).
+      if (context.aovs && context.aovs->has_sample_layers())
+        context.aovs->add_sample(
+            x, y, first_hit_aovs(context.scene, ray, context.aovs->needs_shading(), x, y, s, context.seed), fs.weight);
     }
   }
 

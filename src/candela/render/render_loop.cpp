@@ -18,6 +18,7 @@
 #include <ctime>
 #include <tuple>
 
+#include "candela/film/aov_film.h"
 #include "candela/film/error_estimate.h"
 #include "candela/render/film_part.h"
 #include "candela/render/progress.h"
@@ -40,6 +41,7 @@ struct PassContext {
   const std::atomic<bool>* cancel;
   Cluster& cluster;
   std::atomic<uint64_t>& busy_nanoseconds;
+  LiveFilm* live;
 };
 
 bool cancelled(const PassContext& pc) { return pc.cancel && pc.cancel->load(std::memory_order_relaxed); }
@@ -77,6 +79,7 @@ void run_pass(const PassContext& pc, const std::vector<Tile>& tiles, tbb::task_a
         if (cancelled(pc)) return;
         BusyTimer busy(pc.busy_nanoseconds);
         progress.advance(pc.integrator.render_tile(tiles[t], range, pc.tile, pc.ray_counts.local()));
+        if (pc.live) pc.live->tile_done(film, tiles[t].x0, tiles[t].y0, tiles[t].x1, tiles[t].y1);
       },
       [&](uint64_t first, uint64_t count) {
         if (!progress.enabled()) return;
@@ -86,6 +89,11 @@ void run_pass(const PassContext& pc, const std::vector<Tile>& tiles, tbb::task_a
   std::vector<uint8_t> mine(n, 0);
   for (uint64_t item = 0; item < n; ++item) mine[item * stride % n] = handed[item];
   auto row_of = [&](const Tile& tile, int y) { return &film.pixels()[size_t(y) * size_t(film.width()) + size_t(tile.x0)]; };
+  // The AOVs' sums travel with the film's (each row of the tile after the film's rows).
+  AovFilm* aovs = pc.tile.aovs && pc.tile.aovs->has_sample_layers() ? pc.tile.aovs : nullptr;
+  auto aov_row_bytes = [&](const Tile& tile) {
+    return aovs ? sizeof(double) * aovs->doubles_per_pixel() * size_t(tile.x1 - tile.x0) : 0;
+  };
   exchange_items(
       pc.cluster, mine,
       [&](uint64_t t, std::vector<std::byte>& out) {
@@ -94,6 +102,10 @@ void run_pass(const PassContext& pc, const std::vector<Tile>& tiles, tbb::task_a
           const auto* row = reinterpret_cast<const std::byte*>(row_of(tile, y));
           out.insert(out.end(), row, row + sizeof(PixelSums) * size_t(tile.x1 - tile.x0));
         }
+        for (int y = tile.y0; y < tile.y1 && aovs; ++y) {
+          const auto* row = reinterpret_cast<const std::byte*>(aovs->sums(tile.x0, y));
+          out.insert(out.end(), row, row + aov_row_bytes(tile));
+        }
       },
       [&](uint64_t t, const std::byte* in) {
         const Tile& tile = tiles[t];
@@ -101,6 +113,10 @@ void run_pass(const PassContext& pc, const std::vector<Tile>& tiles, tbb::task_a
           size_t row = sizeof(PixelSums) * size_t(tile.x1 - tile.x0);
           std::memcpy(row_of(tile, y), in, row);
           in += row;
+        }
+        for (int y = tile.y0; y < tile.y1 && aovs; ++y) {
+          std::memcpy(aovs->sums(tile.x0, y), in, aov_row_bytes(tile));
+          in += aov_row_bytes(tile);
         }
         return in;
       });
@@ -236,6 +252,7 @@ void render_adaptive(const PassContext& pc, const std::vector<Tile>& tiles, tbb:
                return SampleRange{int64_t(film.pixel(x, y).count), give[i]};
              },
              progress);
+    if (options.live) options.live->pass_done(film);
     for (int g : give) spent += uint64_t(g);
     bool more = budget > 0 ? spent < budget : true;
     if (stop_after_pass(more) || !more) break;
@@ -470,11 +487,12 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
   NonFiniteLog non_finite_log(options.max_reported_non_finite);
   PassContext pc{integrator,
                  {scene, filter, prototype, film, non_finite, non_finite_log, options.clamp, settings.spectral,
-                  half_block(settings.sampler, set_size)},
+                  half_block(settings.sampler, set_size), options.aovs, settings.seed},
                  ray_counts,
                  options.cancel,
                  cluster,
-                 busy_nanoseconds};
+                 busy_nanoseconds,
+                 options.live};
   const uint64_t samples_before = film.total_samples();
   const uint64_t expected_spp = adaptive && settings.adaptive_spp > 0 ? uint64_t(settings.adaptive_spp) : uint64_t(max_spp);
   ProgressBar progress(pixel_count * expected_spp, options.progress, options.progress_fraction);
@@ -517,6 +535,7 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
                  return SampleRange{have, int(std::max<int64_t>(0, end - have))};
                },
                progress);
+      if (options.live) options.live->pass_done(film);
       bool stop = stop_after_pass(end < settings.spp);
       if (target && !stop && end < settings.spp) {
         const double e = agreed_error_estimate(cluster, film);

@@ -28,11 +28,14 @@
 
 #include "candela/film/film.h"
 #include "candela/film/filter.h"
+#include "candela/film/live_film.h"
 #include "candela/render/cluster.h"
 #include "candela/sampling/samplers.h"
 #include "candela/scene/scene.h"
 
 namespace candela {
+
+class AovFilm;  // film/aov_film.h
 
 struct RenderOptions {
   int threads = 0;       // 0 = all cores
@@ -70,6 +73,12 @@ struct RenderOptions {
   // > 0: render until the image's estimated relMSE (film/error_estimate.h) is at most this, up to
   // settings.spp samples per pixel (or the time limit). Needs independent halves (SamplerDesc::replicas).
   double target_error = 0;
+  // When set, the AOV layers (film/aov_film.h) of every camera sample are added here, sized like the
+  // film (render/first_hit_aovs.h). Drawn from random numbers of their own: the film is unchanged.
+  AovFilm* aovs = nullptr;
+  // When set, each tile's pixels are copied there as the tile finishes and the whole film after each
+  // pass, for viewers watching the render (the browser preview, tev; film/live_film.h).
+  LiveFilm* live = nullptr;
 };
 
 struct NonFiniteSample {
@@ -143,6 +152,9 @@ struct TileContext {
   // Sample i of a pixel is in the film's first half when (i / half_block) is even (half_block()).
   uint64_t half_block;
   bool first_half(uint64_t sample_index) const { return (sample_index / half_block) % 2 == 0; }
+  // RenderOptions::aovs, and the seed their random numbers are drawn with (render/first_hit_aovs.h).
+  AovFilm* aovs = nullptr;
+  uint64_t seed = 0;
 };
 
 // An integrator as the loop sees it: renders the samples `range` names for every pixel of a tile,

@@ -580,6 +580,9 @@ struct FilmDesc {
   int width = 512;
   int height = 512;
   std::string filename;  // empty = the command line's default
+  // The AOV layers written beside the colour in an EXR output, as --aov takes them ("albedo,normal";
+  // film/aov_film.h); empty = none. The command line's --aov replaces it.
+  std::string aovs;
 };
 
 // How pixel samples are placed (Häkkinen 2002, sec. 4.3).

@@ -2,7 +2,9 @@
 #include "candela/io/json/reader.h"
 
 #include <limits>
+#include <stdexcept>
 
+#include "candela/film/aov_film.h"
 #include "candela/integrators/integrator.h"
 
 namespace candela::json {
@@ -85,6 +87,14 @@ void JsonSceneReader::read_render(const Json& value, const std::string& pointer)
   settings.integrator = render.string_or("integrator", scene_.media.empty() ? settings.integrator : "volpath");
   if (settings.integrator.empty()) report_.fail(render.pointer_of("integrator"), "the integrator name is empty");
   scene_.film.filename = render.string_or("output", "");
+  scene_.film.aovs = render.string_or("aovs", "");
+  if (!scene_.film.aovs.empty()) {
+    try {
+      parse_aovs(scene_.film.aovs);
+    } catch (const std::invalid_argument& e) {
+      report_.fail(render.pointer_of("aovs"), "{}", e.what());
+    }
+  }
   settings.rr_start_depth = render.integer_or("rr_start_depth", settings.rr_start_depth, 0, kIntMax);
   if (const Json* times = render.find("transform_times"))
     read_transform_times(*times, render.pointer_of("transform_times"));
