@@ -274,6 +274,14 @@ void expect_create(const std::vector<uint8_t>& packet, int width, int height) {
   EXPECT_TRUE(c->grab_focus);
 }
 
+// The first packet of a connection: CreateImage of the film's size, which `image` then mirrors.
+void receive_create(Receiver& rx, int width, int height, TevImage& image) {
+  std::optional<std::vector<uint8_t>> first = rx.next_packet(2000ms);
+  ASSERT_TRUE(first);
+  expect_create(*first, width, height);
+  image.create(*parse_create(*first));
+}
+
 // Receives UpdateImage packets until `rows` have all come (each once), checking each packet's layout
 // and that its values are the LiveFilm's; applies them to `image`.
 void receive_rows(Receiver& rx, const LiveFilm& live, std::set<int> rows, TevImage& image, int max_rows_per_packet) {
@@ -413,12 +421,7 @@ TEST(TevClient, StreamsTheChangedRowsAndTheFinalImage) {
   TevClient client(rx.address(), kName, live, options);
   ASSERT_TRUE(rx.accept_within(2000ms));
   TevImage image;
-  {
-    std::optional<std::vector<uint8_t>> first = rx.next_packet(2000ms);
-    ASSERT_TRUE(first);
-    expect_create(*first, W, H);
-    image.create(*parse_create(*first));
-  }
+  receive_create(rx, W, H, image);
   live.start("test", 2, false, 0, 0);
 
   live.tile_done(film, 0, 1, W, 4);  // rows 1-3: two packets, rows 1-2 and 3
@@ -444,12 +447,7 @@ TEST(TevClient, ReconnectsAndSendsEverythingAgain) {
   TevClient client(rx->address(), kName, live, fast_options());
   ASSERT_TRUE(rx->accept_within(2000ms));
   TevImage image;
-  {
-    std::optional<std::vector<uint8_t>> first = rx->next_packet(2000ms);
-    ASSERT_TRUE(first);
-    expect_create(*first, W, H);
-    image.create(*parse_create(*first));
-  }
+  receive_create(*rx, W, H, image);
   live.start("test", 2, false, 0, 0);
   live.pass_done(film);
   receive_rows(*rx, live, row_range(0, H), image, H);
@@ -459,12 +457,7 @@ TEST(TevClient, ReconnectsAndSendsEverythingAgain) {
   rx = std::make_unique<Receiver>(port);
   ASSERT_TRUE(rx->accept_within(3000ms));
   TevImage again;
-  {
-    std::optional<std::vector<uint8_t>> first = rx->next_packet(2000ms);
-    ASSERT_TRUE(first);
-    expect_create(*first, W, H);
-    again.create(*parse_create(*first));
-  }
+  receive_create(*rx, W, H, again);
   receive_rows(*rx, live, row_range(0, H), again, H);
   expect_image_equals_film(again, live, film);
 
@@ -488,10 +481,7 @@ TEST(TevClient, StopSendsWhatTevHasNotSeen) {
   auto client = std::make_unique<TevClient>(rx.address(), kName, live, options);
   ASSERT_TRUE(rx.accept_within(2000ms));
   TevImage image;
-  std::optional<std::vector<uint8_t>> first = rx.next_packet(2000ms);
-  ASSERT_TRUE(first);
-  expect_create(*first, W, H);
-  image.create(*parse_create(*first));
+  receive_create(rx, W, H, image);
   live.start("test", 1, false, 0, 0);
   live.pass_done(film);
   const auto t0 = Clock::now();
