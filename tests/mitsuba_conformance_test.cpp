@@ -56,6 +56,10 @@ TEST_P(MitsubaConformance, PassesMitsubasRenderTest) {
   const ConformanceCase& c = std::get<0>(GetParam());
   const SamplerType sampler = std::get<1>(GetParam());
   const Expect expect = c.expect(sampler);
+  // A known failure asserts nothing but that it renders, and its renders are among the longest of the
+  // suite (100 s of CI's time): they run when asked, to update docs/conformance.md's pass fractions.
+  if (expect == Expect::KnownFailure && !std::getenv("CANDELA_CONFORMANCE_KNOWN_FAILURES"))
+    GTEST_SKIP() << "a known failure (docs/conformance.md); CANDELA_CONFORMANCE_KNOWN_FAILURES=1 renders it";
   namespace fs = std::filesystem;
   const fs::path dir = fs::path(CANDELA_SHARED_DIR) / "scenes/mitsuba-tests/tests/scenes" / c.folder;
   const fs::path file = dir / (std::string(c.scene) + ".xml");
