@@ -43,11 +43,13 @@ class Render:
                     found.set()
             found.set()
 
-        threading.Thread(target=read, daemon=True).start()
+        self.reader = threading.Thread(target=read, daemon=True)
+        self.reader.start()
         assert found.wait(60) and self.url, f"no preview address printed: {''.join(self.stderr)}"
 
     def finish(self, timeout=60):
         out, _ = self.proc.communicate(timeout=timeout)
+        self.reader.join(10)  # the last lines of stderr, up to its end
         return self.proc.returncode, out, "".join(self.stderr)
 
     def kill(self):
@@ -142,7 +144,8 @@ def test_page_shows_the_render_converging_and_stops_it(browser, tmp_path):
 
 def test_adaptive_render_shows_a_samples_per_pixel_heat_map(browser, tmp_path):
     out = tmp_path / "adaptive.exr"
-    render = Render([CORNELL_BOX, "--resolution", "64x48", "--adaptive-spp", "256", "--adaptive-batch", "16", "--threads", "1",
+    # Long enough (several seconds) that the page loads well before the render ends.
+    render = Render([CORNELL_BOX, "--resolution", "96x72", "--adaptive-spp", "512", "--adaptive-batch", "16", "--threads", "1",
                      "-o", str(out)])
     try:
         browser.get(render.url)
