@@ -30,7 +30,7 @@ class Render:
 
     def __init__(self, args):
         self.proc = subprocess.Popen([CLI, "render", *args, "--preview", "127.0.0.1:0", "-q"],
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
         self.stderr, self.url = [], None
         found = threading.Event()
 
@@ -48,9 +48,10 @@ class Render:
         assert found.wait(60) and self.url, f"no preview address printed: {''.join(self.stderr)}"
 
     def finish(self, timeout=60):
-        out, _ = self.proc.communicate(timeout=timeout)
+        # Not communicate(): it would read stderr too, racing the reader thread for the last lines.
+        self.proc.wait(timeout=timeout)
         self.reader.join(10)  # the last lines of stderr, up to its end
-        return self.proc.returncode, out, "".join(self.stderr)
+        return self.proc.returncode, "".join(self.stderr)
 
     def kill(self):
         if self.proc.poll() is None:
@@ -131,7 +132,7 @@ def test_page_shows_the_render_converging_and_stops_it(browser, tmp_path):
         # Stop: the render ends as after SIGINT (exit status 3) with the image so far written.
         spp_at_stop = mean_spp(browser)
         browser.find_element(By.ID, "stop").click()
-        code, stdout, stderr = render.finish(60)
+        code, stderr = render.finish(60)
         assert code == 3, stderr
         assert "stopped from the preview page" in stderr
         assert out.exists() and out.stat().st_size > 0
@@ -165,7 +166,7 @@ def test_adaptive_render_shows_a_samples_per_pixel_heat_map(browser, tmp_path):
         assert colours >= 3, colours
         ARTIFACTS.mkdir(parents=True, exist_ok=True)
         browser.save_screenshot(str(ARTIFACTS / "preview-heat-map.png"))
-        code, _, stderr = render.finish(120)
+        code, stderr = render.finish(120)
         assert code == 0, stderr
         assert out.exists()
     finally:
