@@ -1,6 +1,8 @@
 #include "candela/film/error_estimate.h"
 
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -139,53 +141,69 @@ ErrorEstimate estimate_error(const Film& film, double scale_relative_error, std:
   // 3.9-6.1 -> 1.18-1.22, at 64 spp 1.61-2.57 -> 0.98-1.20; within 0.03 elsewhere
   // (docs/error-estimates.md).
   const std::vector<double> local = box_mean(mean, w, h, kLocalRadius);
-  std::vector<double> scratch;
+  // Rows in parallel, their sums added in row order: the same estimate for any number of threads.
+  struct RowSums {
+    double sum = 0, sum_sq = 0, splat_sum = 0;
+    uint64_t covered = 0;
+  };
+  std::vector<RowSums> rows(static_cast<size_t>(h));
+  tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& range) {
+    std::vector<double> scratch;
+    double around[8];
+    for (int y = range.begin(); y < range.end(); ++y) {
+      RowSums& row = rows[size_t(y)];
+      for (int x = 0; x < w; ++x) {
+        const size_t i = size_t(y) * size_t(w) + size_t(x);
+        if (std::isnan(variance[3 * i])) continue;
+        double pixel_error = 0, splat_error = 0;
+        for (int c = 0; c < 3; ++c) {
+          const double own = mean[3 * i + size_t(c)], var = variance[3 * i + size_t(c)];
+          const double lesser = lesser_half[3 * i + size_t(c)];
+          double brightest = -std::numeric_limits<double>::infinity();
+          int k = 0;
+          for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy)
+            for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx) {
+              const size_t j = 3 * (size_t(yy) * size_t(w) + size_t(xx)) + size_t(c);
+              if ((xx == x && yy == y) || std::isnan(mean[j])) continue;
+              brightest = std::max(brightest, lesser_half[j]);
+              around[k++] = mean[j];
+            }
+          if (k == 0) {
+            brightest = own;  // no neighbour rendered
+          } else {
+            std::nth_element(around, around + k / 2, around + k);
+            brightest = std::max(brightest, around[k / 2]);
+          }
+          const bool firefly = own > brightest;
+          // Where every neighbour and both halves saw nothing yet but this pixel saw something (a
+          // render so short that most paths find no light), the wider neighbourhood's mean.
+          if (brightest <= 0 && lesser <= 0) brightest = local[3 * i + size_t(c)];
+          const double capped = std::max(std::min(own, brightest), lesser);
+          double truth_sq = std::max({capped * capped - var / 2, capped * capped / 2, lesser * lesser});
+          if (firefly) {
+            const double floor = trimmed_local_mean(mean, w, h, x, y, c, kFireflyRadius, scratch);
+            truth_sq = std::max(truth_sq, floor * floor);
+          }
+          pixel_error += var / (truth_sq + kErrorEpsilon);
+          if (splats) splat_error += splat_variance[3 * i + size_t(c)] / (truth_sq + kErrorEpsilon);
+        }
+        pixel_error /= 3;
+        row.splat_sum += splat_error / 3;
+        if (pixel_errors) (*pixel_errors)[i] = pixel_error;
+        row.sum += pixel_error;
+        row.sum_sq += pixel_error * pixel_error;
+        ++row.covered;
+      }
+    }
+  });
   double sum = 0, sum_sq = 0, splat_sum = 0;
   uint64_t covered = 0;
-  double around[8];
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const size_t i = size_t(y) * size_t(w) + size_t(x);
-      if (std::isnan(variance[3 * i])) continue;
-      double pixel_error = 0, splat_error = 0;
-      for (int c = 0; c < 3; ++c) {
-        const double own = mean[3 * i + size_t(c)], var = variance[3 * i + size_t(c)];
-        const double lesser = lesser_half[3 * i + size_t(c)];
-        double brightest = -std::numeric_limits<double>::infinity();
-        int k = 0;
-        for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy)
-          for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx) {
-            const size_t j = 3 * (size_t(yy) * size_t(w) + size_t(xx)) + size_t(c);
-            if ((xx == x && yy == y) || std::isnan(mean[j])) continue;
-            brightest = std::max(brightest, lesser_half[j]);
-            around[k++] = mean[j];
-          }
-        if (k == 0) {
-          brightest = own;  // no neighbour rendered
-        } else {
-          std::nth_element(around, around + k / 2, around + k);
-          brightest = std::max(brightest, around[k / 2]);
-        }
-        const bool firefly = own > brightest;
-        // Where every neighbour and both halves saw nothing yet but this pixel saw something (a
-        // render so short that most paths find no light), the wider neighbourhood's mean.
-        if (brightest <= 0 && lesser <= 0) brightest = local[3 * i + size_t(c)];
-        const double capped = std::max(std::min(own, brightest), lesser);
-        double truth_sq = std::max({capped * capped - var / 2, capped * capped / 2, lesser * lesser});
-        if (firefly) {
-          const double floor = trimmed_local_mean(mean, w, h, x, y, c, kFireflyRadius, scratch);
-          truth_sq = std::max(truth_sq, floor * floor);
-        }
-        pixel_error += var / (truth_sq + kErrorEpsilon);
-        if (splats) splat_error += splat_variance[3 * i + size_t(c)] / (truth_sq + kErrorEpsilon);
-      }
-      pixel_error /= 3;
-      splat_sum += splat_error / 3;
-      if (pixel_errors) (*pixel_errors)[i] = pixel_error;
-      sum += pixel_error;
-      sum_sq += pixel_error * pixel_error;
-      ++covered;
-    }
+  for (const RowSums& row : rows) {
+    sum += row.sum;
+    sum_sq += row.sum_sq;
+    splat_sum += row.splat_sum;
+    covered += row.covered;
+  }
   e.valid = true;
   e.pixels = covered;
   const double count = double(covered);

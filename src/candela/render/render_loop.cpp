@@ -522,8 +522,10 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
     // last pass was cut short) gets exactly the samples an uninterrupted render would add, in order.
     int pass_spp = sampler_type == SamplerType::Poisson ? set_size : kPassSpp;
     // With an error target: where the estimate says the target will be met (the error of the mean
-    // falls as 1 / spp), so that the last pass does not overshoot by much.
-    int64_t target_end = settings.spp;
+    // falls as 1 / spp), so that the last pass does not overshoot by much; the first estimate as
+    // soon as both halves have a few samples (ZSobol's replicas 8 each, independent samples 4), so
+    // that a loose target is not overshot by a whole pass either.
+    int64_t target_end = target && !set_based ? std::max<int64_t>(8, 2 * int64_t(pc.tile.half_block)) : settings.spp;
     uint64_t least = options.only_x >= 0 ? film.pixel(options.only_x, options.only_y).count : film.min_samples();
     const int first_pass = int(std::min<uint64_t>(least, uint64_t(settings.spp)) / uint64_t(pass_spp)) * pass_spp;
     for (int pass = first_pass, end = 0; pass < settings.spp; pass = end) {
@@ -538,13 +540,17 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
       if (options.live) options.live->pass_done(film);
       bool stop = stop_after_pass(end < settings.spp);
       if (target && !stop && end < settings.spp) {
-        const double e = agreed_error_estimate(cluster, film);
+        const double e = arena.execute([&] { return agreed_error_estimate(cluster, film); });
         if (e <= options.target_error) {
           stats.reached_target = true;
           stop = true;
-        } else if (std::isfinite(e)) {
-          // Whole blocks of the halves, at least one more of each half.
-          const int64_t block = int64_t(pc.tile.half_block);
+        } else if (!std::isfinite(e)) {
+          target_end = settings.spp;  // no estimate yet: plain passes until there is one
+        } else {
+          // The estimate holds for halves of unequal size, so the render may stop at any sample
+          // count, except inside a set of a set-based sampler (a partial set would leave part of the
+          // pixel unsampled): there whole blocks of the halves, at least one more of each half.
+          const int64_t block = set_based ? int64_t(pc.tile.half_block) : 1;
           const double predicted = double(end) * e / options.target_error;
           target_end = std::max<int64_t>(end + block, int64_t(std::ceil(predicted / double(block))) * block);
         }
