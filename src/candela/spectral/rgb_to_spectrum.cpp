@@ -1,16 +1,14 @@
 #include "candela/spectral/rgb_to_spectrum.h"
 
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
-#include <memory>
-#include <vector>
 
 #include "candela/spectral/cie.h"
+#include "candela/spectral/rgb_to_spectrum_table.h"
 
 namespace candela {
 
@@ -25,150 +23,12 @@ namespace {
 
 constexpr int kRes = kRgbToSpectrumResolution;
 
-// The fit works on the trapezoid rule over the 5 nm samples of the tables (exact for their linear
-// interpolation), with the D65-weighted matching functions divided by the luminance integral (so
-// that the constant spectrum 1 has Y = 1).
-struct Quadrature {
-  static constexpr int kPoints = 95;
-  double t[kPoints];
-  cie::Xyz weight[kPoints];
-  cie::Xyz white;  // XYZ of the constant spectrum 1 under D65: the CIELAB white point
-  Quadrature() {
-    double norm = 1.0 / cie::y_integral();
-    for (int i = 0; i < kPoints; ++i) {
-      double lambda = cie::kLambdaMin + 5 * i;
-      t[i] = double(i) / (kPoints - 1);
-      cie::Xyz m = cie::matching(lambda);
-      double w = cie::d65(lambda) * norm * (i == 0 || i == kPoints - 1 ? 2.5 : 5.0);
-      weight[i] = {m.x * w, m.y * w, m.z * w};
-      white.x += weight[i].x;
-      white.y += weight[i].y;
-      white.z += weight[i].z;
-    }
-  }
-};
-
-const Quadrature& quadrature() {
-  static const Quadrature q;
-  return q;
-}
-
-double lab_f(double t) { return t > 216.0 / 24389.0 ? std::cbrt(t) : (24389.0 / 27.0 * t + 16) / 116; }
-
-std::array<double, 3> to_lab(const cie::Xyz& c, const cie::Xyz& white) {
-  double fx = lab_f(c.x / white.x), fy = lab_f(c.y / white.y), fz = lab_f(c.z / white.z);
-  return {116 * fy - 16, 500 * (fx - fy), 200 * (fy - fz)};
-}
-
-// CIELAB of the sigmoid spectrum with coefficients c (normalised t) under D65.
-std::array<double, 3> spectrum_lab(const std::array<double, 3>& c) {
-  const Quadrature& q = quadrature();
-  cie::Xyz xyz;
-  for (int i = 0; i < Quadrature::kPoints; ++i) {
-    double x = (c[0] * q.t[i] + c[1]) * q.t[i] + c[2];
-    double s = 0.5 + x / (2 * std::sqrt(1 + x * x));
-    xyz.x += s * q.weight[i].x;
-    xyz.y += s * q.weight[i].y;
-    xyz.z += s * q.weight[i].z;
-  }
-  return to_lab(xyz, q.white);
-}
-
-// Gauss-Newton on the CIELAB difference (forward-difference Jacobian), starting from c.
-void fit(const std::array<double, 3>& rgb, std::array<double, 3>& c) {
-  const std::array<double, 3> target = to_lab(cie::linear_srgb_to_xyz(rgb[0], rgb[1], rgb[2]), quadrature().white);
-  for (int iteration = 0; iteration < 30; ++iteration) {
-    std::array<double, 3> lab = spectrum_lab(c), r;
-    for (int k = 0; k < 3; ++k) r[k] = lab[k] - target[k];
-    double err = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-    if (err < 1e-8) return;  // CIELAB units: far below what anyone sees
-    double J[3][3];
-    for (int j = 0; j < 3; ++j) {
-      std::array<double, 3> cp = c;
-      const double h = 1e-5;
-      cp[j] += h;
-      std::array<double, 3> lp = spectrum_lab(cp);
-      for (int k = 0; k < 3; ++k) J[k][j] = (lp[k] - lab[k]) / h;
-    }
-    // Solve J d = -r by Cramer's rule (3 x 3).
-    auto det3 = [](double a[3][3]) {
-      return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-             a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-    };
-    double det = det3(J);
-    if (!(std::abs(det) > 1e-15)) return;
-    std::array<double, 3> d;
-    for (int j = 0; j < 3; ++j) {
-      double M[3][3];
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) M[a][b] = b == j ? -r[a] : J[a][b];
-      d[j] = det3(M) / det;
-    }
-    // Halve the step until the error falls (the sigmoid saturates: full steps can overshoot).
-    double step = 1;
-    for (int tries = 0; tries < 20; ++tries, step *= 0.5) {
-      std::array<double, 3> cn = {c[0] + step * d[0], c[1] + step * d[1], c[2] + step * d[2]};
-      std::array<double, 3> ln = spectrum_lab(cn);
-      double en = 0;
-      for (int k = 0; k < 3; ++k) en += (ln[k] - target[k]) * (ln[k] - target[k]);
-      if (en < err) {
-        c = cn;
-        break;
-      }
-    }
-    if (step < 1e-5) return;
-    // Keep the polynomial bounded: beyond this the spectrum is a step and the fit gains nothing.
-    double m = std::max({std::abs(c[0]), std::abs(c[1]), std::abs(c[2])});
-    if (m > 200) {
-      for (double& v : c) v *= 200 / m;
-    }
-  }
-}
-
-// The table, laid out as pbrt-v4's: for the largest component l (3 regions), its value z on a grid
-// that is denser near 0 and 1 (z_k = smoothstep(smoothstep(k / (res - 1)))), and the other two as
-// fractions x, y of it on a uniform grid.
-struct Table {
-  std::vector<float> z_nodes;
-  std::vector<std::array<float, 3>> coefficients;  // [l][zi][yi][xi]
-  size_t index(int l, int zi, int yi, int xi) const { return ((size_t(l) * kRes + zi) * kRes + yi) * kRes + xi; }
-
-  Table() : z_nodes(kRes), coefficients(size_t(3) * kRes * kRes * kRes) {
-    auto smoothstep = [](double x) { return x * x * (3 - 2 * x); };
-    for (int k = 0; k < kRes; ++k) z_nodes[k] = float(smoothstep(smoothstep(double(k) / (kRes - 1))));
-    auto fit_row = [&](int row) {
-      int l = row / kRes, yi = row % kRes;
-      double y = double(yi) / (kRes - 1);
-      for (int xi = 0; xi < kRes; ++xi) {
-        double x = double(xi) / (kRes - 1);
-        // Start at a middling brightness from the zero polynomial, then walk up and down in z, each
-        // fit starting from its neighbour's coefficients.
-        const int start = kRes / 5;
-        auto solve_at = [&](int zi, std::array<double, 3>& c) {
-          double z = z_nodes[zi];
-          std::array<double, 3> rgb;
-          rgb[l] = z;
-          rgb[(l + 1) % 3] = x * z;
-          rgb[(l + 2) % 3] = y * z;
-          fit(rgb, c);
-          coefficients[index(l, zi, yi, xi)] = {float(c[0]), float(c[1]), float(c[2])};
-        };
-        std::array<double, 3> c = {0, 0, 0};
-        for (int zi = start; zi < kRes; ++zi) solve_at(zi, c);
-        c = {0, 0, 0};
-        for (int zi = start; zi >= 0; --zi) solve_at(zi, c);
-      }
-    };
-    // Isolated: a thread waiting here must not pick up an outer task (a render tile) that would ask
-    // for the table again while it is being built.
-    tbb::this_task_arena::isolate([&] { tbb::parallel_for(0, 3 * kRes, fit_row); });
-  }
-};
-
-const Table& table() {
-  static const std::unique_ptr<Table> t = std::make_unique<Table>();
-  return *t;
-}
+// The grid's z values, for the lookup's search.
+constexpr std::array<float, kRes> kZNodes = [] {
+  std::array<float, kRes> z{};
+  for (int k = 0; k < kRes; ++k) z[size_t(k)] = rgb_to_spectrum_z_node(k);
+  return z;
+}();
 
 SigmoidPolynomial table_lookup(const RGB& in) {
   float rgb[3] = {std::clamp(in.r, 0.0f, 1.0f), std::clamp(in.g, 0.0f, 1.0f), std::clamp(in.b, 0.0f, 1.0f)};
@@ -179,18 +39,20 @@ SigmoidPolynomial table_lookup(const RGB& in) {
     if (v >= 1) return {0, 0, std::numeric_limits<float>::infinity()};
     return {0, 0, (v - 0.5f) / std::sqrt(v * (1 - v))};
   }
-  const Table& tab = table();
+  const std::array<float, kRes>& nodes = kZNodes;
   int l = rgb[0] > rgb[1] ? (rgb[0] > rgb[2] ? 0 : 2) : (rgb[1] > rgb[2] ? 1 : 2);
   float z = rgb[l];
   float x = rgb[(l + 1) % 3] / z * (kRes - 1), y = rgb[(l + 2) % 3] / z * (kRes - 1);
   int xi = std::min(int(x), kRes - 2), yi = std::min(int(y), kRes - 2);
-  int zi = int(std::upper_bound(tab.z_nodes.begin(), tab.z_nodes.end(), z) - tab.z_nodes.begin()) - 1;
+  int zi = int(std::upper_bound(nodes.begin(), nodes.end(), z) - nodes.begin()) - 1;
   zi = std::clamp(zi, 0, kRes - 2);
   float dx = x - float(xi), dy = y - float(yi);
-  float dz = (z - tab.z_nodes[zi]) / (tab.z_nodes[zi + 1] - tab.z_nodes[zi]);
+  float dz = (z - nodes[size_t(zi)]) / (nodes[size_t(zi) + 1] - nodes[size_t(zi)]);
   float c[3];
   for (int k = 0; k < 3; ++k) {
-    auto co = [&](int a, int b, int d) { return tab.coefficients[tab.index(l, zi + a, yi + b, xi + d)][k]; };
+    auto co = [&](int a, int b, int d) {
+      return kRgbToSpectrumTable[rgb_to_spectrum_index(l, zi + a, yi + b, xi + d) + size_t(k)];
+    };
     auto lerp1 = [](float t, float a, float b) { return a + t * (b - a); };
     c[k] = lerp1(dz, lerp1(dy, lerp1(dx, co(0, 0, 0), co(0, 0, 1)), lerp1(dx, co(0, 1, 0), co(0, 1, 1))),
                  lerp1(dy, lerp1(dx, co(1, 0, 0), co(1, 0, 1)), lerp1(dx, co(1, 1, 0), co(1, 1, 1))));

@@ -3,9 +3,8 @@
 // Spectral Upsampling", 2019), as pbrt-v4 turns its RGB parameters into spectra:
 //   s(lambda) = S(c0 t^2 + c1 t + c2),  t = (lambda - 360) / (830 - 360),  S(x) = 1/2 + x / (2 sqrt(1 + x^2))
 // a sigmoid of a quadratic, bounded by [0, 1] like every reflectance, whose colour under D65 is the
-// given linear sRGB colour. The coefficients come from a table over the RGB cube built once per
-// process (about a second on 2 cores, the first time one is asked for) by Gauss-Newton fits in CIELAB,
-// and are interpolated trilinearly from it.
+// given linear sRGB colour. The coefficients come from a table over the RGB cube fitted at build time
+// (rgb_to_spectrum_table.h), and are interpolated trilinearly from it.
 #include <array>
 
 #include "candela/math/color.h"
@@ -20,8 +19,5 @@ struct SigmoidPolynomial {
 // The spectrum whose reflected D65 light has linear sRGB colour `rgb` (each component clamped to
 // [0, 1]). Grey is exact: the constant spectrum of that value.
 SigmoidPolynomial rgb_to_sigmoid(const RGB& rgb);
-
-// The table's resolution along each axis (pbrt-v4 uses 64).
-inline constexpr int kRgbToSpectrumResolution = 32;
 
 }  // namespace candela

@@ -5,9 +5,11 @@
 
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "candela/spectral/cie.h"
 #include "candela/spectral/rgb_to_spectrum.h"
+#include "candela/spectral/rgb_to_spectrum_table.h"
 #include "candela/spectral/wavelengths.h"
 #include "candela/testing/statistics.h"
 
@@ -70,6 +72,25 @@ TEST(RgbToSpectrum, GreyIsExactAndColoursRoundTrip) {
   for (float l = 360; l <= 830; l += 10) {
     EXPECT_GE(red(l), 0.0f);
     EXPECT_LE(red(l), 1.0f);
+  }
+}
+
+// The table the build fitted (apps/make_rgb_to_spectrum_table) is the fits' own: rows refitted here,
+// one per region and a corner row, agree with it (to rounding: the generator may be compiled with
+// other flags than the library).
+TEST(RgbToSpectrum, TheBuiltInTableIsTheFitsTable) {
+  constexpr int r = kRgbToSpectrumResolution;
+  std::vector<float> refit(kRgbToSpectrumTableSize, std::nanf(""));
+  const std::pair<int, int> rows[] = {{0, 0}, {1, r / 2}, {2, r - 1}, {0, 7}};
+  for (auto [l, yi] : rows) {
+    fit_rgb_to_spectrum_row(l, yi, refit.data());
+    for (int zi = 0; zi < r; ++zi)
+      for (int xi = 0; xi < r; ++xi)
+        for (int c = 0; c < 3; ++c) {
+          const size_t i = rgb_to_spectrum_index(l, zi, yi, xi) + size_t(c);
+          ASSERT_NEAR(kRgbToSpectrumTable[i], refit[i], 1e-4f * (1 + std::abs(refit[i])))
+              << "l " << l << " z " << zi << " y " << yi << " x " << xi << " c " << c;
+        }
   }
 }
 
