@@ -228,8 +228,7 @@ TEST_F(InterruptResume, TimeLimitWritesTheImageAndExits0) {
   EXPECT_EQ(meta.count("candela:interrupted"), 0u);
   long long spp = std::stoll(meta["candela:spp"]);
   EXPECT_GT(spp, 0);
-  EXPECT_LT(spp, 100000);
-  EXPECT_EQ(spp % 4, 0);
+  EXPECT_LT(spp, 100000);  // the last pass cut to what fitted: any count, the same in every pixel
 }
 
 TEST_F(InterruptResume, ClampBoundsEveryPixel) {

@@ -7,6 +7,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "candela/integrators/mlt.h"
 #include "candela/integrators/volpath.h"
 #include "candela/render/cluster.h"
 
@@ -65,8 +66,7 @@ AutoChoice choose_integrator(const Scene& scene, const RenderSettings& settings,
       pilot_settings.mlt.bootstrap = std::min(settings.mlt.bootstrap, std::max(1000, settings.mlt.bootstrap / 100));
       bootstrap_scale = double(settings.mlt.bootstrap) / double(pilot_settings.mlt.bootstrap);
       pilot_settings.spp = std::min(settings.spp, 256);
-      auto direct_spp = [](int spp) { return double(std::clamp(spp / 16, 16, 256)); };
-      direct_scale = direct_spp(settings.spp) / direct_spp(pilot_settings.spp);
+      direct_scale = double(mlt_direct_spp(settings.spp)) / double(mlt_direct_spp(pilot_settings.spp));
     }
     RenderOptions pilot = options;
     pilot.progress = false;
@@ -96,9 +96,16 @@ AutoChoice choose_integrator(const Scene& scene, const RenderSettings& settings,
     // MLT's set-up in the real render: its depth-0 pass and bootstrap scaled up; its normalisation
     // (a ninth of a time limit, else in proportion to the mutations, part of the work) is priced
     // below, once the remaining budget is known.
-    run.full_setup_seconds = mlt ? cluster.from_root(stats.mlt_direct_seconds) * direct_scale +
-                                       cluster.from_root(stats.mlt_bootstrap_seconds) * bootstrap_scale
-                                 : run.setup_seconds;
+    if (mlt) {
+      // The real depth-0 pass: its samples at the pilot's pace, but under a time limit at most its
+      // share of it (and at least the pilot's one pass).
+      const double direct = cluster.from_root(stats.mlt_direct_seconds);
+      double full_direct = direct * direct_scale;
+      if (time_limit > 0) full_direct = std::min(full_direct, std::max(direct, time_limit * kMltDirectTimeShare));
+      run.full_setup_seconds = full_direct + cluster.from_root(stats.mlt_bootstrap_seconds) * bootstrap_scale;
+    } else {
+      run.full_setup_seconds = run.setup_seconds;
+    }
     run.error = estimate_error(pilot_film, stats.mlt_normalization_relative_error);
     choice.pilot_seconds += run.seconds;
     choice.pilots.push_back(run);

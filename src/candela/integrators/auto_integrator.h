@@ -8,8 +8,8 @@
 // set-up, the bootstrap and normalisation, then counts twice and is priced in).
 //
 // The pilots aim at 10% of the budget together: with a time limit T each of n gets 0.1 T / n;
-// with an error target or spp, each gets kPilotSeconds (a pilot ends after a whole pass or round, so it
-// can take a little longer). MLT's pilot bootstraps with a hundredth of the paths (its set-up would
+// with an error target or spp, each gets kPilotSeconds (a time limit cuts a render's last pass to what
+// fits, but a pilot's first pass and MLT's set-up are not cut, so it can take a little longer). MLT's pilot bootstraps with a hundredth of the paths (its set-up would
 // otherwise take more than the slice on deep scenes) and renders its depth-0 pass at 16 spp; its full
 // set-up time is extrapolated part by part. Path and bdpt pilots render every k-th tile: their error
 // is scaled to the whole image's (but for bdpt's splats, which already cover it).

@@ -6,7 +6,8 @@
 // and its contribution is multiplied by the number of strategies of that depth.
 //
 //   0. Depth 0 (emission seen directly) is rendered as the path tracer does, into the film's pixel
-//      sums; the chains render the depths >= 1 on top of it.
+//      sums, with spp / 16 samples per pixel (16 to 256; under a time limit at most a twentieth of
+//      it); the chains render the depths >= 1 on top of it.
 //   1. Bootstrap: n_bootstrap x (max_depth + 1) independent states with their luminance. The
 //      brightness of each depth (its mean luminance over the film) is estimated separately, by
 //      max(n_bootstrap, mutations / 8) bidirectional samples (all strategies) through a jittered
@@ -25,11 +26,17 @@
 //
 // Chains are independent and their deposits are summed in fixed point, so the image is the same
 // for any number of threads.
+#include <algorithm>
+
 #include "candela/film/film.h"
 #include "candela/render/render_loop.h"
 #include "candela/scene/scene.h"
 
 namespace candela {
+
+// Depth 0's samples per pixel for `spp` mutations per pixel, and its most share of a time limit.
+inline int mlt_direct_spp(int spp) { return std::clamp(spp / 16, 16, 256); }
+inline constexpr double kMltDirectTimeShare = 1.0 / 20;
 
 // Integrator "mlt": renders settings.spp mutations per pixel into film's splats (and sets its
 // splat scale), on top of depth 0 rendered by the path tracer into its pixel sums.

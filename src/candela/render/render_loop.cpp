@@ -526,10 +526,15 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
     // soon as both halves have a few samples (ZSobol's replicas 8 each, independent samples 4), so
     // that a loose target is not overshot by a whole pass either.
     int64_t target_end = target && !set_based ? std::max<int64_t>(8, 2 * int64_t(pc.tile.half_block)) : settings.spp;
+    // With a time limit: where the samples that still fit in it end (predicted from the pace of the
+    // pass before), so that the last pass is cut to them rather than run whole past the limit. Not
+    // with set-based samplers, whose sets must not be cut short.
+    int64_t time_end = settings.spp;
     uint64_t least = options.only_x >= 0 ? film.pixel(options.only_x, options.only_y).count : film.min_samples();
     const int first_pass = int(std::min<uint64_t>(least, uint64_t(settings.spp)) / uint64_t(pass_spp)) * pass_spp;
     for (int pass = first_pass, end = 0; pass < settings.spp; pass = end) {
-      end = int(std::min<int64_t>({int64_t(pass) + pass_spp, int64_t(settings.spp), std::max<int64_t>(target_end, pass + 1)}));
+      end = int(std::min<int64_t>({int64_t(pass) + pass_spp, int64_t(settings.spp), std::max<int64_t>(target_end, pass + 1),
+                                   std::max<int64_t>(time_end, pass + 1)}));
       const auto pass_start = std::chrono::steady_clock::now();
       run_pass(pc, tiles, arena,
                [&](int x, int y) {
@@ -539,6 +544,19 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
                progress);
       if (options.live) options.live->pass_done(film);
       bool stop = stop_after_pass(end < settings.spp);
+      if (!stop && options.time_limit_seconds > 0 && !set_based && end < settings.spp) {
+        // The root's clock decides, so that every rank cuts the same pass.
+        const auto now = std::chrono::steady_clock::now();
+        const double left = options.time_limit_seconds - std::chrono::duration<double>(now - start).count();
+        const double per_spp = std::chrono::duration<double>(now - pass_start).count() / double(end - pass);
+        const double fits = cluster.from_root(per_spp > 0 ? std::floor(left / per_spp) : double(settings.spp));
+        if (fits < 1) {
+          stats.time_limited = true;
+          stop = true;
+        } else {
+          time_end = end + int64_t(std::min(fits, double(settings.spp)));
+        }
+      }
       if (target && !stop && end < settings.spp) {
         const double e = arena.execute([&] { return agreed_error_estimate(cluster, film); });
         if (e <= options.target_error) {

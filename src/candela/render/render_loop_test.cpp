@@ -64,18 +64,23 @@ TEST(RenderControl, StoppedAndContinuedFilmIsBitwiseTheUninterruptedOne) {
   EXPECT_TRUE(same_sums(part, full));
 }
 
-TEST(RenderControl, TimeLimitStopsAfterWholePasses) {
-  SceneDesc d = small_scene(1 << 20);
-  Scene scene(d);
-  Film film(d.film.width, d.film.height);
-  RenderOptions o = quiet_options();
-  o.time_limit_seconds = 0.05;
-  RenderStats s = render(scene, d.settings, film, o);
-  EXPECT_TRUE(s.time_limited);
-  EXPECT_GT(film.min_samples(), 0u);
-  EXPECT_EQ(film.min_samples(), film.max_samples());
-  EXPECT_EQ(film.min_samples() % 4, 0u);
-  EXPECT_LT(film.min_samples(), uint64_t(1 << 20));
+// A time limit stops the render with every pixel at the same count: after whole passes with a
+// set-based sampler (its sets are not cut), with others after a last pass cut to what fits.
+TEST(RenderControl, TimeLimitStopsWithEveryPixelAtTheSameCount) {
+  for (SamplerType type : {SamplerType::Stratified, SamplerType::Independent, SamplerType::ZSobol}) {
+    SceneDesc d = small_scene(1 << 20);
+    d.settings.sampler.type = type;
+    Scene scene(d);
+    Film film(d.film.width, d.film.height);
+    RenderOptions o = quiet_options();
+    o.time_limit_seconds = 0.05;
+    RenderStats s = render(scene, d.settings, film, o);
+    EXPECT_TRUE(s.time_limited);
+    EXPECT_GT(film.min_samples(), 0u);
+    EXPECT_EQ(film.min_samples(), film.max_samples());
+    if (type == SamplerType::Stratified) EXPECT_EQ(film.min_samples() % 16, 0u);
+    EXPECT_LT(film.min_samples(), uint64_t(1 << 20));
+  }
 }
 
 TEST(RenderControl, SinglePixelMatchesTheFullRender) {
