@@ -16,27 +16,40 @@ constexpr double kSystematic = 0.3;
 constexpr int kLocalRadius = 3;  // the 7x7 neighbourhood whose mean floors the truth
 constexpr int kFireflyRadius = 5;  // the 11x11 neighbourhood whose trimmed mean floors a firefly's truth
 
-// The mean of channel c of `mean` over the (2r+1)^2 pixels around (x, y), without its largest 1/24
-// (5 of 121): the fireflies among them.
-double trimmed_local_mean(const std::vector<double>& mean, int w, int h, int x, int y, int c, int r,
-                          std::vector<double>& scratch) {
-  scratch.clear();
-  for (int yy = std::max(0, y - r); yy <= std::min(h - 1, y + r); ++yy)
-    for (int xx = std::max(0, x - r); xx <= std::min(w - 1, x + r); ++xx) {
-      const double v = mean[3 * (size_t(yy) * size_t(w) + size_t(xx)) + size_t(c)];
-      if (!std::isnan(v)) scratch.push_back(v);
-    }
-  const size_t keep = scratch.size() - scratch.size() / 24;
-  if (keep == 0) return 0;
-  std::nth_element(scratch.begin(), scratch.begin() + std::ptrdiff_t(keep - 1), scratch.end());
-  double sum = 0;
-  for (size_t k = 0; k < keep; ++k) sum += scratch[k];
-  return sum / double(keep);
+// Per channel, the sums and counts of the values of `v` (3 values per pixel, NaN = no value) over the
+// (2r+1)^2 pixels around each pixel, separably.
+struct BoxSums {
+  std::vector<double> sums, counts;
+};
+BoxSums box_sums(const std::vector<double>& v, int w, int h, int r);
+
+// The mean of channel c of `mean` over the (2r+1)^2 pixels around (x, y) (`box` holds their sums and
+// counts), without its largest 1/24 (5 of 121): the fireflies among them.
+double trimmed_local_mean(const std::vector<double>& mean, const BoxSums& box, int w, int h, int x, int y, int c,
+                          int r) {
+  const size_t at = 3 * (size_t(y) * size_t(w) + size_t(x)) + size_t(c);
+  const size_t n = size_t(box.counts[at]), drop = n / 24;
+  if (n == drop) return 0;
+  // The `drop` largest values (at most a few): kept in descending order.
+  constexpr size_t kMostDropped = 8;
+  double largest[kMostDropped];
+  size_t held = 0;
+  if (drop > 0) {
+    for (int yy = std::max(0, y - r); yy <= std::min(h - 1, y + r); ++yy)
+      for (int xx = std::max(0, x - r); xx <= std::min(w - 1, x + r); ++xx) {
+        const double v = mean[3 * (size_t(yy) * size_t(w) + size_t(xx)) + size_t(c)];
+        if (std::isnan(v) || (held == std::min(drop, kMostDropped) && v <= largest[held - 1])) continue;
+        size_t k = held < std::min(drop, kMostDropped) ? held++ : held - 1;
+        for (; k > 0 && largest[k - 1] < v; --k) largest[k] = largest[k - 1];
+        largest[k] = v;
+      }
+  }
+  double dropped = 0;
+  for (size_t k = 0; k < held; ++k) dropped += largest[k];
+  return (box.sums[at] - dropped) / double(n - held);
 }
 
-// Per channel, the mean of `v` (3 values per pixel, NaN = no value) over the (2r+1)^2 pixels around
-// each pixel, separably.
-std::vector<double> box_mean(const std::vector<double>& v, int w, int h, int r) {
+BoxSums box_sums(const std::vector<double>& v, int w, int h, int r) {
   auto pass = [&](const std::vector<double>& sums, const std::vector<double>& counts, bool along_y,
                   std::vector<double>& out_sums, std::vector<double>& out_counts) {
     out_sums.assign(sums.size(), 0);
@@ -60,11 +73,18 @@ std::vector<double> box_mean(const std::vector<double>& v, int w, int h, int r) 
     sums[i] = has ? v[i] : 0;
     counts[i] = has ? 1 : 0;
   }
-  std::vector<double> row_sums, row_counts, box_sums, box_counts;
+  std::vector<double> row_sums, row_counts;
+  BoxSums box;
   pass(sums, counts, false, row_sums, row_counts);
-  pass(row_sums, row_counts, true, box_sums, box_counts);
-  for (size_t i = 0; i < v.size(); ++i) box_sums[i] = box_counts[i] > 0 ? box_sums[i] / box_counts[i] : 0;
-  return box_sums;
+  pass(row_sums, row_counts, true, box.sums, box.counts);
+  return box;
+}
+
+// Per channel, the mean of `v` (NaN = no value) over the (2r+1)^2 pixels around each pixel.
+std::vector<double> box_mean(const std::vector<double>& v, int w, int h, int r) {
+  BoxSums box = box_sums(v, w, h, r);
+  for (size_t i = 0; i < v.size(); ++i) box.sums[i] = box.counts[i] > 0 ? box.sums[i] / box.counts[i] : 0;
+  return box.sums;
 }
 }  // namespace
 
@@ -141,6 +161,7 @@ ErrorEstimate estimate_error(const Film& film, double scale_relative_error, std:
   // 3.9-6.1 -> 1.18-1.22, at 64 spp 1.61-2.57 -> 0.98-1.20; within 0.03 elsewhere
   // (docs/error-estimates.md).
   const std::vector<double> local = box_mean(mean, w, h, kLocalRadius);
+  const BoxSums firefly_box = box_sums(mean, w, h, kFireflyRadius);
   // Rows in parallel, their sums added in row order: the same estimate for any number of threads.
   struct RowSums {
     double sum = 0, sum_sq = 0, splat_sum = 0;
@@ -148,7 +169,6 @@ ErrorEstimate estimate_error(const Film& film, double scale_relative_error, std:
   };
   std::vector<RowSums> rows(static_cast<size_t>(h));
   tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& range) {
-    std::vector<double> scratch;
     double around[8];
     for (int y = range.begin(); y < range.end(); ++y) {
       RowSums& row = rows[size_t(y)];
@@ -181,7 +201,7 @@ ErrorEstimate estimate_error(const Film& film, double scale_relative_error, std:
           const double capped = std::max(std::min(own, brightest), lesser);
           double truth_sq = std::max({capped * capped - var / 2, capped * capped / 2, lesser * lesser});
           if (firefly) {
-            const double floor = trimmed_local_mean(mean, w, h, x, y, c, kFireflyRadius, scratch);
+            const double floor = trimmed_local_mean(mean, firefly_box, w, h, x, y, c, kFireflyRadius);
             truth_sq = std::max(truth_sq, floor * floor);
           }
           pixel_error += var / (truth_sq + kErrorEpsilon);
