@@ -525,7 +525,10 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
     // falls as 1 / spp), so that the last pass does not overshoot by much; the first estimate as
     // soon as both halves have a few samples (ZSobol's replicas 8 each, independent samples 4), so
     // that a loose target is not overshot by a whole pass either.
+    // The estimate is checked there, or where the spp has doubled since the last check (a pass over
+    // the pixels each time: not after every pass of a long render).
     int64_t target_end = target && !set_based ? std::max<int64_t>(8, 2 * int64_t(pc.tile.half_block)) : settings.spp;
+    int64_t last_check = 0;
     // With a time limit: where the samples that still fit in it end (predicted from the pace of the
     // pass before), so that the last pass is cut to them rather than run whole past the limit. Not
     // with set-based samplers, whose sets must not be cut short.
@@ -557,7 +560,8 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
           time_end = end + int64_t(std::min(fits, double(settings.spp)));
         }
       }
-      if (target && !stop && end < settings.spp) {
+      if (target && !stop && end < settings.spp && (end >= target_end || end >= 2 * last_check)) {
+        last_check = end;
         const double e = arena.execute([&] { return agreed_error_estimate(cluster, film); });
         if (e <= options.target_error) {
           stats.reached_target = true;
