@@ -15,6 +15,7 @@ namespace {
 constexpr double kSystematic = 0.3;
 constexpr int kLocalRadius = 3;  // the 7x7 neighbourhood whose mean floors the truth
 constexpr int kFireflyRadius = 5;  // the 11x11 neighbourhood whose trimmed mean floors a firefly's truth
+constexpr size_t kMostDropped = 8;  // the most fireflies left out of that mean
 
 // Per channel, the sums and counts of the values of `v` (3 values per pixel, NaN = no value) over the
 // (2r+1)^2 pixels around each pixel, separably.
@@ -31,7 +32,6 @@ double trimmed_local_mean(const std::vector<double>& mean, const BoxSums& box, i
   const size_t n = size_t(box.counts[at]), drop = n / 24;
   if (n == drop) return 0;
   // The `drop` largest values (at most a few): kept in descending order.
-  constexpr size_t kMostDropped = 8;
   double largest[kMostDropped];
   size_t held = 0;
   if (drop > 0) {
@@ -49,34 +49,53 @@ double trimmed_local_mean(const std::vector<double>& mean, const BoxSums& box, i
   return (box.sums[at] - dropped) / double(n - held);
 }
 
+// Whether the trimmed mean around a pixel (at `at`, own mean `own`) could raise truth_sq: without
+// the scan over the window when a bound on it says not. Removing the largest values never raises a
+// mean, and where no mean is negative the removed ones sum to at least the pixel's own.
+bool floor_can_matter(const BoxSums& box, size_t at, double own, bool any_negative, double truth_sq) {
+  const double n = box.counts[at], held = std::min(std::floor(n / 24), double(kMostDropped));
+  if (any_negative || held == 0 || n == held) return true;
+  const double bound = (box.sums[at] - own) / (n - held);
+  return bound * bound > truth_sq;
+}
+
 BoxSums box_sums(const std::vector<double>& v, int w, int h, int r) {
-  auto pass = [&](const std::vector<double>& sums, const std::vector<double>& counts, bool along_y,
-                  std::vector<double>& out_sums, std::vector<double>& out_counts) {
-    out_sums.assign(sums.size(), 0);
-    out_counts.assign(counts.size(), 0);
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const int at = along_y ? y : x, size = along_y ? h : w;
-        for (int k = std::max(0, at - r); k <= std::min(size - 1, at + r); ++k) {
-          const size_t from = along_y ? size_t(k) * size_t(w) + size_t(x) : size_t(y) * size_t(w) + size_t(k);
-          const size_t to = size_t(y) * size_t(w) + size_t(x);
+  const size_t row = 3 * size_t(w);
+  // Along x: each row's window sums; then along y: each output row adds the rows of its window
+  // (contiguous, so the compiler vectorises it). Rows in parallel; the same sums for any thread count.
+  std::vector<double> row_sums(v.size()), row_counts(v.size());
+  tbb::parallel_for(tbb::blocked_range<int>(0, h, 16), [&](const tbb::blocked_range<int>& range) {
+    for (int y = range.begin(); y < range.end(); ++y) {
+      const double* in = v.data() + size_t(y) * row;
+      double* sums = row_sums.data() + size_t(y) * row;
+      double* counts = row_counts.data() + size_t(y) * row;
+      for (int x = 0; x < w; ++x)
+        for (int k = std::max(0, x - r); k <= std::min(w - 1, x + r); ++k)
           for (int c = 0; c < 3; ++c) {
-            out_sums[3 * to + size_t(c)] += sums[3 * from + size_t(c)];
-            out_counts[3 * to + size_t(c)] += counts[3 * from + size_t(c)];
+            const double value = in[3 * size_t(k) + size_t(c)];
+            const bool has = !std::isnan(value);
+            sums[3 * size_t(x) + size_t(c)] += has ? value : 0;
+            counts[3 * size_t(x) + size_t(c)] += has ? 1 : 0;
           }
+    }
+  });
+  BoxSums box;
+  box.sums.assign(v.size(), 0);
+  box.counts.assign(v.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, h, 16), [&](const tbb::blocked_range<int>& range) {
+    for (int y = range.begin(); y < range.end(); ++y) {
+      double* sums = box.sums.data() + size_t(y) * row;
+      double* counts = box.counts.data() + size_t(y) * row;
+      for (int k = std::max(0, y - r); k <= std::min(h - 1, y + r); ++k) {
+        const double* from_sums = row_sums.data() + size_t(k) * row;
+        const double* from_counts = row_counts.data() + size_t(k) * row;
+        for (size_t i = 0; i < row; ++i) {
+          sums[i] += from_sums[i];
+          counts[i] += from_counts[i];
         }
       }
-  };
-  std::vector<double> sums(v.size()), counts(v.size());
-  for (size_t i = 0; i < v.size(); ++i) {
-    const bool has = !std::isnan(v[i]);
-    sums[i] = has ? v[i] : 0;
-    counts[i] = has ? 1 : 0;
-  }
-  std::vector<double> row_sums, row_counts;
-  BoxSums box;
-  pass(sums, counts, false, row_sums, row_counts);
-  pass(row_sums, row_counts, true, box.sums, box.counts);
+    }
+  });
   return box;
 }
 
@@ -104,37 +123,55 @@ ErrorEstimate estimate_error(const Film& film, double scale_relative_error, std:
   // pixel has no samples (not rendered) or lacks a half.
   std::vector<double> mean(3 * n, std::nan("")), variance(3 * n, std::nan("")), lesser_half(3 * n, 0);
   std::vector<double> splat_variance(splats ? 3 * n : 0, 0);  // of the splats' part alone
-  uint64_t missing = 0, rendered = 0;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const size_t i = size_t(y) * size_t(w) + size_t(x);
-      const PixelSums& p = film.pixel(x, y);
-      if (p.count == 0) continue;  // not rendered (a part, one pixel)
-      ++rendered;
-      const double w_a = p.half_weight, w_b = p.weight - p.half_weight;
-      if (p.half_count == 0 || p.half_count == p.count || w_a == 0 || w_b == 0) {
-        ++missing;
-        continue;
-      }
-      // The pixel sums' share of the weight in the first half sets how the halves combine (the
-      // splats split about evenly too).
-      const double f = w_a / p.weight;
-      const RGB splat_all = splats ? film.splats().at(x, y) : RGB(0.0f);
-      const RGB splat_a = splats ? film.half_splats().at(x, y) : RGB(0.0f);
-      for (int c = 0; c < 3; ++c) {
-        const double s_all = double(splat_all[c]) * scale, s_a = double(splat_a[c]) * scale;
-        const double a = p.half_weighted[c] / w_a + (splats ? s_a / f_splat : 0);
-        const double b = (p.weighted[c] - p.half_weighted[c]) / w_b + (splats ? (s_all - s_a) / (1 - f_splat) : 0);
-        mean[3 * i + size_t(c)] = p.weighted[c] / p.weight + s_all;
-        lesser_half[3 * i + size_t(c)] = std::min(a, b);
-        if (splats) {
-          const double sa = s_a / f_splat, sb = (s_all - s_a) / (1 - f_splat);
-          splat_variance[3 * i + size_t(c)] = f_splat * (1 - f_splat) * (sa - sb) * (sa - sb);
+  // Rows in parallel, each writing its own pixels; per row, how many pixels were rendered and how
+  // many lack a half, and whether any mean is negative (a filter's negative lobe).
+  struct RowCounts {
+    uint64_t missing = 0, rendered = 0;
+    bool negative = false;
+  };
+  std::vector<RowCounts> row_counts(static_cast<size_t>(h));
+  tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& range) {
+    for (int y = range.begin(); y < range.end(); ++y) {
+      RowCounts& counts = row_counts[size_t(y)];
+      for (int x = 0; x < w; ++x) {
+        const size_t i = size_t(y) * size_t(w) + size_t(x);
+        const PixelSums& p = film.pixel(x, y);
+        if (p.count == 0) continue;  // not rendered (a part, one pixel)
+        ++counts.rendered;
+        const double w_a = p.half_weight, w_b = p.weight - p.half_weight;
+        if (p.half_count == 0 || p.half_count == p.count || w_a == 0 || w_b == 0) {
+          ++counts.missing;
+          continue;
         }
-        variance[3 * i + size_t(c)] = f * (1 - f) * (a - b) * (a - b) +
-                                      scale_relative_error * scale_relative_error * s_all * s_all;
+        // The pixel sums' share of the weight in the first half sets how the halves combine (the
+        // splats split about evenly too).
+        const double f = w_a / p.weight;
+        const RGB splat_all = splats ? film.splats().at(x, y) : RGB(0.0f);
+        const RGB splat_a = splats ? film.half_splats().at(x, y) : RGB(0.0f);
+        for (int c = 0; c < 3; ++c) {
+          const double s_all = double(splat_all[c]) * scale, s_a = double(splat_a[c]) * scale;
+          const double a = p.half_weighted[c] / w_a + (splats ? s_a / f_splat : 0);
+          const double b = (p.weighted[c] - p.half_weighted[c]) / w_b + (splats ? (s_all - s_a) / (1 - f_splat) : 0);
+          mean[3 * i + size_t(c)] = p.weighted[c] / p.weight + s_all;
+          counts.negative = counts.negative || mean[3 * i + size_t(c)] < 0;
+          lesser_half[3 * i + size_t(c)] = std::min(a, b);
+          if (splats) {
+            const double sa = s_a / f_splat, sb = (s_all - s_a) / (1 - f_splat);
+            splat_variance[3 * i + size_t(c)] = f_splat * (1 - f_splat) * (sa - sb) * (sa - sb);
+          }
+          variance[3 * i + size_t(c)] =
+              f * (1 - f) * (a - b) * (a - b) + scale_relative_error * scale_relative_error * s_all * s_all;
+        }
       }
     }
+  });
+  uint64_t missing = 0, rendered = 0;
+  bool any_negative = false;
+  for (const RowCounts& counts : row_counts) {
+    missing += counts.missing;
+    rendered += counts.rendered;
+    any_negative = any_negative || counts.negative;
+  }
   // A few pixels may lack a half (adaptive sampling's pixels that got one batch); most may not.
   if (rendered == 0 || missing * 100 > rendered) {
     e.why_not = rendered == 0 ? "no pixel has samples"
@@ -200,7 +237,7 @@ ErrorEstimate estimate_error(const Film& film, double scale_relative_error, std:
           if (brightest <= 0 && lesser <= 0) brightest = local[3 * i + size_t(c)];
           const double capped = std::max(std::min(own, brightest), lesser);
           double truth_sq = std::max({capped * capped - var / 2, capped * capped / 2, lesser * lesser});
-          if (firefly) {
+          if (firefly && floor_can_matter(firefly_box, 3 * i + size_t(c), own, any_negative, truth_sq)) {
             const double floor = trimmed_local_mean(mean, firefly_box, w, h, x, y, c, kFireflyRadius);
             truth_sq = std::max(truth_sq, floor * floor);
           }
