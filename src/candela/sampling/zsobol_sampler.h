@@ -182,18 +182,22 @@ class ZSobolSampler {
     low_reversed_ = log2_n_ == 0 ? 0 : sobol::reverse_bits32(uint32_t(index_in_set)) >> (32 - log2_n_);
     // The permuted digits above the sample index depend only on the pixel, the set and the
     // dimension: keep them while the same pixel's samples are drawn one after another. The
-    // dimensions' hashes and scramble seeds depend on the set alone.
-    if (set != cached_set_) {
+    // dimensions' hashes and scramble seeds depend on the set alone. With replicas a pixel's samples
+    // alternate between two sets every 8 samples: each replica keeps its own (the set's low bit is
+    // the replica), so that neither is recomputed at every switch (8% of a render at 16 spp a pass).
+    cache_index_ = int(set & (replicas_ ? 1 : 0));
+    SetCache& cache = caches_[size_t(cache_index_)];
+    if (set != cache.set) {
       uint64_t set_seed = hash_values(seed_, set);
       for (int d = 0; d < kScrambledDimensions; ++d) {
-        dimension_hashes_[size_t(d)] = hash_values(set_seed, uint64_t(d));
-        scramble_seeds_[size_t(d)] = scramble_seeds(dimension_hashes_[size_t(d)]);
+        cache.dimension_hashes[size_t(d)] = hash_values(set_seed, uint64_t(d));
+        cache.scramble_seeds[size_t(d)] = scramble_seeds(cache.dimension_hashes[size_t(d)]);
       }
     }
-    if (pixel_code != cached_pixel_ || set != cached_set_) {
-      cached_pixel_ = pixel_code;
-      cached_set_ = set;
-      cached_dimensions_ = 0;
+    if (pixel_code != cache.pixel || set != cache.set) {
+      cache.pixel = pixel_code;
+      cache.set = set;
+      cache.dimensions = 0;
     }
     dimension_ = 0;
   }
@@ -204,7 +208,7 @@ class ZSobolSampler {
     const PixelPart& pixel = pixel_part(d);
     const uint32_t low = scrambled_low_index(pixel.low_seed);
     return scrambled_sample(pixel.sobol_reversed[0] ^ low_tables_->product_reversed(low, 0),
-                            uint32_t(scramble_seeds_[size_t(d)]));
+                            uint32_t(caches_[size_t(cache_index_)].scramble_seeds[size_t(d)]));
   }
 
   Vec2 get_2d() {
@@ -217,7 +221,7 @@ class ZSobolSampler {
     dimension_ += 2;
     const PixelPart& pixel = pixel_part(d);
     const uint32_t low = scrambled_low_index(pixel.low_seed);
-    const uint64_t seeds = scramble_seeds_[size_t(d)];
+    const uint64_t seeds = caches_[size_t(cache_index_)].scramble_seeds[size_t(d)];
     return {scrambled_sample(pixel.sobol_reversed[0] ^ low_tables_->product_reversed(low, 0), uint32_t(seeds)),
             scrambled_sample(pixel.sobol_reversed[1] ^ low_tables_->product_reversed(low, 1), uint32_t(seeds >> 32))};
   }
@@ -257,15 +261,16 @@ class ZSobolSampler {
   };
   const PixelPart& pixel_part(int d) {
     const uint64_t bit = uint64_t(1) << d;
-    PixelPart& part = pixel_parts_[size_t(d)];
-    if (!(cached_dimensions_ & bit)) {
-      const uint64_t dimension_hash = dimension_hashes_[size_t(d)];
+    SetCache& cache = caches_[size_t(cache_index_)];
+    PixelPart& part = cache.pixel_parts[size_t(d)];
+    if (!(cache.dimensions & bit)) {
+      const uint64_t dimension_hash = cache.dimension_hashes[size_t(d)];
       const int first_pixel_digit = (log2_n_ + 1) / 2;  // digit i spans bits 2i - odd, 2i - odd + 1
       const uint64_t high = permuted_pixel_digits(dimension_hash, first_pixel_digit);
       part.sobol_reversed[0] = sobol::reverse_bits32(sobol::sample_bits(high, 0));
       part.sobol_reversed[1] = sobol::reverse_bits32(sobol::sample_bits(high, 1));
       part.low_seed = uint32_t(hash_values(dimension_hash, morton_index_ >> log2_n_));
-      cached_dimensions_ |= bit;
+      cache.dimensions |= bit;
     }
     return part;
   }
@@ -342,10 +347,15 @@ class ZSobolSampler {
   std::array<int, 2> rng_pixel_{};
   uint64_t rng_sample_ = 0;
   bool rng_seeded_ = false;
-  uint64_t cached_pixel_ = ~uint64_t(0), cached_set_ = ~uint64_t(0);
-  uint64_t cached_dimensions_ = 0;  // bit d: pixel_parts_[d] is valid
-  std::array<PixelPart, kScrambledDimensions> pixel_parts_{};
-  std::array<uint64_t, kScrambledDimensions> dimension_hashes_{}, scramble_seeds_{};
+  // What start_pixel_sample keeps for a set and a pixel; one per replica.
+  struct SetCache {
+    uint64_t pixel = ~uint64_t(0), set = ~uint64_t(0);
+    uint64_t dimensions = 0;  // bit d: pixel_parts[d] is valid
+    std::array<PixelPart, kScrambledDimensions> pixel_parts{};
+    std::array<uint64_t, kScrambledDimensions> dimension_hashes{}, scramble_seeds{};
+  };
+  std::array<SetCache, 2> caches_;
+  int cache_index_ = 0;  // the current sample's
 };
 
 }  // namespace candela
