@@ -522,10 +522,8 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
     // With a time limit, the next round is cut to the mutations that still fit in it at this round's
     // pace, so that the render ends at the limit, not a round past it.
     if (mutations_per_chain < per_chain && options.time_limit_seconds > 0) {
-      const double left = cluster.from_root(
-          options.time_limit_seconds -
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count());
-      const double fits = round_seconds > 0 ? std::floor(left / (round_seconds / double(steps))) : double(round_length);
+      const double fits = units_fitting_in_time_limit(cluster, options.time_limit_seconds, start_time, round_seconds,
+                                                      double(steps), double(round_length));
       if (fits < 1) {
         stats.time_limited = true;
         break;

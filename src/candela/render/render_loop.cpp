@@ -433,6 +433,14 @@ void NonFiniteLog::add(int x, int y, uint64_t s) {
   if (samples_.size() > limit_) samples_.pop_back();
 }
 
+double units_fitting_in_time_limit(Cluster& cluster, double time_limit_seconds,
+                                   std::chrono::steady_clock::time_point start, double last_seconds,
+                                   double last_units, double if_unknown) {
+  const double left =
+      time_limit_seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return cluster.from_root(last_seconds > 0 ? std::floor(left / (last_seconds / last_units)) : if_unknown);
+}
+
 double agreed_error_estimate(Cluster& cluster, const Film& film, double scale_relative_error) {
   double e = std::numeric_limits<double>::infinity();
   auto estimate = [&](const Film& f) {
@@ -554,11 +562,10 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
       if (options.live) options.live->pass_done(film);
       bool stop = stop_after_pass(end < settings.spp);
       if (!stop && options.time_limit_seconds > 0 && !set_based && end < settings.spp) {
-        // The root's clock decides, so that every rank cuts the same pass.
-        const auto now = std::chrono::steady_clock::now();
-        const double left = options.time_limit_seconds - std::chrono::duration<double>(now - start).count();
-        const double per_spp = std::chrono::duration<double>(now - pass_start).count() / double(end - pass);
-        const double fits = cluster.from_root(per_spp > 0 ? std::floor(left / per_spp) : double(settings.spp));
+        const double fits = units_fitting_in_time_limit(
+            cluster, options.time_limit_seconds, start,
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - pass_start).count(), double(end - pass),
+            double(settings.spp));
         if (fits < 1) {
           stats.time_limited = true;
           stop = true;

@@ -18,6 +18,7 @@
 // An integrator gives the loop a TileIntegrator (usually CameraSampleTiles, render/camera_sample_tiles.h,
 // around its radiance function); integrators/integrator.h chooses the integrator.
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <mutex>
@@ -199,6 +200,14 @@ void exchange_items(Cluster& cluster, const std::vector<uint8_t>& mine,
 // by the root and agreed. Across ranks, where each rank's film holds only its own splats, they are
 // added up first (in a copy).
 double agreed_error_estimate(Cluster& cluster, const Film& film, double scale_relative_error = 0);
+
+// With a time limit started at `start`: how many more units of work (a pass's spp, MLT's mutations
+// per chain) fit in what is left of it, at the pace of the last `last_units`, which took
+// `last_seconds` (`if_unknown` when that took no measurable time). The root's clock decides, so that
+// every rank cuts the same pass. Below 1: none fits.
+double units_fitting_in_time_limit(Cluster& cluster, double time_limit_seconds,
+                                   std::chrono::steady_clock::time_point start, double last_seconds,
+                                   double last_units, double if_unknown);
 
 // The tiles a film is cut into, in the order the loop hands them out (row by row of tiles).
 std::vector<Tile> make_tiles(int width, int height);
