@@ -236,6 +236,30 @@ TEST(SamplerZSobol, AlignedPixelQuadsTogetherFormALargerNet) {
   }
 }
 
+// With replicas a pixel's samples switch replica every 8 and each replica keeps its own per-pixel
+// state: drawn in order, pixel after pixel, every sample must be the one a fresh sampler draws for
+// it alone (no state of the other replica or of the previous pixel left behind), each replica's
+// block of 8 a net, and the two replicas different randomisations.
+TEST(SamplerZSobol, ReplicasDrawTheSameSamplesWhateverCameBefore) {
+  auto make_replicas = [] {
+    return make_sampler(SamplerDesc{SamplerType::ZSobol, true, true}, 32, 5, kImageSize, kImageSize);
+  };
+  Sampler in_order = make_replicas();
+  for (auto [x, y] : {std::pair{3, 7}, {4, 7}, {3, 8}, {60, 1}}) {
+    auto draws = draw_pixel(in_order, x, y, 0, 40);
+    for (int i = 0; i < 40; ++i) {
+      Sampler fresh = make_replicas();
+      EXPECT_EQ(draws[size_t(i)], draw_sample(fresh, x, y, uint64_t(i))) << x << "," << y << " sample " << i;
+    }
+    for (int block = 0; block < 4; ++block) {
+      std::vector<std::vector<float>> eight(draws.begin() + 8 * block, draws.begin() + 8 * block + 8);
+      for (int slot : k2DSlots) EXPECT_TRUE(is_02_net(slot_points(eight, slot), 3)) << block << " " << slot;
+    }
+    EXPECT_NE(std::vector<std::vector<float>>(draws.begin(), draws.begin() + 8),
+              std::vector<std::vector<float>>(draws.begin() + 8, draws.begin() + 16));
+  }
+}
+
 // ---------------------------------------------------------------- poisson
 
 double min_pairwise_distance(const std::vector<Vec2>& points) {
