@@ -224,7 +224,7 @@ int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RG
         // as light vertices, so its MIS weight is 1. A path of depth n - 1, as volpath counts it
         // (there, at every tentative collision of a segment).
         if (crossed_emission && m.is_emissive() && n - 1 <= max_depth_)
-          crossed_emission[n + 1] += beta * (RGB(1.0f) - albedo) * illuminant_at(m.emission(), wl);
+          crossed_emission[n + 1] += beta * (RGB(1.0f) - albedo) * illuminant_at(m.emission(v.p), wl);
         beta *= albedo;
         v.beta = beta;
         v.pdf_fwd = convert_density(pdf_fwd, prev, v);

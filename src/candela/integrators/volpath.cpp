@@ -27,14 +27,15 @@ RGB clamp_zero(const RGB& c) { return {std::max(c.r, 0.0f), std::max(c.g, 0.0f),
 struct MediumValues {
   const Medium& medium;
   const Wavelengths* wl;
-  RGB sigma_t, albedo, emission;
+  RGB sigma_t, albedo;
   MediumValues(const Medium& m, const Wavelengths* w)
       : medium(m),
         wl(w),
         sigma_t(w ? unbounded_at(m.sigma_t(), *w) : m.sigma_t()),
         albedo(m.has_albedo_grid() ? RGB(0.0f)  // looked up per point instead
-                                   : w ? reflectance_at(m.albedo(Point3(0.0f)), *w) : m.albedo(Point3(0.0f))),
-        emission(illuminant_at(m.emission(), w)) {}
+                                   : w ? reflectance_at(m.albedo(Point3(0.0f)), *w) : m.albedo(Point3(0.0f))) {}
+  // The radiance emitted at p, at the path's wavelengths.
+  RGB emission(const Point3& p) const { return illuminant_at(medium.emission(p), wl); }
   MediumPoint at(const Point3& p) const {
     RGB st = sigma_t * medium.density(p);
     RGB a = albedo;
@@ -163,7 +164,7 @@ RGB VolPathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, co
             if (depth <= max_depth_ && m.is_emissive()) {
               float pdf = sigma_maj[hero] * T[hero];
               RGB r_e = r_u * sigma_maj * T / pdf;
-              if (!r_e.is_black()) L += beta * T / pdf * mp.sigma_a * mv.emission / r_e.average();
+              if (!r_e.is_black()) L += beta * T / pdf * mp.sigma_a * mv.emission(p) / r_e.average();
             }
             // A real collision (with probability sigma_t over the majorant) scatters, its weight
             // the albedo: absorption is taken as a weight, not by ending paths (as Mitsuba's

@@ -130,6 +130,58 @@ TEST(VolPath, AnEmittingAbsorbingMediumGivesLeTimesOneMinusItsTransmittance) {
   expect_channels(render_means(medium_in_sphere(medium, RGB(0.0f))), expected, "emitting absorber");
 }
 
+TEST(VolPath, AGlowingTemperatureGridGivesTheQuadratureOfItsEmission) {
+  // An absorbing slab whose density, temperature and emission scale vary with depth (pbrt-v4's
+  // blackbody emission from a temperature grid), seen along its depth by an orthographic camera
+  // against black: L = integral of sigma_a(z) Le(z) exp(-optical depth to z) dz, by quadrature.
+  SceneDesc d = volpath_scene(8, 64);
+  d.camera.projection = Projection::Orthographic;
+  d.camera.world_from_camera = Transform::look_at_right_handed({0, 0, -3}, {0, 0, 0}, {0, 1, 0});
+  MediumDesc fire;
+  fire.sigma_t = {1.0f, 1.5f, 0.7f};
+  fire.albedo.constant = RGB(0.0f);
+  const Transform box = Transform::translate({-5, -5, -0.5f}) * Transform::scale({10, 10, 1});
+  auto column = [&](std::vector<float> v) {
+    VolumeDesc g;
+    g.resolution = {1, 1, int(v.size())};
+    g.values = std::make_shared<const std::vector<float>>(std::move(v));
+    g.to_world = box;
+    return g;
+  };
+  fire.density = column({0.5f, 1.0f, 2.0f, 0.7f});
+  fire.temperature = column({1500, 3000, 6000, 2500});
+  fire.temperature_offset = 200;
+  fire.temperature_scale = 1.2f;
+  fire.emission_scale = column({2.0f, 1.0f, 0.5f, 3.0f});
+  d.media = {fire};
+  d.materials = {InterfaceMaterial{}};
+  ShapeDesc slab;
+  slab.geometry = BoxShape{{-5, -5, -0.5f}, {5, 5, 0.5f}};
+  slab.material = 0;
+  slab.interior_medium = 0;
+  d.shapes = {slab};
+  const Medium medium(fire);
+  ASSERT_TRUE(medium.is_emissive());
+  RGB expected(0.0f);
+  double depth[3] = {0, 0, 0};
+  const int steps = 100000;
+  for (int i = 0; i < steps; ++i) {
+    const float z = -0.5f + (float(i) + 0.5f) / steps;
+    const Point3 p(0.1f, -0.2f, z);
+    const RGB le = medium.emission(p);
+    for (int c = 0; c < 3; ++c) {
+      const double sigma_a = double(medium.sigma_t()[c]) * medium.density(p), dz = 1.0 / steps;
+      expected[c] += float(sigma_a * le[c] * std::exp(-(depth[c] + 0.5 * sigma_a * dz)) * dz);
+      depth[c] += sigma_a * dz;
+    }
+  }
+  ASSERT_GT(expected.min_component(), 0.01f);
+  expect_channels(render_means(d), expected, "temperature grid, volpath", 1e-3f);
+  // BDPT takes the medium's light where its camera subpaths collide (the collision estimator).
+  d.settings.integrator = "bdpt";
+  expect_channels(render_means(d), expected, "temperature grid, bdpt", 1e-3f);
+}
+
 TEST(VolPath, EmittingWallsAndAnEmittingScatteringMediumAreInEquilibrium) {
   // Kirchhoff: walls and medium at the same "temperature" (both emit Le where they absorb) give Le
   // everywhere, whatever the albedo, the extinction's colour and the phase function.

@@ -177,27 +177,41 @@ std::vector<std::string> grid_names_in_file(const fs::path& file, const SourceLo
   return names;
 }
 
-void write_grid_file(const fs::path& file, const std::string& grid_name, const std::array<int, 3>& resolution,
-                     const std::vector<float>& values, float voxel_size, const std::array<int, 3>& offset) {
+void write_grid_file(const fs::path& file, const std::vector<NamedGridValues>& grids, const std::array<int, 3>& resolution,
+                     float voxel_size, const std::array<int, 3>& offset) {
   initialize_openvdb();
-  openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
-  grid->setName(grid_name);
-  grid->setGridClass(openvdb::GRID_FOG_VOLUME);
-  grid->setTransform(openvdb::math::Transform::createLinearTransform(voxel_size));
-  auto accessor = grid->getAccessor();
-  size_t k = 0;
-  for (int z = 0; z < resolution[2]; ++z)
-    for (int y = 0; y < resolution[1]; ++y)
-      for (int x = 0; x < resolution[0]; ++x, ++k)
-        if (values[k] != 0) accessor.setValue(openvdb::Coord(x + offset[0], y + offset[1], z + offset[2]), values[k]);
-  const std::string ext = lower_extension(file);
-  if (ext == ".nvdb") {
-    nanovdb::io::writeGrid(file.string(), nanovdb::openToNanoVDB(*grid));
+  openvdb::GridPtrVec vdb_grids;
+  std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> nano_grids;
+  const bool nano = lower_extension(file) == ".nvdb";
+  for (const NamedGridValues& named : grids) {
+    openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
+    grid->setName(named.name);
+    grid->setGridClass(openvdb::GRID_FOG_VOLUME);
+    grid->setTransform(openvdb::math::Transform::createLinearTransform(voxel_size));
+    auto accessor = grid->getAccessor();
+    size_t k = 0;
+    for (int z = 0; z < resolution[2]; ++z)
+      for (int y = 0; y < resolution[1]; ++y)
+        for (int x = 0; x < resolution[0]; ++x, ++k)
+          if (named.values[k] != 0)
+            accessor.setValue(openvdb::Coord(x + offset[0], y + offset[1], z + offset[2]), named.values[k]);
+    if (nano)
+      nano_grids.push_back(nanovdb::openToNanoVDB(*grid));
+    else
+      vdb_grids.push_back(grid);
+  }
+  if (nano) {
+    nanovdb::io::writeGrids(file.string(), nano_grids);
   } else {
     openvdb::io::File out(file.string());
-    out.write({grid});
+    out.write(vdb_grids);
     out.close();
   }
+}
+
+void write_grid_file(const fs::path& file, const std::string& grid_name, const std::array<int, 3>& resolution,
+                     const std::vector<float>& values, float voxel_size, const std::array<int, 3>& offset) {
+  write_grid_file(file, {{grid_name, values}}, resolution, voxel_size, offset);
 }
 
 }  // namespace candela

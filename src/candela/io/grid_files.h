@@ -34,5 +34,12 @@ std::vector<std::string> grid_names_in_file(const std::filesystem::path& file, c
 // size; zeros are left inactive. For tests, examples and benchmarks that make their own clouds.
 void write_grid_file(const std::filesystem::path& file, const std::string& grid_name, const std::array<int, 3>& resolution,
                      const std::vector<float>& values, float voxel_size, const std::array<int, 3>& offset = {0, 0, 0});
+// The same with several grids of the same placement in one file ("density" and "temperature").
+struct NamedGridValues {
+  std::string name;
+  std::vector<float> values;
+};
+void write_grid_file(const std::filesystem::path& file, const std::vector<NamedGridValues>& grids,
+                     const std::array<int, 3>& resolution, float voxel_size, const std::array<int, 3>& offset = {0, 0, 0});
 
 }  // namespace candela

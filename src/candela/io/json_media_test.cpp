@@ -119,6 +119,43 @@ TEST(JsonMedia, InlineGrids) {
   EXPECT_EQ(constant.albedo.constant, RGB(0.9f));
 }
 
+// Emission that varies: a temperature's blackbody (pbrt-v4's) and an emission scale, each a number
+// or a grid, with pbrt-v4's temperature mapping.
+TEST(JsonMedia, TemperatureAndEmissionScale) {
+  SceneDesc scene = read(with_media(R"({
+    "fire": {"type": "grid", "sigma_t": 1, "albedo": 0, "density": 1,
+             "temperature": {"resolution": [2, 1, 1], "values": [1500, 3000]},
+             "emission_scale": 2, "temperature_scale": 1.5, "temperature_offset": 100, "temperature_cutoff": 200},
+    "ember": {"type": "homogeneous", "sigma_t": 1, "albedo": 0, "temperature": 2000,
+              "emission_scale": {"resolution": [1, 1, 2], "values": [0, 1]}}})"));
+  ASSERT_EQ(scene.media.size(), 2u);
+  const MediumDesc& fire = scene.media[0];
+  ASSERT_TRUE(fire.temperature.has_value());
+  EXPECT_EQ(*fire.temperature->values, (std::vector<float>{1500, 3000}));
+  EXPECT_EQ(fire.emission_scale.constant, RGB(2.0f));
+  EXPECT_FLOAT_EQ(fire.temperature_scale, 1.5f);
+  EXPECT_FLOAT_EQ(fire.temperature_offset, 100);
+  EXPECT_FLOAT_EQ(fire.temperature_cutoff, 200);
+  const MediumDesc& ember = scene.media[1];
+  ASSERT_TRUE(ember.temperature.has_value());
+  EXPECT_TRUE(ember.temperature->is_constant());
+  EXPECT_EQ(ember.temperature->constant, RGB(2000.0f));
+  EXPECT_EQ(*ember.emission_scale.values, (std::vector<float>{0, 1}));
+  EXPECT_FALSE(scene.media.empty());
+  // Errors name the place.
+  expect_error_containing(with_medium(R"({"type": "homogeneous", "sigma_t": 1, "temperature": 2000, "emission": 1})"),
+                          "at /media/m/temperature: a medium emits its \"temperature\"'s blackbody or \"emission\", not both");
+  expect_error_containing(with_medium(R"({"type": "homogeneous", "sigma_t": 1, "emission_scale": -1})"),
+                          "at /media/m/emission_scale");
+  expect_error_containing(
+      with_medium(R"({"type": "homogeneous", "sigma_t": 1, "temperature": {"resolution": [1, 1, 1], "channels": 3,
+                                                                           "values": [1, 2, 3]}})"),
+      "temperature needs 1");
+  expect_error_containing(
+      with_medium(R"({"type": "homogeneous", "sigma_t": 1, "emission_scale": {"resolution": [2, 1, 1], "values": [1, -1]}})"),
+      "emission_scale value -1 (number 1) must be finite and >= 0");
+}
+
 TEST(JsonMedia, GridsFromVolFiles) {
   VolumeFiles files;
   files.write("density.vol", {2, 2, 1}, 1, {0, 1, 2, 3});

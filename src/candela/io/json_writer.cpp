@@ -305,6 +305,14 @@ Json medium_json(const MediumDesc& m) {
   if (!homogeneous && m.majorant_cell_samples != MediumDesc{}.majorant_cell_samples)
     j["majorant_cell_samples"] = m.majorant_cell_samples;
   if (!m.emission.is_black()) j["emission"] = rgb(m.emission);
+  auto scalar_or_grid = [](const VolumeDesc& v) { return v.is_constant() ? Json(v.constant.r) : volume_json(v); };
+  if (!(m.emission_scale.is_constant() && m.emission_scale.constant.r == 1))
+    j["emission_scale"] = scalar_or_grid(m.emission_scale);
+  if (m.temperature) j["temperature"] = scalar_or_grid(*m.temperature);
+  const MediumDesc defaults;
+  if (m.temperature_scale != defaults.temperature_scale) j["temperature_scale"] = m.temperature_scale;
+  if (m.temperature_offset != defaults.temperature_offset) j["temperature_offset"] = m.temperature_offset;
+  if (m.temperature_cutoff != defaults.temperature_cutoff) j["temperature_cutoff"] = m.temperature_cutoff;
   return j;
 }
 

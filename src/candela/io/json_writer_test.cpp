@@ -135,6 +135,12 @@ void expect_same_media(const SceneDesc& back, const SceneDesc& original) {
     EXPECT_EQ(b.emission, o.emission) << i;
     expect_same_volume(b.density, o.density);
     expect_same_volume(b.albedo, o.albedo);
+    expect_same_volume(b.emission_scale, o.emission_scale);
+    ASSERT_EQ(b.temperature.has_value(), o.temperature.has_value()) << i;
+    if (o.temperature) expect_same_volume(*b.temperature, *o.temperature);
+    EXPECT_EQ(b.temperature_scale, o.temperature_scale) << i;
+    EXPECT_EQ(b.temperature_offset, o.temperature_offset) << i;
+    EXPECT_EQ(b.temperature_cutoff, o.temperature_cutoff) << i;
   }
 }
 
@@ -227,7 +233,10 @@ TEST(ConvertJson, PbrtMediaRoundTrip) {
       "  \"float density\" [ 0 0.25 0.5 1 ] \"point3 p0\" [ -1 -1 -1 ] \"point3 p1\" [ 1 1 1 ]\n"
       "MediumInterface \"smoke\" \"air\"\n"
       "Material \"interface\"\n"
-      "Shape \"sphere\"\n",
+      "Shape \"sphere\"\n"
+      "MakeNamedMedium \"fire\" \"string type\" \"uniformgrid\" \"integer nx\" 2 \"float density\" [ 1 2 ]\n"
+      "  \"float temperature\" [ 1500 2500 ] \"float Lescale\" [ 2 3 ] \"float temperaturescale\" 1.5\n"
+      "  \"float temperatureoffset\" 10 \"float temperaturecutoff\" 300\n",
       "media.pbrt", fs::temp_directory_path(), warnings);
   SceneDesc back = read_json_scene(scene_to_json(pbrt), "converted.json", fs::temp_directory_path());
   expect_same_media(back, pbrt);

@@ -6,7 +6,10 @@
 #include <vector>
 
 #include "candela/base/error.h"
+#include "candela/io/grid_files.h"
 #include "candela/io/named_spectra.h"
+#include "candela/media/medium.h"
+#include "candela/spectral/blackbody.h"
 #include "candela/io/pbrt_reader.h"
 #include "candela/scene/description.h"
 #include "candela/testing/pbrt_reader_helpers.h"
@@ -126,17 +129,73 @@ TEST(PbrtMedia, UniformGridIsPlacedByTheCtmAndTheBox) {
   expect_near(swapped.media.at(0).density.to_world.point({1, 1, 1}), {1, 1, 1});
 }
 
+// pbrt-v4's GridMedium emission: "Le" times "Lescale" looked up as a grid (one value: a one-voxel
+// grid, which fades to half at the box's faces), or the blackbody of a "temperature" grid.
 TEST(PbrtMedia, UniformGridEmission) {
-  Warned read = read_warned({"WorldBegin",
-                             "MakeNamedMedium \"fire\" \"string type\" \"uniformgrid\" \"float density\" [ 1 2 ] "
-                             "\"integer nx\" 2 \"rgb Le\" [ 1 0.5 0 ] \"float Lescale\" 3"});
-  EXPECT_EQ(read.scene.media.at(0).emission, RGB(3, 1.5f, 0));
-  expect_warning({"WorldBegin", "MakeNamedMedium \"fire\" \"string type\" \"uniformgrid\" \"float density\" [ 1 2 ] "
-                                "\"integer nx\" 2 \"rgb Le\" [ 1 0.5 0 ]"},
-                 2, "\"rgb Le\"", "pbrt-v4's fades from the box's centre towards its faces");
-  // pbrt-v4 reads these whether or not there is a temperature grid.
-  EXPECT_NO_THROW(read_lines({"WorldBegin", "MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" 1 "
-                                            "\"float temperaturescale\" 2 \"float temperatureoffset\" 1"}));
+  const std::string fire = "MakeNamedMedium \"fire\" \"string type\" \"uniformgrid\" \"float density\" [ 1 2 ] "
+                           "\"integer nx\" 2 ";
+  {
+    const Medium m(read_lines({"WorldBegin", fire + "\"rgb Le\" [ 1 0.5 0 ] \"float Lescale\" 3"}).media.at(0));
+    ASSERT_TRUE(m.is_emissive());
+    expect_rgb_near(m.emission(Point3(0.5f, 0.5f, 0.5f)), RGB(3, 1.5f, 0));     // the one sample
+    expect_rgb_near(m.emission(Point3(0.0f, 0.5f, 0.5f)), RGB(1.5f, 0.75f, 0));  // a face: half
+    expect_rgb_near(m.emission(Point3(0.0f, 0.0f, 0.0f)), RGB(0.375f, 0.1875f, 0));  // a corner: an eighth
+  }
+  {
+    // A value per voxel, at the voxel centres x = 1/4 and 3/4.
+    const Medium m(read_lines({"WorldBegin", fire + "\"rgb Le\" [ 1 1 1 ] \"float Lescale\" [ 2 4 ]"}).media.at(0));
+    expect_rgb_near(m.emission(Point3(0.25f, 0.5f, 0.5f)), RGB(2.0f));
+    expect_rgb_near(m.emission(Point3(0.75f, 0.5f, 0.5f)), RGB(4.0f));
+    expect_rgb_near(m.emission(Point3(0.5f, 0.5f, 0.5f)), RGB(3.0f));
+  }
+  {
+    // Temperatures 1000 and 2000, offset by 100 and doubled: 1800 K and 3800 K at the voxel centres;
+    // "Le" is ignored with a warning, as pbrt-v4 ignores it.
+    Warned read = read_warned({"WorldBegin", fire + "\"float temperature\" [ 1000 2000 ] \"float temperatureoffset\" 100 "
+                                                    "\"float temperaturescale\" 2 \"float Lescale\" [ 1 0.5 ] "
+                                                    "\"rgb Le\" [ 1 1 1 ]"});
+    ASSERT_EQ(read.warnings.size(), 1u);
+    EXPECT_NE(read.warnings[0].find("\"Le\" is not used where there is a \"temperature\" grid"), std::string::npos);
+    const Medium m(read.scene.media.at(0));
+    ASSERT_TRUE(m.is_emissive());
+    const RGB bb1800 = blackbody_peak_normalised_rgb(1800);  // its blue is negative: clipped
+    ASSERT_LT(bb1800.b, 0);
+    expect_rgb_near(m.emission(Point3(0.25f, 0.5f, 0.5f)), RGB(bb1800.r, bb1800.g, 0.0f), 1e-7f);
+    expect_rgb_near(m.emission(Point3(0.75f, 0.5f, 0.5f)), blackbody_peak_normalised_rgb(3800) * 0.5f, 1e-6f);
+  }
+  {
+    // At or below the cutoff (100 K by default, as pbrt-v4's grid medium), nothing.
+    const Medium m(read_lines({"WorldBegin", fire + "\"float temperature\" [ 90 5000 ]"}).media.at(0));
+    EXPECT_EQ(m.emission(Point3(0.25f, 0.5f, 0.5f)), RGB(0.0f));
+    EXPECT_GT(m.emission(Point3(0.75f, 0.5f, 0.5f)).luminance(), 0.1f);
+    const Medium cut(read_lines({"WorldBegin", fire + "\"float temperature\" [ 90 5000 ] \"float temperaturecutoff\" "
+                                                      "6000"}).media.at(0));
+    EXPECT_EQ(cut.emission(Point3(0.75f, 0.5f, 0.5f)), RGB(0.0f));
+  }
+  // Without "Le" or a temperature the medium does not glow.
+  EXPECT_FALSE(Medium(read_lines({"WorldBegin", fire}).media.at(0)).is_emissive());
+}
+
+// pbrt-v4's NanoVDBMedium glows where its file has a "temperature" grid: the blackbody of the
+// offset and scaled temperature, times "Lescale".
+TEST(PbrtMedia, NanoVdbTemperatureGridGlows) {
+  for (const char* name : {"fire.nvdb", "fire.vdb"}) {
+    const fs::path file = scratch_dir() / name;
+    fs::create_directories(scratch_dir());
+    // 2 x 1 x 1 voxels of size 1 at indices (0..1, 0, 0): VDB puts their centres at x = 0 and 1.
+    write_grid_file(file, {{"density", {1.0f, 2.0f}}, {"temperature", {1500.0f, 3000.0f}}}, {2, 1, 1}, 1.0f);
+    const Medium m(read_lines({"WorldBegin", std::string("MakeNamedMedium \"fire\" \"string type\" \"nanovdb\" "
+                                                         "\"string filename\" \"") + name + "\" \"float Lescale\" 4 "
+                                                         "\"float temperaturescale\" 2"}).media.at(0));
+    ASSERT_TRUE(m.is_emissive()) << name;
+    expect_rgb_near(m.emission(Point3(0.0f)), blackbody_peak_normalised_rgb(3000) * 4.0f, 1e-5f);
+    expect_rgb_near(m.emission(Point3(1.0f, 0.0f, 0.0f)), blackbody_peak_normalised_rgb(6000) * 4.0f, 1e-5f);
+    // A file without one: no emission.
+    write_grid_file(file, "density", {2, 1, 1}, {1.0f, 2.0f}, 1.0f);
+    EXPECT_FALSE(Medium(read_lines({"WorldBegin", std::string("MakeNamedMedium \"fire\" \"string type\" \"nanovdb\" "
+                                                              "\"string filename\" \"") + name + "\""}).media.at(0))
+                     .is_emissive());
+  }
 }
 
 // ---------------------------------------------------------------- MediumInterface
@@ -289,12 +348,14 @@ TEST(PbrtMedia, GridErrors) {
                "must be at least 1");
   expect_error({"WorldBegin", grid + "\"float density\" 1 \"point3 p0\" [ 0 0 0 ] \"point3 p1\" [ 1 0 1 ]"}, 2,
                "\"point3 p1\"", "the grid's box has no volume");
-  expect_error({"WorldBegin", grid + "\"integer nx\" 2 \"float density\" [ 1 2 ] \"float temperature\" [ 900 1000 ]"},
-               2, "\"float temperature\"", "\"temperature\" is not supported yet");
-  expect_error({"WorldBegin", grid + "\"integer nx\" 2 \"float density\" [ 1 2 ] \"float Lescale\" [ 1 2 ]"}, 2,
-               "\"float Lescale\"", "is not supported yet as a grid (a value per voxel)");
+  expect_error({"WorldBegin", grid + "\"integer nx\" 2 \"float density\" [ 1 2 ] \"float temperature\" [ 900 ]"},
+               2, "\"float temperature\"", "\"float temperature\" has 1 values; nx ny nz = 2 x 1 x 1 needs 2");
   expect_error({"WorldBegin", grid + "\"integer nx\" 3 \"float density\" [ 1 2 3 ] \"float Lescale\" [ 1 2 ]"}, 2,
-               "\"float Lescale\"", "takes exactly 1 value, got 2");
+               "\"float Lescale\"", "\"float Lescale\" has 2 values; nx ny nz = 3 x 1 x 1 needs 3");
+  expect_error({"WorldBegin", grid + "\"integer nx\" 2 \"float density\" [ 1 2 ] \"float Lescale\" [ 1 -2 ]"}, 2,
+               "\"float Lescale\"", "value -2 (number 2, x fastest) must be finite and not negative");
+  expect_error({"WorldBegin", grid + "\"float density\" 1 \"float Lescale\" -1"}, 2, "\"float Lescale\"",
+               "must be finite and not negative, got -1");
   expect_error({"WorldBegin", grid + "\"float density\" 1 \"string preset\" \"Apple\""}, 2, "\"string preset\"",
                "unused parameter \"string preset\"");
 }

@@ -6,18 +6,21 @@
 
 #include <fmt/format.h>
 
+#include "candela/spectral/blackbody.h"
+
 namespace candela {
 
 namespace {
 
 bool valid_rgb(const RGB& c) { return c.is_finite() && c.min_component() >= 0; }
 
-std::string volume_problem(const VolumeDesc& v, const char* what, bool scalar_only, float max_value) {
+std::string volume_problem(const VolumeDesc& v, const char* what, bool scalar_only, float max_value,
+                           float min_value = 0) {
   const std::string source = v.filename.empty() ? std::string(what) : fmt::format("{} grid \"{}\"", what, v.filename);
   if (v.is_constant()) {
-    if (!valid_rgb(v.constant) || v.constant.max_component() > max_value)
-      return fmt::format("{} ({}, {}, {}) must be within [0, {}]", what, v.constant.r, v.constant.g, v.constant.b,
-                         max_value);
+    if (!v.constant.is_finite() || v.constant.min_component() < min_value || v.constant.max_component() > max_value)
+      return fmt::format("{} ({}, {}, {}) must be within [{}, {}]", what, v.constant.r, v.constant.g, v.constant.b,
+                         min_value, max_value);
     return "";
   }
   const auto& r = v.resolution;
@@ -31,8 +34,8 @@ std::string volume_problem(const VolumeDesc& v, const char* what, bool scalar_on
                        r[2], v.channels, expected);
   for (size_t i = 0; i < v.values->size(); ++i) {
     float x = (*v.values)[i];
-    if (!std::isfinite(x) || x < 0 || x > max_value)
-      return fmt::format("{}: value {} (number {}) must be within [0, {}]", source, x, i, max_value);
+    if (!std::isfinite(x) || x < min_value || x > max_value)
+      return fmt::format("{}: value {} (number {}) must be within [{}, {}]", source, x, i, min_value, max_value);
   }
   return "";
 }
@@ -47,6 +50,13 @@ std::string medium_problem(const MediumDesc& m) {
   if (m.majorant_cell_samples < 0) return fmt::format("majorant_cell_samples {} must be >= 0", m.majorant_cell_samples);
   constexpr float kHuge = std::numeric_limits<float>::max();
   if (std::string p = volume_problem(m.density, "density", true, kHuge); !p.empty()) return p;
+  if (std::string p = volume_problem(m.emission_scale, "emission scale", true, kHuge); !p.empty()) return p;
+  if (m.temperature)
+    if (std::string p = volume_problem(*m.temperature, "temperature", true, kHuge, -kHuge); !p.empty()) return p;
+  for (auto [name, value] : {std::pair{"temperature scale", m.temperature_scale},
+                             std::pair{"temperature offset", m.temperature_offset},
+                             std::pair{"temperature cutoff", m.temperature_cutoff}})
+    if (!std::isfinite(value)) return fmt::format("{} {} must be finite", name, value);
   return volume_problem(m.albedo, "albedo", false, 1.0f);
 }
 
@@ -97,6 +107,20 @@ float Volume::scalar_at(const Point3& p) const {
   return lookup(world_to_grid_.point(p), 0);
 }
 
+RGB Medium::emission(const Point3& p) const {
+  if (!emissive_) return RGB(0.0f);
+  const float scale = emission_scale_.scalar_at(p);
+  if (!(scale > 0)) return RGB(0.0f);
+  if (!has_temperature_) return emission_ * scale;
+  // Possibly nothing: pbrt-v4 emits only above the cutoff (its grid medium's 100 K).
+  const float kelvin = (temperature_.scalar_at(p) - temperature_offset_) * temperature_scale_;
+  if (!(kelvin > temperature_cutoff_)) return RGB(0.0f);
+  // Below about 1,900 K the blackbody lies outside the sRGB gamut (blue, then green, negative):
+  // clipped, as emission is never negative.
+  const RGB c = blackbody_peak_normalised_rgb(kelvin) * scale;
+  return {std::max(c.r, 0.0f), std::max(c.g, 0.0f), std::max(c.b, 0.0f)};
+}
+
 float Volume::max_in(const Point3& lo, const Point3& hi) const {
   if (!values_) return constant_.r;
   // The samples a lookup in [lo, hi] interpolates: from floor(lo n - 1/2) to floor(hi n - 1/2) + 1.
@@ -116,9 +140,18 @@ float Volume::max_in(const Point3& lo, const Point3& hi) const {
 Medium::Medium(const MediumDesc& desc)
     : density_(desc.density),
       albedo_(desc.albedo),
+      emission_scale_(desc.emission_scale),
+      temperature_(desc.temperature.value_or(VolumeDesc{})),
       sigma_t_(desc.sigma_t * desc.scale),
       emission_(desc.emission),
+      has_temperature_(desc.temperature.has_value()),
+      temperature_scale_(desc.temperature_scale),
+      temperature_offset_(desc.temperature_offset),
+      temperature_cutoff_(desc.temperature_cutoff),
       phase_{desc.g} {
+  // Emissive unless the scale is 0 everywhere, or nothing is emitted where it is not.
+  const bool scale_is_zero = emission_scale_.is_constant() && !(emission_scale_.constant().r > 0);
+  emissive_ = !scale_is_zero && (has_temperature_ || !emission_.is_black());
   if (density_.is_constant()) return;
   // The majorant grid: a cell per majorant_cell_samples^3 samples of the density (4 by default), at
   // most 64 per axis and at least one (pbrt-v4 uses a fixed 16^3; scaling with the grid keeps empty

@@ -24,8 +24,8 @@ namespace candela {
 
 // Why `medium` cannot be rendered, or "" when it can: a negative or non-finite coefficient, scale or
 // emission, an albedo outside [0, 1], g outside (-1, 1), a grid whose value count is not nx ny nz
-// channels, a density grid that is not scalar, an albedo grid that is neither scalar nor RGB, or a
-// grid value that is negative or not finite. Readers call it to point at the place in the file.
+// channels, a density, emission-scale or temperature grid that is not scalar, an albedo grid that is
+// neither scalar nor RGB, or a grid value that is negative or not finite (a temperature: not finite). Readers call it to point at the place in the file.
 std::string medium_problem(const MediumDesc& medium);
 
 // A VolumeDesc ready for lookups at world points.
@@ -73,8 +73,10 @@ class Medium {
   float density(const Point3& p) const;
   RGB albedo(const Point3& p) const { return albedo_.at(p); }
   bool has_albedo_grid() const { return !albedo_.is_constant(); }
-  const RGB& emission() const { return emission_; }
-  bool is_emissive() const { return !emission_.is_black(); }
+  // The radiance emitted at p (MediumDesc: `emission` or a temperature's blackbody, times the
+  // emission scale; the blackbody's negative, out-of-gamut components clipped to 0).
+  RGB emission(const Point3& p) const;
+  bool is_emissive() const { return emissive_; }
   const HenyeyGreenstein& phase() const { return phase_; }
   bool is_homogeneous() const { return density_.is_constant() && albedo_.is_constant(); }
   // The extinction is the same everywhere (the albedo may still vary).
@@ -91,8 +93,10 @@ class Medium {
   const std::array<int, 3>& majorant_resolution() const { return majorant_resolution_; }
 
  private:
-  Volume density_, albedo_;
+  Volume density_, albedo_, emission_scale_, temperature_;
   RGB sigma_t_{1.0f}, emission_{0.0f};
+  bool has_temperature_ = false, emissive_ = false;
+  float temperature_scale_ = 1, temperature_offset_ = 0, temperature_cutoff_ = 100;
   HenyeyGreenstein phase_;
   // Density grids: the largest density over each cell of a coarse grid over the unit cube.
   std::array<int, 3> majorant_resolution_{1, 1, 1};

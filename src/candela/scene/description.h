@@ -431,8 +431,9 @@ struct VolumeDesc {
 // heterogeneous): extinction sigma_t(p) = scale * sigma_t * density(p), of which the fraction
 // albedo(p) scatters (sigma_s = albedo sigma_t) and the rest is absorbed (sigma_a = sigma_t - sigma_s).
 // A medium whose density is a grid has no density outside the grid's cube (Mitsuba bounds a
-// heterogeneous medium by its volume's box). It emits radiance `emission` in proportion to absorption
-// (the source term sigma_a Le, as pbrt-v4 defines Le). Light scatters by Henyey-Greenstein's phase
+// heterogeneous medium by its volume's box). It emits radiance Le(p) (`emission`, or a temperature's
+// blackbody, times an emission scale) in proportion to absorption (the source term sigma_a Le, as
+// pbrt-v4 defines Le). Light scatters by Henyey-Greenstein's phase
 // function with mean cosine g in (-1, 1) (0: isotropic).
 struct MediumDesc {
   RGB sigma_t{1.0f};    // per unit length, times density and scale
@@ -440,6 +441,13 @@ struct MediumDesc {
   VolumeDesc albedo;    // RGB in [0, 1]
   float scale = 1;
   RGB emission{0.0f};
+  // Emission that varies through the medium (pbrt-v4's grid and NanoVDB media): the radiance emitted
+  // at p is emission_scale(p) times, with a temperature, pbrt-v4's peak-normalised blackbody
+  // (spectral/blackbody.h) at (temperature(p) - temperature_offset) x temperature_scale kelvin where
+  // that exceeds temperature_cutoff (nothing elsewhere), and without one `emission`.
+  VolumeDesc emission_scale;               // a scalar >= 0; constant 1 by default
+  std::optional<VolumeDesc> temperature;  // a scalar (kelvin before offset and scale)
+  float temperature_scale = 1, temperature_offset = 0, temperature_cutoff = 100;
   float g = 0;
   // A density grid's majorant: the largest density over cells of this many samples along each axis
   // (at most 64 cells per axis), traversed cell by cell; 0 = one majorant for the whole grid (what

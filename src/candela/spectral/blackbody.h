@@ -2,6 +2,8 @@
 // Planck's law: the spectral radiance of a black body. pbrt-v4 and Mitsuba 3 evaluate it with
 // different constants (CODATA 2010 and 2014), units and expressions; candela reproduces each bit
 // for bit for the scenes of that format, so the formula takes the difference as a recipe.
+#include "candela/math/color.h"
+
 namespace candela {
 
 struct PlanckRecipe {
@@ -18,5 +20,13 @@ inline constexpr PlanckRecipe kMitsubaPlanck{2.99792458e8, 6.62607004e-34, 1.380
 // The radiance at `wavelength_nm` of a black body at `kelvin`:
 // scale * 2 h c^2 / (l^5 (e^(h c / (l k T)) - 1)), l the wavelength in metres.
 double planck(double wavelength_nm, double kelvin, const PlanckRecipe& recipe);
+
+// pbrt-v4's BlackbodySpectrum, Planck's law over its value at the peak (Wien's displacement law), as
+// linear sRGB: its CIE XYZ over the luminance of a constant spectrum of 1 (as a film records it).
+// What the temperature grids of pbrt-v4's media emit, times their "Lescale". Interpolated in a table
+// over 100 K to 100,000 K (log-spaced; within 1e-4 of the integral), computed beyond it; 0 at or below 0 K.
+RGB blackbody_peak_normalised_rgb(float kelvin);
+// The same by direct integration (1 nm steps): the table's reference.
+RGB blackbody_peak_normalised_rgb_integrated(double kelvin);
 
 }  // namespace candela

@@ -6,6 +6,8 @@
 
 #include <cmath>
 
+#include "candela/io/named_spectra.h"
+
 namespace candela {
 namespace {
 
@@ -29,6 +31,31 @@ TEST(Blackbody, RecipesMatchTheReadersFormerFormulasBitForBit) {
       EXPECT_EQ(planck(nm, double(kelvin), kMitsubaPlanck), old_mitsuba(nm, double(kelvin)))
           << nm << " nm, " << kelvin << " K";
     }
+}
+
+// The peak-normalised blackbody (what pbrt-v4's temperature grids emit): its table agrees with the
+// integral, its colour is that of the luminance-normalised blackbody the pbrt reader gives lights
+// (written separately), and its luminance follows the peak normalisation: about 0.5-1 near 6,000 K,
+// vanishingly small at 800 K, nothing at 0 K.
+TEST(Blackbody, PeakNormalisedRgbAgreesWithItsIntegralAndTheLightsColour) {
+  for (float kelvin : {100.5f, 450.0f, 800.0f, 1234.5f, 1900.0f, 3000.0f, 5777.0f, 6504.0f, 12000.0f, 40000.0f, 99000.0f,
+                       150000.0f}) {
+    const RGB table = blackbody_peak_normalised_rgb(kelvin);
+    const RGB exact = blackbody_peak_normalised_rgb_integrated(kelvin);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(table[c], exact[c], 1e-4 * exact.max_component() + 1e-30) << kelvin << " K, channel " << c;
+    const float luminance = exact.luminance();
+    if (kelvin >= 450) ASSERT_GT(luminance, 0) << kelvin;  // below, less than a float holds
+    if (kelvin >= 800) {
+      const RGB light = pbrt_spectra::blackbody_rgb(kelvin);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(exact[c] / luminance, light[c], 2e-3 * light.max_component()) << kelvin;
+    }
+  }
+  EXPECT_GT(blackbody_peak_normalised_rgb(5777).luminance(), 0.5f);
+  EXPECT_LT(blackbody_peak_normalised_rgb(5777).luminance(), 1.0f);
+  EXPECT_LT(blackbody_peak_normalised_rgb(800).luminance(), 1e-5f);
+  EXPECT_EQ(blackbody_peak_normalised_rgb(0).max_component(), 0);
+  EXPECT_EQ(blackbody_peak_normalised_rgb(-10).max_component(), 0);
 }
 
 }  // namespace

@@ -63,6 +63,25 @@ MediumDesc JsonSceneReader::read_medium(const Json& value, const std::string& po
   if (!(medium.g > -1 && medium.g < 1))
     report_.fail(m.pointer_of("g"), "g (Henyey-Greenstein's mean cosine) must be in (-1, 1), got {}", medium.g);
   medium.emission = m.rgb_or("emission", ColorKind::Emission, medium.emission);
+  // Emission that varies through the medium: a scale, and a temperature whose blackbody replaces
+  // "emission" (each a number or a grid).
+  auto scalar_or_grid = [&](const Json& v, std::string_view key) {
+    if (v.is_object()) return read_volume(v, m.pointer_of(key), key);
+    VolumeDesc constant;
+    const float x = read_float(report_, v, m.pointer_of(key));
+    constant.constant = RGB(key == "temperature" ? x : check_bound(report_, x, Bound::NonNegative, m.pointer_of(key)));
+    return constant;
+  };
+  if (const Json* scale = m.find("emission_scale")) medium.emission_scale = scalar_or_grid(*scale, "emission_scale");
+  if (const Json* temperature = m.find("temperature")) {
+    if (m.has("emission"))
+      report_.fail(m.pointer_of("temperature"), "a medium emits its \"temperature\"'s blackbody or \"emission\", not "
+                   "both");
+    medium.temperature = scalar_or_grid(*temperature, "temperature");
+  }
+  medium.temperature_scale = m.number_or("temperature_scale", medium.temperature_scale);
+  medium.temperature_offset = m.number_or("temperature_offset", medium.temperature_offset);
+  medium.temperature_cutoff = m.number_or("temperature_cutoff", medium.temperature_cutoff);
   if (grid) {
     const Json& density = m.require("density");
     if (density.is_object())
@@ -79,20 +98,20 @@ MediumDesc JsonSceneReader::read_medium(const Json& value, const std::string& po
   return medium;
 }
 
-// A grid of values over the unit cube of its space, which "transform" places: a Mitsuba .vol file, or
-// the samples inline. `what` is "density" (1 channel, values >= 0) or "albedo" (1 or 3 channels, values
-// in [0, 1]).
+// A grid of values over the unit cube of its space, which "transform" places: a Mitsuba .vol file, an
+// OpenVDB or NanoVDB grid, or the samples inline. `what` is "density" or "emission_scale" (1 channel,
+// values >= 0), "temperature" (1 channel, finite values) or "albedo" (1 or 3 channels, values in [0, 1]).
 VolumeDesc JsonSceneReader::read_volume(const Json& value, const std::string& pointer, std::string_view what) const {
   CheckedObject v(report_, value, pointer);
-  const bool is_density = what == "density";
+  const bool is_albedo = what == "albedo", is_temperature = what == "temperature";
   const bool from_file = v.has("filename");
   const bool inline_data = v.has("resolution") || v.has("values") || v.has("channels");
   if (from_file == inline_data)
     report_.fail(pointer, "a grid takes either \"filename\" or inline \"resolution\" and \"values\", {}",
                  from_file ? "not both" : "and has neither");
   auto check_channels = [&](int channels, const std::string& at, const std::string& source) {
-    if (is_density ? channels != 1 : channels != 1 && channels != 3)
-      report_.fail(at, "{} has {} channels; {} needs {}", source, channels, what, is_density ? "1" : "1 or 3");
+    if (is_albedo ? channels != 1 && channels != 3 : channels != 1)
+      report_.fail(at, "{} has {} channels; {} needs {}", source, channels, what, is_albedo ? "1 or 3" : "1");
   };
   VolumeDesc volume;
   std::vector<float> values;
@@ -135,12 +154,13 @@ VolumeDesc JsonSceneReader::read_volume(const Json& value, const std::string& po
     values.resize(samples.size());
     for (size_t k = 0; k < samples.size(); ++k) values[k] = read_float_element(report_, samples, k, values_pointer);
   }
-  const float max_value = is_density ? std::numeric_limits<float>::max() : 1.0f;
+  const float max_value = is_albedo ? 1.0f : std::numeric_limits<float>::max();
+  const float min_value = is_temperature ? -std::numeric_limits<float>::max() : 0.0f;
   const std::string in_file = from_file ? fmt::format(" in '{}'", volume.filename) : std::string();
   for (size_t k = 0; k < values.size(); ++k)
-    if (!(values[k] >= 0 && values[k] <= max_value))
+    if (!(values[k] >= min_value && values[k] <= max_value))
       report_.fail(from_file ? values_pointer : child_pointer(values_pointer, k), "{} value {} (number {}{}) must be {}",
-                   what, values[k], k, in_file, is_density ? "finite and >= 0" : "in [0, 1]");
+                   what, values[k], k, in_file, is_albedo ? "in [0, 1]" : is_temperature ? "finite" : "finite and >= 0");
   volume.values = std::make_shared<const std::vector<float>>(std::move(values));
   volume.to_world = read_transform_key(v) * volume.file_to_world;
   if (const Json* border = v.find("border"))

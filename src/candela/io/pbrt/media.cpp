@@ -218,13 +218,9 @@ MediumDesc SceneParser::make_homogeneous_medium(ParamList& params) {
 // A grid of nx ny nz densities over the box from p0 to p1 in the medium's space (pbrt-v4's
 // GridMedium): extinction (sigma_a + sigma_s) scale density(p), the samples at the voxel centres, and
 // zero beyond them (pbrt's SampledGrid), so the density fades to zero over the outer half voxel.
+// Emission: "Lescale" (one value, or one per voxel) looked up in the same way, times the blackbody of
+// a "temperature" grid where there is one (offset, scaled, above a cutoff of 100 K), else "Le".
 MediumDesc SceneParser::make_grid_medium(ParamList& params) {
-  if (params.has("temperature"))
-    params.fail("temperature", "is not supported yet: the emission of a grid medium must be a constant \"Le\"");
-  // Read by pbrt-v4 whether or not there is a temperature grid; without one they change nothing.
-  for (std::string_view unused : {"temperaturescale", "temperatureoffset", "temperaturecutoff"})
-    params.get_float(unused, 0);
-
   int resolution[3];
   for (int axis = 0; axis < 3; ++axis) {
     const char* name = axis == 0 ? "nx" : axis == 1 ? "ny" : "nz";
@@ -232,20 +228,25 @@ MediumDesc SceneParser::make_grid_medium(ParamList& params) {
     if (resolution[axis] < 1) params.fail(name, "must be at least 1, got {}", resolution[axis]);
   }
   const int64_t voxels = int64_t{resolution[0]} * resolution[1] * resolution[2];
+  // A per-voxel grid given inline: `name`'s values, all finite (and >= 0 unless negatives are allowed).
+  auto read_voxels = [&](const Param& p, bool allow_negative) {
+    if (int64_t(p.count()) != voxels)
+      throw_scene_error(p.where, "{}: {} has {} values; nx ny nz = {} x {} x {} needs {}", params.owner(),
+                        p.declaration(), p.count(), resolution[0], resolution[1], resolution[2], voxels);
+    std::vector<float> values(p.numbers.size());
+    for (size_t i = 0; i < values.size(); ++i) {
+      values[i] = static_cast<float>(p.numbers[i]);
+      if (!std::isfinite(values[i]) || (!allow_negative && values[i] < 0))
+        throw_scene_error(p.where, "{}: {}: value {} (number {}, x fastest) must be finite{}", params.owner(),
+                          p.declaration(), p.numbers[i], i + 1, allow_negative ? "" : " and not negative");
+    }
+    return values;
+  };
   const Param* density = params.take("density", {"float"});
   if (!density)
     throw_scene_error(params.directive(), "{}: a \"uniformgrid\" medium needs \"float density\" (nx ny nz values)",
                       params.owner());
-  if (int64_t(density->count()) != voxels)
-    throw_scene_error(density->where, "{}: {} has {} values; nx ny nz = {} x {} x {} needs {}", params.owner(),
-                      density->declaration(), density->count(), resolution[0], resolution[1], resolution[2], voxels);
-  std::vector<float> values(density->numbers.size());
-  for (size_t i = 0; i < values.size(); ++i) {
-    values[i] = static_cast<float>(density->numbers[i]);
-    if (!(values[i] >= 0) || !std::isfinite(values[i]))
-      throw_scene_error(density->where, "{}: {}: value {} (number {}, x fastest) must be finite and not negative",
-                        params.owner(), density->declaration(), density->numbers[i], i + 1);
-  }
+  std::vector<float> values = read_voxels(*density, false);
 
   // Bounds3f(p0, p1) in pbrt: the box between the two corners, whichever way round.
   Point3 p0 = params.get_point3("p0", Point3(0.0f)), p1 = params.get_point3("p1", Point3(1.0f));
@@ -258,34 +259,60 @@ MediumDesc SceneParser::make_grid_medium(ParamList& params) {
 
   MediumDesc medium;
   read_scattering(params, medium, std::nullopt, std::nullopt);
-  medium.density.resolution = {resolution[0], resolution[1], resolution[2]};
-  medium.density.channels = 1;
-  medium.density.values = std::make_shared<const std::vector<float>>(std::move(values));
-  medium.density.to_world = state_.ctm.start * Transform::translate(lo) * Transform::scale(hi - lo);
-  medium.density.border = VolumeBorder::Zero;
+  // Every grid of the medium shares the box and pbrt's lookup (zero beyond the outer samples).
+  auto grid = [&](std::vector<float> v, std::array<int, 3> res) {
+    VolumeDesc g;
+    g.resolution = res;
+    g.channels = 1;
+    g.values = std::make_shared<const std::vector<float>>(std::move(v));
+    g.to_world = state_.ctm.start * Transform::translate(lo) * Transform::scale(hi - lo);
+    g.border = VolumeBorder::Zero;
+    return g;
+  };
+  const std::array<int, 3> res{resolution[0], resolution[1], resolution[2]};
+  medium.density = grid(std::move(values), res);
 
-  // pbrt-v4 reads "Lescale" as a grid of nx ny nz values, or of one value for a one-voxel grid.
-  float le_scale = 1;
+  // pbrt-v4 reads "Lescale" as a grid of nx ny nz values, or of one value (a one-voxel grid, whose
+  // lookup fades from the box's centre to half at its faces).
   if (const Param* scale = params.take("Lescale", {"float"})) {
-    if (scale->count() != 1 && int64_t(scale->count()) == voxels)
-      throw_scene_error(scale->where, "{}: {} is not supported yet as a grid (a value per voxel); give one value",
-                        params.owner(), scale->declaration());
-    params.expect_count(*scale, 1);
-    le_scale = static_cast<float>(scale->numbers[0]);
+    if (scale->count() == 1) {
+      if (!(scale->numbers[0] >= 0) || !std::isfinite(scale->numbers[0]))
+        params.fail("Lescale", "must be finite and not negative, got {}", scale->numbers[0]);
+      medium.emission_scale = grid({static_cast<float>(scale->numbers[0])}, {1, 1, 1});
+    } else {
+      medium.emission_scale = grid(read_voxels(*scale, false), res);
+    }
+  } else {
+    medium.emission_scale = grid({1.0f}, {1, 1, 1});
   }
-  medium.emission = read_medium_emission(params, le_scale);
-  // pbrt-v4 looks its constant "Lescale" up in a grid of one sample, which fades towards the box's
-  // faces as the density does (a trilinear tent with its peak at the centre); candela's is uniform.
-  if (!medium.emission.is_black())
-    warn(params.where("Le"), "{}: the emission is the same everywhere in the grid's box; pbrt-v4's fades from the "
-         "box's centre towards its faces", params.owner());
+  if (const Param* temperature = params.take("temperature", {"float"})) {
+    medium.temperature = grid(read_voxels(*temperature, true), res);
+    if (params.has("Le"))
+      warn(params.where("Le"), "{}: \"Le\" is not used where there is a \"temperature\" grid (as in pbrt-v4)",
+           params.owner());
+    params.take("Le", {"rgb", "spectrum", "blackbody"});
+  } else {
+    medium.emission = read_medium_emission(params, 1);
+  }
+  read_temperature_mapping(params, medium);
   return medium;
 }
 
+// pbrt-v4's temperature mapping, read whether or not there is a temperature grid (as pbrt-v4 does):
+// the blackbody of (T - "temperatureoffset") x "temperaturescale" kelvin, above "temperaturecutoff".
+void SceneParser::read_temperature_mapping(ParamList& params, MediumDesc& medium) {
+  medium.temperature_offset = params.get_float("temperatureoffset", 0);
+  medium.temperature_scale = params.get_float("temperaturescale", 1);
+  medium.temperature_cutoff = params.get_float("temperaturecutoff", 100);
+  for (auto [name, value] : {std::pair{"temperatureoffset", medium.temperature_offset},
+                             std::pair{"temperaturescale", medium.temperature_scale},
+                             std::pair{"temperaturecutoff", medium.temperature_cutoff}})
+    if (!std::isfinite(value)) params.fail(name, "must be finite, got {}", value);
+}
+
 // pbrt-v4's NanoVDBMedium: the "density" grid of a NanoVDB file (io/grid_files.h; an OpenVDB .vdb
-// file is read too), placed by the file's own transform and then the CTM. Its emission comes from a
-// "temperature" grid by Planck's law, which candela does not render yet: a file with one is read
-// with a warning when that emission would show (Lescale > 0).
+// file is read too), placed by the file's own transform and then the CTM. Where the file has a
+// "temperature" grid too, the medium emits its blackbody (see read_temperature_mapping) times "Lescale".
 MediumDesc SceneParser::make_nanovdb_medium(ParamList& params) {
   const Param* name = params.take("filename", {"string"});
   if (!name) throw_scene_error(params.directive(), "{}: a \"nanovdb\" medium needs \"string filename\"", params.owner());
@@ -296,11 +323,14 @@ MediumDesc SceneParser::make_nanovdb_medium(ParamList& params) {
   medium.density = read_grid_file(file, "density", name->where);
   medium.density.to_world = state_.ctm.start * medium.density.to_world;
   const float le_scale = params.get_float("Lescale", 1);
-  for (std::string_view unused : {"temperaturescale", "temperatureoffset", "temperaturecutoff"}) params.get_float(unused, 0);
+  if (!(le_scale >= 0) || !std::isfinite(le_scale)) params.fail("Lescale", "must be finite and not negative, got {}", le_scale);
+  medium.emission_scale.constant = RGB(le_scale);
+  read_temperature_mapping(params, medium);
   const std::vector<std::string> grids = grid_names_in_file(file, name->where);
-  if (le_scale > 0 && std::find(grids.begin(), grids.end(), "temperature") != grids.end())
-    warn(name->where, "{}: the \"temperature\" grid of '{}' is ignored: blackbody emission from grids is not "
-         "supported yet, so the medium does not glow", params.owner(), file.string());
+  if (std::find(grids.begin(), grids.end(), "temperature") != grids.end()) {
+    medium.temperature = read_grid_file(file, "temperature", name->where);
+    medium.temperature->to_world = state_.ctm.start * medium.temperature->to_world;
+  }
   return medium;
 }
 

@@ -230,6 +230,7 @@ class SceneParser {
   MediumDesc make_homogeneous_medium(ParamList& params);
   MediumDesc make_grid_medium(ParamList& params);
   MediumDesc make_nanovdb_medium(ParamList& params);
+  void read_temperature_mapping(ParamList& params, MediumDesc& medium);
 
   std::vector<std::string>& warnings_;
   SceneDesc scene_;
