@@ -118,18 +118,25 @@ INSTANTIATE_TEST_SUITE_P(Scenes, MitsubaConformance,
                                   sampler_name(std::get<1>(info.param));
                          });
 
+// Standard normal numbers, deterministic: Box-Muller on a 64-bit LCG.
+class Gaussian {
+ public:
+  explicit Gaussian(uint64_t seed) : state_(seed) {}
+  float operator()() { return float(std::sqrt(-2 * std::log(uniform())) * std::cos(2 * 3.14159265358979 * uniform())); }
+
+ private:
+  double uniform() {
+    state_ = state_ * 6364136223846793005ull + 1442695040888963407ull;
+    return (double(state_ >> 11) + 0.5) / double(1ull << 53);
+  }
+  uint64_t state_;
+};
+
 // The protocol itself: unbiased noise of the reference's variance passes, a 20% bias does not.
 TEST(MitsubaZTest, PassesUnbiasedNoiseAndFailsABias) {
   const int w = 48, h = 48, spp = testing::mitsuba_test_spp(w, h);
   Image reference(w, h), variance(w, h), noisy(w, h), biased(w, h);
-  uint64_t state = 12345;
-  auto gaussian = [&] {  // Box-Muller on a 64-bit LCG: deterministic
-    auto uniform = [&] {
-      state = state * 6364136223846793005ull + 1442695040888963407ull;
-      return (double(state >> 11) + 0.5) / double(1ull << 53);
-    };
-    return std::sqrt(-2 * std::log(uniform())) * std::cos(2 * 3.14159265358979 * uniform());
-  };
+  Gaussian gaussian(12345);
   for (size_t i = 0; i < reference.rgb.size(); ++i) {
     reference.rgb[i] = 0.5f;
     variance.rgb[i] = 0.25f;
@@ -146,14 +153,7 @@ TEST(MitsubaZTest, PassesUnbiasedNoiseAndFailsABias) {
 TEST(MitsubaZTest, TheImageMeanCatchesABiasThePerPixelTestPasses) {
   const int w = 48, h = 48, spp = testing::mitsuba_test_spp(w, h);
   Image reference(w, h), variance(w, h), unbiased(w, h), biased(w, h);
-  uint64_t state = 4242;
-  auto gaussian = [&] {
-    auto uniform = [&] {
-      state = state * 6364136223846793005ull + 1442695040888963407ull;
-      return (double(state >> 11) + 0.5) / double(1ull << 53);
-    };
-    return float(std::sqrt(-2 * std::log(uniform())) * std::cos(2 * 3.14159265358979 * uniform()));
-  };
+  Gaussian gaussian(4242);
   for (size_t i = 0; i < reference.rgb.size(); ++i) {
     reference.rgb[i] = 0.5f;
     variance.rgb[i] = 0.25f;
@@ -178,14 +178,7 @@ TEST(MitsubaZTest, JudgesInXyzWhereTheVarianceWasComputed) {
                0.055648f * c.r - 0.204043f * c.g + 1.057311f * c.b);
   };
   Image reference(w, h), variance(w, h), noisy(w, h);
-  uint64_t state = 777;
-  auto gaussian = [&] {
-    auto uniform = [&] {
-      state = state * 6364136223846793005ull + 1442695040888963407ull;
-      return (double(state >> 11) + 0.5) / double(1ull << 53);
-    };
-    return float(std::sqrt(-2 * std::log(uniform())) * std::cos(2 * 3.14159265358979 * uniform()));
-  };
+  Gaussian gaussian(777);
   const RGB xyz_mean(0.5f, 0.6f, 0.7f);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {

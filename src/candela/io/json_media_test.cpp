@@ -141,7 +141,6 @@ TEST(JsonMedia, TemperatureAndEmissionScale) {
   EXPECT_TRUE(ember.temperature->is_constant());
   EXPECT_EQ(ember.temperature->constant, RGB(2000.0f));
   EXPECT_EQ(*ember.emission_scale.values, (std::vector<float>{0, 1}));
-  EXPECT_FALSE(scene.media.empty());
   // Errors name the place.
   expect_error_containing(with_medium(R"({"type": "homogeneous", "sigma_t": 1, "temperature": 2000, "emission": 1})"),
                           "at /media/m/temperature: a medium emits its \"temperature\"'s blackbody or \"emission\", not both");

@@ -107,20 +107,6 @@ float Volume::scalar_at(const Point3& p) const {
   return lookup(world_to_grid_.point(p), 0);
 }
 
-RGB Medium::emission(const Point3& p) const {
-  if (!emissive_) return RGB(0.0f);
-  const float scale = emission_scale_.scalar_at(p);
-  if (!(scale > 0)) return RGB(0.0f);
-  if (!has_temperature_) return emission_ * scale;
-  // Possibly nothing: pbrt-v4 emits only above the cutoff (its grid medium's 100 K).
-  const float kelvin = (temperature_.scalar_at(p) - temperature_offset_) * temperature_scale_;
-  if (!(kelvin > temperature_cutoff_)) return RGB(0.0f);
-  // Below about 1,900 K the blackbody lies outside the sRGB gamut (blue, then green, negative):
-  // clipped, as emission is never negative.
-  const RGB c = blackbody_peak_normalised_rgb(kelvin) * scale;
-  return {std::max(c.r, 0.0f), std::max(c.g, 0.0f), std::max(c.b, 0.0f)};
-}
-
 float Volume::max_in(const Point3& lo, const Point3& hi) const {
   if (!values_) return constant_.r;
   // The samples a lookup in [lo, hi] interpolates: from floor(lo n - 1/2) to floor(hi n - 1/2) + 1.
@@ -135,6 +121,20 @@ float Volume::max_in(const Point3& lo, const Point3& hi) const {
     for (int y = first[1]; y <= last[1]; ++y)
       for (int x = first[0]; x <= last[0]; ++x) m = std::max(m, sample(x, y, z, 0));
   return m;
+}
+
+RGB Medium::emission(const Point3& p) const {
+  if (!emissive_) return RGB(0.0f);
+  const float scale = emission_scale_.scalar_at(p);
+  if (!(scale > 0)) return RGB(0.0f);
+  if (!has_temperature_) return emission_ * scale;
+  // Possibly nothing: pbrt-v4 emits only above the cutoff (its grid medium's 100 K).
+  const float kelvin = (temperature_.scalar_at(p) - temperature_offset_) * temperature_scale_;
+  if (!(kelvin > temperature_cutoff_)) return RGB(0.0f);
+  // Below about 1,900 K the blackbody lies outside the sRGB gamut (blue, then green, negative):
+  // clipped, as emission is never negative.
+  const RGB c = blackbody_peak_normalised_rgb(kelvin) * scale;
+  return {std::max(c.r, 0.0f), std::max(c.g, 0.0f), std::max(c.b, 0.0f)};
 }
 
 Medium::Medium(const MediumDesc& desc)
