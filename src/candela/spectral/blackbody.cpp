@@ -64,8 +64,10 @@ RGB blackbody_peak_normalised_rgb_integrated(double kelvin) {
 }
 
 RGB blackbody_peak_normalised_rgb(float kelvin) {
-  if (!(kelvin > 0)) return RGB(0.0f);
-  if (kelvin < kTableMin || kelvin > kTableMax) return blackbody_peak_normalised_rgb_integrated(kelvin);
+  // Below the table the visible part of the peak-normalised spectrum is under 1e-60: 0 in a float,
+  // without integrating at every lookup.
+  if (!(kelvin >= kTableMin)) return RGB(0.0f);
+  if (kelvin > kTableMax) return blackbody_peak_normalised_rgb_integrated(kelvin);
   const std::vector<TableEntry>& table = blackbody_table();
   const double f = std::log(kelvin / kTableMin) / std::log(kTableMax / kTableMin) * (kTableSize - 1);
   const int i = std::clamp(int(f), 0, kTableSize - 2);

@@ -24,7 +24,8 @@ double planck(double wavelength_nm, double kelvin, const PlanckRecipe& recipe);
 // pbrt-v4's BlackbodySpectrum, Planck's law over its value at the peak (Wien's displacement law), as
 // linear sRGB: its CIE XYZ over the luminance of a constant spectrum of 1 (as a film records it).
 // What the temperature grids of pbrt-v4's media emit, times their "Lescale". Interpolated in a table
-// over 100 K to 100,000 K (log-spaced; within 1e-4 of the integral), computed beyond it; 0 at or below 0 K.
+// over 100 K to 100,000 K (log-spaced; within 1e-4 of the integral), computed above it; 0 below it
+// (where the visible part is too small for a float).
 RGB blackbody_peak_normalised_rgb(float kelvin);
 // The same by direct integration (1 nm steps): the table's reference.
 RGB blackbody_peak_normalised_rgb_integrated(double kelvin);

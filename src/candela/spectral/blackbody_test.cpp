@@ -54,6 +54,8 @@ TEST(Blackbody, PeakNormalisedRgbAgreesWithItsIntegralAndTheLightsColour) {
   EXPECT_GT(blackbody_peak_normalised_rgb(5777).luminance(), 0.5f);
   EXPECT_LT(blackbody_peak_normalised_rgb(5777).luminance(), 1.0f);
   EXPECT_LT(blackbody_peak_normalised_rgb(800).luminance(), 1e-5f);
+  EXPECT_EQ(blackbody_peak_normalised_rgb_integrated(99).max_component(), 0);  // below the table: 0 either way
+  EXPECT_EQ(blackbody_peak_normalised_rgb(99).max_component(), 0);
   EXPECT_EQ(blackbody_peak_normalised_rgb(0).max_component(), 0);
   EXPECT_EQ(blackbody_peak_normalised_rgb(-10).max_component(), 0);
 }
