@@ -27,16 +27,16 @@ RGB PixelSums::mean() const {
 }
 
 RGB PixelSums::standard_error() const {
-  RGB se(0.0f);
-  if (count < 2 || weight == 0) return se;
+  if (count < 2 || weight == 0) return RGB(0.0f);
   double n = double(count), mean_weight = weight / n;
+  float se[3];
   for (int c = 0; c < 3; ++c) {
     // Sample variance of w L, scaled to the ratio estimator sum(w L) / sum(w).
     double m = weighted[c] / n;
     double var = std::max(0.0, (weighted_sq[c] - n * m * m) / (n - 1));
     se[c] = float(std::sqrt(var / n) / std::abs(mean_weight));
   }
-  return se;
+  return RGB(se[0], se[1], se[2]);
 }
 
 Image Film::mean_image() const {

@@ -103,12 +103,14 @@ int BdptIntegrator::camera_subpath(const Ray& ray, Sampler& sampler, RayCounts& 
   // An orthographic camera's directions are a delta: no strategy connects to it (t = 1), and MIS
   // leaves that strategy out as it leaves out connections to delta lights.
   camera.delta = scene_.camera().is_delta_direction();
-  // Media whose extinction differs between the channels are sampled by one channel per path, which
-  // then counts for three.
+  // Media whose extinction differs between the lanes are sampled by one lane per path (a colour
+  // channel, or a wavelength), which then counts for all of them.
   if (scene_.has_media() && (wl || chromatic_media_)) {
-    camera.hero = int8_t(std::min(int(sampler.get_1d() * 3), 2));
-    camera.beta = RGB(0.0f);
-    camera.beta[camera.hero] = 3;
+    const int lanes = transport_lanes(wl);
+    camera.hero = int8_t(std::min(int(sampler.get_1d() * float(lanes)), lanes - 1));
+    // (In an RGB render the fourth lane mirrors green, hero or not.)
+    const int hero = camera.hero, mirror = wl ? -1 : 3;
+    camera.beta = RGB::from_lanes([&](int c) { return c == hero || (c == mirror && hero == 1) ? float(lanes) : 0.0f; });
   }
   ++counts.camera;
   Ray r = ray;

@@ -18,8 +18,8 @@
 // distance; a medium vertex scatters by its phase function and connects like a surface vertex), and
 // connections carry the transmittance between their ends (exact in homogeneous media, ratio tracking
 // in grids) across interfaces. Every sampling decision uses one extinction per path: where media are
-// chromatic (or the render spectral), a hero channel chosen per camera sample, whose value then counts
-// three times (the others zero): unbiased for every channel, with more colour noise than volpath's
+// chromatic (or the render spectral), a hero lane (colour channel or wavelength) chosen per camera
+// sample, whose value then counts for all the lanes (the others zero): unbiased for every channel, with more colour noise than volpath's
 // spectral MIS. The MIS densities leave out transmittance and the distance-sampling densities, as
 // pbrt-v3 does: the weights still sum to one over the strategies, so the estimate stays unbiased.
 // An emissive medium's light is taken where camera subpaths scatter in it (the s = 0 strategy alone,
@@ -64,7 +64,7 @@ struct BdptVertex {
   float nee_ratio = 1;
   int medium = -1;    // surfaces: the medium the subpath arrived in; medium vertices and lights: the one they are in
   float g = 0;        // medium vertices: the phase function's mean cosine
-  int8_t hero = -1;   // camera vertices: the colour channel that drives sampling in media (-1: all alike)
+  int8_t hero = -1;   // camera vertices: the lane (channel, wavelength) that drives sampling in media (-1: all alike)
   bool delta = false;        // scattered by a delta lobe
   bool at_infinity = false;  // a light at infinity (then p is a point along its direction), or an escaped ray
 

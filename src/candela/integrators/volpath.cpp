@@ -15,13 +15,12 @@ namespace {
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
-// exp(-sigma dt) per channel; 1 where sigma is 0, also over an infinite distance.
+// exp(-sigma dt) per lane; 1 where sigma is 0, also over an infinite distance.
 RGB exp_neg(const RGB& sigma, float dt) {
-  auto e = [dt](float s) { return s > 0 ? std::exp(-s * dt) : 1.0f; };
-  return {e(sigma.r), e(sigma.g), e(sigma.b)};
+  return sigma.map([dt](float s) { return s > 0 ? std::exp(-s * dt) : 1.0f; });
 }
 
-RGB clamp_zero(const RGB& c) { return {std::max(c.r, 0.0f), std::max(c.g, 0.0f), std::max(c.b, 0.0f)}; }
+RGB clamp_zero(const RGB& c) { return c.map([](float v) { return std::max(v, 0.0f); }); }
 
 // A medium's coefficients at a path's wavelengths (RGB when there are none).
 struct MediumValues {
@@ -110,7 +109,9 @@ RGB VolPathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, co
   ray.t_min *= length_scale;
 
   RGB L(0.0f), beta(1.0f), r_u(1.0f), r_l(1.0f);
-  const int hero = std::min(int(sampler.get_1d() * 3), 2);
+  // The hero lane drives distance sampling in media; the others follow by spectral MIS.
+  const int lanes = transport_lanes(wl);
+  const int hero = std::min(int(sampler.get_1d() * float(lanes)), lanes - 1);
   bool specular_bounce = false;
   float eta_scale = 1;
   LightSampleContext prev_ctx;
@@ -121,7 +122,7 @@ RGB VolPathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, co
   // Possibly terminate the path with Russian roulette (after a real scattering event); survivors
   // are reweighted so that the estimate stays unbiased.
   auto survives_roulette = [&]() {
-    RGB rr_beta = beta * (eta_scale / r_u.average());
+    RGB rr_beta = beta * (eta_scale / r_u.lane_average(lanes));
     float u = sampler.get_1d();
     if (depth > rr_start_depth_ && rr_beta.max_component() < 1) {
       float q = std::max(0.0f, 1 - rr_beta.max_component());
@@ -135,12 +136,12 @@ RGB VolPathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, co
   // the previous real scattering point unless nothing else could have found it.
   auto add_emitted = [&](const RGB& Le, uint32_t light, const Point3& p, const Normal3& n) {
     if (depth == 0 || specular_bounce) {
-      L += beta * Le / r_u.average();
+      L += beta * Le / r_u.lane_average(lanes);
       return;
     }
     float light_pdf = scene_.light_sampler().pmf(prev_ctx, light) *
                       light_pdf_li(scene_.lights()[light], prev_ctx, ray.direction, p, n);
-    L += beta * Le / (r_u + r_l * light_pdf).average();
+    L += beta * Le / (r_u + r_l * light_pdf).lane_average(lanes);
   };
 
   for (;;) {
@@ -164,7 +165,7 @@ RGB VolPathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, co
             if (depth <= max_depth_ && m.is_emissive()) {
               float pdf = sigma_maj[hero] * T[hero];
               RGB r_e = r_u * sigma_maj * T / pdf;
-              if (!r_e.is_black()) L += beta * T / pdf * mp.sigma_a * mv.emission(p) / r_e.average();
+              if (!r_e.is_black()) L += beta * T / pdf * mp.sigma_a * mv.emission(p) / r_e.lane_average(lanes);
             }
             // A real collision (with probability sigma_t over the majorant) scatters, its weight
             // the albedo: absorption is taken as a weight, not by ending paths (as Mitsuba's
@@ -348,9 +349,9 @@ RGB VolPathIntegrator::sample_direct(const ScatterPoint& at, Sampler& sampler, c
 
   const RGB Le = illuminant_at(ls.radiance, at.wl);
   r_l *= r_p * (pmf * ls.pdf);
-  if (ls.is_delta) return beta * f_hat * T_ray * Le / r_l.average();
+  if (ls.is_delta) return beta * f_hat * T_ray * Le / r_l.lane_average(transport_lanes(at.wl));
   r_u *= r_p * scatter_pdf;
-  return beta * f_hat * T_ray * Le / (r_l + r_u).average();
+  return beta * f_hat * T_ray * Le / (r_l + r_u).lane_average(transport_lanes(at.wl));
 }
 
 RGB VolPathIntegrator::trace_transmittance(Point3 origin, const Vec3& dir, float t_max, int medium, int hero,
@@ -392,7 +393,7 @@ RGB VolPathIntegrator::trace_transmittance(Point3 origin, const Vec3& dir, float
                                     r_l *= T * sigma_maj / pdf;
                                     r_u *= T * sigma_n / pdf;
                                     // Russian roulette where little light gets through.
-                                    RGB Tr = T_ray / (r_l + r_u).average();
+                                    RGB Tr = T_ray / (r_l + r_u).lane_average(transport_lanes(wl));
                                     if (Tr.max_component() < 0.05f) {
                                       if (rng.next_float() < 0.75f)
                                         T_ray = RGB(0.0f);
@@ -431,7 +432,7 @@ RGB VolPathIntegrator::transmittance(const Point3& from, const Point3& to, int m
   RayCounts counts;
   float d = length(to - from);
   RGB T = trace_transmittance(from, (to - from) / d, d, medium, hero, seed, time, wl, r_u, r_l, counts);
-  return T / r_l.average();
+  return T / r_l.lane_average(transport_lanes(wl));
 }
 
 RenderStats render_volpath(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options) {

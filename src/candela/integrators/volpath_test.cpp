@@ -48,13 +48,13 @@ ChannelMeans render_means(const SceneDesc& desc) {
       sum2[c] += m * m;
     }
   }
-  ChannelMeans out;
-  for (int c = 0; c < 3; ++c) {
-    double m = sum[c] / kSeeds, v = std::max(0.0, (sum2[c] - kSeeds * m * m) / (kSeeds - 1));
-    out.mean[c] = float(m);
-    out.standard_error[c] = float(std::sqrt(v / kSeeds));
-  }
-  return out;
+  auto mean = [&](int c) { return sum[c] / kSeeds; };
+  auto standard_error = [&](int c) {
+    double m = mean(c), v = std::max(0.0, (sum2[c] - kSeeds * m * m) / (kSeeds - 1));
+    return float(std::sqrt(v / kSeeds));
+  };
+  return {RGB(float(mean(0)), float(mean(1)), float(mean(2))),
+          RGB(standard_error(0), standard_error(1), standard_error(2))};
 }
 
 void expect_channels(const ChannelMeans& got, const RGB& expected, const char* what, float floor = 1e-4f) {
@@ -125,8 +125,8 @@ TEST(VolPath, AnEmittingAbsorbingMediumGivesLeTimesOneMinusItsTransmittance) {
   medium.sigma_t = {0.1f, 0.5f, 2.0f};
   medium.albedo.constant = RGB(0.0f);
   medium.emission = {3.0f, 1.0f, 2.0f};
-  RGB expected;
-  for (int c = 0; c < 3; ++c) expected[c] = medium.emission[c] * (1 - std::exp(-2 * medium.sigma_t[c]));
+  const RGB expected = RGB::from_lanes(
+      [&](int c) { return medium.emission[c] * (1 - std::exp(-2 * medium.sigma_t[c])); });
   expect_channels(render_means(medium_in_sphere(medium, RGB(0.0f))), expected, "emitting absorber");
 }
 
@@ -162,8 +162,7 @@ TEST(VolPath, AGlowingTemperatureGridGivesTheQuadratureOfItsEmission) {
   d.shapes = {slab};
   const Medium medium(fire);
   ASSERT_TRUE(medium.is_emissive());
-  RGB expected(0.0f);
-  double depth[3] = {0, 0, 0};
+  double expected_sum[3] = {0, 0, 0}, depth[3] = {0, 0, 0};
   const int steps = 100000;
   for (int i = 0; i < steps; ++i) {
     const float z = -0.5f + (float(i) + 0.5f) / steps;
@@ -171,10 +170,11 @@ TEST(VolPath, AGlowingTemperatureGridGivesTheQuadratureOfItsEmission) {
     const RGB le = medium.emission(p);
     for (int c = 0; c < 3; ++c) {
       const double sigma_a = double(medium.sigma_t()[c]) * medium.density(p), dz = 1.0 / steps;
-      expected[c] += float(sigma_a * le[c] * std::exp(-(depth[c] + 0.5 * sigma_a * dz)) * dz);
+      expected_sum[c] += sigma_a * le[c] * std::exp(-(depth[c] + 0.5 * sigma_a * dz)) * dz;
       depth[c] += sigma_a * dz;
     }
   }
+  const RGB expected = RGB(float(expected_sum[0]), float(expected_sum[1]), float(expected_sum[2]));
   ASSERT_GT(expected.min_component(), 0.01f);
   expect_channels(render_means(d), expected, "temperature grid, volpath", 1e-3f);
   // BDPT takes the medium's light where its camera subpaths collide (the collision estimator).

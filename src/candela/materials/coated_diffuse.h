@@ -147,9 +147,7 @@ struct CoatedDiffuseBsdf {
     RGB denom = nonlinear ? RGB(1.0f) - R * fdr : RGB(1 - fdr);
     float t = coat_transmittance(wo.z) * coat_transmittance(wi.z);
     float s = t * kInvPi / (eta * eta);
-    RGB f;
-    for (int c = 0; c < 3; ++c) f[c] = denom[c] > 0 ? R[c] * s / denom[c] : 0.0f;
-    return f;
+    return RGB::from_lanes([&](int c) { return denom[c] > 0 ? R[c] * s / denom[c] : 0.0f; });
   }
 
   // The rough coat's reflection, wo and wi in the upper hemisphere.

@@ -359,23 +359,19 @@ inline float fresnel_complex(float cos_i, std::complex<float> eta_c) {
   return (r_s + r_p) / 2;
 }
 
-// Per RGB channel.
+// Per lane.
 inline RGB fresnel_complex(float cos_i, const RGB& eta, const RGB& k) {
-  RGB f;
-  for (int c = 0; c < 3; ++c) f[c] = fresnel_complex(cos_i, std::complex<float>(eta[c], k[c]));
-  return f;
+  return RGB::from_lanes([&](int c) { return fresnel_complex(cos_i, std::complex<float>(eta[c], k[c])); });
 }
 
 // pbrt-v4's "artist" conductor parametrisation: with eta = 1, the absorption coefficient
 // k = 2 sqrt(r) / sqrt(1 - r) gives normal-incidence reflectance exactly r. r is clamped below 1,
 // where k would be infinite.
 inline RGB conductor_k_from_reflectance(const RGB& r) {
-  RGB k;
-  for (int c = 0; c < 3; ++c) {
-    float rc = std::clamp(r[c], 0.0f, 0.9999f);
-    k[c] = 2 * std::sqrt(rc) / std::sqrt(1 - rc);
-  }
-  return k;
+  return r.map([](float v) {
+    float rc = std::clamp(v, 0.0f, 0.9999f);
+    return 2 * std::sqrt(rc) / std::sqrt(1 - rc);
+  });
 }
 
 // The cosine-weighted hemispherical average of the dielectric Fresnel reflectance,

@@ -125,7 +125,7 @@ inline float fresnel_schlick(float r0, float cos_i, float eta) {
 }
 inline RGB fresnel_schlick(const RGB& r0, float cos_i, float eta) {
   float w = fresnel_schlick_weight(cos_i, eta);
-  return RGB(lerp_to(w, 1.0f, r0.r), lerp_to(w, 1.0f, r0.g), lerp_to(w, 1.0f, r0.b));
+  return r0.map([w](float c) { return lerp_to(w, 1.0f, c); });
 }
 
 // Smith masking with Mitsuba's orientation rule: zero where v sees the back of the facet m.
@@ -255,7 +255,7 @@ struct PrincipledBsdf {
       float t = w_trans * (1 - q.F) * distribution.D(q.wh) * smith_g1(distribution, wo, q.wh) *
                 smith_g1(distribution, wi, q.wh) * std::abs(q.cos_oh * cos_ih) /
                 (abs_cos_o * abs_cos_i * sqr(q.cos_oh + q.eta_path * cos_ih));
-      RGB tint(std::sqrt(base_color.r), std::sqrt(base_color.g), std::sqrt(base_color.b));
+      RGB tint = base_color.map([](float c) { return std::sqrt(c); });
       f = tint * t;
     }
     return f;

@@ -134,7 +134,7 @@ RGB Medium::emission(const Point3& p) const {
   // Below about 1,900 K the blackbody lies outside the sRGB gamut (blue, then green, negative):
   // clipped, as emission is never negative.
   const RGB c = blackbody_peak_normalised_rgb(kelvin) * scale;
-  return {std::max(c.r, 0.0f), std::max(c.g, 0.0f), std::max(c.b, 0.0f)};
+  return c.map([](float v) { return std::max(v, 0.0f); });
 }
 
 Medium::Medium(const MediumDesc& desc)

@@ -703,7 +703,7 @@ struct RenderSettings {
   SamplerDesc sampler;
   FilterDesc filter;
   bool hide_emitters = false;  // emitters seen directly by the camera (depth 0) are not shown (Mitsuba's)
-  // Spectral transport (spectral/wavelengths.h): each sample carries three wavelengths and RGB
+  // Spectral transport (spectral/wavelengths.h): each sample carries four wavelengths and RGB
   // parameters become smooth spectra, as in pbrt-v4; off = RGB transport.
   bool spectral = false;
   // Power, uniform and bvh choose lights for every integrator (scene.h's light_sampler()); the

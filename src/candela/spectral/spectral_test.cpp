@@ -99,14 +99,14 @@ TEST(Wavelengths, SamplerMatchesItsDensity) {
   double total = 0;
   for (double l = cie::kLambdaMin; l < cie::kLambdaMax; l += 0.01) total += visible_wavelength_pdf(float(l + 0.005)) * 0.01;
   EXPECT_NEAR(total, 1.0, 1e-3);
-  // ...and each of the three wavelengths follows it (chi-square over 47 bins of 10 nm).
+  // ...and each of the four wavelengths follows it (chi-square over 47 bins of 10 nm).
   const int bins = 47, samples = 200000;
   std::vector<double> observed(bins, 0), expected(bins, 0);
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> uni(0, 1);
   for (int i = 0; i < samples; ++i) {
     Wavelengths wl = sample_visible_wavelengths(uni(rng));
-    int k = i % 3;
+    int k = i % Wavelengths::kCount;
     int b = std::min(bins - 1, int((wl.lambda[k] - cie::kLambdaMin) / 10));
     observed[size_t(b)] += 1;
     EXPECT_NEAR(wl.pdf[k], visible_wavelength_pdf(wl.lambda[k]), 1e-6f);
@@ -115,6 +115,28 @@ TEST(Wavelengths, SamplerMatchesItsDensity) {
     for (int j = 0; j < 100; ++j)
       expected[size_t(b)] += visible_wavelength_pdf(cie::kLambdaMin + 10 * b + 0.1f * (j + 0.5f)) * 0.1 * samples;
   EXPECT_GT(testing::chi_square_p_value(observed, expected), testing::kChiSquareAlpha);
+}
+
+TEST(Wavelengths, OneSampleTakesOneWavelengthFromEachQuarterOfTheDensity) {
+  // Stratified as pbrt-v4 does: wavelength i of u is the inverse CDF at u + i/4 (mod 1), so the four
+  // fall in different quarters of the density's mass, whatever u.
+  auto cdf = [](float lambda) {
+    double sum = 0;
+    for (double l = cie::kLambdaMin; l < lambda; l += 0.01) sum += visible_wavelength_pdf(float(l + 0.005)) * 0.01;
+    return sum;
+  };
+  static_assert(Wavelengths::kCount == 4);
+  for (float u : {0.0f, 0.1f, 0.37f, 0.74f, 0.999f}) {
+    Wavelengths wl = sample_visible_wavelengths(u);
+    bool quarter_taken[4] = {};
+    for (int i = 0; i < Wavelengths::kCount; ++i) {
+      double c = cdf(wl.lambda[i]);
+      double expected = std::fmod(double(u) + i / 4.0, 1.0);
+      EXPECT_NEAR(c, expected, 2e-3) << "u " << u << " wavelength " << i;
+      quarter_taken[std::min(3, int(expected * 4))] = true;
+    }
+    for (bool taken : quarter_taken) EXPECT_TRUE(taken) << "u " << u;
+  }
 }
 
 // Mean of wavelengths_to_rgb over many samples, with its standard error per channel.
@@ -158,7 +180,7 @@ TEST(Wavelengths, SpectralSamplesEstimateTheSpectrumsColour) {
   Wavelengths wl = sample_visible_wavelengths(0.3f);
   RGB eta(0.2f, 0.9f, 1.1f), v = unbounded_at(eta, wl);
   SigmoidPolynomial se = rgb_to_sigmoid(eta / 2.2f);
-  for (int i = 0; i < 3; ++i) EXPECT_NEAR(v[i], 2.2f * se(wl.lambda[i]), 1e-5f);
+  for (int i = 0; i < Wavelengths::kCount; ++i) EXPECT_NEAR(v[i], 2.2f * se(wl.lambda[i]), 1e-5f);
   EXPECT_EQ(unbounded_at(RGB(1.5f), wl), RGB(1.5f));
 }
 

@@ -43,7 +43,7 @@ RGB wavelengths_to_rgb(const RGB& values, const Wavelengths& wl) {
 namespace {
 
 RGB sigmoid_at(const SigmoidPolynomial& s, const Wavelengths& wl) {
-  return {s(wl.lambda[0]), s(wl.lambda[1]), s(wl.lambda[2])};
+  return {s(wl.lambda[0]), s(wl.lambda[1]), s(wl.lambda[2]), s(wl.lambda[3])};
 }
 
 }  // namespace
@@ -63,7 +63,8 @@ RGB reflectance_at(const RGB& rgb, const Wavelengths& wl) {
 
 RGB illuminant_at(const RGB& rgb, const Wavelengths& wl) {
   RGB s = unbounded_at(rgb, wl);
-  return {s.r * float(cie::d65(wl.lambda[0])), s.g * float(cie::d65(wl.lambda[1])), s.b * float(cie::d65(wl.lambda[2]))};
+  return s * RGB(float(cie::d65(wl.lambda[0])), float(cie::d65(wl.lambda[1])), float(cie::d65(wl.lambda[2])),
+                 float(cie::d65(wl.lambda[3])));
 }
 
 }  // namespace candela

@@ -1,7 +1,7 @@
 #pragma once
 // Spectral rendering with the RGB transport type: in a spectral render each camera sample draws
-// three wavelengths, and every RGB the path carries (throughput, radiance, BSDF values) holds the
-// values at those three wavelengths instead of red, green and blue. RGB scene parameters become
+// four wavelengths, as pbrt-v4 does, and every RGB the path carries (throughput, radiance, BSDF
+// values) holds the values at those four wavelengths in its four lanes instead of red, green, blue. RGB scene parameters become
 // spectra as pbrt-v4 makes them (rgb_to_spectrum.h): reflectances as bounded sigmoid spectra,
 // unbounded values (eta, k) as a scale times one, emission as one times the D65 illuminant; the
 // sample's value reaches the film as linear sRGB through the CIE matching functions.
@@ -10,19 +10,18 @@
 namespace candela {
 
 struct Wavelengths {
-  static constexpr int kCount = 3;  // one per slot of the RGB that carries the values
+  static constexpr int kCount = RGB::kLanes;  // one per lane of the RGB that carries the values
   float lambda[kCount] = {};        // nm
   float pdf[kCount] = {};           // density of each, per nm
 };
 
-// Three wavelengths stratified over [360, 830] nm by one uniform number (u, u + 1/3, u + 2/3 mod
-// 1), each importance-sampled from pbrt-v4's visible-wavelength density, proportional to
+// Four wavelengths stratified over [360, 830] nm by one uniform number (u + i/4 mod 1), each importance-sampled from pbrt-v4's visible-wavelength density, proportional to
 // 1 / cosh^2(0.0072 (lambda - 538)).
 Wavelengths sample_visible_wavelengths(float u);
 float visible_wavelength_pdf(float lambda);
 
 // Linear sRGB of the sample whose values at wl are `values`: the Monte Carlo estimate of the
-// spectrum's XYZ, (1/3) sum_i values_i xyz-bar(lambda_i) / pdf_i / integral(y-bar), turned into sRGB.
+// spectrum's XYZ, (1/4) sum_i values_i xyz-bar(lambda_i) / pdf_i / integral(y-bar), turned into sRGB.
 RGB wavelengths_to_rgb(const RGB& values, const Wavelengths& wl);
 
 // The values at wl of the spectra pbrt-v4 makes from RGB parameters:
@@ -33,6 +32,10 @@ RGB wavelengths_to_rgb(const RGB& values, const Wavelengths& wl);
 RGB reflectance_at(const RGB& rgb, const Wavelengths& wl);
 RGB unbounded_at(const RGB& rgb, const Wavelengths& wl);
 RGB illuminant_at(const RGB& rgb, const Wavelengths& wl);
+
+// The lanes of an RGB that carry values: the wavelengths of a spectral render, the three colour
+// channels of an RGB render (wl null), whose fourth lane only mirrors green.
+inline int transport_lanes(const Wavelengths* wl) { return wl ? Wavelengths::kCount : 3; }
 
 // The same for a render that may be RGB (wl null): then the colour is returned as it is.
 inline RGB illuminant_at(const RGB& rgb, const Wavelengths* wl) { return wl ? illuminant_at(rgb, *wl) : rgb; }

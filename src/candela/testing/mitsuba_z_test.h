@@ -89,12 +89,9 @@ inline ImageMeanAgreement image_mean_agreement(const Image& rgb_image, const Ima
     sum[i % 3] += reference.rgb[i];
     var[i % 3] += std::max(double(variance.rgb[i]), 0.0) * (1.0 / spp + 1.0 / reference_spp);
   }
-  ImageMeanAgreement a;
-  for (int c = 0; c < 3; ++c) {
-    a.z[c] = float(difference[c] / std::sqrt(std::max(var[c], 1e-30)));
-    a.relative_difference[c] = float(difference[c] / std::max(std::abs(sum[c]), 1e-30));
-  }
-  return a;
+  auto z = [&](int c) { return float(difference[c] / std::sqrt(std::max(var[c], 1e-30))); };
+  auto relative = [&](int c) { return float(difference[c] / std::max(std::abs(sum[c]), 1e-30)); };
+  return {RGB(z(0), z(1), z(2)), RGB(relative(0), relative(1), relative(2))};
 }
 
 }  // namespace candela::testing

@@ -79,9 +79,8 @@ RGB read_rgb(const ErrorReporter& report, const Json& value, const std::string& 
   if (value.is_number()) return RGB(read_color_component(report, value, pointer, kind));
   if (!value.is_array() || value.size() != 3)
     report.fail(pointer, "expected a colour, [r, g, b] or a single number, got {}", describe(value));
-  RGB rgb;
-  for (int i = 0; i < 3; ++i) rgb[i] = read_color_component(report, value[i], child_pointer(pointer, size_t(i)), kind);
-  return rgb;
+  auto channel = [&](int i) { return read_color_component(report, value[i], child_pointer(pointer, size_t(i)), kind); };
+  return RGB(channel(0), channel(1), channel(2));
 }
 
 Vec3 read_direction(const ErrorReporter& report, const Json& value, const std::string& pointer) {

@@ -91,7 +91,7 @@ MaterialDesc SceneParser::make_material(const std::string& type, const SourceLoc
     // pbrt-v4 clamps scale * value to [0, 1].
     auto clamp01 = [](ColorInput c) {
       if (c.is_constant())
-        for (int i = 0; i < 3; ++i) c.value[i] = std::clamp(c.value[i], 0.0f, 1.0f);
+        c.value = c.value.map([](float v) { return std::clamp(v, 0.0f, 1.0f); });
       return c;
     };
     m.reflectance = clamp01(scaled(reflectance, scale, params.directive()));

@@ -44,9 +44,8 @@ RGB spectrum_rgb(const Param& p, const ParamList& params, Role role) {
                         p.numbers[i], p.numbers[i + 1]);
   }
   RGB rgb = pbrt_spectra::sampled_spectrum_rgb(p.numbers, role);
-  for (int c = 0; c < 3; ++c) rgb[c] = std::max(rgb[c], 0.0f);
-  if (role == Role::Reflectance)
-    for (int c = 0; c < 3; ++c) rgb[c] = std::min(rgb[c], 1.0f);
+  rgb = rgb.map([](float v) { return std::max(v, 0.0f); });
+  if (role == Role::Reflectance) rgb = rgb.map([](float v) { return std::min(v, 1.0f); });
   return rgb;
 }
 
