@@ -284,7 +284,7 @@ uint32_t LightSampler::build_wide(uint32_t binary_node, uint32_t parent, uint8_t
     slots.push_back(binary_node);
   } else {
     slots = {nodes_[binary_node].child_or_light, nodes_[binary_node].child_or_light + 1};
-    while (slots.size() < 4) {
+    while (slots.size() < size_t(kWidth)) {
       auto largest = std::max_element(slots.begin(), slots.end(), [&](uint32_t a, uint32_t b) {
         return (nodes_[a].leaf ? 0 : nodes_[a].lights) < (nodes_[b].leaf ? 0 : nodes_[b].lights);
       });
@@ -300,7 +300,8 @@ uint32_t LightSampler::build_wide(uint32_t binary_node, uint32_t parent, uint8_t
     WideNode& w = wide_[index];
     w.parent = parent;
     w.parent_slot = parent_slot;
-    for (int k = 0; k < 4; ++k) {
+    w.used = uint8_t(slots.size());
+    for (int k = 0; k < kWidth; ++k) {
       // Unused slots: nothing there (phi = 0), at the origin, a cone the math stays finite on.
       LightImportance li;
       if (k < int(slots.size())) li = LightImportance(bounds_[slots[size_t(k)]]);
@@ -315,9 +316,9 @@ uint32_t LightSampler::build_wide(uint32_t binary_node, uint32_t parent, uint8_t
   for (size_t k = 0; k < slots.size(); ++k) {
     const BuildNode& b = nodes_[slots[k]];
     if (b.leaf) {
-      wide_[index].leaf_mask |= uint8_t(1u << k);
+      wide_[index].leaf_mask = uint16_t(wide_[index].leaf_mask | (1u << k));
       wide_[index].child[k] = b.child_or_light;
-      slot_of_light_[b.child_or_light] = int32_t(4 * index + k);
+      slot_of_light_[b.child_or_light] = int32_t(kWidth * index + k);
     } else {
       const uint32_t child = build_wide(slots[k], index, uint8_t(k));  // (wide_ may move)
       wide_[index].child[k] = child;
@@ -346,40 +347,55 @@ F4 select(I4 mask, F4 a, F4 b) { return mask ? a : b; }
 F4 max4(F4 a, F4 b) { return a > b ? a : b; }
 F4 safe_sqrt4(F4 x) { return sqrt4(max4(x, splat(0.0f))); }
 
+// The importances' total, summed pairwise (the same order wherever a choice's probability is made).
+float sum_of_slots(const float importance[LightSampler::kWidth]) {
+  float s[LightSampler::kWidth];
+  std::memcpy(s, importance, sizeof s);
+  for (int n = LightSampler::kWidth; n > 1; n /= 2)
+    for (int i = 0; i < n / 2; ++i) s[i] = s[2 * i] + s[2 * i + 1];
+  return s[0];
+}
+
 }  // namespace
 
-void LightSampler::importances(const WideNode& node, const LightSampleContext& ctx, float out[4]) {
-  // LightImportance::operator() for the four slots at once; see there for the steps.
-  const F4 radius = load(node.radius);
-  const F4 dx = splat(ctx.p.x) - load(node.cx), dy = splat(ctx.p.y) - load(node.cy), dz = splat(ctx.p.z) - load(node.cz);
-  const F4 d2_true = dx * dx + dy * dy + dz * dz;
-  const F4 radius2 = radius * radius;
-  const F4 d2 = max4(max4(d2_true, radius2), splat(1e-12f));
-  const I4 outside = d2_true > radius2;
-  const F4 inv_d = 1.0f / sqrt4(select(outside, d2_true, splat(1.0f)));
-  const F4 sin_b = select(outside, radius * inv_d, splat(0.0f));
-  const F4 cos_b = select(outside, safe_sqrt4(1.0f - sin_b * sin_b), splat(-1.0f));
-  const F4 wix = select(outside, dx * inv_d, splat(0.0f)), wiy = select(outside, dy * inv_d, splat(0.0f)),
-           wiz = select(outside, dz * inv_d, splat(1.0f));
+void LightSampler::importances(const WideNode& node, const LightSampleContext& ctx, float out[kWidth]) {
+  // LightImportance::operator() for four slots at once; see there for the steps. The passes over
+  // the node's groups of four do not depend on each other; groups of empty slots weigh nothing.
+  int group = 0;
+  for (; group < node.used; group += 4) {
+    const F4 radius = load(node.radius + group);
+    const F4 dx = splat(ctx.p.x) - load(node.cx + group), dy = splat(ctx.p.y) - load(node.cy + group),
+             dz = splat(ctx.p.z) - load(node.cz + group);
+    const F4 d2_true = dx * dx + dy * dy + dz * dz;
+    const F4 radius2 = radius * radius;
+    const F4 d2 = max4(max4(d2_true, radius2), splat(1e-12f));
+    const I4 outside = d2_true > radius2;
+    const F4 inv_d = 1.0f / sqrt4(select(outside, d2_true, splat(1.0f)));
+    const F4 sin_b = select(outside, radius * inv_d, splat(0.0f));
+    const F4 cos_b = select(outside, safe_sqrt4(1.0f - sin_b * sin_b), splat(-1.0f));
+    const F4 wix = select(outside, dx * inv_d, splat(0.0f)), wiy = select(outside, dy * inv_d, splat(0.0f)),
+             wiz = select(outside, dz * inv_d, splat(1.0f));
 
-  F4 cos_w = load(node.wx) * wix + load(node.wy) * wiy + load(node.wz) * wiz;
-  cos_w = select(load(node.two_sided) > 0.0f, select(cos_w < 0.0f, -cos_w, cos_w), cos_w);
-  const F4 cos_o = load(node.cos_o), sin_o = load(node.sin_o);
-  const I4 in_cone = cos_w > cos_o;
-  const F4 sin_w = safe_sqrt4(1.0f - cos_w * cos_w);
-  const F4 cos_x = select(in_cone, splat(1.0f), cos_w * cos_o + sin_w * sin_o);
-  const F4 sin_x = select(in_cone, splat(0.0f), sin_w * cos_o - cos_w * sin_o);
-  const F4 cos_p = select(cos_x > cos_b, splat(1.0f), cos_x * cos_b + sin_x * sin_b);
-  F4 importance = select(cos_p <= load(node.cos_e), splat(0.0f), load(node.phi) * cos_p / d2);
+    F4 cos_w = load(node.wx + group) * wix + load(node.wy + group) * wiy + load(node.wz + group) * wiz;
+    cos_w = select(load(node.two_sided + group) > 0.0f, select(cos_w < 0.0f, -cos_w, cos_w), cos_w);
+    const F4 cos_o = load(node.cos_o + group), sin_o = load(node.sin_o + group);
+    const I4 in_cone = cos_w > cos_o;
+    const F4 sin_w = safe_sqrt4(1.0f - cos_w * cos_w);
+    const F4 cos_x = select(in_cone, splat(1.0f), cos_w * cos_o + sin_w * sin_o);
+    const F4 sin_x = select(in_cone, splat(0.0f), sin_w * cos_o - cos_w * sin_o);
+    const F4 cos_p = select(cos_x > cos_b, splat(1.0f), cos_x * cos_b + sin_x * sin_b);
+    F4 importance = select(cos_p <= load(node.cos_e + group), splat(0.0f), load(node.phi + group) * cos_p / d2);
 
-  if (ctx.n != Normal3(0.0f)) {
-    const F4 cos_i = -(splat(ctx.n.x) * wix + splat(ctx.n.y) * wiy + splat(ctx.n.z) * wiz);
-    const F4 bound = max4(cos_i * cos_b + safe_sqrt4(1.0f - cos_i * cos_i) * sin_b, splat(0.0f));
-    importance *= select(cos_i > cos_b, splat(1.0f), bound);
+    if (ctx.n != Normal3(0.0f)) {
+      const F4 cos_i = -(splat(ctx.n.x) * wix + splat(ctx.n.y) * wiy + splat(ctx.n.z) * wiz);
+      const F4 bound = max4(cos_i * cos_b + safe_sqrt4(1.0f - cos_i * cos_i) * sin_b, splat(0.0f));
+      importance *= select(cos_i > cos_b, splat(1.0f), bound);
+    }
+    // Not finite (or negative): nothing (NaN fails both comparisons).
+    importance = select((importance > 0.0f) & (importance < splat(INFINITY)), importance, splat(0.0f));
+    std::memcpy(out + group, &importance, sizeof importance);
   }
-  // Not finite (or negative): nothing (NaN fails both comparisons).
-  importance = select((importance > 0.0f) & (importance < splat(INFINITY)), importance, splat(0.0f));
-  std::memcpy(out, &importance, sizeof importance);
+  std::fill(out + group, out + kWidth, 0.0f);
 }
 
 int LightSampler::bvh_depth() const {
@@ -437,10 +453,10 @@ float LightSampler::pmf(const LightSampleContext& ctx, size_t light) const {
   return kPaperUniformShare / float(lights_.size()) + (1 - kPaperUniformShare) * tree_pmf(ctx, light);
 }
 
-void LightSampler::slot_importances(const WideNode& node, const LightSampleContext& ctx, float out[4]) const {
+void LightSampler::slot_importances(const WideNode& node, const LightSampleContext& ctx, float out[kWidth]) const {
   importances(node, ctx, out);
   if (mode_ != Mode::Paper || node.leaf_mask == 0) return;
-  for (int k = 0; k < 4; ++k)
+  for (int k = 0; k < kWidth; ++k)
     if (node.leaf_mask & (1u << k)) out[k] = std::max(0.0f, light_importance(lights_[node.child[k]], ctx));
 }
 
@@ -461,14 +477,14 @@ SampledLight LightSampler::sample_tree(const LightSampleContext& ctx, float u) c
   uint32_t node = 0;
   for (;;) {
     const WideNode& w = wide_[node];
-    float importance[4];
+    float importance[kWidth];
     slot_importances(w, ctx, importance);
-    const float total = (importance[0] + importance[1]) + (importance[2] + importance[3]);
+    const float total = sum_of_slots(importance);
     if (!(total > 0)) return {};
     // The slot whose share of [0, total) holds u x total; the last slot with any importance takes
     // what rounding leaves, and no slot of importance 0 is ever chosen.
     const float target = u * total;
-    int last = 3;
+    int last = kWidth - 1;
     while (importance[last] == 0) --last;
     int k = 0;
     float below = 0;
@@ -492,12 +508,12 @@ float LightSampler::tree_pmf(const LightSampleContext& ctx, size_t light) const 
   // The product of the choices on the way down, gathered on the way up from the light's slot.
   float pmf = 1 - p_infinite;
   if (nodes_[0].leaf) return pmf;  // a lone light
-  uint32_t node = uint32_t(slot) / 4, k = uint32_t(slot) % 4;
+  uint32_t node = uint32_t(slot) / kWidth, k = uint32_t(slot) % kWidth;
   for (;;) {
     const WideNode& w = wide_[node];
-    float importance[4];
+    float importance[kWidth];
     slot_importances(w, ctx, importance);
-    const float total = (importance[0] + importance[1]) + (importance[2] + importance[3]);
+    const float total = sum_of_slots(importance);
     if (!(total > 0)) return 0;
     pmf *= importance[k] / total;
     if (node == 0) return pmf;
