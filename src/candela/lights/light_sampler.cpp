@@ -347,11 +347,15 @@ F4 select(I4 mask, F4 a, F4 b) { return mask ? a : b; }
 F4 max4(F4 a, F4 b) { return a > b ? a : b; }
 F4 safe_sqrt4(F4 x) { return sqrt4(max4(x, splat(0.0f))); }
 
-// The importances' total, summed pairwise (the same order wherever a choice's probability is made).
-float sum_of_slots(const float importance[LightSampler::kWidth]) {
+// The importances' total, summed pairwise (the same order wherever a choice's probability is made)
+// over the first `used` slots rounded up to a power of two: the empty slots after them hold 0, and
+// adding those pairwise would change nothing.
+float sum_of_slots(const float importance[LightSampler::kWidth], int used) {
+  int n = 4;
+  while (n < used) n *= 2;
   float s[LightSampler::kWidth];
-  std::memcpy(s, importance, sizeof s);
-  for (int n = LightSampler::kWidth; n > 1; n /= 2)
+  std::memcpy(s, importance, sizeof(float) * size_t(n));
+  for (; n > 1; n /= 2)
     for (int i = 0; i < n / 2; ++i) s[i] = s[2 * i] + s[2 * i + 1];
   return s[0];
 }
@@ -479,12 +483,12 @@ SampledLight LightSampler::sample_tree(const LightSampleContext& ctx, float u) c
     const WideNode& w = wide_[node];
     float importance[kWidth];
     slot_importances(w, ctx, importance);
-    const float total = sum_of_slots(importance);
+    const float total = sum_of_slots(importance, w.used);
     if (!(total > 0)) return {};
     // The slot whose share of [0, total) holds u x total; the last slot with any importance takes
     // what rounding leaves, and no slot of importance 0 is ever chosen.
     const float target = u * total;
-    int last = kWidth - 1;
+    int last = w.used - 1;
     while (importance[last] == 0) --last;
     int k = 0;
     float below = 0;
@@ -513,7 +517,7 @@ float LightSampler::tree_pmf(const LightSampleContext& ctx, size_t light) const 
     const WideNode& w = wide_[node];
     float importance[kWidth];
     slot_importances(w, ctx, importance);
-    const float total = sum_of_slots(importance);
+    const float total = sum_of_slots(importance, w.used);
     if (!(total > 0)) return 0;
     pmf *= importance[k] / total;
     if (node == 0) return pmf;
