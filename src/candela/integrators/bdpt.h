@@ -19,9 +19,10 @@
 // connections carry the transmittance between their ends (exact in homogeneous media, ratio tracking
 // in grids) across interfaces. Every sampling decision uses one extinction per path: where media are
 // chromatic (or the render spectral), a hero lane (colour channel or wavelength) chosen per camera
-// sample, whose value then counts for all the lanes (the others zero): unbiased for every channel, with more colour noise than volpath's
-// spectral MIS. The MIS densities leave out transmittance and the distance-sampling densities, as
-// pbrt-v3 does: the weights still sum to one over the strategies, so the estimate stays unbiased.
+// sample, whose value then counts for all the lanes (the others zero): unbiased for every channel,
+// with more colour noise than volpath's spectral MIS. The MIS densities leave out transmittance and
+// the distance-sampling densities, as pbrt-v3 does: the weights still sum to one over the
+// strategies, so the estimate stays unbiased.
 // An emissive medium's light is taken where camera subpaths scatter in it (the s = 0 strategy alone,
 // weight 1: no strategy samples light vertices in media).
 //

@@ -1,21 +1,23 @@
 #pragma once
 // Spectral rendering with the RGB transport type: in a spectral render each camera sample draws
 // four wavelengths, as pbrt-v4 does, and every RGB the path carries (throughput, radiance, BSDF
-// values) holds the values at those four wavelengths in its four lanes instead of red, green, blue. RGB scene parameters become
-// spectra as pbrt-v4 makes them (rgb_to_spectrum.h): reflectances as bounded sigmoid spectra,
-// unbounded values (eta, k) as a scale times one, emission as one times the D65 illuminant; the
-// sample's value reaches the film as linear sRGB through the CIE matching functions.
+// values) holds the values at those four wavelengths in its four lanes instead of red, green, blue.
+// RGB scene parameters become spectra as pbrt-v4 makes them (rgb_to_spectrum.h): reflectances as
+// bounded sigmoid spectra, unbounded values (eta, k) as a scale times one, emission as one times the
+// D65 illuminant; the sample's value reaches the film as linear sRGB through the CIE matching
+// functions.
 #include "candela/math/color.h"
 
 namespace candela {
 
 struct Wavelengths {
   static constexpr int kCount = RGB::kLanes;  // one per lane of the RGB that carries the values
-  float lambda[kCount] = {};        // nm
-  float pdf[kCount] = {};           // density of each, per nm
+  float lambda[kCount] = {};                  // nm
+  float pdf[kCount] = {};                     // density of each, per nm
 };
 
-// Four wavelengths stratified over [360, 830] nm by one uniform number (u + i/4 mod 1), each importance-sampled from pbrt-v4's visible-wavelength density, proportional to
+// Four wavelengths stratified over [360, 830] nm by one uniform number (u + i/4 mod 1), each
+// importance-sampled from pbrt-v4's visible-wavelength density, proportional to
 // 1 / cosh^2(0.0072 (lambda - 538)).
 Wavelengths sample_visible_wavelengths(float u);
 float visible_wavelength_pdf(float lambda);
