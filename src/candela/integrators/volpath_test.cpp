@@ -89,22 +89,29 @@ SceneDesc medium_in_sphere(const MediumDesc& medium, const RGB& wall) {
   return d;
 }
 
-TEST(VolPath, ChromaticSlabTransmitsExpOfMinusSigmaTTimesThickness) {
-  // An absorbing slab 0.8 thick between an orthographic camera and a white sky: exp(-sigma_t d)
-  // per channel, however unlike the channels' coefficients are (the hero channel drives sampling).
+// A slab of `medium` between z = -half and z = half (10 x 10 wide, bounded by an interface), seen
+// along z by an orthographic camera from z = -3; no lights.
+SceneDesc slab_scene(const MediumDesc& medium, float half) {
   SceneDesc d = volpath_scene(8, 64);
   d.camera.projection = Projection::Orthographic;
   d.camera.world_from_camera = Transform::look_at_right_handed({0, 0, -3}, {0, 0, 0}, {0, 1, 0});
-  MediumDesc fog;
-  fog.sigma_t = {0.2f, 1.0f, 4.0f};
-  fog.albedo.constant = RGB(0.0f);
-  d.media = {fog};
+  d.media = {medium};
   d.materials = {InterfaceMaterial{}};
   ShapeDesc slab;
-  slab.geometry = BoxShape{{-5, -5, -0.4f}, {5, 5, 0.4f}};
+  slab.geometry = BoxShape{{-5, -5, -half}, {5, 5, half}};
   slab.material = 0;
   slab.interior_medium = 0;
   d.shapes = {slab};
+  return d;
+}
+
+TEST(VolPath, ChromaticSlabTransmitsExpOfMinusSigmaTTimesThickness) {
+  // An absorbing slab 0.8 thick between an orthographic camera and a white sky: exp(-sigma_t d)
+  // per channel, however unlike the channels' coefficients are (the hero channel drives sampling).
+  MediumDesc fog;
+  fog.sigma_t = {0.2f, 1.0f, 4.0f};
+  fog.albedo.constant = RGB(0.0f);
+  SceneDesc d = slab_scene(fog, 0.4f);
   d.lights = {SkyLight{RGB(1.0f), RGB(1.0f), RGB(1.0f), {0, 1, 0}}};
   expect_channels(render_means(d), {std::exp(-0.16f), std::exp(-0.8f), std::exp(-3.2f)}, "slab");
 }
@@ -134,9 +141,6 @@ TEST(VolPath, AGlowingTemperatureGridGivesTheQuadratureOfItsEmission) {
   // An absorbing slab whose density, temperature and emission scale vary with depth (pbrt-v4's
   // blackbody emission from a temperature grid), seen along its depth by an orthographic camera
   // against black: L = integral of sigma_a(z) Le(z) exp(-optical depth to z) dz, by quadrature.
-  SceneDesc d = volpath_scene(8, 64);
-  d.camera.projection = Projection::Orthographic;
-  d.camera.world_from_camera = Transform::look_at_right_handed({0, 0, -3}, {0, 0, 0}, {0, 1, 0});
   MediumDesc fire;
   fire.sigma_t = {1.0f, 1.5f, 0.7f};
   fire.albedo.constant = RGB(0.0f);
@@ -153,13 +157,7 @@ TEST(VolPath, AGlowingTemperatureGridGivesTheQuadratureOfItsEmission) {
   fire.temperature_offset = 200;
   fire.temperature_scale = 1.2f;
   fire.emission_scale = column({2.0f, 1.0f, 0.5f, 3.0f});
-  d.media = {fire};
-  d.materials = {InterfaceMaterial{}};
-  ShapeDesc slab;
-  slab.geometry = BoxShape{{-5, -5, -0.5f}, {5, 5, 0.5f}};
-  slab.material = 0;
-  slab.interior_medium = 0;
-  d.shapes = {slab};
+  SceneDesc d = slab_scene(fire, 0.5f);
   const Medium medium(fire);
   ASSERT_TRUE(medium.is_emissive());
   double expected_sum[3] = {0, 0, 0}, depth[3] = {0, 0, 0};
