@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
 """What watching a render costs it: the same render without the preview, with the preview serving
-nobody, with a client polling it as the page does, and with the real page open in headless Chromium
-(on the same cores, as when a user watches on the machine that renders).
+nobody, with a client polling it as the page does, with the real page open in headless Chromium
+(on the same cores, as when a user watches on the machine that renders), and under a slowloris attack
+of --slow-clients connections on loopback (each sends a header byte a second and never ends its
+request; closed, it comes back half a second later).
 
   bench/preview_overhead.py [--candela build/candela] [--resolution 256x256] [--spp 256] [--threads 2]
-                            [--repeats 3] [--no-browser] [--screenshot docs/images/preview.png]
+                            [--repeats 3] [--no-browser] [--slow-clients 200] [--screenshot docs/images/preview.png]
 
 Runs alternate between the modes, `--repeats` times, and prints per mode the median render time (the
 time candela reports for its samples, not the process start) and its ratio to the plain render.
@@ -14,6 +16,7 @@ import argparse
 import json
 import pathlib
 import re
+import socket
 import statistics
 import subprocess
 import sys
@@ -46,19 +49,57 @@ def render_seconds(proc):
     return float(re.search(r" in ([\d.]+) s:", out).group(1))
 
 
+def endpoint(url, path):
+    """The printed address (http://HOST:PORT/?token=T) made into one of an endpoint, with the token."""
+    base, token = url.split("?token=")
+    return f"{base}{path}{'&' if '?' in path else '?'}token={token}"
+
+
 def poll_like_the_page(url, stop):
     """Status twice a second, the image whenever its version changed (what preview_page.html does)."""
     shown = None
     while not stop.is_set():
         try:
-            status = json.load(urllib.request.urlopen(url + "status", timeout=5))
+            status = json.load(urllib.request.urlopen(endpoint(url, "status"), timeout=5))
             if status["version"] != shown:
-                with urllib.request.urlopen(url + "image?max=1280", timeout=5) as r:
+                with urllib.request.urlopen(endpoint(url, "image?max=1280"), timeout=5) as r:
                     r.read()
                     shown = int(r.headers["X-Version"])
         except OSError:
             return
         stop.wait(0.5)
+
+
+def slow_clients(url, count, stop):
+    """`count` connections that each send a header byte a second and never finish their request."""
+    port = int(re.search(r":(\d+)/", url).group(1))
+    clients, next_byte = [], 0.0
+    while not stop.is_set():
+        clients = [c for c in clients if c is not None]
+        while len(clients) < count:
+            try:
+                c = socket.create_connection(("127.0.0.1", port), timeout=1)
+            except OSError:
+                break
+            c.setblocking(False)
+            c.send(f"GET /status HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n".encode())
+            clients.append(c)
+        if time.time() >= next_byte:
+            next_byte = time.time() + 1
+            for i, c in enumerate(clients):
+                try:
+                    c.send(b"X")
+                    if c.recv(4096) == b"":
+                        raise OSError
+                except BlockingIOError:
+                    pass
+                except OSError:
+                    c.close()
+                    clients[i] = None
+        stop.wait(0.5)
+    for c in clients:
+        if c is not None:
+            c.close()
 
 
 def browser(headless_size="1100,760"):
@@ -79,12 +120,15 @@ def main():
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--no-browser", action="store_true")
+    p.add_argument("--slow-clients", type=int, default=0, help="add a mode under this many slowloris clients")
     p.add_argument("--screenshot")
     args = p.parse_args()
 
     modes = ["plain", "preview, nobody watching", "preview, polled as the page does"]
     if not args.no_browser:
         modes.append("preview, page open in Chromium")
+    if args.slow_clients:
+        modes.append(f"preview, {args.slow_clients} slow clients")
     driver = None if args.no_browser else browser()
     times = {m: [] for m in modes}
     for _ in range(args.repeats):
@@ -98,6 +142,8 @@ def main():
                 threading.Thread(target=poll_like_the_page, args=(url, stop), daemon=True).start()
             elif mode.startswith("preview, page"):
                 driver.get(url)
+            elif mode.endswith("slow clients"):
+                threading.Thread(target=slow_clients, args=(url, args.slow_clients, stop), daemon=True).start()
             times[mode].append(render_seconds(proc))
             stop.set()
     base = statistics.median(times["plain"])

@@ -250,8 +250,8 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
     if (!cmd.preview.empty()) {
       const PreviewAddress address = parse_preview_address(cmd.preview);
       if (!address.loopback() && !cmd.preview_public)
-        throw UsageError(fmt::format("--preview {}: the page has no authentication, so it listens on this machine only "
-                                     "(127.0.0.1) unless --preview-public is given", cmd.preview));
+        throw UsageError(fmt::format("--preview {}: the preview listens on this machine only (127.0.0.1) unless "
+                                     "--preview-public is given", cmd.preview));
       if (pixel_mode) throw UsageError("--preview shows the whole image: it cannot be combined with --pixel");
     }
     if (!cmd.display_server.empty()) {
@@ -470,13 +470,18 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
     tev = std::make_unique<TevClient>(cmd.display_server, outputs.front().filename().string(), *live);
   if (live && !cmd.preview.empty()) {
     const PreviewAddress address = parse_preview_address(cmd.preview);
-    preview = std::make_unique<PreviewServer>(address, *live, [] {
-      g_stopped_from_page.store(true);
-      g_stop.store(true);
-    });
+    preview = std::make_unique<PreviewServer>(
+        address, *live,
+        [] {
+          g_stopped_from_page.store(true);
+          g_stop.store(true);
+        },
+        cmd.preview_public);
     if (!address.loopback())
-      std::fprintf(stderr, "candela: warning: the preview at %s has no authentication: anyone who can reach this "
-                           "machine can watch the render and stop it\n", preview->url().c_str());
+      std::fprintf(stderr, "candela: warning: the preview listens on %s, which other machines can reach: anyone who "
+                           "sees its address (with the token) can watch the render and stop it, and it travels "
+                           "unencrypted; an SSH tunnel to a loopback preview is safer (docs/preview.md)\n",
+                   address.host.c_str());
     std::fprintf(stderr, "candela: preview at %s\n", preview->url().c_str());
     std::fflush(stderr);
   }
@@ -744,7 +749,8 @@ int main(int argc, char** argv) {
                          "Serve a page showing the render as it converges at [HOST:]PORT (default host 127.0.0.1; "
                          "port 0 = any free port, printed); open it in a browser (docs/preview.md)");
   render_cmd->add_flag("--preview-public", cmd.preview_public,
-                       "Allow --preview on an address other machines can reach (the page has no authentication)");
+                       "Allow --preview on an address other machines can reach (the token is still needed; a "
+                       "warning is printed)");
   render_cmd->add_option("--spp-map", cmd.spp_map,
                          "Also write the per-pixel sample counts: a heat map (.png) or raw counts (.exr, .pfm)");
   render_cmd->add_option("--display-server", cmd.display_server,

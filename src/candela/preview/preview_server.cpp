@@ -1,6 +1,7 @@
 #include "candela/preview/preview_server.h"
 
 #include <httplib.h>
+#include <pthread.h>
 
 #include <algorithm>
 #include <bit>
@@ -98,9 +99,28 @@ PreviewAddress parse_preview_address(const std::string& text) {
   return a;
 }
 
-PreviewServer::PreviewServer(const PreviewAddress& address, const LiveFilm& live, std::function<void()> on_stop)
-    : live_(live), on_stop_(std::move(on_stop)), server_(std::make_unique<httplib::Server>()), host_(address.host) {
-  httplib::Server& server = *server_;
+PreviewServer::PreviewServer(const PreviewAddress& address, const LiveFilm& live, std::function<void()> on_stop,
+                             bool public_access, const HttpLimits& limits)
+    : live_(live),
+      on_stop_(std::move(on_stop)),
+      access_(random_preview_token(), address.host, address.port, public_access),
+      server_(std::make_unique<GuardedHttpServer>(limits)),
+      host_(address.host) {
+  GuardedHttpServer& server = *server_;
+  // Refuse what may not be served before any handler runs (preview_access.h); every answer forbids
+  // framing (a page elsewhere cannot overlay the stop button) and sends the token's URL to no other site.
+  server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    res.set_header("X-Frame-Options", "DENY");
+    res.set_header("Content-Security-Policy", "frame-ancestors 'none'");
+    res.set_header("Referrer-Policy", "same-origin");
+    res.set_header("X-Content-Type-Options", "nosniff");
+    if (std::optional<std::string> why = access_.refusal(req)) {
+      res.status = 403;
+      res.set_content("candela preview: refused: " + *why + "\n", "text/plain; charset=utf-8");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
+  });
   // One cached copy of the image shared by every viewer: copied from the live film only when it changed.
   auto cache = std::make_shared<std::pair<std::mutex, LiveSnapshot>>();
   auto stop_requested = std::make_shared<std::atomic<bool>>(false);
@@ -154,23 +174,23 @@ PreviewServer::PreviewServer(const PreviewAddress& address, const LiveFilm& live
     int yes = 1;
     setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, reinterpret_cast<const void*>(&yes), sizeof(yes));
   });
-  server.set_read_timeout(5, 0);
-  server.set_write_timeout(5, 0);
-  // Browsers keep connections open; each open one holds a pool thread, so keep-alive is bounded.
-  server.set_keep_alive_timeout(2);
 
-  port_ = address.port == 0 ? server.bind_to_any_port(address.host) : address.port;
-  if (port_ <= 0 || (address.port != 0 && !server.bind_to_port(address.host, address.port)))
+  port_ = server.bind(address.host, address.port);
+  if (port_ <= 0)
     throw std::runtime_error(fmt::format("--preview: cannot listen on {}:{} (address in use or not on this machine)",
                                          address.host, address.port));
-  thread_ = std::thread([this] { server_->listen_after_bind(); });
+  access_.set_port(port_);
+  thread_ = std::thread([this] {
+    ::pthread_setname_np(::pthread_self(), "http-accept");
+    server_->listen_after_bind();
+  });
   // stop() only stops a server that is running: wait for it, so that destroying this at once cannot hang.
   for (int ms = 0; ms < 5000 && !server_->is_running(); ++ms) std::this_thread::sleep_for(std::chrono::milliseconds(1));
 }
 
 std::string PreviewServer::url() const {
   const bool v6 = host_.find(':') != std::string::npos;
-  return fmt::format("http://{}{}{}:{}/", v6 ? "[" : "", host_, v6 ? "]" : "", port_);
+  return fmt::format("http://{}{}{}:{}/?token={}", v6 ? "[" : "", host_, v6 ? "]" : "", port_, access_.token());
 }
 
 PreviewServer::~PreviewServer() {

@@ -9,11 +9,14 @@
 //                     taller than `max` (query parameter, default 1280) are averaged down by an
 //                     integer factor, so a 4K render costs a viewer 8 MB a frame, not 130.
 //   POST /stop        stops the render as SIGINT does (the image so far is written)
+// Every request must carry the run's token and name this server in its Host header, and a browser's
+// request from another origin is refused (preview_access.h); the transport bounds connections, sizes
+// and times so that slow or hostile clients cannot hold the render's machine (guarded_http_server.h).
 // The server is cpp-httplib (Debian's libcpp-httplib-dev): a maintained library that serves HTTP/1.1
 // from a thread pool in a few lines, with no event loop to drive and nothing else to link; the render
 // threads never wait for it (viewers copy the live film under its lock, which the render holds for one
 // tile's means at a time). Any number of browsers can watch; a viewer that disconnects changes nothing.
-// The page has no authentication: by default the server listens on the loopback interface only.
+// By default the server listens on the loopback interface only.
 #include <atomic>
 #include <chrono>
 #include <functional>
@@ -23,10 +26,8 @@
 #include <thread>
 
 #include "candela/film/live_film.h"
-
-namespace httplib {
-class Server;
-}
+#include "candela/preview/guarded_http_server.h"
+#include "candela/preview/preview_access.h"
 
 namespace candela {
 
@@ -46,8 +47,10 @@ std::string_view preview_page_html();
 class PreviewServer {
  public:
   // Starts serving `live` at `address` (throws std::runtime_error if it cannot bind). `on_stop` is
-  // called (from a server thread) when a viewer presses stop.
-  PreviewServer(const PreviewAddress& address, const LiveFilm& live, std::function<void()> on_stop);
+  // called (from a server thread) when a viewer presses stop. `public_access` (--preview-public): any
+  // Host header is taken, for an address other machines reach by the machine's own names.
+  PreviewServer(const PreviewAddress& address, const LiveFilm& live, std::function<void()> on_stop,
+                bool public_access = false, const HttpLimits& limits = {});
   // Keeps serving for up to a second and a half after the render's end so that the pages watching
   // see its final state, then stops.
   ~PreviewServer();
@@ -55,12 +58,18 @@ class PreviewServer {
   PreviewServer& operator=(const PreviewServer&) = delete;
 
   int port() const { return port_; }
+  const std::string& token() const { return access_.token(); }
+  // The page's address with the token: http://HOST:PORT/?token=...
   std::string url() const;
+  // Answers the request on connected socket `sock` on this thread, as a connection the server
+  // accepted is answered, and closes it: for the HTTP fuzz target (fuzz/http_request_fuzz.cpp).
+  void serve_connection(int sock) { server_->serve(sock); }
 
  private:
   const LiveFilm& live_;
   std::function<void()> on_stop_;
-  std::unique_ptr<httplib::Server> server_;
+  PreviewAccess access_;
+  std::unique_ptr<GuardedHttpServer> server_;
   std::thread thread_;
   std::string host_;
   int port_ = 0;

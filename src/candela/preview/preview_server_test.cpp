@@ -96,8 +96,9 @@ TEST(PreviewServer, ServesStatusImageAndStop) {
   int stops = 0;
   PreviewServer server(parse_preview_address("127.0.0.1:0"), live, [&] { ++stops; });
   ASSERT_GT(server.port(), 0);
-  EXPECT_EQ(server.url(), "http://127.0.0.1:" + std::to_string(server.port()) + "/");
+  EXPECT_EQ(server.url(), "http://127.0.0.1:" + std::to_string(server.port()) + "/?token=" + server.token());
   httplib::Client client("127.0.0.1", server.port());
+  client.set_default_headers({{"X-Candela-Token", server.token()}});
 
   auto page = client.Get("/");
   ASSERT_TRUE(page);
