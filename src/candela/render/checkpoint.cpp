@@ -194,9 +194,14 @@ Checkpoint parse_checkpoint(std::string_view bytes, const std::filesystem::path&
   cp.width = r.get<int32_t>();
   cp.height = r.get<int32_t>();
   cp.non_finite_samples = r.get<uint64_t>();
-  const uint64_t pixel_bytes = uint64_t(cp.width) * uint64_t(cp.height) * (kPixelSize + (version >= 3 ? kHalfSize : 0));
+  const uint64_t pixel_size = kPixelSize + (version >= 3 ? kHalfSize : 0);
   const uint64_t left = uint64_t(r.end - r.p);
-  if (cp.width < 0 || cp.height < 0 || (version == 1 ? left != pixel_bytes : left < pixel_bytes + 8))
+  // The pixel count is checked against the bytes left by division first: the product of the
+  // size's bytes can pass 2^64 (2^30 x 2^30 x 64 wraps to 0, the size of an empty version 1 film).
+  const bool fits = cp.width >= 0 && cp.height >= 0 &&
+                    (cp.height == 0 || uint64_t(cp.width) <= left / pixel_size / uint64_t(cp.height));
+  const uint64_t pixel_bytes = fits ? uint64_t(cp.width) * uint64_t(cp.height) * pixel_size : 0;
+  if (!fits || (version == 1 ? left != pixel_bytes : left < pixel_bytes + 8))
     fail(file, "corrupt (pixel data does not match the size)");
   cp.pixels.resize(size_t(cp.width) * size_t(cp.height));
   for (PixelSums& px : cp.pixels) {

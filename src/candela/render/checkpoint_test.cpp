@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <regex>
 
 namespace candela {
 namespace {
@@ -114,6 +115,54 @@ TEST_F(CheckpointFile, TruncatedCorruptAndForeignFilesAreRefused) {
   EXPECT_NE(error().find("version"), std::string::npos) << error();
   fs::remove(file);
   EXPECT_NE(error().find("cannot open"), std::string::npos) << error();
+}
+
+// Hostile inputs (docs/reliability.md): the file cut at every 64th of its length, and one bit flipped
+// at every 64th, is refused each time with one message naming the file and what is wrong; never read.
+TEST_F(CheckpointFile, EveryTruncationAndBitFlipIsRefused) {
+  write_checkpoint(file, sample_checkpoint());
+  const std::string good = bytes();
+  ASSERT_GT(good.size(), 64u * 8);
+  const auto refusal = [](const std::string& damaged) {
+    try {
+      parse_checkpoint(damaged, "render.ckpt");
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(read)");
+  };
+  const std::regex expected(
+      R"(checkpoint 'render\.ckpt': (truncated|corrupt|not a candela checkpoint|unsupported version) .*)");
+  for (size_t k = 0; k < 64; ++k) {
+    const size_t at = good.size() * k / 64;
+    const std::string cut = refusal(good.substr(0, at));
+    EXPECT_TRUE(std::regex_match(cut, expected)) << "cut at " << at << ": " << cut;
+    std::string flipped = good;
+    flipped[at] = char(flipped[at] ^ (1 << (k % 8)));
+    const std::string flip = refusal(flipped);
+    EXPECT_TRUE(std::regex_match(flip, expected)) << "bit " << k % 8 << " of byte " << at << " flipped: " << flip;
+  }
+}
+
+// Found by fuzz/checkpoint_reader_fuzz.cpp's input (docs/reliability.md): a version 1 checkpoint
+// of 2^30 x 2^30 pixels and no pixel data. 2^60 pixels of 64 bytes wrap to 0 bytes, which matched
+// the empty payload left, and the reader then asked for 2^60 pixels (std::length_error).
+TEST(CheckpointBytes, SizeWhosePixelBytesPass2To64IsCorrupt) {
+  std::string payload(8 + 4, '\0');  // scene hash, no settings
+  for (int32_t side : {1 << 30, 1 << 30}) payload.append(reinterpret_cast<const char*>(&side), 4);
+  payload.append(8, '\0');  // no non-finite samples
+  const uint32_t version = 1;
+  const uint64_t size = payload.size(), hash = fnv1a64(payload.data(), payload.size());
+  std::string bytes = "CNDLCKPT";
+  bytes.append(reinterpret_cast<const char*>(&version), 4);
+  bytes.append(reinterpret_cast<const char*>(&size), 8);
+  bytes.append(reinterpret_cast<const char*>(&hash), 8);
+  try {
+    parse_checkpoint(bytes + payload, "big.ckpt");
+    FAIL() << "read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "checkpoint 'big.ckpt': corrupt (pixel data does not match the size)");
+  }
 }
 
 TEST(RenderFingerprint, NamesWhatDiffers) {
