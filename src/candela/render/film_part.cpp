@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cstring>
+#include <fstream>
 #include <stdexcept>
 
 #include "candela/film/image_io.h"
@@ -73,6 +75,44 @@ RenderFingerprint without_sample_set(RenderFingerprint fp) {
   return fp;
 }
 
+// The unsigned number `text` in `base`, all of it, or a runtime_error naming the file and the attribute.
+uint64_t parse_u64(const std::filesystem::path& file, const std::string& attribute, const std::string& text, int base) {
+  uint64_t value = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value, base);
+  if (error != std::errc() || end != text.data() + text.size() || text.empty())
+    fail(file, fmt::format("{} '{}' is not a {} number below 2^64", attribute, text, base == 16 ? "hexadecimal" : "decimal"));
+  return value;
+}
+
+// OpenEXR (3.1) allocates each header attribute's declared size before it reads the value, so a
+// 500-byte file declaring a 2 GB attribute costs 2 GB and seconds before it fails. The header is
+// walked first: every attribute (name, type, 4-byte size, value) must fit in the file's first 64 KB
+// (a part's header takes a few KB). A part is a single-part image (write_part writes no other), so
+// multi-part and deep files are refused here too.
+void check_exr_header(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string header(64 * 1024, '\0');
+  in.read(header.data(), std::streamsize(header.size()));
+  header.resize(size_t(in.gcount()));
+  if (header.size() < 8 || header.compare(0, 4, "\x76\x2f\x31\x01") != 0) fail(file, "not an OpenEXR file");
+  if (uint8_t(header[5]) & 0x18) fail(file, "not a candela part (a multi-part or deep OpenEXR file)");
+  const std::string cut_short = "its OpenEXR header is cut short or longer than 64 KB";
+  for (size_t at = 8;;) {
+    const size_t name_end = header.find('\0', at);
+    if (name_end == std::string::npos) fail(file, cut_short);
+    if (name_end == at) return;  // the empty name ends the header
+    const std::string name = header.substr(at, name_end - at);
+    const size_t type_end = header.find('\0', name_end + 1);
+    if (type_end == std::string::npos || header.size() - type_end - 1 < 4) fail(file, cut_short);
+    int32_t size = 0;
+    std::memcpy(&size, header.data() + type_end + 1, 4);
+    at = type_end + 5;
+    if (size < 0 || uint64_t(size) > header.size() - at)
+      fail(file, fmt::format("its OpenEXR header attribute '{}' claims {} bytes; {}", name, size, cut_short));
+    at += size_t(size);
+  }
+}
+
 std::string setting(const RenderFingerprint& fp, const std::string& key) {
   for (const auto& [k, v] : fp.settings)
     if (k == key) return v;
@@ -108,6 +148,7 @@ void write_part(const std::filesystem::path& file, const FilmPart& part, std::ma
 
 FilmPart read_part(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file)) fail(file, "no such file");
+  check_exr_header(file);
   std::map<std::string, std::string> metadata = read_image_metadata(file);
   FilmPart part;
   const std::string& which = attribute(metadata, file, "candela:part");
@@ -115,7 +156,8 @@ FilmPart read_part(const std::filesystem::path& file) {
       part.index > part.count)
     fail(file, fmt::format("candela:part '{}' is not K/N with 1 <= K <= N", which));
   --part.index;
-  part.fingerprint.scene_hash = std::stoull(attribute(metadata, file, "candela:scene_hash"), nullptr, 16);
+  part.fingerprint.scene_hash =
+      parse_u64(file, "candela:scene_hash", attribute(metadata, file, "candela:scene_hash"), 16);
   const std::string& settings = attribute(metadata, file, "candela:settings");
   for (size_t at = 0; at < settings.size();) {
     size_t end = settings.find('\n', at), eq = settings.find('=', at);
@@ -124,7 +166,8 @@ FilmPart read_part(const std::filesystem::path& file) {
     at = end + 1;
   }
   part.splat_area = std::strtod(attribute(metadata, file, "candela:splat_area").c_str(), nullptr);
-  part.non_finite_samples = std::stoull(attribute(metadata, file, "candela:non_finite_samples"));
+  part.non_finite_samples =
+      parse_u64(file, "candela:non_finite_samples", attribute(metadata, file, "candela:non_finite_samples"), 10);
 
   ExactChannels channels = read_exact_channels(file, kPrefix);
   const size_t words = channels.names.size();
@@ -133,7 +176,9 @@ FilmPart read_part(const std::filesystem::path& file) {
   const size_t pixels = channels.values.size() / words;
   std::string resolution = setting(part.fingerprint, "resolution");
   int width = 0, height = 0;
-  if (std::sscanf(resolution.c_str(), "%dx%d", &width, &height) != 2 || size_t(width) * size_t(height) != pixels)
+  // Both sides positive: -2 x -2 would pass the product check as 4 pixels, and make a film of negative width.
+  if (std::sscanf(resolution.c_str(), "%dx%d", &width, &height) != 2 || width <= 0 || height <= 0 ||
+      size_t(width) * size_t(height) != pixels)
     fail(file, fmt::format("its pixels do not match its resolution setting '{}'", resolution));
   part.film = Film(width, height);
   if (words > kPixelWords) part.film.enable_splats();
@@ -194,7 +239,9 @@ MergedRender merge_parts(const std::vector<std::filesystem::path>& files) {
     for (size_t i = 0; i < parts.size(); ++i)
       if (setting(parts[i].fingerprint, "seed") == seed) of_set.push_back(int(i));
     const FilmPart& lead = parts[size_t(of_set[0])];
-    std::vector<int> holder(size_t(lead.count), -1);
+    // The index into parts of each part number. A map, not a vector of lead.count entries: one file
+    // claiming to be part 1 of 2147483647 must not cost 8 GB before it is found missing the others.
+    std::map<int, int> holder;
     for (int i : of_set) {
       const FilmPart& p = parts[size_t(i)];
       if (p.count != lead.count)
@@ -203,19 +250,19 @@ MergedRender merge_parts(const std::vector<std::filesystem::path>& files) {
       if (setting(p.fingerprint, "spp") != setting(lead.fingerprint, "spp"))
         fail(files[size_t(i)], fmt::format("has spp {} but {} of the same seed {} has spp {}", setting(p.fingerprint, "spp"),
                                            files[size_t(of_set[0])].string(), seed, setting(lead.fingerprint, "spp")));
-      if (holder[size_t(p.index)] >= 0)
+      if (const auto held = holder.find(p.index); held != holder.end())
         fail(files[size_t(i)], fmt::format("is part {}/{} of seed {}, as {} is", p.index + 1, p.count, seed,
-                                           files[size_t(holder[size_t(p.index)])].string()));
-      holder[size_t(p.index)] = i;
+                                           files[size_t(held->second)].string()));
+      holder[p.index] = i;
     }
-    for (int k = 0; k < lead.count; ++k)
-      if (holder[size_t(k)] < 0)
+    for (int k = 0; k < lead.count; ++k)  // stops at the first missing part, at most of_set.size() on
+      if (!holder.contains(k))
         throw std::runtime_error(fmt::format("merge: part {}/{} of seed {} is missing (have {})", k + 1, lead.count,
                                              seed, files[size_t(of_set[0])].string()));
     // This sample set's film: each tile's pixels from the part that rendered it, splats summed.
     Film set(width, height);
     for (size_t t = 0; t < tiles.size(); ++t) {
-      const Film& from = parts[size_t(holder[t % size_t(lead.count)])].film;
+      const Film& from = parts[size_t(holder.at(int(t % size_t(lead.count))))].film;
       for (int y = tiles[t].y0; y < tiles[t].y1; ++y)
         for (int x = tiles[t].x0; x < tiles[t].x1; ++x)
           set.pixels()[size_t(y) * size_t(width) + size_t(x)] = from.pixel(x, y);
