@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (clang-14, -fsanitize=fuzzer,address,undefined) in build-fuzz/.
-# Usage: fuzz/build.sh            -> build-fuzz/fuzz_{json,pbrt,obj,ply,serialized}_reader
+# Usage: fuzz/build.sh   -> build-fuzz/fuzz_{json,pbrt,obj,ply,serialized,mitsuba,gltf,vol,nanovdb,part,checkpoint}_reader
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${FUZZ_BUILD_DIR:-$root/build-fuzz}"

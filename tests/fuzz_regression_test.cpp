@@ -1,6 +1,7 @@
 // Every input that once crashed a fuzz target (fuzz/regressions/<target>/, docs/reliability.md) is
 // read again by the same reader, the way the fuzz target reads it: the reader must either succeed
-// or throw SceneError. Under the ASan+UBSan build in CI a memory error fails the test as well.
+// or throw its documented error (SceneError; std::runtime_error for render parts and checkpoints).
+// Under the ASan+UBSan build in CI a memory error fails the test as well.
 #include <gtest/gtest.h>
 #include <unistd.h>
 #include <zlib.h>
@@ -13,10 +14,18 @@
 #include <string>
 #include <vector>
 
+#include "../fuzz/checkpoint_input.h"
+#include "../fuzz/grid_input.h"
 #include "candela/base/error.h"
+#include "candela/geometry/sdf_grid.h"
+#include "candela/io/gltf_reader.h"
+#include "candela/io/grid_files.h"
 #include "candela/io/mesh_io.h"
+#include "candela/io/mitsuba_reader.h"
 #include "candela/io/pbrt_reader.h"
 #include "candela/io/scene_reader.h"
+#include "candela/render/checkpoint.h"
+#include "candela/render/film_part.h"
 
 namespace candela {
 namespace {
@@ -69,16 +78,17 @@ class FuzzRegression : public ::testing::Test {
   fs::path dir_;
 };
 
-// Runs `read` on each input; a SceneError is fine, another exception fails the test.
-template <typename Read>
+// Runs `read` on each input; the reader's documented error (SceneError unless said otherwise) is
+// fine, another exception fails the test.
+template <typename DocumentedError = SceneError, typename Read>
 void expect_no_crash(const std::string& target, Read read) {
   for (const fs::path& input : inputs_of(target)) {
     SCOPED_TRACE(input.string());
     try {
       read(input);
-    } catch (const SceneError&) {
+    } catch (const DocumentedError&) {
     } catch (const std::exception& e) {
-      ADD_FAILURE() << "not a SceneError: " << e.what();
+      ADD_FAILURE() << "not the reader's documented error: " << e.what();
     }
   }
 }
@@ -132,6 +142,59 @@ TEST_F(FuzzRegression, SerializedReader) {
       } catch (const SceneError&) {
       }
     }
+  });
+}
+
+TEST_F(FuzzRegression, MitsubaReader) {
+  expect_no_crash("mitsuba_reader", [&](const fs::path& input) {
+    std::vector<std::string> warnings;
+    (void)read_mitsuba_scene_text(read_bytes(input), input.filename().string(), dir_, warnings);
+  });
+}
+
+TEST_F(FuzzRegression, GltfReader) {
+  // As fuzz/gltf_reader_fuzz.cpp: a .glb when the input starts with "glTF", else a .gltf.
+  expect_no_crash("gltf_reader", [&](const fs::path& input) {
+    const std::string name = read_bytes(input).starts_with("glTF") ? "input.glb" : "input.gltf";
+    std::vector<std::string> warnings;
+    (void)read_gltf_scene(copy_in(input, name), warnings, GltfOptions{dir_ / "gltf-cache", 64});
+  });
+}
+
+TEST_F(FuzzRegression, VolReader) {
+  expect_no_crash("vol_reader", [&](const fs::path& input) {
+    const fs::path file = copy_in(input, "input.vol");
+    try {
+      (void)read_grid_file(file, "density", SourceLocation{"fuzz", 1, 1, {}});
+    } catch (const SceneError&) {
+    }
+    (void)read_sdf_grid_file(file, SourceLocation{"fuzz", 1, 1, {}}, SdfNormals::Smooth);
+  });
+}
+
+TEST_F(FuzzRegression, NanovdbReader) {
+  // As fuzz/nanovdb_reader_fuzz.cpp: the file fuzz/grid_input.h makes, its grids listed, the first read.
+  expect_no_crash("nanovdb_reader", [&](const fs::path& input) {
+    const candela_fuzz::GridInput grid = candela_fuzz::grid_input_of(read_bytes(input), dir_);
+    write(dir_ / grid.file_name, grid.bytes);
+    std::vector<std::string> names;
+    try {
+      names = grid_names_in_file(dir_ / grid.file_name, SourceLocation{"fuzz", 1, 1, {}});
+    } catch (const SceneError&) {
+    }
+    (void)read_grid_file(dir_ / grid.file_name, names.empty() ? "density" : names.front(), SourceLocation{"fuzz", 1, 1, {}});
+  });
+}
+
+TEST_F(FuzzRegression, PartReader) {
+  expect_no_crash<std::runtime_error>("part_reader",
+                                      [&](const fs::path& input) { (void)merge_parts({copy_in(input, "input.exr")}); });
+}
+
+TEST_F(FuzzRegression, CheckpointReader) {
+  // As fuzz/checkpoint_reader_fuzz.cpp: the input made into a checkpoint by fuzz/checkpoint_input.h.
+  expect_no_crash<std::runtime_error>("checkpoint_reader", [&](const fs::path& input) {
+    (void)parse_checkpoint(candela_fuzz::checkpoint_bytes_of(read_bytes(input)), "fuzz.ckpt");
   });
 }
 

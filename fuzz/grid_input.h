@@ -1,0 +1,59 @@
+#pragma once
+// How fuzz/nanovdb_reader_fuzz.cpp (and tests/fuzz_regression_test.cpp, replaying its findings)
+// turn an input into a grid file. The first byte modulo 3 picks what the rest is:
+//   0: a whole .nvdb file;
+//   1: a whole .vdb file;
+//   2: patches to a valid .nvdb file of a 2 x 2 x 2 float grid "density" (written by candela's
+//      write_grid_file), each 4 bytes of offset (little-endian, modulo the file's size), a length
+//      byte, and that many bytes written over the file there. A NanoVDB grid holds its nodes at
+//      full size (this one is 613 KB), too big for seed files, so the fuzzer reaches the internal
+//      and leaf nodes through patches.
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "candela/io/grid_files.h"
+
+namespace candela_fuzz {
+
+struct GridInput {
+  std::string bytes;
+  const char* file_name;  // input.nvdb or input.vdb
+};
+
+// The patched file of mode 2, written once into `dir` and kept in memory.
+inline const std::string& nanovdb_template(const std::filesystem::path& dir) {
+  static const std::string bytes = [&] {
+    const std::filesystem::path file = dir / "template.nvdb";
+    candela::write_grid_file(file, "density", {2, 2, 2}, {0, 1, 0.5f, 0, 0, 0.25f, 1, 2}, 0.5f, {-1, 0, 3});
+    std::ifstream in(file, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }();
+  return bytes;
+}
+
+inline GridInput grid_input_of(std::string_view input, const std::filesystem::path& dir) {
+  if (input.empty()) return {{}, "input.nvdb"};
+  std::string_view rest = input.substr(1);
+  switch (uint8_t(input[0]) % 3) {
+    case 0: return {std::string(rest), "input.nvdb"};
+    case 1: return {std::string(rest), "input.vdb"};
+  }
+  std::string file = nanovdb_template(dir);
+  while (rest.size() >= 5) {
+    uint32_t offset;
+    std::memcpy(&offset, rest.data(), 4);
+    offset %= uint32_t(file.size());
+    const size_t length = std::min<size_t>({uint8_t(rest[4]), rest.size() - 5, file.size() - offset});
+    file.replace(offset, length, rest.substr(5, length));
+    rest.remove_prefix(5 + length);
+  }
+  return {std::move(file), "input.nvdb"};
+}
+
+}  // namespace candela_fuzz
