@@ -1,5 +1,6 @@
 // The command line end to end: bad input exits non-zero with one message naming the file and place,
 // and leaves an existing output file untouched; good input writes the image with its metadata.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -8,11 +9,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <regex>
+#include <set>
 #include <sstream>
 
 #include "candela/film/image_io.h"
 #include "candela/testing/command_line.h"
+#include "candela/testing/gzip_bytes.h"
 
 namespace fs = std::filesystem;
 
@@ -44,12 +48,13 @@ class CommandLine : public ::testing::Test {
     return ss.str();
   }
   // Runs and expects failure with a message matching `pattern`, and the old output untouched.
-  void expect_failure(const std::string& args, const std::string& pattern) {
+  RunResult expect_failure(const std::string& args, const std::string& pattern) {
     RunResult r = run_cli(args);
     EXPECT_NE(r.exit_code, 0) << r.output;
     EXPECT_THAT_MATCHES(r.output, pattern);
     EXPECT_EQ(previous_output(), "previous render");
     EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << "one message expected:\n" << r.output;
+    return r;
   }
   static void EXPECT_THAT_MATCHES(const std::string& text, const std::string& pattern) {
     EXPECT_TRUE(std::regex_search(text, std::regex(pattern))) << "output:\n" << text << "\ndoes not match: " << pattern;
@@ -380,6 +385,176 @@ TEST_F(CommandLine, UnsupportedOutputAndIntegrator) {
   std::string scene = write("good.json", kGoodJson);
   expect_failure("render " + scene + " -o " + (dir_ / "out.bmp").string(), "out\\.bmp.*unsupported");
   expect_failure("render " + scene + " -o " + out() + " --integrator teleport", "teleport");
+}
+
+// ---------------------------------------------------------------- hostile inputs
+
+// The table "Hostile inputs" of docs/reliability.md: each input is refused with one message naming the
+// file (and line) and the limit, exit status 1, no crash, and no file written or left behind.
+class HostileInput : public CommandLine {
+ protected:
+  void expect_refused(const std::string& args, const std::string& pattern) {
+    const std::set<std::string> before = files();
+    EXPECT_EQ(expect_failure(args, "^candela: error: " + pattern).exit_code, 1);
+    EXPECT_EQ(files(), before);
+  }
+  std::set<std::string> files() const {
+    std::set<std::string> names;
+    for (const auto& entry : fs::directory_iterator(dir_)) names.insert(entry.path().filename().string());
+    return names;
+  }
+  // `text` as a regular expression that matches it literally.
+  static std::string quoted(const std::string& text) {
+    return std::regex_replace(text, std::regex(R"([.^$|()\[\]*+?{}\\])"), R"(\$&)");
+  }
+};
+
+TEST_F(HostileInput, GzipBombInAnInclude) {
+  const std::string bomb = write("bomb.pbrt.gz", testing::gzip_bomb(1025));  // 1 MB, 1025 MiB inflated
+  const std::string scene = write("scene.pbrt", "WorldBegin\nInclude \"bomb.pbrt.gz\"\n");
+  expect_refused("render " + scene + " -o " + out(),
+                 quoted(scene + ":2:9: cannot read \"" + bomb + "\": gzip: it decompresses to more than 1.0 GiB, the "
+                        "limit for a gzipped file (a gzip bomb?); gunzip it to read it without this limit"));
+}
+
+TEST_F(HostileInput, DeepIncludesAndInstancing) {
+  // pbrt: a file including itself; a chain of 100 files; objects inside objects.
+  const std::string self = write("self.pbrt", "WorldBegin\nInclude \"self.pbrt\"\n");
+  expect_refused("render " + self + " -o " + out(), quoted(self + ":2:9: \"" + self + "\" includes itself"));
+  for (int k = 1; k < 100; ++k) write(fmt::format("f{}.pbrt", k), fmt::format("Include \"f{}.pbrt\"\n", k + 1));
+  write("f100.pbrt", "Shape \"sphere\"\n");
+  const std::string chain = write("chain.pbrt", "WorldBegin\nInclude \"f1.pbrt\"\n");
+  expect_refused("render " + chain + " -o " + out(), ".*f63\\.pbrt:1:9: files are included more than 64 deep \\(in the "
+                 "file included at .*f62\\.pbrt:1:9, included at .*f61\\.pbrt:1:9, \\.\\.\\. 60 more Includes "
+                 "\\.\\.\\., included at .*chain\\.pbrt:2:9\\)\n");
+  const std::string nested = write("nested.pbrt", "WorldBegin\nObjectBegin \"a\"\nObjectBegin \"b\"\n");
+  expect_refused("render " + nested + " -o " + out(),
+                 ".*nested\\.pbrt:3:1: ObjectBegin inside the definition of \"a\"");
+  const std::string instance = write("instance.pbrt", "WorldBegin\nObjectBegin \"a\"\nObjectInstance \"a\"\n");
+  expect_refused("render " + instance + " -o " + out(), ".*instance\\.pbrt:3:1: ObjectInstance inside the definition");
+  // Mitsuba: objects nested 100,000 deep; a file including itself.
+  std::string deep = "<scene version=\"3.0.0\">\n";
+  for (int k = 0; k < 100000; ++k) deep += "<bsdf type=\"twosided\">";
+  for (int k = 0; k < 100000; ++k) deep += "</bsdf>";
+  const std::string xml = write("deep.xml", deep + "\n</scene>\n");
+  expect_refused("render " + xml + " -o " + out(), quoted(xml + ":2: <bsdf> is nested more than 100 objects deep"));
+  const std::string self_xml = write("self.xml", "<scene version=\"3.0.0\"><include filename=\"self.xml\"/></scene>");
+  expect_refused("render " + self_xml + " -o " + out(), ".*self\\.xml:1: more than 15 nested <include>s");
+}
+
+TEST_F(HostileInput, AbsurdResolution) {
+  const std::string scene = write("good.json", kGoodJson);
+  expect_refused("render " + scene + " -o " + out() + " --resolution 1000000000x1000000000",
+                 quoted("resolution 1000000000x1000000000 is out of range (each side 1..65536, at most 268435456 "
+                        "pixels)"));
+  const std::string pbrt = write("wide.pbrt", "Film \"rgb\" \"integer xresolution\" 1000000000\nWorldBegin\n");
+  expect_refused("render " + pbrt + " -o " + out(),
+                 quoted(pbrt + ":1:12: Film \"rgb\": \"xresolution\" must be between 1 and 65536, got 1000000000"));
+  const std::string json = write("wide.json", R"({"camera": {"width": 1000000000, "height": 1000000000}})");
+  expect_refused("render " + json + " -o " + out(),
+                 quoted(json) + ":1:13: at /camera/width: expected an integer in \\[1, 65536\\], got 1000000000");
+}
+
+TEST_F(HostileInput, TextureHeaderClaimingTenBillionTexels) {
+  // A PFM of a few bytes whose header says 100000 x 100000.
+  const std::string pfm = write("huge.pfm", "PF\n100000 100000\n-1.0\n" + std::string(1200, '\0'));
+  const std::string scene =
+      write("texture.json", R"({"textures": {"wood": {"type": "image", "filename": ")" + pfm + R"("}},
+  "materials": {"m": {"type": "diffuse", "reflectance": "wood"}},
+  "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]})");
+  expect_refused("render " + scene + " -o " + out(),
+                 quoted(scene + ":1:15: at /textures/wood: " + pfm + ": the image is 100000 x 100000 texels, more "
+                        "than candela reads (at most 65536 on a side and 536870912 = 2^29 in all)"));
+}
+
+TEST_F(HostileInput, MeshIndicesAndCountsNearTwoToThe32) {
+  const std::string obj = write("big.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2147483648\n");
+  expect_refused("render " + obj + " -o " + out(),
+                 quoted(obj + ": cannot read mesh '" + obj + "': malformed OBJ: line 4: face index '2147483648' is out "
+                        "of range (at most 2147483647 in size)"));
+  const std::string ply = write("big.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 4294967295\n"
+                                           "property float x\nproperty float y\nproperty float z\nend_header\n" +
+                                               std::string(36, '\0'));
+  expect_refused("render " + ply + " -o " + out(),
+                 quoted(ply + ": cannot read mesh '" + ply + "': corrupt PLY header") + ".*4294967295 'vertex'");
+}
+
+TEST_F(HostileInput, NonFinitePlyVertices) {
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                             "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string nan = write("nan.ply", header + "0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n");
+  expect_refused("render " + nan + " -o " + out(), quoted(nan + ": cannot read mesh '" + nan +
+                                                          "': malformed PLY: line 11: 'nan' is not a finite number"));
+  std::string binary = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                       "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const float vertices[9] = {0, 0, 0, std::numeric_limits<float>::infinity(), 0, 0, 0, 1, 0};
+  const int32_t face[3] = {0, 1, 2};
+  binary.append(reinterpret_cast<const char*>(vertices), sizeof vertices).append(1, '\3');
+  binary.append(reinterpret_cast<const char*>(face), sizeof face);
+  const std::string inf = write("inf.ply", binary);
+  expect_refused("render " + inf + " -o " + out(),
+                 quoted(inf + ": cannot read mesh '" + inf + "': vertex 1 has a non-finite position (inf, 0, 0)"));
+}
+
+TEST_F(HostileInput, DamagedCheckpoint) {
+  // (Every 64th truncation and bit flip: CheckpointFile.EveryTruncationAndBitFlipIsRefused.)
+  const std::string scene = write("good.json", kGoodJson);
+  const std::string checkpoint = (dir_ / "render.ckpt").string(), image = (dir_ / "image.exr").string();
+  ASSERT_EQ(run_cli("render " + scene + " -o " + image + " --spp 8 --checkpoint " + checkpoint +
+                    " --checkpoint-every 0.000001 -q").exit_code, 0);
+  const std::string good = testing::file_bytes(checkpoint);
+  ASSERT_GT(good.size(), 1000u);
+  write("render.ckpt", good.substr(0, good.size() / 2));
+  expect_refused("render " + scene + " -o " + out() + " --spp 16 --resume " + checkpoint,
+                 quoted("checkpoint '" + checkpoint + "': truncated (") + ".*");
+  std::string flipped = good;
+  flipped[good.size() / 2] ^= 0x08;
+  write("render.ckpt", flipped);
+  expect_refused("render " + scene + " -o " + out() + " --spp 16 --resume " + checkpoint,
+                 quoted("checkpoint '" + checkpoint + "': corrupt (checksum mismatch)"));
+}
+
+TEST_F(HostileInput, OutputsThatCannotBeWritten) {
+  const std::string scene = write("good.json", kGoodJson);
+  expect_refused("render " + scene + " -o /dev/full/x.png",
+                 quoted("output '/dev/full/x.png': '/dev/full' is not a directory"));
+  fs::create_directory(dir_ / "folder.exr");
+  const std::string folder = (dir_ / "folder.exr").string();
+  expect_refused("render " + scene + " -o " + folder, quoted("output '" + folder + "': it is a directory"));
+  // /sys takes no new files, even from root (for whom permissions do not stop a write).
+  if (testing::run_command("touch /sys/candela-probe").exit_code == 0) GTEST_SKIP() << "/sys is writable here";
+  const std::string in_sys = ": cannot write in directory '/sys': .+";
+  expect_refused("render " + scene + " -o /sys/x.png", quoted("output '/sys/x.png'") + in_sys);
+  const std::string render = "render " + scene + " -o " + out();
+  expect_refused(render + " --checkpoint /sys/x.ckpt", quoted("--checkpoint '/sys/x.ckpt'") + in_sys);
+  expect_refused(render + " --spp-map /sys/x.png", quoted("--spp-map '/sys/x.png'") + in_sys);
+  expect_refused("convert " + scene + " /sys/x.json", quoted("output '/sys/x.json'") + in_sys);
+  expect_refused("merge " + out() + " -o /sys/x.exr", quoted("output '/sys/x.exr'") + in_sys);
+}
+
+// A full disk: a 64 KiB tmpfs mounted in a mount namespace of its own (root with CAP_SYS_ADMIN only; the
+// mount goes with the namespace). The image and the checkpoint fail to write; the earlier files are
+// left as they were and no temporary file is left beside them.
+TEST_F(HostileInput, FullDisk) {
+  const std::string scene = write("good.json", kGoodJson);
+  const fs::path disk = dir_ / "disk";
+  fs::create_directory(disk);
+  const std::string mount = "unshare -m sh -c 'mount -t tmpfs -o size=64k tmpfs " + disk.string();
+  const auto on_full_disk = [&](const std::string& args) {
+    return testing::run_command(mount + " && cd " + disk.string() + " && printf previous > out.pfm && " +
+                                "printf previous > render.ckpt && " + CANDELA_CLI_PATH + " render " + scene + " " +
+                                args + "; echo \"status $?\"; ls -A; cat out.pfm render.ckpt'");
+  };
+  const RunResult probe = testing::run_command(mount + "'");
+  if (probe.exit_code != 0) GTEST_SKIP() << "cannot mount a tmpfs here: " << probe.output;
+  // 512 x 512 float RGB is 3 MiB.
+  RunResult image = on_full_disk("-o out.pfm --resolution 512x512 --spp 1 -q");
+  EXPECT_THAT_MATCHES(image.output, "^candela: error: out\\.pfm: cannot write image: No space left on device\n"
+                                    "status 1\nout\\.pfm\nrender\\.ckpt\npreviousprevious$");
+  RunResult checkpoint =
+      on_full_disk("-o out.pfm --resolution 512x512 --spp 8 --checkpoint render.ckpt --checkpoint-every 0.000001 -q");
+  EXPECT_THAT_MATCHES(checkpoint.output, "^candela: error: checkpoint 'render\\.ckpt': cannot write: No space left on "
+                                         "device\nstatus 1\nout\\.pfm\nrender\\.ckpt\npreviousprevious$");
 }
 
 }  // namespace

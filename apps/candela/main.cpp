@@ -11,6 +11,7 @@
 #include <cctype>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -141,13 +142,31 @@ bool is_exr(const fs::path& file) {
   return ext == ".exr";
 }
 
+// That `file` can be written, found out before the scene is read and rendered rather than after:
+// its directory exists and takes a new file (the temporary file it is written to, then renamed).
+// `what` names the file in the message, e.g. "output 'out.png'". A full disk is still only found
+// when the image is written; the existing file is then left as it was.
+void check_can_write(const fs::path& file, const std::string& what) {
+  const fs::path dir = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) throw UsageError(fmt::format("{}: directory '{}' does not exist", what, dir.string()));
+  if (!fs::is_directory(dir, ec)) throw UsageError(fmt::format("{}: '{}' is not a directory", what, dir.string()));
+  if (fs::is_directory(file, ec)) throw UsageError(fmt::format("{}: it is a directory", what));
+  // Permissions alone do not tell (root writes anywhere, but not on a read-only file system or in
+  // /sys): create a file there and remove it.
+  std::string probe = (dir / ".candela-write-check-XXXXXX").string();
+  const int fd = mkstemp(probe.data());
+  if (fd < 0)
+    throw UsageError(fmt::format("{}: cannot write in directory '{}': {}", what, dir.string(), std::strerror(errno)));
+  close(fd);
+  unlink(probe.c_str());
+}
+
 void check_outputs(const std::vector<fs::path>& files) {
   for (const auto& f : files) {
     if (!is_supported_output(f))
       throw UsageError(fmt::format("output '{}': unsupported image format (use .exr, .png or .pfm)", f.string()));
-    fs::path dir = f.has_parent_path() ? f.parent_path() : fs::path(".");
-    if (!fs::is_directory(dir))
-      throw UsageError(fmt::format("output '{}': directory '{}' does not exist", f.string(), dir.string()));
+    check_can_write(f, fmt::format("output '{}'", f.string()));
   }
 }
 
@@ -274,6 +293,8 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
     apply_request(cmd, desc);
     if (!cmd.spp_map.empty() && !is_supported_output(cmd.spp_map))
       throw UsageError(fmt::format("--spp-map '{}': unsupported image format (use .exr, .png or .pfm)", cmd.spp_map));
+    if (!cmd.spp_map.empty() && cluster.is_root())
+      check_can_write(cmd.spp_map, fmt::format("--spp-map '{}'", cmd.spp_map));
     adaptive = desc.settings.adaptive();
     if (cmd.checkpoint_every && cmd.checkpoint.empty()) throw UsageError("--checkpoint-every needs --checkpoint FILE");
 
@@ -342,12 +363,8 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
     if (!pixel_mode && cluster.is_root()) check_outputs(outputs);
     // Refuse what cannot fit in memory before allocating the scene and the film.
     check_resources(desc);
-    if (!cmd.checkpoint.empty()) {
-      fs::path p(cmd.checkpoint);
-      fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-      if (cluster.is_root() && !fs::is_directory(dir))
-        throw UsageError(fmt::format("--checkpoint '{}': directory '{}' does not exist", cmd.checkpoint, dir.string()));
-    }
+    if (!cmd.checkpoint.empty() && cluster.is_root())
+      check_can_write(cmd.checkpoint, fmt::format("--checkpoint '{}'", cmd.checkpoint));
   });
   // Every rank must render the same scene: a file changed on one node is refused.
   if (cluster.distributed()) on_every_rank(cluster, [&] {
@@ -615,6 +632,7 @@ int run_convert(const std::string& in, const std::string& out) {
   const std::filesystem::path output(out);
   if (output.extension() != ".json")
     throw UsageError(fmt::format("convert writes candela's JSON format: the output must end in .json, got \"{}\"", out));
+  check_can_write(output, fmt::format("output '{}'", out));
   SceneDesc scene = read_scene_file(in);
   g_phase.store(kWriting);
   write_json_scene(scene, output);

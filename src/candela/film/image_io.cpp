@@ -147,6 +147,22 @@ void write_image_with(const std::filesystem::path& file, const Image& image,
   }
 }
 
+// check_image_size, and for a PFM (uncompressed) that the file holds the pixels its header claims:
+// OpenImageIO would allocate them all before finding the file cut short.
+void check_image_header(const std::filesystem::path& file, const OIIO::ImageInput& in) {
+  const OIIO::ImageSpec& spec = in.spec();
+  check_image_size(file, spec.width, spec.height);
+  // OpenImageIO reads PFM with its PNM reader; PFM is the PNM with float pixels.
+  if (std::string_view(in.format_name()) != "pnm" || spec.format != OIIO::TypeDesc::FLOAT) return;
+  std::error_code ec;
+  const uint64_t file_bytes = std::filesystem::file_size(file, ec);
+  const uint64_t pixel_bytes = uint64_t(spec.width) * uint64_t(spec.height) * spec.pixel_bytes();
+  if (!ec && file_bytes < pixel_bytes)
+    throw std::runtime_error(fmt::format("{}: cannot read image: the file has {} bytes, too few for the {} x {} pixels "
+                                         "its header claims (cut short?)",
+                                         file.string(), file_bytes, spec.width, spec.height));
+}
+
 // The channels of `file` whose names start with `prefix` (together), each checked by `check`
 // (which throws) and read as `format` into `values`.
 template <typename T, typename Check>
@@ -154,6 +170,7 @@ std::vector<std::string> read_channels(const std::filesystem::path& file, const 
                                        OIIO::TypeDesc format, Check check, std::vector<T>& values) {
   auto in = OIIO::ImageInput::open(file.string());
   if (!in) throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
+  check_image_header(file, *in);
   const OIIO::ImageSpec& spec = in->spec();
   std::vector<std::string> names;
   int first = -1, last = -1;
@@ -177,6 +194,13 @@ std::vector<std::string> read_channels(const std::filesystem::path& file, const 
 }
 
 }  // namespace
+
+void check_image_size(const std::filesystem::path& file, int64_t width, int64_t height) {
+  if (width > kMaxImageSide || height > kMaxImageSide || width * height > kMaxImageTexels)
+    throw std::runtime_error(fmt::format("{}: the image is {} x {} texels, more than candela reads (at most {} on a "
+                                         "side and {} = 2^29 in all)",
+                                         file.string(), width, height, kMaxImageSide, kMaxImageTexels));
+}
 
 void write_image(const std::filesystem::path& file, const Image& image,
                  const std::map<std::string, std::string>& metadata) {
@@ -234,6 +258,7 @@ Image read_image(const std::filesystem::path& file, IntegerEncoding encoding) {
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
     throw std::runtime_error(fmt::format("{}: cannot read image: empty image", file.string()));
+  check_image_header(file, *in);
   Image img(spec.width, spec.height);
   bool ok;
   if (spec.format == OIIO::TypeDesc::UINT8) {

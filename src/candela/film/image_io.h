@@ -53,6 +53,16 @@ FloatChannels read_float_channels(const std::filesystem::path& file, const std::
 // The names of all channels of `file`, in the order the reader gives them.
 std::vector<std::string> read_channel_names(const std::filesystem::path& file);
 
+// The largest image read (a texture, an environment map, a part file): at most kMaxImageSide texels
+// on a side and kMaxImageTexels in all (6 GiB as float RGB; a 32768 x 16384 environment map fits).
+// Checked from the header, before the pixels are allocated, so that a small file whose header claims
+// 100000 x 100000 is refused at once.
+inline constexpr int64_t kMaxImageSide = 65536;
+inline constexpr int64_t kMaxImageTexels = int64_t(1) << 29;
+// Throws std::runtime_error "FILE: the image is W x H texels, more than candela reads (...)" for an
+// image beyond those limits.
+void check_image_size(const std::filesystem::path& file, int64_t width, int64_t height);
+
 // How 8- and 16-bit pixel values become linear: the exact sRGB decoding curve, or value / max.
 // Float pixels (EXR, HDR, PFM) are linear either way, as in pbrt-v4 and Mitsuba, whose encoding
 // options also only apply to integer images.

@@ -3,9 +3,12 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <regex>
+#include <tuple>
 
 #include "candela/integrators/integrator.h"
 
@@ -35,6 +38,31 @@ void check_positive(const char* option, const std::optional<T>& value) {
     throw UsageError(fmt::format("{}: must be a positive number, got {}", option, *value));
 }
 
+// `shown` is the size as the user gave it (WIDTHxHEIGHT), for the message.
+void check_resolution_range(long long width, long long height, const std::string& shown) {
+  if (width < 1 || height < 1 || width > kMaxResolution || height > kMaxResolution || width * height > kMaxPixels)
+    throw UsageError(fmt::format("resolution {} is out of range (each side 1..{}, at most {} pixels)", shown,
+                                 kMaxResolution, kMaxPixels));
+}
+
+// --resolution WIDTHxHEIGHT, in range. Sides of any number of digits are read (saturating), so that
+// 1000000000x1000000000 is out of range, not malformed.
+std::pair<int, int> parse_resolution(const std::string& text) {
+  std::smatch m;
+  static const std::regex pattern(R"((\d+)[xX](\d+))");
+  if (!std::regex_match(text, m, pattern))
+    throw UsageError(fmt::format("--resolution: expected WIDTHxHEIGHT such as 640x480, got '{}'", text));
+  const auto side = [](const std::string& digits) {
+    long long value = 0;
+    if (std::from_chars(digits.data(), digits.data() + digits.size(), value).ec != std::errc())
+      value = std::numeric_limits<long long>::max();
+    return value;
+  };
+  const long long width = side(m[1]), height = side(m[2]);
+  check_resolution_range(width, height, text);
+  return {int(width), int(height)};
+}
+
 }  // namespace
 
 void check_request_values(const RenderRequest& r) {
@@ -55,6 +83,7 @@ void check_request_values(const RenderRequest& r) {
   check_positive("--target-error", r.target_error);
   check_positive("--clamp", r.clamp);
   if (!r.time_limit.empty()) parse_duration("--time-limit", r.time_limit);
+  if (!r.resolution.empty()) parse_resolution(r.resolution);
 }
 
 namespace {
@@ -169,19 +198,10 @@ void apply_request(const RenderRequest& request, SceneDesc& scene) {
   if (rs.adaptive_spp > 0 && rs.adaptive_max_spp > 0 && rs.adaptive_max_spp < rs.adaptive_spp)
     throw UsageError(fmt::format("--max-spp ({}) must be at least --adaptive-spp ({})", rs.adaptive_max_spp,
                                  rs.adaptive_spp));
-  if (!request.resolution.empty()) {
-    std::smatch m;
-    static const std::regex pattern(R"((\d{1,9})[xX](\d{1,9}))");
-    if (!std::regex_match(request.resolution, m, pattern))
-      throw UsageError(fmt::format("--resolution: expected WIDTHxHEIGHT such as 640x480, got '{}'", request.resolution));
-    scene.film.width = std::stoi(m[1]);
-    scene.film.height = std::stoi(m[2]);
-  }
+  if (!request.resolution.empty())
+    std::tie(scene.film.width, scene.film.height) = parse_resolution(request.resolution);
   const auto& f = scene.film;
-  if (f.width < 1 || f.height < 1 || f.width > kMaxResolution || f.height > kMaxResolution ||
-      (long long)f.width * f.height > kMaxPixels)
-    throw UsageError(fmt::format("resolution {}x{} is out of range (each side 1..{}, at most {} pixels)", f.width,
-                                 f.height, kMaxResolution, kMaxPixels));
+  check_resolution_range(f.width, f.height, fmt::format("{}x{}", f.width, f.height));
   if (request.target_error && rs.adaptive())
     throw UsageError("--target-error: adaptive sampling (--adaptive-threshold, --adaptive-spp) has its own stopping "
                      "rule; use one or the other");

@@ -48,7 +48,8 @@ struct RenderRequest {
   bool quiet = false;  // no progress bar, no notes
 };
 
-// Checks each value on its own (ranges, the time limit's form), before a scene is read. Throws UsageError.
+// Checks each value on its own (ranges, the time limit's and the resolution's form), before a scene is read.
+// Throws UsageError.
 void check_request_values(const RenderRequest& request);
 
 // Checks every value (check_request_values), applies the request to `scene` (its settings and film size) and

@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "candela/testing/gzip_bytes.h"
+
 namespace candela {
 namespace {
 
@@ -398,6 +400,20 @@ TEST_F(MeshIo, ObjIndicesOutOfRangeAreAnError) {
                         {"normal 3"});
 }
 
+// Indices near and beyond 2^31 (docs/reliability.md, "Hostile inputs"): tinyobjloader would wrap them
+// around, 2^31 to an index before the first vertex and 10^20 to a valid one.
+TEST_F(MeshIo, ObjFaceIndicesNearTwoToThe31AreAnError) {
+  const std::string vertices = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\n";
+  expect_error_mentions(write("max.obj", vertices + "f 1 2 2147483647\n"),
+                        {"malformed OBJ", "face 1 refers to vertex 2147483647 but the file has 3 of them"});
+  for (const char* index : {"2147483648", "-2147483648", "99999999999999999999", "-99999999999999999999"})
+    expect_error_mentions(write("beyond.obj", vertices + "f 1 2 " + index + "\n"),
+                          {"malformed OBJ: line 5: face index '" + std::string(index) +
+                           "' is out of range (at most 2147483647 in size)"});
+  expect_error_mentions(write("uv.obj", vertices + "f 1/1 2/1 3/4294967296\n"), {"line 5", "'4294967296'"});
+  expect_error_mentions(write("normal.obj", vertices + "f 1//1 2//1 3//2147483648\n"), {"line 5", "'2147483648'"});
+}
+
 TEST_F(MeshIo, ObjNonFiniteCoordinatesAreAnError) {
   expect_error_mentions(write("nan.obj", "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n"), {"line 2", "'nan'"});
   expect_error_mentions(write("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 -inf 0\nf 1 2 3\n"), {"line 3", "'-inf'"});
@@ -701,6 +717,21 @@ TEST_F(MeshIo, PlyUnrecognisedLineInsideAnElementIsAnError) {
 }
 
 // ---------------------------------------------------------------- file names and places
+
+// pbrt-v4's "mesh.ply.gz": decompressed whole (io/gzip.h, whose tests hold the limit), then read by its
+// format's reader; a damaged one is an error naming the mesh.
+TEST_F(MeshIo, GzippedMeshesAreDecompressedFirst) {
+  const std::string ply = kPlyTriangleHeader + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  EXPECT_EQ(triangle_set(load(write("triangle.ply.gz", testing::gzip_bytes(ply)))),
+            triangle_set(load(write("triangle.ply", ply))));
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  EXPECT_EQ(load(write("triangle.OBJ.GZ", testing::gzip_bytes(obj))).triangle_count(), 1u);
+  const std::string gzipped = testing::gzip_bytes(ply);
+  expect_error_mentions(write("cut.ply.gz", gzipped.substr(0, gzipped.size() / 2)),
+                        {"cut.ply.gz': gzip: the compressed data is cut short"});
+  expect_error_mentions(write("bomb.ply.gz", testing::gzip_bomb(1025)),
+                        {"bomb.ply.gz': gzip: it decompresses to more than 1.0 GiB, the limit for a gzipped file"});
+}
 
 TEST_F(MeshIo, MissingFileNamesBothPlaces) {
   const fs::path missing = kTestData / "no_such_mesh.obj";

@@ -123,6 +123,41 @@ TEST(MitsubaReader, RefsIncludeAndOneSidedWrapping) {
   EXPECT_TRUE(std::holds_alternative<DiskShape>(s.shapes[2].geometry));
 }
 
+// Recursion a hostile file could make deep (docs/reliability.md, "Hostile inputs"): each is refused at
+// a limit, with the place, rather than overflowing the stack or reading files without end.
+TEST(MitsubaReader, DeepNestingAndIncludesAreRefusedAtTheirLimits) {
+  std::string deep;
+  for (int k = 0; k < 100000; ++k) deep += "<bsdf type=\"twosided\">";
+  deep += "<bsdf type=\"diffuse\"/>";
+  for (int k = 0; k < 100000; ++k) deep += "</bsdf>";
+  EXPECT_EQ(error_of(deep), "test.xml:2: <bsdf> is nested more than 100 objects deep");
+
+  std::ofstream(temp_dir() / "self.xml") << R"(<scene version="3.0.0"><include filename="self.xml"/></scene>)";
+  EXPECT_NE(error_of(R"(<include filename="self.xml"/>)").find("self.xml:1: more than 15 nested <include>s"),
+            std::string::npos)
+      << error_of(R"(<include filename="self.xml"/>)");
+  // Files that each include the next ten times, 15 levels: 10^15 includes.
+  for (int k = 1; k <= 15; ++k) {
+    std::ofstream file(temp_dir() / ("tenfold" + std::to_string(k) + ".xml"));
+    file << "<scene version=\"3.0.0\">";
+    for (int copy = 0; copy < 10 && k < 15; ++copy) file << "<include filename=\"tenfold" << k + 1 << ".xml\"/>";
+    file << "</scene>";
+  }
+  EXPECT_NE(error_of(R"(<include filename="tenfold1.xml"/>)").find("more than 100000 <include>s in all"),
+            std::string::npos);
+
+  // Instancing cannot recurse: a shapegroup holds neither shapegroups nor instances.
+  EXPECT_NE(error_of(R"(<shape type="shapegroup" id="a"><shape type="shapegroup" id="b"><shape type="sphere"/></shape>
+      </shape><shape type="instance"><ref id="a"/></shape>)")
+                .find("a shapegroup cannot hold another shapegroup (instancing does not nest)"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"(<shape type="shapegroup" id="a"><shape type="sphere"/></shape>
+      <shape type="shapegroup" id="b"><shape type="instance"><ref id="a"/></shape></shape>
+      <shape type="instance"><ref id="b"/></shape>)")
+                .find("a shapegroup cannot hold an instance (instancing does not nest)"),
+            std::string::npos);
+}
+
 TEST(MitsubaReader, Bsdfs) {
   SceneDesc s = read_text(R"(
     <shape type="sphere"><bsdf type="dielectric"><string name="int_ior" value="diamond"/></bsdf></shape>

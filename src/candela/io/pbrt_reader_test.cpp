@@ -21,6 +21,8 @@
 #include "candela/io/scene_reader.h"
 #include "candela/scene/description.h"
 #include "candela/spectral/cie.h"
+#include "candela/testing/command_line.h"
+#include "candela/testing/gzip_bytes.h"
 #include "candela/testing/pbrt_reader_helpers.h"
 
 namespace candela {
@@ -570,6 +572,74 @@ TEST(PbrtReader, IncludeCycleIsAnError) {
   EXPECT_NE(message.find("cycle_b.pbrt:1:9: \"" + (kTestData / "include/cycle_a.pbrt").string() + "\" includes itself"),
             std::string::npos)
       << message;
+}
+
+// Files for the tests below, in a directory of their own.
+class PbrtFiles {
+ public:
+  PbrtFiles() : dir_(testing::fresh_test_directory("candela_pbrt_files")) {}
+  ~PbrtFiles() { fs::remove_all(dir_); }
+  fs::path write(const std::string& name, const std::string& bytes) const {
+    std::ofstream(dir_ / name, std::ios::binary) << bytes;
+    return dir_ / name;
+  }
+
+ private:
+  fs::path dir_;
+};
+
+TEST(PbrtReader, IncludeChainsDeeperThan64FilesAreRefused) {
+  PbrtFiles files;
+  for (int k = 1; k < 100; ++k) files.write(fmt::format("f{}.pbrt", k), fmt::format("Include \"f{}.pbrt\"\n", k + 1));
+  files.write("f100.pbrt", "Shape \"sphere\"\n");
+  const fs::path main = files.write("main.pbrt", "WorldBegin\nInclude \"f1.pbrt\"\n");
+  const std::string message = error_reading(main);
+  // The innermost places first, the top-level file's last; the 60 between them counted, not listed.
+  EXPECT_EQ(message, fmt::format("{0}f63.pbrt:1:9: files are included more than 64 deep (in the file included at "
+                                 "{0}f62.pbrt:1:9, included at {0}f61.pbrt:1:9, ... 60 more Includes ..., included at "
+                                 "{1}:2:9)",
+                                 (main.parent_path() / "").string(), main.string()));
+}
+
+TEST(PbrtReader, AFileIncludedManyTimesOverIsRefused) {
+  // 20 levels of files that each include the next twice: 2^20 files to read.
+  PbrtFiles files;
+  for (int k = 1; k < 20; ++k)
+    files.write(fmt::format("f{}.pbrt", k), fmt::format("Include \"f{0}.pbrt\"\nInclude \"f{0}.pbrt\"\n", k + 1));
+  files.write("f20.pbrt", "");
+  const fs::path main = files.write("main.pbrt", "WorldBegin\nInclude \"f1.pbrt\"\n");
+  const std::string message = error_reading(main);
+  EXPECT_NE(message.find(": more than 100000 files are included in all (a file included many times over?)"),
+            std::string::npos)
+      << message;
+}
+
+TEST(PbrtReader, GzippedIncludesImportsMeshesAndScenesAreRead) {
+  PbrtFiles files;
+  files.write("geometry.pbrt.gz", testing::gzip_bytes("Shape \"sphere\" \"float radius\" 2\n"));
+  files.write("imported.pbrt.gz", testing::gzip_bytes("Material \"conductor\"\nShape \"sphere\"\n"));
+  files.write("triangle.ply.gz", testing::gzip_bytes("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                                     "property float y\nproperty float z\nelement face 1\n"
+                                                     "property list uchar int vertex_indices\nend_header\n"
+                                                     "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"));
+  const std::string text = "WorldBegin\nInclude \"geometry.pbrt.gz\"\nImport \"imported.pbrt.gz\"\n"
+                           "Shape \"plymesh\" \"string filename\" \"triangle.ply.gz\"\n";
+  const fs::path main = files.write("main.pbrt", text);
+  const SceneDesc scene = read_pbrt_scene(main);
+  ASSERT_EQ(scene.shapes.size(), 3u);
+  EXPECT_FLOAT_EQ(std::get<SphereShape>(scene.shapes[0].geometry).radius, 2);
+  EXPECT_EQ(scene.shapes[0].where.to_string(), (main.parent_path() / "geometry.pbrt.gz").string() + ":1:1");
+  EXPECT_EQ(mesh_of(scene.shapes[2]).triangle_count(), 1u);
+  // The whole scene gzipped, as pbrt-v4 reads it.
+  const SceneDesc gzipped = read_scene_file(files.write("main.pbrt.gz", testing::gzip_bytes(text)));
+  EXPECT_EQ(gzipped.shapes.size(), 3u);
+
+  // A damaged one is an error at the Include that names it.
+  const std::string whole = testing::gzip_bytes("Shape \"sphere\"\n");
+  files.write("cut.pbrt.gz", whole.substr(0, whole.size() - 3));
+  const fs::path cut = files.write("cut.pbrt", "WorldBegin\nInclude \"cut.pbrt.gz\"\n");
+  EXPECT_EQ(error_reading(cut), fmt::format("{}:2:9: cannot read \"{}\": gzip: the compressed data is cut short",
+                                            cut.string(), (cut.parent_path() / "cut.pbrt.gz").string()));
 }
 
 TEST(PbrtReader, ImportedGraphicsStateDoesNotLeak) {

@@ -52,6 +52,9 @@ std::string read_text_file(const fs::path& file) {
 SceneDesc read_scene_file(const std::filesystem::path& file, const SceneReadOptions& options) {
   check_is_readable_file(file);
   std::string extension = lowercase_extension(file);
+  // As pbrt-v4, a gzipped pbrt scene or PLY mesh ("scene.pbrt.gz"): their readers decompress it (io/gzip.h).
+  const std::string inner = lowercase_extension(file.stem());
+  if (extension == ".gz" && (inner == ".pbrt" || inner == ".ply")) extension = inner;
   if (!options.parameters.empty() && extension != ".xml")
     throw_scene_error(location_of_file(file), "${} is a Mitsuba scene parameter, and this is not a Mitsuba .xml file",
                       options.parameters.begin()->first);
@@ -71,7 +74,8 @@ SceneDesc read_scene_file(const std::filesystem::path& file, const SceneReadOpti
                              : read_mitsuba_scene(file, MitsubaReadOptions{options.parameters});
   else
     throw_scene_error(location_of_file(file),
-                      "unsupported scene file extension {}; supported: .json, .pbrt, .xml (Mitsuba 3), .gltf, .glb, .obj, .ply",
+                      "unsupported scene file extension {}; supported: .json, .pbrt, .xml (Mitsuba 3), .gltf, .glb, "
+                      ".obj, .ply, and .pbrt.gz and .ply.gz gzipped",
                       extension.empty() ? std::string("(none)") : "\"" + extension + "\"");
   scene.source_file = file.string();
   return scene;

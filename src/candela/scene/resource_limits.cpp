@@ -15,6 +15,7 @@
 #include <variant>
 
 #include "candela/film/film.h"
+#include "candela/film/image_io.h"
 #include "candela/geometry/sdf_grid.h"
 #include "candela/base/error.h"
 #include "candela/base/overloaded.h"
@@ -95,7 +96,9 @@ ShapeCost shape_cost(const ShapeDesc& shape) {
 // ---------------------------------------------------------------- images
 
 // Bytes for one image read into a float RGB Image, from its header; 0 when it cannot be opened.
-uint64_t image_bytes(const std::string& filename, uint64_t extra_per_texel) {
+// Throws SceneError at `where` (the scene's entry naming the image) for an image larger than
+// candela reads at all (film/image_io.h), whatever the memory.
+uint64_t image_bytes(const std::string& filename, uint64_t extra_per_texel, const SourceLocation& where) {
   if (filename.empty()) return 0;
   auto in = OIIO::ImageInput::open(filename);
   if (!in) {
@@ -103,6 +106,11 @@ uint64_t image_bytes(const std::string& filename, uint64_t extra_per_texel) {
     return 0;
   }
   const OIIO::ImageSpec& spec = in->spec();
+  try {
+    check_image_size(filename, spec.width, spec.height);
+  } catch (const std::runtime_error& too_large) {
+    throw_scene_error(where, "{}", too_large.what());
+  }
   const uint64_t texels = mul(non_negative(spec.width), non_negative(spec.height));
   const uint64_t file_pixel = mul(non_negative(spec.nchannels), spec.format.size());
   in->close();
@@ -110,8 +118,8 @@ uint64_t image_bytes(const std::string& filename, uint64_t extra_per_texel) {
 }
 
 // The image a texture reads, in memory.
-uint64_t texture_image_bytes(const TextureDesc& texture) {
-  return std::visit(overloaded{[](const ImageTexture& image) { return image_bytes(image.filename, 0); },
+uint64_t texture_image_bytes(const TextureDesc& texture, const SourceLocation& where) {
+  return std::visit(overloaded{[&](const ImageTexture& image) { return image_bytes(image.filename, 0, where); },
                                // no images of their own
                                [](const CheckerboardTexture&) { return uint64_t(0); },
                                [](const ScaleTexture&) { return uint64_t(0); },
@@ -122,9 +130,9 @@ uint64_t texture_image_bytes(const TextureDesc& texture) {
 
 // The image a light reads, in memory with its sampling distribution (an environment map's two
 // floats per texel). Spot and projector lights name textures, counted with the textures.
-uint64_t light_image_bytes(const LightDesc& light) {
+uint64_t light_image_bytes(const LightDesc& light, const SourceLocation& where) {
   return std::visit(
-      overloaded{[](const EnvironmentMap& env) { return image_bytes(env.filename, 2 * sizeof(float)); },
+      overloaded{[&](const EnvironmentMap& env) { return image_bytes(env.filename, 2 * sizeof(float), where); },
                  [](const PointLight&) { return uint64_t(0); }, [](const SkyLight&) { return uint64_t(0); },
                  [](const SpotLight&) { return uint64_t(0); }, [](const DistantLight&) { return uint64_t(0); },
                  [](const ProjectorLight&) { return uint64_t(0); }},
@@ -150,9 +158,14 @@ MemoryEstimate estimate_memory(const SceneDesc& desc) {
   scene = add(scene, mul(desc.instances.size(), kBytesPerInstance));
   scene = add(scene, mul(desc.lights.size() + desc.materials.size() + desc.textures.size(), 256));
 
-  for (const TextureDesc& texture : desc.textures)
-    e.texture_bytes = add(e.texture_bytes, texture_image_bytes(texture));
-  for (const LightDesc& light : desc.lights) e.texture_bytes = add(e.texture_bytes, light_image_bytes(light));
+  // Where the scene declares entry i, else the scene file.
+  const auto place = [&](const std::vector<SourceLocation>& places, size_t i) {
+    return i < places.size() ? places[i] : SourceLocation{desc.source_file};
+  };
+  for (size_t i = 0; i < desc.textures.size(); ++i)
+    e.texture_bytes = add(e.texture_bytes, texture_image_bytes(desc.textures[i], place(desc.places.textures, i)));
+  for (size_t i = 0; i < desc.lights.size(); ++i)
+    e.texture_bytes = add(e.texture_bytes, light_image_bytes(desc.lights[i], place(desc.places.lights, i)));
 
   e.scene_bytes = add(scene, e.texture_bytes);
   e.total = add(e.film_bytes, e.scene_bytes);

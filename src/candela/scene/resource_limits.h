@@ -50,7 +50,8 @@ struct MemoryEstimate {
 
 // Overflow-safe: every sum and product saturates at UINT64_MAX. Image files are opened for their
 // headers only (OpenImageIO's ImageInput::open); one that cannot be opened counts as nothing here
-// (reading it later reports the problem).
+// (reading it later reports the problem), one larger than candela reads at all (film/image_io.h's
+// check_image_size) is a SceneError naming the file and the scene's place for it.
 MemoryEstimate estimate_memory(const SceneDesc& desc);
 
 // Throws SceneError "<scene file>: the film resolution W x H is too large ..." for a resolution over

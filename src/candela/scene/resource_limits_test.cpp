@@ -2,9 +2,11 @@
 
 #include <gtest/gtest.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <string>
 
@@ -109,6 +111,74 @@ TEST(ResourceLimits, TexturesAreCountedFromTheirHeaders) {
   desc.textures[0] = ImageTexture{.filename = (file.string() + ".missing")};
   EXPECT_EQ(estimate_memory(desc).texture_bytes, 0u);
   std::filesystem::remove(file);
+}
+
+// A PNG whose header claims width x height 8-bit RGB pixels, followed by a little image data.
+std::string png_claiming(uint32_t width, uint32_t height) {
+  const auto big_endian = [](uint32_t v) {
+    return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
+  };
+  const auto chunk = [&](const std::string& type, const std::string& data) {
+    const std::string typed = type + data;
+    return big_endian(uint32_t(data.size())) + typed +
+           big_endian(uint32_t(crc32(0, reinterpret_cast<const Bytef*>(typed.data()), uInt(typed.size()))));
+  };
+  const std::string row_start(16, '\0');
+  std::string idat(64, '\0');
+  uLongf idat_size = uLongf(idat.size());
+  compress(reinterpret_cast<Bytef*>(idat.data()), &idat_size, reinterpret_cast<const Bytef*>(row_start.data()),
+           uLong(row_start.size()));
+  idat.resize(idat_size);
+  const std::string rgb8 = std::string("\x08\x02\0\0\0", 5);  // bit depth, colour type, compression, filter, interlace
+  return std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", big_endian(width) + big_endian(height) + rgb8) +
+         chunk("IDAT", idat) + chunk("IEND", "");
+}
+
+// Hostile inputs (docs/reliability.md): a texture file of a few bytes whose header claims 100000 x
+// 100000 texels is refused from its header, naming the scene's entry, the file and the limit, before
+// anything is allocated for it; so is a PFM whose pixels are not all in the file.
+TEST(ResourceLimits, ImagesLargerThanCandelaReadsAreRefusedFromTheirHeaders) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("candela_limits_images_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const auto write = [&](const std::string& name, const std::string& bytes) {
+    std::ofstream(dir / name, std::ios::binary) << bytes;
+    return (dir / name).string();
+  };
+  const std::string png = write("huge.png", png_claiming(100000, 100000));
+  const std::string pfm = write("huge.pfm", "PF\n100000 100000\n-1.0\n" + std::string(1200, '\0'));
+  const std::string limit = "more than candela reads (at most 65536 on a side and 536870912 = 2^29 in all)";
+  SceneDesc desc = scene_with(64, 64);
+  desc.textures.push_back(ImageTexture{.filename = png});
+  desc.places.textures.push_back(SourceLocation{"scene.json", 4, 16, "/textures/wood"});
+  try {
+    estimate_memory(desc);
+    ADD_FAILURE() << "not refused";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "scene.json:4:16: at /textures/wood: " + png + ": the image is 100000 x 100000 texels, " + limit);
+  }
+  desc.textures.clear();
+  desc.lights.push_back(EnvironmentMap{.filename = pfm});  // no place known: the scene file is named
+  EXPECT_THROW(estimate_memory(desc), SceneError);
+  for (const std::string& file : {png, pfm}) {
+    try {
+      read_image(file);
+      ADD_FAILURE() << file << " read";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()), file + ": the image is 100000 x 100000 texels, " + limit);
+    }
+  }
+  // Within the limits, but the file holds 1200 of the 4.8 GB of pixels its header claims.
+  const std::string short_pfm = write("short.pfm", "PF\n20000 20000\n-1.0\n" + std::string(1200, '\0'));
+  try {
+    read_image(short_pfm);
+    ADD_FAILURE() << "read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), short_pfm + ": cannot read image: the file has 1220 bytes, too few for the "
+                                                  "20000 x 20000 pixels its header claims (cut short?)");
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(ResourceLimits, NormalScenePasses) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -88,7 +89,29 @@ void check_obj_vertex_line(const std::vector<std::string_view>& words, size_t li
       fail_file_content("malformed OBJ: line {}: '{}' is not a finite number", line_number, printable(words[k]));
 }
 
-void check_obj_vertex_lines(std::string_view text) {
+// tinyobjloader reads a face index beyond int's range wrapped around (2^31 as an index before the
+// first vertex, 10^20 as a valid one), so each index of an 'f' line is checked here first.
+void check_obj_face_line(const std::vector<std::string_view>& words, size_t line_number) {
+  constexpr int64_t kMaxIndex = std::numeric_limits<int>::max();
+  for (size_t k = 1; k < words.size(); ++k) {
+    // A corner is "v", "v/vt", "v//vn" or "v/vt/vn".
+    std::string_view rest = words[k];
+    while (true) {
+      const size_t slash = rest.find('/');
+      const std::string_view index = rest.substr(0, slash);
+      int64_t value = 0;
+      const std::errc error = std::from_chars(index.data(), index.data() + index.size(), value).ec;
+      const bool beyond_int = error == std::errc() && (value > kMaxIndex || value < -kMaxIndex);
+      if (error == std::errc::result_out_of_range || beyond_int)
+        fail_file_content("malformed OBJ: line {}: face index '{}' is out of range (at most {} in size)", line_number,
+                          printable(index), kMaxIndex);
+      if (slash == std::string_view::npos) break;
+      rest.remove_prefix(slash + 1);
+    }
+  }
+}
+
+void check_obj_lines(std::string_view text) {
   size_t line_number = 0, at = 0;
   while (at < text.size()) {
     const size_t end = std::min(text.find('\n', at), text.size());
@@ -98,6 +121,8 @@ void check_obj_vertex_lines(std::string_view text) {
     const std::vector<std::string_view> words = split_words(line.substr(0, line.find('#')));
     if (!words.empty() && (words[0] == "v" || words[0] == "vt" || words[0] == "vn"))
       check_obj_vertex_line(words, line_number);
+    else if (!words.empty() && words[0] == "f")
+      check_obj_face_line(words, line_number);
   }
 }
 
@@ -160,7 +185,7 @@ tinyobj::ObjReader parse_obj(const std::string& text, const std::string& mtl_tex
   config.triangulate = true;
   config.vertex_color = false;
   tinyobj::ObjReader reader;
-  check_obj_vertex_lines(text);
+  check_obj_lines(text);
   // Parsing from strings makes tinyobjloader ignore `mtllib`: the caller reads the library (or not),
   // so a missing or misplaced .mtl file cannot fail the load of the geometry.
   if (!reader.ParseFromString(text, mtl_text, config))

@@ -161,7 +161,8 @@ int Converter::shapegroup(const Object& g) {
     if (child.tag != "shape") continue;
     g.usage.mark_used_at(i);
     if (child.type == "shapegroup" || child.type == "instance")
-      throw_scene_error(child.where.loc(), "a shapegroup cannot hold a {}", child.type);
+      throw_scene_error(child.where.loc(), "a shapegroup cannot hold {} (instancing does not nest)",
+                        child.type == "instance" ? "an instance" : "another shapegroup");
     shape(child, &obj);
   }
   check_all_used(g);

@@ -20,6 +20,11 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr int kMaxIncludeDepth = 15;     // Mitsuba's MI_XML_INCLUDE_MAX_RECURSION
+// Files included in all: 15 levels of files that each include the next ten times would read 10^15.
+constexpr int kMaxIncludes = 100000;
+// Objects inside objects (a bsdf in a bsdf...): parsed recursively, so a hostile file nesting them
+// 100,000 deep would overflow the stack. Real scenes nest a handful.
+constexpr int kMaxObjectDepth = 100;
 
 bool is_object_tag(std::string_view tag) {
   static const std::set<std::string_view> tags = {"scene",   "bsdf",       "shape",   "emitter", "sensor",
@@ -289,6 +294,8 @@ class XmlParser {
     if (tag == "spectrum" && node.attribute("type")) tag = "texture";  // spectrum plugins are textures
     if (is_object_tag(tag)) {
       if (tag == "scene") throw_scene_error(where.loc(), "<scene> can only be the root element");
+      if (depth > kMaxObjectDepth)
+        throw_scene_error(where.loc(), "<{}> is nested more than {} objects deep", tag, kMaxObjectDepth);
       check_attributes(doc, node, {"type", "id", "name", "version"});
       Object* o = new_object(tag, required(doc, node, "type"), where);
       if (pugi::xml_attribute id = node.attribute("id")) {
@@ -474,6 +481,8 @@ class XmlParser {
     std::string name = required(doc, node, "filename");
     if (++include_depth_ > kMaxIncludeDepth)
       throw_scene_error(where.loc(), "more than {} nested <include>s (an include cycle?)", kMaxIncludeDepth);
+    if (++includes_read_ > kMaxIncludes)
+      throw_scene_error(where.loc(), "more than {} <include>s in all (a file included many times over?)", kMaxIncludes);
     fs::path file = doc.dir / name;
     if (!fs::exists(file)) {
       std::optional<fs::path> found = resolve(name);
@@ -500,6 +509,7 @@ class XmlParser {
   std::vector<std::pair<std::string, std::string>> params_;
   int arg_counter_ = 0;
   int include_depth_ = 0;
+  int includes_read_ = 0;
 };
 
 }  // namespace

@@ -4,11 +4,20 @@
 #include <fstream>
 #include <sstream>
 
+#include "candela/io/gzip.h"
+
 namespace candela::pbrt {
 
 namespace {
 
+// A SceneError from an included file that already names where the file was included.
+struct IncludedFileError : SceneError {
+  using SceneError::SceneError;
+};
+
 constexpr int kMaxIncludeDepth = 64;
+// Files read in all: 30 levels of files that each include the next twice would read 2^30 files.
+constexpr int kMaxFilesRead = 100000;
 
 std::string read_file_text(const fs::path& file, const SourceLocation& where) {
   std::ifstream in(file, std::ios::binary);
@@ -16,7 +25,14 @@ std::string read_file_text(const fs::path& file, const SourceLocation& where) {
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw_scene_error(where, "cannot read \"{}\"", file.string());
-  return std::move(text).str();
+  std::string bytes = std::move(text).str();
+  // pbrt-v4 reads gzipped scene files ("geometry.pbrt.gz") as their text.
+  if (!is_gzip(bytes)) return bytes;
+  try {
+    return gunzip(bytes);
+  } catch (const FileContentError& problem) {
+    throw_scene_error(where, "cannot read \"{}\": {}", file.string(), problem.what());
+  }
 }
 
 }  // namespace
@@ -111,6 +127,9 @@ SourceLocation SceneParser::parse_file(const fs::path& file, const SourceLocatio
   if (!included_from && !fs::is_regular_file(file)) throw_scene_error(blame, "no such scene file");
   if (open_files_.size() >= kMaxIncludeDepth)
     throw_scene_error(blame, "files are included more than {} deep", kMaxIncludeDepth);
+  if (++files_read_ > kMaxFilesRead)
+    throw_scene_error(blame, "more than {} files are included in all (a file included many times over?)",
+                      kMaxFilesRead);
   std::error_code error;
   fs::path canonical = fs::weakly_canonical(file, error);
   if (error) canonical = fs::absolute(file).lexically_normal();
@@ -128,22 +147,46 @@ SourceLocation SceneParser::parse_tokens(Tokenizer& tokens, const fs::path& dire
   Tokenizer* outer = std::exchange(tokens_, &tokens);
   fs::path outer_directory = std::exchange(directory_, directory);
   open_files_.push_back(canonical_file);
+  if (included_from) include_places_.push_back(*included_from);
   auto restore = [&] {
     tokens_ = outer;
     directory_ = std::move(outer_directory);
     open_files_.pop_back();
+    if (included_from) include_places_.pop_back();
   };
   try {
     parse_directives();
-  } catch (const SceneError& error) {
+  } catch (const IncludedFileError&) {
     restore();
-    if (!included_from) throw;
-    // Errors inside an included file name that file; add where it was included from.
-    throw SceneError(fmt::format("{} (in the file included at {})", error.what(), included_from->to_string()));
+    throw;  // already says where its file was included from
+  } catch (const SceneError& error) {
+    if (!included_from) {
+      restore();
+      throw;
+    }
+    // Errors inside an included file name that file; add where it was included from, and so on out.
+    IncludedFileError with_places(fmt::format("{} {}", error.what(), describe_include_places()));
+    restore();
+    throw with_places;
   }
   SourceLocation end = at(tokens.peek());
   restore();
   return end;
+}
+
+// "(in the file included at b.pbrt:1:9, included at main.pbrt:2:9)", from the innermost include
+// out; a chain of more than kShown shows its two innermost places and the top-level file's.
+std::string SceneParser::describe_include_places() const {
+  constexpr size_t kShown = 4;
+  std::string text = "(in the file included at ";
+  const size_t count = include_places_.size();
+  for (size_t k = 0; k < count; ++k) {
+    const bool elided = count > kShown && k >= 2 && k + 1 < count;
+    if (elided && k == 2) text += fmt::format(", ... {} more Includes ...", count - 3);
+    if (elided) continue;
+    text += (k == 0 ? "" : ", included at ") + include_places_[count - 1 - k].to_string();
+  }
+  return text + ")";
 }
 
 void SceneParser::parse_directives() {

@@ -119,6 +119,7 @@ class SceneParser {
   SourceLocation parse_tokens(Tokenizer& tokens, const fs::path& directory, const fs::path& canonical_file,
                               const SourceLocation* included_from);
   void parse_directives();
+  std::string describe_include_places() const;
   fs::path resolve_path(const std::string& name, const SourceLocation& where, std::string_view what) const;
   void check_end_of_scene(const SourceLocation& end) const;
 
@@ -251,6 +252,8 @@ class SceneParser {
   // Canonical paths of the files being read, to catch include cycles (empty for text not read from
   // a file).
   std::vector<fs::path> open_files_;
+  std::vector<SourceLocation> include_places_;  // where each of them was included, for messages
+  int files_read_ = 0;  // every Include and Import so far, against a file including others many times over
   fs::path top_directory_;
 };
 
