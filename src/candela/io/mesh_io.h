@@ -1,6 +1,6 @@
 #pragma once
 // Triangle meshes from files: .obj through tinyobjloader, .ply through Assimp, Mitsuba's .serialized
-// through zlib.
+// through zlib; any of them gzipped ("mesh.ply.gz", as pbrt-v4 reads) is decompressed first (io/gzip.h).
 #include <filesystem>
 #include <string>
 #include <vector>
