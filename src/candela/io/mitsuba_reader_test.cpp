@@ -100,6 +100,19 @@ TEST(MitsubaReader, MaxDepthMapping) {
                   .settings.hide_emitters);
 }
 
+// Found by fuzz/mitsuba_reader_fuzz.cpp (fuzz/regressions/mitsuba_reader/ub-integer-beyond-int.xml): the
+// value was cast to int, undefined behaviour that UBSan reported.
+TEST(MitsubaReader, IntegerBeyondIntIsAnError) {
+  EXPECT_EQ(error_of(R"(<sensor type="perspective"><sampler type="independent">
+                        <integer name="sample_count" value="5e123"/></sampler></sensor>)"),
+            "test.xml:3: sampler \"independent\": \"sample_count\" is 5e+123, beyond the integers candela takes "
+            "(-2147483648 to 2147483647)");
+  EXPECT_EQ(read_text(R"(<integrator type="path"><integer name="max_depth" value="2147483647"/></integrator>)")
+                .settings.max_depth, 2147483646);
+  EXPECT_EQ(read_text(R"(<integrator type="path"><integer name="rr_depth" value="-2147483648"/></integrator>)")
+                .settings.rr_start_depth, 1);
+}
+
 TEST(MitsubaReader, RefsIncludeAndOneSidedWrapping) {
   {
     std::ofstream f(temp_dir() / "inc.xml");

@@ -1,6 +1,8 @@
 // The Mitsuba converter: the scene's objects in turn, and the access to their properties.
 #include "candela/io/mitsuba/converter.h"
 
+#include <limits>
+
 namespace candela::mitsuba {
 
 SceneDesc Converter::convert(const Object& scene) {
@@ -80,8 +82,13 @@ float Converter::get_float(const Object& o, std::string_view name, float fallbac
 int Converter::get_int(const Object& o, std::string_view name, int fallback) {
   const Property* p = find(o, name);
   if (!p) return fallback;
-  if (p->kind == Property::Kind::Integer) return int(p->number);
-  wrong_kind(o, *p, "an integer");
+  if (p->kind != Property::Kind::Integer) wrong_kind(o, *p, "an integer");
+  // Mitsuba's integers are 64-bit, candela's parameters int: a value beyond int is refused, not cast
+  // (which is undefined behaviour).
+  if (!(p->number >= std::numeric_limits<int>::min() && p->number <= std::numeric_limits<int>::max()))
+    throw_scene_error(p->where.loc(), "{}: \"{}\" is {}, beyond the integers candela takes ({} to {})", o.describe(),
+                      p->name, p->number, std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
+  return int(p->number);
 }
 
 bool Converter::get_bool(const Object& o, std::string_view name, bool fallback) {

@@ -181,8 +181,9 @@ void Converter::integrator(const Object& i) {
     rs.max_depth = candela_depth(get_int(i, "max_depth", -1));
     // Russian roulette from the rr_depth-th bounce on: path.cpp tests depth >= rr_depth after counting
     // the bounce, volpath.cpp depth > rr_depth at the top of its loop, one bounce later.
+    // (max(2, rr) - 1, not max(1, rr - 1): rr - 1 overflows at INT_MIN.)
     int rr = get_int(i, "rr_depth", 5);
-    rs.rr_start_depth = rs.integrator == "volpath" ? std::max(1, rr) : std::max(1, rr - 1);
+    rs.rr_start_depth = rs.integrator == "volpath" ? std::max(1, rr) : std::max(2, rr) - 1;
     rs.hide_emitters = get_bool(i, "hide_emitters", false);
     if (i.type == "ptracer")
       warn(i.where, "integrator \"ptracer\": rendering with candela's bidirectional path tracer (the same expectation)");
