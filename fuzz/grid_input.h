@@ -21,6 +21,10 @@
 
 namespace candela_fuzz {
 
+// The dense samples the target reads a grid into at most: a few bytes of a sparse grid can span the
+// reader's own limit (kMaxDenseGridSamples, 4 GiB of floats), more than libFuzzer's 2 GiB.
+inline constexpr uint64_t kMaxFuzzedDenseSamples = uint64_t(1) << 20;
+
 struct GridInput {
   std::string bytes;
   const char* file_name;  // input.nvdb or input.vdb

@@ -1,7 +1,8 @@
 // libFuzzer target: the VDB grid files of io/grid_files.cpp, NanoVDB's .nvdb (the header-only NanoVDB
 // reader, instrumented with candela's code) and OpenVDB's .vdb (Debian's libopenvdb, not
 // instrumented), as grid_input.h makes them from the input. The target lists the grids
-// (grid_names_in_file) and reads the first one, or "density" when none is listed.
+// (grid_names_in_file) and reads the first one, or "density" when none is listed, into at most
+// kMaxFuzzedDenseSamples samples.
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -25,7 +26,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     candela_fuzz::rejected(e);
   }
   try {
-    (void)candela::read_grid_file(file, names.empty() ? "density" : names.front(), where);
+    (void)candela::read_grid_file(file, names.empty() ? "density" : names.front(), where,
+                                  candela_fuzz::kMaxFuzzedDenseSamples);
   } catch (const candela::SceneError& e) {
     candela_fuzz::rejected(e);
   }

@@ -182,7 +182,8 @@ TEST_F(FuzzRegression, NanovdbReader) {
       names = grid_names_in_file(dir_ / grid.file_name, SourceLocation{"fuzz", 1, 1, {}});
     } catch (const SceneError&) {
     }
-    (void)read_grid_file(dir_ / grid.file_name, names.empty() ? "density" : names.front(), SourceLocation{"fuzz", 1, 1, {}});
+    (void)read_grid_file(dir_ / grid.file_name, names.empty() ? "density" : names.front(), SourceLocation{"fuzz", 1, 1, {}},
+                         candela_fuzz::kMaxFuzzedDenseSamples);
   });
 }
 

@@ -22,9 +22,10 @@ inline constexpr uint64_t kMaxDenseGridSamples = uint64_t(1) << 30;
 // ignored), with to_world mapping its unit cube to the file's world space (.vol: the identity, as
 // Mitsuba places it). Throws SceneError "<referenced_from>: cannot read volume grid 'FILE': <why>"
 // for a missing or malformed file, a missing grid (naming the grids there are), a grid that is not
-// of floats, a non-zero background, or more than kMaxDenseGridSamples samples.
+// of floats, a non-zero background, or more than `max_dense_samples` samples (a sparse grid's few
+// bytes can span that many: the fuzz target asks for fewer than libFuzzer's memory limit holds).
 VolumeDesc read_grid_file(const std::filesystem::path& file, const std::string& grid_name,
-                          const SourceLocation& referenced_from);
+                          const SourceLocation& referenced_from, uint64_t max_dense_samples = kMaxDenseGridSamples);
 
 // The names of the grids in a .vdb or .nvdb file (empty for .vol), for messages and warnings.
 std::vector<std::string> grid_names_in_file(const std::filesystem::path& file, const SourceLocation& referenced_from);

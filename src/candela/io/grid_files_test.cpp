@@ -78,9 +78,45 @@ TEST_F(GridFiles, ProblemsNameTheFile) {
             std::string::npos);
   EXPECT_NE(message([&] { read_grid_file(dir_ / "missing.vdb", "density", {}); }).find("cannot read volume grid"),
             std::string::npos);
-  // (Truncated and malformed .vdb and .nvdb files are refused by OpenVDB's and NanoVDB's readers,
-  // whose messages the error carries; they are not tested here: on some truncations the libraries
-  // take tens of seconds to give up, too long and too variable for the suite.)
+  // (Truncated and malformed .vdb files are refused by OpenVDB's reader, whose messages the error
+  // carries; they are not tested here: on some truncations the library takes tens of seconds to give
+  // up, too long and too variable for the suite. .nvdb files are checked by candela: next test.)
+}
+
+// Found by fuzz/nanovdb_reader_fuzz.cpp (fuzz/regressions/nanovdb_reader/): NanoVDB's own reader read
+// a grid name without its NUL byte past its end (ASan: heap-buffer-overflow), and followed node
+// offsets as the file gave them. candela reads the file itself and checks both first.
+TEST_F(GridFiles, NanoVdbFilesAreCheckedBeforeTheyAreRead) {
+  const fs::path file = dir_ / "cloud.nvdb";
+  write_grid_file(file, "density", kRes, values_, kVoxel, kOffset);
+  std::ifstream in(file, std::ios::binary);
+  const std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto error_of = [&](const std::string& contents) {
+    std::ofstream(file, std::ios::binary) << contents;
+    try {
+      read_grid_file(file, "density", {});
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  auto error_with = [&](size_t at, const std::string& bytes) {
+    std::string patched = good;
+    return error_of(patched.replace(at, bytes.size(), bytes));
+  };
+  const std::string prefix = "<input>: cannot read volume grid '" + file.string() + "': ";
+  // The file: a 16-byte segment header, 176 bytes of the grid's metadata, its name "density\0", then
+  // the grid: 672 bytes of header, then the tree, whose root node's offset is its fourth 8-byte word.
+  const size_t name_end = 16 + 176 + 7, root_offset = name_end + 1 + 672 + 24;
+  ASSERT_EQ(good.compare(name_end - 7, 8, std::string("density\0", 8)), 0);
+  EXPECT_EQ(error_with(name_end, "x"), prefix + "a grid's name does not end in a NUL byte");
+  EXPECT_EQ(error_with(root_offset, std::string("\0\0\0\0\0\1\0\0", 8)),
+            prefix + "grid \"density\" is corrupt: its root node lies outside it");
+  EXPECT_EQ(error_of(good.substr(0, good.size() - 1)),
+            prefix + "grid \"density\" of " + std::to_string(good.size() - name_end - 1) +
+                " bytes runs past the end of the file");
+  EXPECT_EQ(error_with(0, "NanoVDB1"), prefix + "no NanoVDB segment at byte 0");
+  EXPECT_EQ(error_of(good), "no error");
 }
 
 TEST_F(GridFiles, PbrtNanoVdbMediumAndJsonGridsReadThem) {
