@@ -3,7 +3,8 @@
 # fuzz/regressions/<target>/ once each, then SECONDS (default 30) of fuzzing over fuzz/corpus/<target>/.
 # Exits non-zero on the first crash, sanitizer report, timeout (>10 s for one input) or OOM.
 # Usage: fuzz/run.sh [SECONDS] [TARGET...]   TARGET is json_reader, pbrt_reader, obj_reader, ply_reader,
-# serialized_reader, mitsuba_reader, gltf_reader, vol_reader, nanovdb_reader, part_reader, checkpoint_reader
+# serialized_reader, mitsuba_reader, gltf_reader, vol_reader, nanovdb_reader, part_reader, checkpoint_reader,
+# http_request
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${FUZZ_BUILD_DIR:-$root/build-fuzz}"
@@ -11,7 +12,7 @@ seconds="${1:-30}"
 shift || true
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(json_reader pbrt_reader obj_reader ply_reader serialized_reader mitsuba_reader gltf_reader
-  vol_reader nanovdb_reader part_reader checkpoint_reader)
+  vol_reader nanovdb_reader part_reader checkpoint_reader http_request)
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 for target in "${targets[@]}"; do
