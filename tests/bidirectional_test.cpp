@@ -31,7 +31,7 @@ using testing::look_at_camera;
 using testing::region_mean;
 using testing::rel_mse;
 
-const std::string kShared = CANDELA_SHARED_DIR;
+const std::string kSharedDir = CANDELA_SHARED_DIR;
 const std::string kScenes = std::string(CANDELA_SOURCE_DIR) + "/scenes/";
 
 Film render_film(SceneDesc d, const std::string& integrator, int spp, uint64_t seed, int threads = 0,
@@ -450,7 +450,7 @@ void expect_metropolis_agrees(const SceneDesc& d, int mutations, int bdpt_spp, c
 }
 
 TEST(BidirectionalAgreement, VeachMis) {
-  SceneDesc d = scene_at(kShared + "/scenes/bitterli/veach-mis/scene-v4.pbrt", 64, 36);
+  SceneDesc d = scene_at(kSharedDir + "/scenes/bitterli/veach-mis/scene-v4.pbrt", 64, 36);
   expect_integrators_agree(d, {{"path", 256}, {"bdpt", 64}}, 0.005, "veach-mis");
   d.settings.mlt.bootstrap = 20000;
   d.settings.mlt.chains = 256;

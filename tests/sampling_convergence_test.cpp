@@ -41,7 +41,7 @@ double rmse(const Image& a, const Image& b) {
   return std::sqrt(s / double(a.rgb.size()));
 }
 
-const Image& reference() {
+const Image& soft_shadows_reference() {
   static Image ref = testing::render_description(soft_shadows(SamplerType::ZSobol, 8192, 99)).mean_image();
   return ref;
 }
@@ -50,7 +50,8 @@ const Image& reference() {
 double mean_rmse(SamplerType sampler, int spp, int seeds = 6) {
   double ms = 0;
   for (int s = 0; s < seeds; ++s) {
-    double e = rmse(testing::render_description(soft_shadows(sampler, spp, uint64_t(s + 1))).mean_image(), reference());
+    const Image image = testing::render_description(soft_shadows(sampler, spp, uint64_t(s + 1))).mean_image();
+    double e = rmse(image, soft_shadows_reference());
     ms += e * e;
   }
   return std::sqrt(ms / seeds);
@@ -77,7 +78,7 @@ TEST(SamplingConvergence, StratifiedPoissonAndSobolBeatIndependent) {
 
 TEST(SamplingConvergence, EverySamplerIsUnbiased) {
   // Image means at 64 spp agree with the reference within 4 standard errors.
-  const Image& ref = reference();
+  const Image& ref = soft_shadows_reference();
   for (SamplerType type : {SamplerType::Independent, SamplerType::Stratified, SamplerType::Poisson, SamplerType::ZSobol}) {
     double sum = 0, sum_sq = 0;
     const int seeds = 8;

@@ -24,7 +24,7 @@ namespace {
 
 using testing::look_at_camera;
 
-constexpr int kSeeds = 8;
+constexpr int kSeedsPerCase = 8;
 
 // Mean over seeds of each channel's image mean, and its standard error.
 struct ChannelMeans {
@@ -34,7 +34,7 @@ struct ChannelMeans {
 ChannelMeans render_means(const SceneDesc& desc) {
   const Scene scene(desc);
   double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
-  for (uint64_t seed = 1; seed <= kSeeds; ++seed) {
+  for (uint64_t seed = 1; seed <= kSeedsPerCase; ++seed) {
     RenderSettings settings = desc.settings;
     settings.seed = seed;
     Film film(desc.film.width, desc.film.height);
@@ -48,10 +48,10 @@ ChannelMeans render_means(const SceneDesc& desc) {
       sum2[c] += m * m;
     }
   }
-  auto mean = [&](int c) { return sum[c] / kSeeds; };
+  auto mean = [&](int c) { return sum[c] / kSeedsPerCase; };
   auto standard_error = [&](int c) {
-    double m = mean(c), v = std::max(0.0, (sum2[c] - kSeeds * m * m) / (kSeeds - 1));
-    return float(std::sqrt(v / kSeeds));
+    double m = mean(c), v = std::max(0.0, (sum2[c] - kSeedsPerCase * m * m) / (kSeedsPerCase - 1));
+    return float(std::sqrt(v / kSeedsPerCase));
   };
   return {RGB(float(mean(0)), float(mean(1)), float(mean(2))),
           RGB(standard_error(0), standard_error(1), standard_error(2))};

@@ -44,7 +44,7 @@ Json read_json(const fs::path& file) {
   return Json::parse(in);
 }
 
-SceneDesc load(const fs::path& file, std::vector<std::string>* warnings_out = nullptr) {
+SceneDesc load_gltf(const fs::path& file, std::vector<std::string>* warnings_out = nullptr) {
   std::vector<std::string> warnings;
   SceneDesc scene = read_gltf_scene(file, warnings);
   if (warnings_out) *warnings_out = warnings;
@@ -162,13 +162,13 @@ class GltfSampleModel : public ::testing::TestWithParam<std::string> {};
 TEST_P(GltfSampleModel, Loads) {
   const fs::path file = kAssets / GetParam();
   if (GetParam().find("Draco") != std::string::npos) {
-    std::string message = scene_error_of([&] { load(file); }, "a Draco-compressed file");
+    std::string message = scene_error_of([&] { load_gltf(file); }, "a Draco-compressed file");
     EXPECT_NE(message.find(file.string()), std::string::npos) << message;
     EXPECT_NE(message.find("Draco"), std::string::npos) << message;
     EXPECT_NE(message.find("mesh \""), std::string::npos) << message;
     return;
   }
-  SceneDesc scene = load(file);
+  SceneDesc scene = load_gltf(file);
   EXPECT_FALSE(scene.shapes.empty() && scene.instances.empty());
   EXPECT_FALSE(scene.lights.empty());
   EXPECT_GT(scene.film.width, 0);
@@ -201,21 +201,21 @@ TEST(GltfSampleModels, AllTwentySevenArePresent) { EXPECT_GE(sample_files().size
 // ---------------------------------------------------------------- geometry and transforms
 
 TEST(GltfGeometry, BoxInterleavedIsBox) {
-  expect_same_geometry(load(asset("Box")), load(asset("BoxInterleaved")));
+  expect_same_geometry(load_gltf(asset("Box")), load_gltf(asset("BoxInterleaved")));
 }
 
 TEST(GltfGeometry, EmbeddedAndBinaryAreTheSame) {
-  expect_same_geometry(load(asset("Box")), load(asset("Box", "glTF-Embedded")));
-  expect_same_geometry(load(asset("Box")), load(asset("Box", "glTF-Binary")));
+  expect_same_geometry(load_gltf(asset("Box")), load_gltf(asset("Box", "glTF-Embedded")));
+  expect_same_geometry(load_gltf(asset("Box")), load_gltf(asset("Box", "glTF-Binary")));
 }
 
 TEST(GltfGeometry, TriangleWithoutIndicesIsTriangle) {
-  expect_same_geometry(load(asset("Triangle")), load(asset("TriangleWithoutIndices")));
+  expect_same_geometry(load_gltf(asset("Triangle")), load_gltf(asset("TriangleWithoutIndices")));
 }
 
 TEST(GltfGeometry, StripsAndFansBecomeFrontFacingTriangles) {
   std::vector<std::string> warnings;
-  SceneDesc scene = load(asset("MeshPrimitiveModes"), &warnings);
+  SceneDesc scene = load_gltf(asset("MeshPrimitiveModes"), &warnings);
   // Points and the three kinds of lines are skipped with a warning each.
   EXPECT_EQ(std::count_if(warnings.begin(), warnings.end(),
                           [](const std::string& w) { return w.find("are not surfaces") != std::string::npos; }),
@@ -236,7 +236,7 @@ TEST(GltfGeometry, StripsAndFansBecomeFrontFacingTriangles) {
 }
 
 TEST(GltfTransforms, OrientationTestNodesAreWhereTheFileSays) {
-  SceneDesc scene = load(asset("OrientationTest"));
+  SceneDesc scene = load_gltf(asset("OrientationTest"));
   Json j = read_json(asset("OrientationTest"));
   int checked = 0;
   for (const Json& node : j["nodes"]) {
@@ -258,7 +258,7 @@ TEST(GltfTransforms, OrientationTestNodesAreWhereTheFileSays) {
 }
 
 TEST(GltfTransforms, NegativeScaleKeepsFrontFacesAndNormalsTogether) {
-  SceneDesc scene = load(asset("NegativeScaleTest"));
+  SceneDesc scene = load_gltf(asset("NegativeScaleTest"));
   int mirrored = 0;
   for (const ShapeDesc& shape : scene.shapes) {
     if (shape.to_world.swaps_handedness()) ++mirrored;
@@ -281,7 +281,7 @@ TEST(GltfTransforms, NegativeScaleKeepsFrontFacesAndNormalsTogether) {
 }
 
 TEST(GltfTransforms, SimpleInstancingMakesOneObjectAndItsInstances) {
-  SceneDesc scene = load(asset("SimpleInstancing"));
+  SceneDesc scene = load_gltf(asset("SimpleInstancing"));
   ASSERT_EQ(scene.objects.size(), 1u);
   ASSERT_EQ(scene.instances.size(), 125u);  // EXT_mesh_gpu_instancing's 125 TRS triples
   EXPECT_TRUE(scene.shapes.empty());
@@ -310,14 +310,14 @@ TEST(GltfPlaces, DescriptionsNameTheirElements) {
   ASSERT_EQ(cube.places.lights.size(), cube.lights.size());  // the sky added for a file without lights
   EXPECT_TRUE(cube.places.lights[0].file.empty());
 
-  SceneDesc instancing = load(asset("SimpleInstancing"));
+  SceneDesc instancing = load_gltf(asset("SimpleInstancing"));
   ASSERT_EQ(instancing.objects.size(), 1u);
   EXPECT_TRUE(instancing.objects[0].where.key_path.starts_with("/meshes/")) << instancing.objects[0].where.key_path;
   ASSERT_FALSE(instancing.instances.empty());
   EXPECT_TRUE(instancing.instances[0].where.key_path.ends_with("/extensions/EXT_mesh_gpu_instancing[0]"))
       << instancing.instances[0].where.key_path;
 
-  SceneDesc lamp = load(asset("LightsPunctualLamp"));
+  SceneDesc lamp = load_gltf(asset("LightsPunctualLamp"));
   ASSERT_EQ(lamp.places.lights.size(), lamp.lights.size());
   for (const SourceLocation& l : lamp.places.lights) EXPECT_TRUE(l.key_path.starts_with("/nodes/")) << l.key_path;
 }
@@ -325,7 +325,7 @@ TEST(GltfPlaces, DescriptionsNameTheirElements) {
 // ---------------------------------------------------------------- materials
 
 TEST(GltfMaterials, MetalRoughSpheresHaveTheirFactors) {
-  SceneDesc scene = load(asset("MetalRoughSpheresNoTextures"));
+  SceneDesc scene = load_gltf(asset("MetalRoughSpheresNoTextures"));
   Json j = read_json(asset("MetalRoughSpheresNoTextures"));
   size_t triangles = 0;
   for (const ShapeDesc& s : scene.shapes) triangles += mesh_of(s).triangle_count();
@@ -387,7 +387,7 @@ TEST(GltfMaterials, TexturesMapChannelsAndColourSpaces) {
 
 TEST(GltfMaterials, TextureTransformOffsetsRotatesAndScales) {
   std::vector<std::string> warnings;
-  SceneDesc scene = load(asset("TextureTransformTest"), &warnings);
+  SceneDesc scene = load_gltf(asset("TextureTransformTest"), &warnings);
   Json j = read_json(asset("TextureTransformTest"));
   // Material name -> the glTF transform (offset, rotation, scale), as the file states it.
   struct Transform {
@@ -433,7 +433,7 @@ TEST(GltfMaterials, TextureTransformOffsetsRotatesAndScales) {
 }
 
 TEST(GltfMaterials, EmissiveStrengthMultipliesTheFactor) {
-  SceneDesc scene = load(asset("EmissiveStrengthTest"));
+  SceneDesc scene = load_gltf(asset("EmissiveStrengthTest"));
   Json j = read_json(asset("EmissiveStrengthTest"));
   std::vector<float> strengths;
   for (const ShapeDesc& shape : scene.shapes) {
@@ -449,7 +449,7 @@ TEST(GltfMaterials, EmissiveStrengthMultipliesTheFactor) {
 }
 
 TEST(GltfMaterials, AlphaBlendModesBecomeMasks) {
-  SceneDesc scene = load(asset("AlphaBlendModeTest"));
+  SceneDesc scene = load_gltf(asset("AlphaBlendModeTest"));
   int masks = 0, textured = 0;
   for (const MaterialDesc& m : scene.materials)
     if (const auto* mask = std::get_if<MaskMaterial>(&m)) {
@@ -463,7 +463,7 @@ TEST(GltfMaterials, AlphaBlendModesBecomeMasks) {
 // ---------------------------------------------------------------- lights and cameras
 
 TEST(GltfLights, PunctualLampPointLights) {
-  SceneDesc scene = load(asset("LightsPunctualLamp"));
+  SceneDesc scene = load_gltf(asset("LightsPunctualLamp"));
   Json j = read_json(asset("LightsPunctualLamp"));
   const Json& lights = j["extensions"]["KHR_lights_punctual"]["lights"];
   std::vector<PointLight> points;
@@ -524,7 +524,7 @@ TEST(GltfLights, SpotAndDirectional) {
 }
 
 TEST(GltfCameras, PerspectiveCameraFromTheFirstCameraNode) {
-  SceneDesc scene = load(asset("Cameras"));
+  SceneDesc scene = load_gltf(asset("Cameras"));
   const CameraDesc& c = scene.camera;
   EXPECT_EQ(c.projection, Projection::Perspective);
   EXPECT_EQ(c.fov_axis, FovAxis::Y);
@@ -546,7 +546,7 @@ TEST(GltfCameras, OrthographicCameraScalesByMagnification) {
   j["cameras"][1]["orthographic"]["ymag"] = 1.0;
   j["scenes"][0]["nodes"] = Json::array({0, 2});  // the orthographic camera's node only
   fs::copy_file(kAssets / "Cameras/glTF/simpleSquare.bin", scratch.dir() / "simpleSquare.bin");
-  SceneDesc scene = load(scratch.write("ortho.gltf", j.dump()));
+  SceneDesc scene = load_gltf(scratch.write("ortho.gltf", j.dump()));
   const CameraDesc& c = scene.camera;
   EXPECT_EQ(c.projection, Projection::Orthographic);
   EXPECT_EQ(scene.film.width, 2 * scene.film.height);  // xmag / ymag
@@ -557,7 +557,7 @@ TEST(GltfCameras, OrthographicCameraScalesByMagnification) {
 }
 
 TEST(GltfCameras, NoCameraFramesTheModelUnderASky) {
-  SceneDesc scene = load(asset("Box"));
+  SceneDesc scene = load_gltf(asset("Box"));
   ASSERT_EQ(scene.lights.size(), 1u);
   EXPECT_TRUE(std::holds_alternative<SkyLight>(scene.lights[0]));
   const CameraDesc& c = scene.camera;
@@ -571,7 +571,7 @@ TEST(GltfCameras, NoCameraFramesTheModelUnderASky) {
 
 // A sample model rendered from its own camera on a width x height film: the mean image.
 Image render_model(const std::string& model, int width, int height, int spp, int max_depth) {
-  SceneDesc scene = load(asset(model));
+  SceneDesc scene = load_gltf(asset(model));
   scene.film = {width, height, ""};
   scene.settings.spp = spp;
   scene.settings.max_depth = max_depth;
@@ -608,7 +608,7 @@ TEST(GltfMalformed, TruncatedGlbNamesTheFile) {
   Scratch scratch;
   std::string bytes = read_bytes(asset("Box", "glTF-Binary"));
   fs::path file = scratch.write("truncated.glb", bytes.substr(0, bytes.size() / 2));
-  std::string message = scene_error_of([&] { load(file); }, "a truncated .glb");
+  std::string message = scene_error_of([&] { load_gltf(file); }, "a truncated .glb");
   EXPECT_NE(message.find(file.string()), std::string::npos) << message;
 }
 
@@ -629,7 +629,7 @@ TEST(GltfMalformed, IndexOutOfRangeNamesTheAccessor) {
   j["accessors"][0]["byteOffset"] = 12;  // from the second position on: 1.0f's bits as an index
   fs::copy_file(kAssets / "Triangle/glTF/simpleTriangle.bin", scratch.dir() / "simpleTriangle.bin");
   fs::path file = scratch.write("bad.gltf", j.dump());
-  std::string message = scene_error_of([&] { load(file); }, "out-of-range indices");
+  std::string message = scene_error_of([&] { load_gltf(file); }, "out-of-range indices");
   EXPECT_NE(message.find(file.string()), std::string::npos) << message;
   EXPECT_NE(message.find("/meshes/0/primitives/0/indices"), std::string::npos) << message;
 }
@@ -640,7 +640,7 @@ TEST(GltfMalformed, UnsupportedRequiredExtensionIsRefused) {
   j["extensionsRequired"] = Json::array({"EXT_made_up"});
   j["extensionsUsed"] = Json::array({"EXT_made_up"});
   fs::copy_file(kAssets / "Triangle/glTF/simpleTriangle.bin", scratch.dir() / "simpleTriangle.bin");
-  EXPECT_THROW(load(scratch.write("ext.gltf", j.dump())), SceneError);
+  EXPECT_THROW(load_gltf(scratch.write("ext.gltf", j.dump())), SceneError);
 }
 
 }  // namespace

@@ -23,7 +23,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kShared = fs::path(CANDELA_SHARED_DIR) / "meshes";
+const fs::path kMeshes = fs::path(CANDELA_SHARED_DIR) / "meshes";
 const fs::path kTestData = fs::path(CANDELA_SOURCE_DIR) / "tests" / "data" / "meshes";
 
 const SourceLocation kWhere{"scene.json", 0, 0, "/shapes/2/file"};
@@ -136,7 +136,7 @@ const std::string kPlyTriangleHeader =
 // ---------------------------------------------------------------- OBJ files of the shared meshes
 
 TEST_F(MeshIo, SpotObjHasAllTrianglesWithUvs) {
-  const TriangleMesh spot = load(kShared / "spot" / "spot.obj");
+  const TriangleMesh spot = load(kMeshes / "spot" / "spot.obj");
   expect_well_formed(spot);
   EXPECT_EQ(spot.triangle_count(), 5856u);
   EXPECT_EQ(spot.uvs.size(), spot.positions.size());
@@ -157,15 +157,15 @@ TEST_F(MeshIo, SpotObjHasAllTrianglesWithUvs) {
 }
 
 TEST_F(MeshIo, SpotQuadrangulatedObjGivesTheSameTriangleCount) {
-  const TriangleMesh quads = load(kShared / "spot" / "spot" / "spot_quadrangulated.obj");
-  const TriangleMesh triangles = load(kShared / "spot" / "spot" / "spot_triangulated.obj");
+  const TriangleMesh quads = load(kMeshes / "spot" / "spot" / "spot_quadrangulated.obj");
+  const TriangleMesh triangles = load(kMeshes / "spot" / "spot" / "spot_triangulated.obj");
   EXPECT_EQ(quads.triangle_count(), 5856u);
   EXPECT_EQ(triangles.triangle_count(), 5856u);
   EXPECT_NEAR(surface_area(quads), surface_area(triangles), 1e-3 * surface_area(triangles));
 }
 
 TEST_F(MeshIo, TeapotObjKeepsSharedVertices) {
-  const TriangleMesh teapot = load(kShared / "teapot" / "teapot.obj");
+  const TriangleMesh teapot = load(kMeshes / "teapot" / "teapot.obj");
   expect_well_formed(teapot);
   EXPECT_EQ(teapot.triangle_count(), 6320u);
   EXPECT_EQ(teapot.positions.size(), 3644u);  // one vertex per 'v' line: nothing duplicated
@@ -177,7 +177,7 @@ TEST_F(MeshIo, TeapotObjKeepsSharedVertices) {
 // ---------------------------------------------------------------- PLY files of the shared meshes
 
 TEST_F(MeshIo, StanfordBunnyPly) {
-  const TriangleMesh bunny = load(kShared / "bunny" / "stanford-original" / "bun_zipper.ply");
+  const TriangleMesh bunny = load(kMeshes / "bunny" / "stanford-original" / "bun_zipper.ply");
   expect_well_formed(bunny);
   EXPECT_EQ(bunny.triangle_count(), 69451u);
   EXPECT_EQ(bunny.positions.size(), 35947u);
@@ -187,7 +187,7 @@ TEST_F(MeshIo, StanfordBunnyPly) {
 }
 
 TEST_F(MeshIo, StanfordBunnyLowResolutionPly) {
-  const TriangleMesh bunny = load(kShared / "bunny" / "stanford-original" / "bun_zipper_res4.ply");
+  const TriangleMesh bunny = load(kMeshes / "bunny" / "stanford-original" / "bun_zipper_res4.ply");
   expect_well_formed(bunny);
   EXPECT_EQ(bunny.triangle_count(), 948u);
   EXPECT_EQ(bunny.positions.size(), 453u);
@@ -195,8 +195,8 @@ TEST_F(MeshIo, StanfordBunnyLowResolutionPly) {
 }
 
 TEST_F(MeshIo, BunnyObjAndPlyHoldTheSameSurface) {
-  const TriangleMesh ply = load(kShared / "bunny" / "stanford-original" / "bun_zipper.ply");
-  const TriangleMesh obj = load(kShared / "bunny" / "stanford-bunny.obj");
+  const TriangleMesh ply = load(kMeshes / "bunny" / "stanford-original" / "bun_zipper.ply");
+  const TriangleMesh obj = load(kMeshes / "bunny" / "stanford-bunny.obj");
   EXPECT_EQ(obj.triangle_count(), ply.triangle_count());
   EXPECT_NEAR(surface_area(obj), surface_area(ply), 1e-4 * surface_area(ply));
   const Bounds3 a = bounds_of(obj), b = bounds_of(ply);
@@ -204,7 +204,7 @@ TEST_F(MeshIo, BunnyObjAndPlyHoldTheSameSurface) {
 }
 
 TEST_F(MeshIo, DragonPlyHasNormals) {
-  const TriangleMesh dragon = load(kShared / "dragon" / "dragon_100k.ply");
+  const TriangleMesh dragon = load(kMeshes / "dragon" / "dragon_100k.ply");
   expect_well_formed(dragon);
   EXPECT_EQ(dragon.triangle_count(), 100000u);
   EXPECT_EQ(dragon.positions.size(), 50000u);
@@ -217,8 +217,8 @@ TEST_F(MeshIo, DragonPlyHasNormals) {
 // ---------------------------------------------------------------- Assimp's PLY test files
 
 TEST_F(MeshIo, AsciiAndBinaryPlyGiveTheSameTriangles) {
-  const TriangleMesh ascii = load(kShared / "ply-tests" / "cube.ply");  // quads
-  const TriangleMesh binary = load(kShared / "ply-tests" / "cube_binary.ply");  // triangles
+  const TriangleMesh ascii = load(kMeshes / "ply-tests" / "cube.ply");  // quads
+  const TriangleMesh binary = load(kMeshes / "ply-tests" / "cube_binary.ply");  // triangles
   expect_well_formed(ascii);
   expect_well_formed(binary);
   EXPECT_EQ(ascii.triangle_count(), 12u);
@@ -227,7 +227,7 @@ TEST_F(MeshIo, AsciiAndBinaryPlyGiveTheSameTriangles) {
 }
 
 TEST_F(MeshIo, PlyQuadsBecomeTwoTrianglesEach) {
-  const TriangleMesh cube = load(kShared / "ply-tests" / "cube.ply");
+  const TriangleMesh cube = load(kMeshes / "ply-tests" / "cube.ply");
   EXPECT_EQ(cube.triangle_count(), 2u * 6u);
   EXPECT_EQ(cube.positions.size(), 8u);
   EXPECT_NEAR(surface_area(cube), 6.0, 1e-6);
@@ -235,7 +235,7 @@ TEST_F(MeshIo, PlyQuadsBecomeTwoTrianglesEach) {
 }
 
 TEST_F(MeshIo, PlyUvsAndNormalsAreRead) {
-  const TriangleMesh cube = load(kShared / "ply-tests" / "cube_uv.ply");
+  const TriangleMesh cube = load(kMeshes / "ply-tests" / "cube_uv.ply");
   expect_well_formed(cube);
   EXPECT_EQ(cube.triangle_count(), 12u);
   ASSERT_EQ(cube.positions.size(), 24u);
@@ -250,7 +250,7 @@ TEST_F(MeshIo, PlyUvsAndNormalsAreRead) {
   EXPECT_EQ(cube.uvs[2].y, 1.0f);
   EXPECT_NEAR(surface_area(cube), 24.0, 1e-4);
 
-  const TriangleMesh wuson = load(kShared / "ply-tests" / "Wuson.ply");
+  const TriangleMesh wuson = load(kMeshes / "ply-tests" / "Wuson.ply");
   expect_well_formed(wuson);
   EXPECT_EQ(wuson.triangle_count(), 3732u);
   EXPECT_EQ(wuson.uvs.size(), wuson.positions.size());
@@ -258,7 +258,7 @@ TEST_F(MeshIo, PlyUvsAndNormalsAreRead) {
 }
 
 TEST_F(MeshIo, PlyColoursBecomeAColorAttribute) {
-  const TriangleMesh triangle = load(kShared / "ply-tests" / "float-color.ply");
+  const TriangleMesh triangle = load(kMeshes / "ply-tests" / "float-color.ply");
   ASSERT_EQ(triangle.triangle_count(), 1u);
   ASSERT_EQ(triangle.positions.size(), 3u);
   EXPECT_EQ(triangle.positions[triangle.indices[0]], Vec3(0, 0, 0));
@@ -324,17 +324,17 @@ TEST_F(MeshIo, PlyExtraPropertiesBecomeAttributesInFileOrder) {
 }
 
 TEST_F(MeshIo, PlyPointCloudHasNoTriangles) {
-  expect_error_mentions(kShared / "ply-tests" / "points.ply", {"no triangles", "4 'vertex'"});
+  expect_error_mentions(kMeshes / "ply-tests" / "points.ply", {"no triangles", "4 'vertex'"});
 }
 
 TEST_F(MeshIo, TruncatedPlyIsAnError) {
   // pond.0.ply declares 70,051 vertices of 31 bytes but holds 69 bytes less than that.
-  expect_error_mentions(kShared / "ply-tests" / "pond.0.ply", {"truncated PLY", "70048 of the 70051 'vertex'"});
+  expect_error_mentions(kMeshes / "ply-tests" / "pond.0.ply", {"truncated PLY", "70048 of the 70051 'vertex'"});
 }
 
 TEST_F(MeshIo, MalformedPlyIsAnError) {
   // issue623.ply declares a list property on its vertices that the vertex lines do not hold.
-  expect_error_mentions(kShared / "ply-tests" / "issue623.ply", {"malformed PLY", "line 13", "'vertex'"});
+  expect_error_mentions(kMeshes / "ply-tests" / "issue623.ply", {"malformed PLY", "line 13", "'vertex'"});
 }
 
 // ---------------------------------------------------------------- OBJ test data of this repository
@@ -438,7 +438,7 @@ TEST_F(MeshIo, ObjWithoutFacesIsAnError) {
 
 TEST_F(MeshIo, BigEndianPlyGivesTheSameTriangles) {
   // cube_binary.ply rewritten big-endian: 8 vertices of 3 floats, 12 faces of a uchar and 3 ints.
-  const std::string little = read(kShared / "ply-tests" / "cube_binary.ply");
+  const std::string little = read(kMeshes / "ply-tests" / "cube_binary.ply");
   const size_t data = little.find("end_header\n") + 11;
   std::string big = little.substr(0, data);
   big.replace(big.find("binary_little_endian"), 20, "binary_big_endian");
@@ -452,7 +452,8 @@ TEST_F(MeshIo, BigEndianPlyGivesTheSameTriangles) {
     for (size_t k = 0; k < 3; ++k) append_reversed(at + 1 + 4 * k, 4);
   }
   ASSERT_EQ(big.size(), little.size() - 3);  // "little" -> "big" in the format line
-  EXPECT_EQ(triangle_set(load(write("cube_be.ply", big))), triangle_set(load(kShared / "ply-tests" / "cube_binary.ply")));
+  EXPECT_EQ(triangle_set(load(write("cube_be.ply", big))),
+            triangle_set(load(kMeshes / "ply-tests" / "cube_binary.ply")));
 }
 
 TEST_F(MeshIo, PlyHeaderClaimingBillionsOfElementsFailsFast) {
@@ -532,8 +533,8 @@ TEST_F(MeshIo, PlyCutShortAnywhereIsAnErrorNotACrash) {
   // Assimp alone loops forever on a header without "end_header" and reads past the end of (or
   // asserts on) data cut short; every prefix must either load completely or fail with a SceneError.
   for (const char* name : {"cube_binary.ply", "cube_uv.ply", "cube.ply"}) {
-    const std::string whole = read(kShared / "ply-tests" / name);
-    const TriangleMesh complete = load(kShared / "ply-tests" / name);
+    const std::string whole = read(kMeshes / "ply-tests" / name);
+    const TriangleMesh complete = load(kMeshes / "ply-tests" / name);
     for (size_t cut = 0; cut < whole.size(); ++cut) {
       const fs::path file = write("cut.ply", whole.substr(0, cut));
       try {
@@ -616,7 +617,7 @@ TEST_F(MeshIo, PlyTriangleStripsBecomeConsistentlyWoundTriangles) {
 }
 
 TEST_F(MeshIo, IgeaScanReadsAllItsStripTriangles) {
-  const TriangleMesh igea = load(kShared / "igea/igea.ply");
+  const TriangleMesh igea = load(kMeshes / "igea/igea.ply");
   EXPECT_EQ(igea.triangle_count(), 268686u);  // as the shared README counts them
   EXPECT_EQ(igea.positions.size(), 134345u);
 }
@@ -629,7 +630,7 @@ TEST_F(MeshIo, PlyMalformedHeaderIsAnError) {
   expect_error_mentions(write("no_end.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"),
                         {"no 'end_header'"});
   // An empty element without properties is harmless; a non-empty one is not.
-  const std::string cube = read(kShared / "ply-tests" / "cube_binary.ply");
+  const std::string cube = read(kMeshes / "ply-tests" / "cube_binary.ply");
   const size_t first_element = cube.find("element");
   const std::string with_empty_element =
       cube.substr(0, first_element) + "element nothing 0\n" + cube.substr(first_element);
@@ -710,7 +711,7 @@ TEST_F(MeshIo, PlyUnrecognisedLineInsideAnElementIsAnError) {
   expect_error_mentions(fuzzed("oom-unrecognised-header-line.ply"),
                         {"unrecognised header line"});
   // Before the first element, a stray line (Blender 2.4's broken comment) is still skipped.
-  const fs::path wuson = kShared / "ply-tests" / "Wuson.ply";
+  const fs::path wuson = kMeshes / "ply-tests" / "Wuson.ply";
   if (fs::exists(wuson)) {
     EXPECT_GT(load(wuson).triangle_count(), 0u);
   }
@@ -757,7 +758,7 @@ TEST_F(MeshIo, DirectoryNamedLikeAMeshIsAnError) {
 
 TEST_F(MeshIo, ExtensionIsMatchedIgnoringCase) {
   EXPECT_EQ(load(write("TRIANGLE.OBJ", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")).triangle_count(), 1u);
-  EXPECT_EQ(load(write("Cube.Ply", read(kShared / "ply-tests" / "cube.ply"))).triangle_count(), 12u);
+  EXPECT_EQ(load(write("Cube.Ply", read(kMeshes / "ply-tests" / "cube.ply"))).triangle_count(), 12u);
 }
 
 // ---------------------------------------------------------------- Mitsuba .serialized
@@ -886,7 +887,7 @@ TEST_F(MeshIo, SerializedErrorsAreClear) {
   EXPECT_NE(error(write("short.serialized", serialized_file({short_raw}, 3)), 0).find("truncated .serialized"),
             std::string::npos);
   // A shape index is for .serialized files only.
-  EXPECT_NE(error(kShared / "ply-tests" / "cube.ply", 1).find("only meaningful for a .serialized file"),
+  EXPECT_NE(error(kMeshes / "ply-tests" / "cube.ply", 1).find("only meaningful for a .serialized file"),
             std::string::npos);
 }
 

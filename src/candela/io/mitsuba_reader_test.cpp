@@ -37,7 +37,7 @@ const M& inside_one_sided(const SceneDesc& s, size_t shape) {
   return std::get<M>(s.materials[std::get<OneSidedMaterial>(s.materials[s.shapes[shape].material]).material]);
 }
 
-std::string error_of(const std::string& body) {
+std::string mitsuba_error_of(const std::string& body) {
   try {
     read_text(body);
   } catch (const SceneError& e) {
@@ -85,7 +85,7 @@ TEST(MitsubaReader, DefaultsParametersAndOverrides) {
   MitsubaReadOptions o;
   o.parameters["spp"] = "64";
   EXPECT_EQ(read_text(body, o).settings.spp, 64);
-  EXPECT_NE(error_of("<integer name=\"x\" value=\"$nope\"/>").find("undefined parameter"), std::string::npos);
+  EXPECT_NE(mitsuba_error_of("<integer name=\"x\" value=\"$nope\"/>").find("undefined parameter"), std::string::npos);
 }
 
 TEST(MitsubaReader, MaxDepthMapping) {
@@ -103,7 +103,7 @@ TEST(MitsubaReader, MaxDepthMapping) {
 // Found by fuzz/mitsuba_reader_fuzz.cpp (fuzz/regressions/mitsuba_reader/ub-integer-beyond-int.xml): the
 // value was cast to int, undefined behaviour that UBSan reported.
 TEST(MitsubaReader, IntegerBeyondIntIsAnError) {
-  EXPECT_EQ(error_of(R"(<sensor type="perspective"><sampler type="independent">
+  EXPECT_EQ(mitsuba_error_of(R"(<sensor type="perspective"><sampler type="independent">
                         <integer name="sample_count" value="5e123"/></sampler></sensor>)"),
             "test.xml:3: sampler \"independent\": \"sample_count\" is 5e+123, beyond the integers candela takes "
             "(-2147483648 to 2147483647)");
@@ -143,12 +143,12 @@ TEST(MitsubaReader, DeepNestingAndIncludesAreRefusedAtTheirLimits) {
   for (int k = 0; k < 100000; ++k) deep += "<bsdf type=\"twosided\">";
   deep += "<bsdf type=\"diffuse\"/>";
   for (int k = 0; k < 100000; ++k) deep += "</bsdf>";
-  EXPECT_EQ(error_of(deep), "test.xml:2: <bsdf> is nested more than 100 objects deep");
+  EXPECT_EQ(mitsuba_error_of(deep), "test.xml:2: <bsdf> is nested more than 100 objects deep");
 
   std::ofstream(temp_dir() / "self.xml") << R"(<scene version="3.0.0"><include filename="self.xml"/></scene>)";
-  EXPECT_NE(error_of(R"(<include filename="self.xml"/>)").find("self.xml:1: more than 15 nested <include>s"),
+  EXPECT_NE(mitsuba_error_of(R"(<include filename="self.xml"/>)").find("self.xml:1: more than 15 nested <include>s"),
             std::string::npos)
-      << error_of(R"(<include filename="self.xml"/>)");
+      << mitsuba_error_of(R"(<include filename="self.xml"/>)");
   // Files that each include the next ten times, 15 levels: 10^15 includes.
   for (int k = 1; k <= 15; ++k) {
     std::ofstream file(temp_dir() / ("tenfold" + std::to_string(k) + ".xml"));
@@ -156,15 +156,15 @@ TEST(MitsubaReader, DeepNestingAndIncludesAreRefusedAtTheirLimits) {
     for (int copy = 0; copy < 10 && k < 15; ++copy) file << "<include filename=\"tenfold" << k + 1 << ".xml\"/>";
     file << "</scene>";
   }
-  EXPECT_NE(error_of(R"(<include filename="tenfold1.xml"/>)").find("more than 100000 <include>s in all"),
+  EXPECT_NE(mitsuba_error_of(R"(<include filename="tenfold1.xml"/>)").find("more than 100000 <include>s in all"),
             std::string::npos);
 
   // Instancing cannot recurse: a shapegroup holds neither shapegroups nor instances.
-  EXPECT_NE(error_of(R"(<shape type="shapegroup" id="a"><shape type="shapegroup" id="b"><shape type="sphere"/></shape>
+  EXPECT_NE(mitsuba_error_of(R"(<shape type="shapegroup" id="a"><shape type="shapegroup" id="b"><shape type="sphere"/></shape>
       </shape><shape type="instance"><ref id="a"/></shape>)")
                 .find("a shapegroup cannot hold another shapegroup (instancing does not nest)"),
             std::string::npos);
-  EXPECT_NE(error_of(R"(<shape type="shapegroup" id="a"><shape type="sphere"/></shape>
+  EXPECT_NE(mitsuba_error_of(R"(<shape type="shapegroup" id="a"><shape type="sphere"/></shape>
       <shape type="shapegroup" id="b"><shape type="instance"><ref id="a"/></shape></shape>
       <shape type="instance"><ref id="b"/></shape>)")
                 .find("a shapegroup cannot hold an instance (instancing does not nest)"),
@@ -315,14 +315,14 @@ TEST(MitsubaReader, SpectrumFilesReadAsInlinePairs) {
   EXPECT_NEAR(r.r, 0.935761f, 1e-4);  // the inline pairs' value (SpectraAsMitsubasRgbVariant)
   EXPECT_NEAR(r.b, 0.704686f, 1e-4);
   std::ofstream(file) << "400 0.5\n380 0.5\n";
-  std::string message = error_of(R"(<shape type="rectangle"><bsdf type="diffuse">
+  std::string message = mitsuba_error_of(R"(<shape type="rectangle"><bsdf type="diffuse">
       <spectrum name="reflectance" filename=")" + file.string() + R"("/></bsdf></shape>)");
   EXPECT_NE(message.find(file.string() + ":2:1: wavelengths must increase"), std::string::npos) << message;
   std::ofstream(file) << "400 0.5\n500 x\n";
-  message = error_of(R"(<shape type="rectangle"><bsdf type="diffuse">
+  message = mitsuba_error_of(R"(<shape type="rectangle"><bsdf type="diffuse">
       <spectrum name="reflectance" filename=")" + file.string() + R"("/></bsdf></shape>)");
   EXPECT_NE(message.find(":2:1: expected \"wavelength value\""), std::string::npos) << message;
-  EXPECT_NE(error_of(R"(<shape type="rectangle"><bsdf type="diffuse">
+  EXPECT_NE(mitsuba_error_of(R"(<shape type="rectangle"><bsdf type="diffuse">
       <spectrum name="reflectance" filename="no-such.spd"/></bsdf></shape>)")
                 .find("\"no-such.spd\" not found"),
             std::string::npos);
@@ -367,7 +367,7 @@ TEST(MitsubaReader, BlackbodyAsASpectralVariantRecordsIt) {
   }
   EXPECT_GT(radiance(2000).r, radiance(2000).b);    // red hot
   EXPECT_LT(radiance(10000).r, radiance(10000).b);  // blue white
-  EXPECT_NE(error_of(R"(<shape type="rectangle"><emitter type="area"><spectrum type="blackbody" name="radiance">
+  EXPECT_NE(mitsuba_error_of(R"(<shape type="rectangle"><emitter type="area"><spectrum type="blackbody" name="radiance">
       <float name="temperature" value="-5"/></spectrum></emitter></shape>)")
                 .find("the temperature must be positive"),
             std::string::npos);
@@ -436,24 +436,24 @@ TEST(MitsubaReader, SerializedShapesPickTheirMeshByIndex) {
   const TriangleMesh& first = std::get<MeshShape>(s.shapes[1].geometry).mesh;
   EXPECT_EQ(first.triangle_count(), 512u);
   EXPECT_TRUE(first.normals.empty());
-  EXPECT_NE(error_of(R"(<shape type="serialized"><string name="filename" value=")" + file +
+  EXPECT_NE(mitsuba_error_of(R"(<shape type="serialized"><string name="filename" value=")" + file +
                      R"("/><integer name="shape_index" value="7"/></shape>)")
                 .find("shape_index 7 is out of range"),
             std::string::npos);
 }
 
 TEST(MitsubaReader, ErrorsNameFileAndLine) {
-  EXPECT_NE(error_of("<shape type=\"sphere\">\n<float name=\"radiuss\" value=\"1\"/></shape>").find("test.xml:3"),
+  EXPECT_NE(mitsuba_error_of("<shape type=\"sphere\">\n<float name=\"radiuss\" value=\"1\"/></shape>").find("test.xml:3"),
             std::string::npos);
-  EXPECT_NE(error_of("<shape type=\"sphere\"><float name=\"radiuss\" value=\"1\"/></shape>").find("unknown parameter"),
+  EXPECT_NE(mitsuba_error_of("<shape type=\"sphere\"><float name=\"radiuss\" value=\"1\"/></shape>").find("unknown parameter"),
             std::string::npos);
-  EXPECT_NE(error_of("<shape type=\"teapot\"/>").find("unknown shape type"), std::string::npos);
-  EXPECT_NE(error_of("<shape type=\"sphere\"><ref id=\"nothing\"/></shape>").find("undefined id \"nothing\""),
+  EXPECT_NE(mitsuba_error_of("<shape type=\"teapot\"/>").find("unknown shape type"), std::string::npos);
+  EXPECT_NE(mitsuba_error_of("<shape type=\"sphere\"><ref id=\"nothing\"/></shape>").find("undefined id \"nothing\""),
             std::string::npos);
-  EXPECT_NE(error_of("<shape type=\"obj\"><string name=\"filename\" value=\"missing.obj\"/></shape>")
+  EXPECT_NE(mitsuba_error_of("<shape type=\"obj\"><string name=\"filename\" value=\"missing.obj\"/></shape>")
                 .find("\"missing.obj\" not found"),
             std::string::npos);
-  EXPECT_NE(error_of("<shape type=\"sphere\">").find("malformed XML"), std::string::npos);
+  EXPECT_NE(mitsuba_error_of("<shape type=\"sphere\">").find("malformed XML"), std::string::npos);
 }
 
 // The text entry point: the name given is the file in messages, and relative paths resolve

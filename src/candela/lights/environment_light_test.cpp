@@ -22,7 +22,7 @@
 namespace candela {
 namespace {
 
-constexpr int kSamples = testing::kChiSquareSamples;
+using testing::kChiSquareSamples;
 
 // ---------------------------------------------------------------- the equal-area square
 
@@ -66,7 +66,7 @@ TEST(EqualAreaMapping, IsAreaPreserving) {
   // Uniform points of the square become uniform directions.
   auto sample = [](Vec2 u) { return equal_area_square_to_sphere(u); };
   auto pdf = [](const Vec3&) { return uniform_sphere_pdf(); };
-  EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 31), testing::kChiSquareAlpha);
+  EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kChiSquareSamples, 31), testing::kChiSquareAlpha);
 }
 
 // ---------------------------------------------------------------- environment lights
@@ -80,9 +80,9 @@ EnvironmentLight test_light(EnvironmentMapping mapping) {
   return EnvironmentLight(testing::environment_test_map(mapping), mapping, RGB(1.5f, 1.0f, 0.5f), test_rotation(), 3.0f);
 }
 
-constexpr EnvironmentMapping kMappings[] = {EnvironmentMapping::Equirectangular,
-                                            EnvironmentMapping::EquirectangularPoleRows,
-                                            EnvironmentMapping::EqualAreaOctahedral};
+constexpr EnvironmentMapping kAllMappings[] = {EnvironmentMapping::Equirectangular,
+                                               EnvironmentMapping::EquirectangularPoleRows,
+                                               EnvironmentMapping::EqualAreaOctahedral};
 const char* name(EnvironmentMapping m) {
   switch (m) {
     case EnvironmentMapping::Equirectangular: return "equirectangular";
@@ -117,7 +117,7 @@ TEST(EnvironmentLight, EquirectangularFollowsMitsubasConvention) {
 }
 
 TEST(EnvironmentLight, RadianceIsTheScaledImageAtPixelCentresUnderTheRotation) {
-  for (EnvironmentMapping m : kMappings) {
+  for (EnvironmentMapping m : kAllMappings) {
     Image img = testing::environment_test_map(m);
     EnvironmentLight light = test_light(m);
     for (auto [x, y] : {std::pair{3, 2}, std::pair{img.width / 2 + 3, img.height / 4}, std::pair{10, 7}}) {
@@ -219,7 +219,7 @@ TEST(EnvironmentLight, RadianceIsContinuousAcrossTheImageEdges) {
 }
 
 TEST(EnvironmentLight, SampledDirectionsFollowPdfLi) {
-  for (EnvironmentMapping m : kMappings) {
+  for (EnvironmentMapping m : kAllMappings) {
     EnvironmentLight light = test_light(m);
     LightSampleContext ctx{{0.3f, -1, 2}, Normal3(0.0f)};
     auto sample = [&](Vec2 u) {
@@ -228,14 +228,14 @@ TEST(EnvironmentLight, SampledDirectionsFollowPdfLi) {
     };
     auto pdf = [&](const Vec3& w) { return light.pdf_li(ctx, w, {}, {}); };
     // The pdf is piecewise constant over the pixels: integrate it finely per bin.
-    EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 41, -1, 20, 40, 64),
+    EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kChiSquareSamples, 41, -1, 20, 40, 64),
               testing::kChiSquareAlpha)
         << name(m);
   }
 }
 
 TEST(EnvironmentLight, SamplesAreConsistentWithRadianceAndPdf) {
-  for (EnvironmentMapping m : kMappings) {
+  for (EnvironmentMapping m : kAllMappings) {
     EnvironmentLight light = test_light(m);
     LightSampleContext ctx{{0, 0, 0}, Normal3(0, 1, 0)};
     Rng rng(2, 3);
@@ -272,13 +272,13 @@ RGB sphere_integral(const std::function<RGB(const Vec3&)>& radiance, int nz = 12
 }
 
 TEST(EnvironmentLight, RadianceOverPdfEstimatesTheIntegralOfTheMap) {
-  for (EnvironmentMapping m : kMappings) {
+  for (EnvironmentMapping m : kAllMappings) {
     EnvironmentLight light = test_light(m);
     RGB reference = sphere_integral([&](const Vec3& w) { return light.radiance(w); });
     LightSampleContext ctx{{1, 2, 3}, Normal3(0.0f)};
     Rng rng(12, 34);
     double sum[3] = {0, 0, 0}, sum_sq[3] = {0, 0, 0};
-    const int n = kSamples;
+    const int n = kChiSquareSamples;
     for (int i = 0; i < n; ++i) {
       LightSample s = light.sample_li(ctx, {rng.next_float(), rng.next_float()});
       if (s.pdf == 0) continue;
@@ -313,7 +313,7 @@ TEST(EnvironmentLight, MisCompensationSamplesLuminanceAboveTheMeanAndStaysUnbias
   RGB reference = sphere_integral([&](const Vec3& w) { return plain.radiance(w); }, 600, 1200);
   Rng rng(5, 6);
   double sum = 0, sum_sq = 0;
-  const int n = kSamples;
+  const int n = kChiSquareSamples;
   for (int i = 0; i < n; ++i) {
     LightSample s = compensated.sample_li({}, {rng.next_float(), rng.next_float()});
     if (s.pdf == 0) continue;

@@ -18,7 +18,7 @@
 namespace candela {
 namespace {
 
-constexpr int kSamples = testing::kChiSquareSamples;
+using testing::kChiSquareSamples;
 
 // Chi-square of the directions sample_le(u_pos, u) produces (u_pos fixed, so the point is fixed for
 // area lights) against pdf_le(p, n, w).dir at the point it returns, binned in a frame whose +z is
@@ -38,7 +38,7 @@ double emission_chi_square(const Light& light, Vec2 u_pos, const SceneSphere& sc
     return frame.to_local(e.w);
   };
   auto pdf = [&](const Vec3& local) { return light_pdf_le(light, p, n, frame.to_world(local), scene).dir; };
-  double pv = testing::spherical_chi_square_p_value(sample, pdf, kSamples, seed, z_min, 20, 40, resolution);
+  double pv = testing::spherical_chi_square_p_value(sample, pdf, kChiSquareSamples, seed, z_min, 20, 40, resolution);
   EXPECT_FALSE(moved) << "sample_le's point changed with u_dir";
   return pv;
 }

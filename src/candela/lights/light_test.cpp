@@ -12,7 +12,7 @@
 namespace candela {
 namespace {
 
-constexpr int kSamples = testing::kChiSquareSamples;
+using testing::kChiSquareSamples;
 
 // Directions from `ctx` as seen in a frame whose +z points along `axis`, so narrow cones are binned finely.
 template <typename SampleFn, typename PdfFn>
@@ -23,7 +23,7 @@ double light_chi_square(SampleFn sample_world, PdfFn pdf_world, const Vec3& axis
     return length_squared(w) > 0 ? frame.to_local(w) : w;
   };
   auto pdf = [&](const Vec3& local) { return pdf_world(frame.to_world(local)); };
-  return testing::spherical_chi_square_p_value(sample, pdf, kSamples, 23, z_min, 20, 40, resolution);
+  return testing::spherical_chi_square_p_value(sample, pdf, kChiSquareSamples, 23, z_min, 20, 40, resolution);
 }
 
 // The directions a light's sample_li produces from ctx (zero when it returns no sample).

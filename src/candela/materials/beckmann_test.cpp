@@ -20,8 +20,7 @@ namespace {
 
 using namespace testing;  // the shared BSDF test helpers: directions, albedo, chi-square
 
-constexpr int kSamples = testing::kChiSquareSamples;
-constexpr double kAlpha = testing::kChiSquareAlpha;
+using testing::kChiSquareAlpha;
 
 ConductorBsdf beckmann_conductor(float ax, float ay) {
   return {RGB(0.2f, 0.9f, 1.1f), RGB(3.9f, 2.4f, 2.1f), RGB(1.0f), Beckmann(ax, ay)};
@@ -96,7 +95,7 @@ TEST(Beckmann, VisibleNormalSamplingMatchesPdf) {
     Vec3 w = direction(theta);
     auto sample = [&](Vec2 u) { return d.sample_visible_normal(w, u); };
     auto pdf = [&](const Vec3& wm) { return wm.z > 0 && dot(w, wm) > 0 ? d.pdf(w, wm) : 0.0f; };
-    EXPECT_GT(zoomed_chi_square(sample, pdf, {Vec3(0, 0, 1), zoom, 0, resolution}), kAlpha)
+    EXPECT_GT(zoomed_chi_square(sample, pdf, {Vec3(0, 0, 1), zoom, 0, resolution}), kChiSquareAlpha)
         << ax << " x " << ay << " theta " << theta;
   }
   // Sampled normals are unit, in the upper hemisphere and visible, also for directions below the surface.
@@ -126,32 +125,33 @@ TEST(Beckmann, MicrofacetChoosesTheDistribution) {
 
 TEST(Beckmann, ConductorSamplingMatchesPdf) {
   const Vec3 up(0, 0, 1);
-  EXPECT_GT(bsdf_chi_square(beckmann_conductor(0.05f, 0.05f), direction(0), {up, 6, 0, 12}), kAlpha);
-  EXPECT_GT(bsdf_chi_square(beckmann_conductor(0.05f, 0.05f), direction(80), {up, 1, 0, 24}), kAlpha);
+  EXPECT_GT(bsdf_chi_square(beckmann_conductor(0.05f, 0.05f), direction(0), {up, 6, 0, 12}), kChiSquareAlpha);
+  EXPECT_GT(bsdf_chi_square(beckmann_conductor(0.05f, 0.05f), direction(80), {up, 1, 0, 24}), kChiSquareAlpha);
   for (float theta : {0.0f, 45.0f, 88.0f})
     EXPECT_GT(bsdf_chi_square(beckmann_conductor(0.3f, 0.3f), direction(theta), {up, theta == 0 ? 2.0f : 1.0f, 0, 16}),
-              kAlpha)
+              kChiSquareAlpha)
         << theta;
   for (float theta : {45.0f, 88.0f})
-    EXPECT_GT(bsdf_chi_square(beckmann_conductor(0.7f, 0.7f), direction(theta), {up, 1, 0, 12}), kAlpha) << theta;
-  EXPECT_GT(bsdf_chi_square(beckmann_conductor(0.1f, 0.4f), direction(60), {up, 1, 0, 24}), kAlpha);
-  EXPECT_GT(bsdf_chi_square(beckmann_conductor(0.3f, 0.3f), below(direction(45)), {-up, 1, 0, 16}), kAlpha);
+    EXPECT_GT(bsdf_chi_square(beckmann_conductor(0.7f, 0.7f), direction(theta), {up, 1, 0, 12}), kChiSquareAlpha)
+        << theta;
+  EXPECT_GT(bsdf_chi_square(beckmann_conductor(0.1f, 0.4f), direction(60), {up, 1, 0, 24}), kChiSquareAlpha);
+  EXPECT_GT(bsdf_chi_square(beckmann_conductor(0.3f, 0.3f), below(direction(45)), {-up, 1, 0, 16}), kChiSquareAlpha);
 }
 
 TEST(Beckmann, DielectricSamplingMatchesPdf) {
   for (const RoughGlassCase& c : rough_glass_from_outside())
-    EXPECT_GT(bsdf_chi_square(beckmann_glass(c.alpha_x, c.alpha_y), direction(c.theta), c.binning), kAlpha)
+    EXPECT_GT(bsdf_chi_square(beckmann_glass(c.alpha_x, c.alpha_y), direction(c.theta), c.binning), kChiSquareAlpha)
         << c.alpha_x << " x " << c.alpha_y << " theta " << c.theta;
   const Vec3 up(0, 0, 1);
-  EXPECT_GT(bsdf_chi_square(beckmann_glass(0.2f, 0.2f), below(direction(30)), {up, 1, -1, 16}), kAlpha);
-  EXPECT_GT(bsdf_chi_square(beckmann_glass(0.2f, 0.2f), below(direction(60)), {up, 1, -1, 16}), kAlpha);
+  EXPECT_GT(bsdf_chi_square(beckmann_glass(0.2f, 0.2f), below(direction(30)), {up, 1, -1, 16}), kChiSquareAlpha);
+  EXPECT_GT(bsdf_chi_square(beckmann_glass(0.2f, 0.2f), below(direction(60)), {up, 1, -1, 16}), kChiSquareAlpha);
 }
 
 TEST(Beckmann, CoatedDiffuseSamplingMatchesPdf) {
   const Vec3 up(0, 0, 1);
   for (float alpha : {0.05f, 0.3f})
     for (float theta : {0.0f, 45.0f, 85.0f})
-      EXPECT_GT(bsdf_chi_square(beckmann_plastic(alpha), direction(theta), {up, 1, 0, 16}), kAlpha)
+      EXPECT_GT(bsdf_chi_square(beckmann_plastic(alpha), direction(theta), {up, 1, 0, 16}), kChiSquareAlpha)
           << alpha << " " << theta;
 }
 

@@ -14,23 +14,23 @@ namespace {
 using testing::albedo;
 using testing::direction;
 
-constexpr int kSamples = testing::kChiSquareSamples;
+using testing::kChiSquareSamples;
 
 // Chi-square of the directions sample() returns against pdf(); non-delta samples only.
-double bsdf_chi_square(const Bsdf& bsdf, const Vec3& wo, float z_min = -1) {
+double bsdf_sampling_p_value(const Bsdf& bsdf, const Vec3& wo, float z_min = -1) {
   Rng lobe_rng(42, 43);
   auto sample = [&](Vec2 u) {
     auto s = bsdf_sample(bsdf, wo, lobe_rng.next_float(), u);
     return s && !s->is_delta ? s->wi : Vec3(0.0f);
   };
   auto pdf = [&](const Vec3& wi) { return bsdf_pdf(bsdf, wo, wi); };
-  return testing::spherical_chi_square_p_value(sample, pdf, kSamples, 17, z_min);
+  return testing::spherical_chi_square_p_value(sample, pdf, kChiSquareSamples, 17, z_min);
 }
 
 TEST(Bsdf, DiffuseSamplingMatchesPdf) {
   Bsdf b = DiffuseBsdf{RGB(0.5f)};
-  EXPECT_GT(bsdf_chi_square(b, direction(30)), testing::kChiSquareAlpha);
-  EXPECT_GT(bsdf_chi_square(b, -direction(40)), testing::kChiSquareAlpha);  // two-sided: from below
+  EXPECT_GT(bsdf_sampling_p_value(b, direction(30)), testing::kChiSquareAlpha);
+  EXPECT_GT(bsdf_sampling_p_value(b, -direction(40)), testing::kChiSquareAlpha);  // two-sided: from below
 }
 
 TEST(Bsdf, PhongMixtureSamplingMatchesPdf) {
@@ -43,7 +43,8 @@ TEST(Bsdf, PhongMixtureSamplingMatchesPdf) {
       p.d = 0.4f;
       p.s = 0.5f;
       p.t = 0.0f;
-      EXPECT_GT(bsdf_chi_square(p, direction(theta)), testing::kChiSquareAlpha) << "n " << exponent << " theta " << theta;
+      EXPECT_GT(bsdf_sampling_p_value(p, direction(theta)), testing::kChiSquareAlpha)
+          << "n " << exponent << " theta " << theta;
     }
   }
 }
@@ -54,7 +55,7 @@ TEST(Bsdf, NarrowPhongLobeSamplingMatchesPdf) {
   p.d = 0;
   p.s = 1;
   // The lobe around the mirror direction of normal incidence is narrow: bin finely near the pole.
-  EXPECT_GT(bsdf_chi_square(p, direction(0), 0.9f), testing::kChiSquareAlpha);
+  EXPECT_GT(bsdf_sampling_p_value(p, direction(0), 0.9f), testing::kChiSquareAlpha);
 }
 
 TEST(Bsdf, PhongModeProbabilitiesFollowDST) {

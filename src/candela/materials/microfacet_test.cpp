@@ -20,8 +20,7 @@ namespace {
 
 using namespace testing;  // the shared BSDF test helpers: directions, albedo, chi-square
 
-constexpr int kSamples = testing::kChiSquareSamples;
-constexpr double kAlpha = testing::kChiSquareAlpha;
+using testing::kChiSquareAlpha;
 
 // The former GlassBsdf, verbatim: the reference for the smooth DielectricBsdf.
 struct LegacyGlass {
@@ -57,7 +56,8 @@ TEST(Microfacet, VisibleNormalSamplingMatchesPdf) {
     Vec3 w = direction(theta);
     auto sample = [&](Vec2 u) { return d.sample_visible_normal(w, u); };
     auto pdf = [&](const Vec3& wm) { return wm.z > 0 && dot(w, wm) > 0 ? d.pdf(w, wm) : 0.0f; };
-    EXPECT_GT(zoomed_chi_square(sample, pdf, {Vec3(0, 0, 1), zoom, 0, 32}), kAlpha) << ax << " x " << ay << " theta " << theta;
+    EXPECT_GT(zoomed_chi_square(sample, pdf, {Vec3(0, 0, 1), zoom, 0, 32}), kChiSquareAlpha)
+        << ax << " x " << ay << " theta " << theta;
   }
   // A direction below the surface samples the normals visible from -w, in the upper hemisphere.
   TrowbridgeReitz d(0.3f, 0.3f);
@@ -142,17 +142,17 @@ TEST(Conductor, SamplingMatchesPdf) {
   // Everything is binned over the upper hemisphere (z_min = 0); narrow lobes at normal incidence
   // magnified, those near the horizon integrated more finely.
   const Vec3 up(0, 0, 1);
-  EXPECT_GT(bsdf_chi_square(copper(0.05f, 0.05f), direction(0), {up, 6, 0, 12}), kAlpha);
-  EXPECT_GT(bsdf_chi_square(copper(0.05f, 0.05f), direction(80), {up, 1, 0, 24}), kAlpha);
-  EXPECT_GT(bsdf_chi_square(copper(0.2f, 0.2f), direction(0), {up, 2, 0, 12}), kAlpha);
+  EXPECT_GT(bsdf_chi_square(copper(0.05f, 0.05f), direction(0), {up, 6, 0, 12}), kChiSquareAlpha);
+  EXPECT_GT(bsdf_chi_square(copper(0.05f, 0.05f), direction(80), {up, 1, 0, 24}), kChiSquareAlpha);
+  EXPECT_GT(bsdf_chi_square(copper(0.2f, 0.2f), direction(0), {up, 2, 0, 12}), kChiSquareAlpha);
   for (float theta : {45.0f, 88.0f})
-    EXPECT_GT(bsdf_chi_square(copper(0.2f, 0.2f), direction(theta), {up, 1, 0, 16}), kAlpha) << theta;
+    EXPECT_GT(bsdf_chi_square(copper(0.2f, 0.2f), direction(theta), {up, 1, 0, 16}), kChiSquareAlpha) << theta;
   for (float theta : {45.0f, 88.0f})
-    EXPECT_GT(bsdf_chi_square(copper(0.6f, 0.6f), direction(theta), {up, 1, 0, 12}), kAlpha) << theta;
+    EXPECT_GT(bsdf_chi_square(copper(0.6f, 0.6f), direction(theta), {up, 1, 0, 12}), kChiSquareAlpha) << theta;
   for (float theta : {45.0f, 80.0f})
-    EXPECT_GT(bsdf_chi_square(copper(0.1f, 0.4f), direction(theta), {up, 1, 0, 24}), kAlpha) << theta;
+    EXPECT_GT(bsdf_chi_square(copper(0.1f, 0.4f), direction(theta), {up, 1, 0, 24}), kChiSquareAlpha) << theta;
   // From below (two-sided): binned over the lower hemisphere.
-  EXPECT_GT(bsdf_chi_square(copper(0.2f, 0.2f), below(direction(45)), {-up, 1, 0, 16}), kAlpha);
+  EXPECT_GT(bsdf_chi_square(copper(0.2f, 0.2f), below(direction(45)), {-up, 1, 0, 16}), kChiSquareAlpha);
 }
 
 TEST(Conductor, Reciprocity) {
@@ -233,9 +233,9 @@ TEST(Dielectric, RoughSamplingMatchesPdfFromOutside) {
   // At normal incidence both lobes (reflection around +z, refraction around -z) sit at the poles
   // that the zoom magnifies: a very narrow pair needs a strong zoom.
   const Vec3 up(0, 0, 1);
-  EXPECT_GT(bsdf_chi_square(glass(0.05f, 0.05f), direction(0), {up, 30, -1, 16}), kAlpha);
+  EXPECT_GT(bsdf_chi_square(glass(0.05f, 0.05f), direction(0), {up, 30, -1, 16}), kChiSquareAlpha);
   for (const RoughGlassCase& c : rough_glass_from_outside())
-    EXPECT_GT(bsdf_chi_square(glass(c.alpha_x, c.alpha_y), direction(c.theta), c.binning), kAlpha)
+    EXPECT_GT(bsdf_chi_square(glass(c.alpha_x, c.alpha_y), direction(c.theta), c.binning), kChiSquareAlpha)
         << c.alpha_x << " x " << c.alpha_y << " theta " << c.theta;
 }
 
@@ -243,12 +243,12 @@ TEST(Dielectric, RoughSamplingMatchesPdfFromInside) {
   // wo inside the glass (z < 0): refraction out below the critical angle (41.8 degrees), mostly
   // total internal reflection beyond it.
   const Vec3 up(0, 0, 1);
-  EXPECT_GT(bsdf_chi_square(glass(0.2f, 0.2f), below(direction(30)), {up, 1, -1, 16}), kAlpha);
-  EXPECT_GT(bsdf_chi_square(glass(0.2f, 0.2f), below(direction(60)), {up, 1, -1, 16}), kAlpha);
-  EXPECT_GT(bsdf_chi_square(glass(0.6f, 0.6f), below(direction(0)), {up, 2, -1, 16}), kAlpha);
-  EXPECT_GT(bsdf_chi_square(glass(0.05f, 0.05f), below(direction(60)), {up, 1, -1, 32}), kAlpha);
+  EXPECT_GT(bsdf_chi_square(glass(0.2f, 0.2f), below(direction(30)), {up, 1, -1, 16}), kChiSquareAlpha);
+  EXPECT_GT(bsdf_chi_square(glass(0.2f, 0.2f), below(direction(60)), {up, 1, -1, 16}), kChiSquareAlpha);
+  EXPECT_GT(bsdf_chi_square(glass(0.6f, 0.6f), below(direction(0)), {up, 2, -1, 16}), kChiSquareAlpha);
+  EXPECT_GT(bsdf_chi_square(glass(0.05f, 0.05f), below(direction(60)), {up, 1, -1, 32}), kChiSquareAlpha);
   // eta < 1 from outside is the same interface seen from the other medium.
-  EXPECT_GT(bsdf_chi_square(glass(0.3f, 0.3f, 1 / 1.5f), direction(20)), kAlpha);
+  EXPECT_GT(bsdf_chi_square(glass(0.3f, 0.3f, 1 / 1.5f), direction(20)), kChiSquareAlpha);
 }
 
 TEST(Dielectric, SamplesReportTheRelativeIor) {
@@ -332,13 +332,13 @@ CoatedDiffuseBsdf plastic(float alpha, RGB base = RGB(0.6f, 0.4f, 0.2f), bool no
 TEST(CoatedDiffuse, SamplingMatchesPdf) {
   // Rough coat: glossy and diffuse lobes mixed, binned over the upper hemisphere.
   const Vec3 up(0, 0, 1);
-  EXPECT_GT(bsdf_chi_square(plastic(0.05f), direction(45), {up, 1, 0, 32}), kAlpha);
-  EXPECT_GT(bsdf_chi_square(plastic(0.2f), direction(0), {up, 2, 0, 12}), kAlpha);
-  EXPECT_GT(bsdf_chi_square(plastic(0.2f), direction(80), {up, 1, 0, 16}), kAlpha);
-  EXPECT_GT(bsdf_chi_square(plastic(0.6f, RGB(0.9f), true), direction(88), {up, 1, 0, 12}), kAlpha);
+  EXPECT_GT(bsdf_chi_square(plastic(0.05f), direction(45), {up, 1, 0, 32}), kChiSquareAlpha);
+  EXPECT_GT(bsdf_chi_square(plastic(0.2f), direction(0), {up, 2, 0, 12}), kChiSquareAlpha);
+  EXPECT_GT(bsdf_chi_square(plastic(0.2f), direction(80), {up, 1, 0, 16}), kChiSquareAlpha);
+  EXPECT_GT(bsdf_chi_square(plastic(0.6f, RGB(0.9f), true), direction(88), {up, 1, 0, 12}), kChiSquareAlpha);
   // Smooth coat: the non-delta (diffuse) part only.
-  EXPECT_GT(bsdf_chi_square(plastic(0), direction(0), {up, 1, 0, 12}), kAlpha);
-  EXPECT_GT(bsdf_chi_square(plastic(0), below(direction(60))), kAlpha);
+  EXPECT_GT(bsdf_chi_square(plastic(0), direction(0), {up, 1, 0, 12}), kChiSquareAlpha);
+  EXPECT_GT(bsdf_chi_square(plastic(0), below(direction(60))), kChiSquareAlpha);
 }
 
 TEST(CoatedDiffuse, Reciprocity) {
@@ -406,9 +406,9 @@ TEST(CoatedDiffuse, TabulatedCoatSamplesItsPdfAndWeights) {
   rough.coat_table = &ggx_table;
   CoatedDiffuseBsdf shiny{RGB(0.5f), RGB(1.0f), 1.49f, Beckmann(0.05f, 0.05f), false, &beckmann_table};
   const Vec3 up(0, 0, 1);
-  EXPECT_GT(bsdf_chi_square(rough, direction(0), {up, 2, 0, 12}), kAlpha);
-  EXPECT_GT(bsdf_chi_square(rough, direction(80), {up, 1, 0, 16}), kAlpha);
-  EXPECT_GT(bsdf_chi_square(shiny, direction(45), {up, 1, 0, 32}), kAlpha);
+  EXPECT_GT(bsdf_chi_square(rough, direction(0), {up, 2, 0, 12}), kChiSquareAlpha);
+  EXPECT_GT(bsdf_chi_square(rough, direction(80), {up, 1, 0, 16}), kChiSquareAlpha);
+  EXPECT_GT(bsdf_chi_square(shiny, direction(45), {up, 1, 0, 32}), kChiSquareAlpha);
   // The diffuse lobe is the table's: R t(wo) t(wi) / (pi eta^2 (1 - Ri)), here far from the
   // highlight so that the glossy lobe is negligible.
   CoatedDiffuseBsdf diffuse_only = shiny;
@@ -429,8 +429,8 @@ TEST(CoatedDiffuse, TabulatedCoatSamplesItsPdfAndWeights) {
 
 TEST(DiffuseTransmission, SamplingMatchesPdf) {
   DiffuseTransmissionBsdf b{RGB(0.2f, 0.5f, 0.3f), RGB(0.6f, 0.3f, 0.1f)};
-  EXPECT_GT(bsdf_chi_square(b, direction(30)), kAlpha);
-  EXPECT_GT(bsdf_chi_square(b, below(direction(70))), kAlpha);
+  EXPECT_GT(bsdf_chi_square(b, direction(30)), kChiSquareAlpha);
+  EXPECT_GT(bsdf_chi_square(b, below(direction(70))), kChiSquareAlpha);
 }
 
 TEST(DiffuseTransmission, ReciprocityAndEnergy) {
@@ -475,7 +475,7 @@ TEST(Microfacet, SeparableMaskingShadowingIsTheProductOfTheMaskings) {
   b.distribution = TrowbridgeReitz(0.3f, 0.15f, MaskingShadowing::Separable);
   const Vec3 up(0, 0, 1);
   for (float theta : {30.0f, 80.0f}) {
-    EXPECT_GT(bsdf_chi_square(b, direction(theta), {up, 1, 0, 16}), kAlpha) << theta;
+    EXPECT_GT(bsdf_chi_square(b, direction(theta), {up, 1, 0, 16}), kChiSquareAlpha) << theta;
   }
   for (int i = 0; i < 500; ++i) {
     Vec3 a = random_direction(rng), c = random_direction(rng);

@@ -18,7 +18,7 @@ namespace {
 using testing::below;
 using testing::direction;
 
-constexpr double kAlpha = testing::kChiSquareAlpha;
+using testing::kChiSquareAlpha;
 
 double chi_square(const SurfaceBsdf& b, const Vec3& wo) {
   Rng lobe_rng(42, 43);
@@ -90,7 +90,7 @@ TEST(SurfaceBsdf, OneSidedIsBlackFromTheBack) {
     EXPECT_EQ(b.eval(direction(30), below(direction(40))), RGB(0.0f));
   }
   EXPECT_FLOAT_EQ(b.eval(direction(20), direction(50)).g, 0.6f * kInvPi);
-  EXPECT_GT(chi_square(b, direction(40)), kAlpha);
+  EXPECT_GT(chi_square(b, direction(40)), kChiSquareAlpha);
   // One-sided conductors (Mitsuba's roughconductor without "twosided").
   ConductorMaterial rough;
   rough.roughness.u = rough.roughness.v = 0.3f;
@@ -127,7 +127,7 @@ TEST(SurfaceBsdf, MaskIsOpacityTimesTheMaterialPlusAStraightPassage) {
   }
   EXPECT_NEAR(double(passed) / n, 0.7, 0.005);
   EXPECT_GT(check_weights(b, wo), 5000);
-  EXPECT_GT(chi_square(b, wo), kAlpha);
+  EXPECT_GT(chi_square(b, wo), kChiSquareAlpha);
   // Opacity 0 and 1.
   mask.opacity = 0.0f;
   SurfaceBsdf none = resolve({DiffuseMaterial{RGB(0.8f)}, mask});
@@ -154,7 +154,7 @@ TEST(SurfaceBsdf, BlendMixesEvalPdfAndSampling) {
       for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(b.eval(wo, wi)[ch], f[ch], 1e-5f * (1 + f[ch]));
       EXPECT_NEAR(b.pdf(wo, wi), 0.65f * std::abs(wi.z) * kInvPi + 0.35f * c.pdf(wo, wi), 1e-5f);
       EXPECT_GT(check_weights(b, wo), 15000) << wo.z;
-      EXPECT_GT(chi_square(b, wo), kAlpha) << beckmann << " " << wo.z;
+      EXPECT_GT(chi_square(b, wo), kChiSquareAlpha) << beckmann << " " << wo.z;
     }
   }
 }

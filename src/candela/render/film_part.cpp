@@ -20,7 +20,7 @@ constexpr const char* kPixelFields[] = {"sum.R", "sum.G", "sum.B", "sumsq.R", "s
 constexpr const char* kSplatFields[] = {"splat.R", "splat.G", "splat.B"};
 constexpr size_t kPixelWords = 2 * std::size(kPixelFields), kSplatWords = 2 * std::size(kSplatFields);
 
-[[noreturn]] void fail(const std::filesystem::path& file, const std::string& what) {
+[[noreturn]] void fail_part(const std::filesystem::path& file, const std::string& what) {
   throw std::runtime_error(fmt::format("{}: {}", file.string(), what));
 }
 
@@ -64,7 +64,7 @@ const std::string& attribute(const std::map<std::string, std::string>& metadata,
                              const std::string& key) {
   auto it = metadata.find(key);
   if (it == metadata.end())
-    fail(file, fmt::format("not a candela part (no {} attribute; write parts with candela render --part K/N)", key));
+    fail_part(file, fmt::format("not a candela part (no {} attribute; write parts with candela render --part K/N)", key));
   return it->second;
 }
 
@@ -80,7 +80,7 @@ uint64_t parse_u64(const std::filesystem::path& file, const std::string& attribu
   uint64_t value = 0;
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value, base);
   if (error != std::errc() || end != text.data() + text.size() || text.empty())
-    fail(file, fmt::format("{} '{}' is not a {} number below 2^64", attribute, text, base == 16 ? "hexadecimal" : "decimal"));
+    fail_part(file, fmt::format("{} '{}' is not a {} number below 2^64", attribute, text, base == 16 ? "hexadecimal" : "decimal"));
   return value;
 }
 
@@ -94,21 +94,21 @@ void check_exr_header(const std::filesystem::path& file) {
   std::string header(64 * 1024, '\0');
   in.read(header.data(), std::streamsize(header.size()));
   header.resize(size_t(in.gcount()));
-  if (header.size() < 8 || header.compare(0, 4, "\x76\x2f\x31\x01") != 0) fail(file, "not an OpenEXR file");
-  if (uint8_t(header[5]) & 0x18) fail(file, "not a candela part (a multi-part or deep OpenEXR file)");
+  if (header.size() < 8 || header.compare(0, 4, "\x76\x2f\x31\x01") != 0) fail_part(file, "not an OpenEXR file");
+  if (uint8_t(header[5]) & 0x18) fail_part(file, "not a candela part (a multi-part or deep OpenEXR file)");
   const std::string cut_short = "its OpenEXR header is cut short or longer than 64 KB";
   for (size_t at = 8;;) {
     const size_t name_end = header.find('\0', at);
-    if (name_end == std::string::npos) fail(file, cut_short);
+    if (name_end == std::string::npos) fail_part(file, cut_short);
     if (name_end == at) return;  // the empty name ends the header
     const std::string name = header.substr(at, name_end - at);
     const size_t type_end = header.find('\0', name_end + 1);
-    if (type_end == std::string::npos || header.size() - type_end - 1 < 4) fail(file, cut_short);
+    if (type_end == std::string::npos || header.size() - type_end - 1 < 4) fail_part(file, cut_short);
     int32_t size = 0;
     std::memcpy(&size, header.data() + type_end + 1, 4);
     at = type_end + 5;
     if (size < 0 || uint64_t(size) > header.size() - at)
-      fail(file, fmt::format("its OpenEXR header attribute '{}' claims {} bytes; {}", name, size, cut_short));
+      fail_part(file, fmt::format("its OpenEXR header attribute '{}' claims {} bytes; {}", name, size, cut_short));
     at += size_t(size);
   }
 }
@@ -147,21 +147,21 @@ void write_part(const std::filesystem::path& file, const FilmPart& part, std::ma
 }
 
 FilmPart read_part(const std::filesystem::path& file) {
-  if (!std::filesystem::exists(file)) fail(file, "no such file");
+  if (!std::filesystem::exists(file)) fail_part(file, "no such file");
   check_exr_header(file);
   std::map<std::string, std::string> metadata = read_image_metadata(file);
   FilmPart part;
   const std::string& which = attribute(metadata, file, "candela:part");
   if (std::sscanf(which.c_str(), "%d/%d", &part.index, &part.count) != 2 || part.count < 1 || part.index < 1 ||
       part.index > part.count)
-    fail(file, fmt::format("candela:part '{}' is not K/N with 1 <= K <= N", which));
+    fail_part(file, fmt::format("candela:part '{}' is not K/N with 1 <= K <= N", which));
   --part.index;
   part.fingerprint.scene_hash =
       parse_u64(file, "candela:scene_hash", attribute(metadata, file, "candela:scene_hash"), 16);
   const std::string& settings = attribute(metadata, file, "candela:settings");
   for (size_t at = 0; at < settings.size();) {
     size_t end = settings.find('\n', at), eq = settings.find('=', at);
-    if (end == std::string::npos || eq == std::string::npos || eq > end) fail(file, "candela:settings is malformed");
+    if (end == std::string::npos || eq == std::string::npos || eq > end) fail_part(file, "candela:settings is malformed");
     part.fingerprint.settings.emplace_back(settings.substr(at, eq - at), settings.substr(eq + 1, end - eq - 1));
     at = end + 1;
   }
@@ -172,21 +172,21 @@ FilmPart read_part(const std::filesystem::path& file) {
   ExactChannels channels = read_exact_channels(file, kPrefix);
   const size_t words = channels.names.size();
   if (words != kPixelWords && words != kPixelWords + kSplatWords)
-    fail(file, fmt::format("has {} {}* channels, expected {} or {}", words, kPrefix, kPixelWords, kPixelWords + kSplatWords));
+    fail_part(file, fmt::format("has {} {}* channels, expected {} or {}", words, kPrefix, kPixelWords, kPixelWords + kSplatWords));
   const size_t pixels = channels.values.size() / words;
   std::string resolution = setting(part.fingerprint, "resolution");
   int width = 0, height = 0;
   // Both sides positive: -2 x -2 would pass the product check as 4 pixels, and make a film of negative width.
   if (std::sscanf(resolution.c_str(), "%dx%d", &width, &height) != 2 || width <= 0 || height <= 0 ||
       size_t(width) * size_t(height) != pixels)
-    fail(file, fmt::format("its pixels do not match its resolution setting '{}'", resolution));
+    fail_part(file, fmt::format("its pixels do not match its resolution setting '{}'", resolution));
   part.film = Film(width, height);
   if (words > kPixelWords) part.film.enable_splats();
   // EXR keeps channels sorted by name: find each of ours, in the order write_part made them.
   std::vector<size_t> column;
   for (const std::string& name : channel_names(words > kPixelWords)) {
     auto it = std::find(channels.names.begin(), channels.names.end(), name);
-    if (it == channels.names.end()) fail(file, "has no channel " + name);
+    if (it == channels.names.end()) fail_part(file, "has no channel " + name);
     column.push_back(size_t(it - channels.names.begin()));
   }
   uint32_t in[kPixelWords + kSplatWords];
@@ -213,10 +213,10 @@ MergedRender merge_parts(const std::vector<std::filesystem::path>& files) {
   for (size_t i = 1; i < parts.size(); ++i) {
     std::string diff = without_sample_set(parts[i].fingerprint).difference(reference);
     if (!diff.empty())
-      fail(files[i], fmt::format("does not belong with {}: {} ({} vs {})", files[0].string(), diff, files[i].string(),
+      fail_part(files[i], fmt::format("does not belong with {}: {} ({} vs {})", files[0].string(), diff, files[i].string(),
                                  files[0].string()));
     if (parts[i].film.has_splats() != parts[0].film.has_splats() || parts[i].splat_area != parts[0].splat_area)
-      fail(files[i], fmt::format("does not belong with {}: its light-path splats differ", files[0].string()));
+      fail_part(files[i], fmt::format("does not belong with {}: its light-path splats differ", files[0].string()));
   }
   // Sample sets by seed, in increasing order; each must hold parts 1..N of one N exactly once.
   std::vector<std::string> seeds;
@@ -245,13 +245,13 @@ MergedRender merge_parts(const std::vector<std::filesystem::path>& files) {
     for (int i : of_set) {
       const FilmPart& p = parts[size_t(i)];
       if (p.count != lead.count)
-        fail(files[size_t(i)], fmt::format("is part {}/{} but {} is part {}/{} of the same seed {}", p.index + 1, p.count,
+        fail_part(files[size_t(i)], fmt::format("is part {}/{} but {} is part {}/{} of the same seed {}", p.index + 1, p.count,
                                            files[size_t(of_set[0])].string(), lead.index + 1, lead.count, seed));
       if (setting(p.fingerprint, "spp") != setting(lead.fingerprint, "spp"))
-        fail(files[size_t(i)], fmt::format("has spp {} but {} of the same seed {} has spp {}", setting(p.fingerprint, "spp"),
+        fail_part(files[size_t(i)], fmt::format("has spp {} but {} of the same seed {} has spp {}", setting(p.fingerprint, "spp"),
                                            files[size_t(of_set[0])].string(), seed, setting(lead.fingerprint, "spp")));
       if (const auto held = holder.find(p.index); held != holder.end())
-        fail(files[size_t(i)], fmt::format("is part {}/{} of seed {}, as {} is", p.index + 1, p.count, seed,
+        fail_part(files[size_t(i)], fmt::format("is part {}/{} of seed {}, as {} is", p.index + 1, p.count, seed,
                                            files[size_t(held->second)].string()));
       holder[p.index] = i;
     }

@@ -11,7 +11,7 @@
 namespace candela {
 namespace {
 
-constexpr int kSamples = testing::kChiSquareSamples;
+using testing::kChiSquareSamples;
 
 TEST(PiecewiseConstant1D, PiecewiseConstantSamplesItsPdf) {
   const std::vector<float> weights = {0.5f, 0.0f, 3.0f, 1.0f, 0.0f, 0.25f, 2.0f};
@@ -21,7 +21,7 @@ TEST(PiecewiseConstant1D, PiecewiseConstantSamplesItsPdf) {
   const int bins = 3 * int(weights.size());
   std::vector<double> observed(bins, 0), expected(bins, 0);
   Rng rng(3, 5);
-  for (int i = 0; i < kSamples; ++i) {
+  for (int i = 0; i < kChiSquareSamples; ++i) {
     float pdf;
     size_t cell;
     float x = dist.sample(rng.next_float(), &pdf, &cell);
@@ -34,7 +34,7 @@ TEST(PiecewiseConstant1D, PiecewiseConstantSamplesItsPdf) {
   }
   double total = 0;
   for (int b = 0; b < bins; ++b) {
-    expected[b] = double(kSamples) * dist.pdf((b + 0.5f) / bins) / bins;
+    expected[b] = double(kChiSquareSamples) * dist.pdf((b + 0.5f) / bins) / bins;
     total += dist.pdf((b + 0.5f) / bins) / bins;
   }
   EXPECT_NEAR(total, 1.0, 1e-6);
@@ -68,7 +68,7 @@ TEST(Distribution2D, SamplesFollowThePdf) {
   const int bu = 3 * g.nu, bv = 3 * g.nv;
   std::vector<double> observed(size_t(bu * bv), 0), expected(observed.size(), 0);
   Rng rng(9, 2);
-  for (int i = 0; i < kSamples; ++i) {
+  for (int i = 0; i < kChiSquareSamples; ++i) {
     Distribution2DSample s = dist.sample({rng.next_float(), rng.next_float()});
     ASSERT_GE(s.point.x, 0);
     ASSERT_LT(s.point.x, 1);
@@ -82,7 +82,8 @@ TEST(Distribution2D, SamplesFollowThePdf) {
   }
   for (int v = 0; v < bv; ++v)
     for (int u = 0; u < bu; ++u)
-      expected[size_t(v * bu + u)] = double(kSamples) * dist.pdf({(u + 0.5f) / bu, (v + 0.5f) / bv}) / (bu * bv);
+      expected[size_t(v * bu + u)] =
+          double(kChiSquareSamples) * dist.pdf({(u + 0.5f) / bu, (v + 0.5f) / bv}) / (bu * bv);
   EXPECT_GT(testing::chi_square_p_value(observed, expected), testing::kChiSquareAlpha);
 }
 

@@ -13,20 +13,20 @@
 namespace candela {
 namespace {
 
-constexpr int kSamples = testing::kChiSquareSamples;
+using testing::kChiSquareSamples;
 
 // Monte Carlo integral of pdf over the sphere with uniform directions: must be 1 within 5 sigma.
 void expect_pdf_integrates_to_one(const std::function<float(const Vec3&)>& pdf) {
   Rng rng(7, 11);
   double sum = 0, sum_sq = 0;
-  for (int i = 0; i < kSamples; ++i) {
+  for (int i = 0; i < kChiSquareSamples; ++i) {
     Vec3 w = square_to_uniform_sphere({rng.next_float(), rng.next_float()});
     double v = pdf(w) / uniform_sphere_pdf();
     sum += v;
     sum_sq += v * v;
   }
-  double mean = sum / kSamples;
-  double se = std::sqrt((sum_sq / kSamples - mean * mean) / kSamples);
+  double mean = sum / kChiSquareSamples;
+  double se = std::sqrt((sum_sq / kChiSquareSamples - mean * mean) / kChiSquareSamples);
   EXPECT_NEAR(mean, 1.0, 5 * se + 1e-3);
 }
 
@@ -35,7 +35,7 @@ TEST(Warp, UniformSphere) {
   for (int i = 0; i < 10000; ++i) EXPECT_NEAR(length(square_to_uniform_sphere({rng.next_float(), rng.next_float()})), 1, 1e-5);
   auto sample = [](Vec2 u) { return square_to_uniform_sphere(u); };
   auto pdf = [](const Vec3&) { return uniform_sphere_pdf(); };
-  EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 3), testing::kChiSquareAlpha);
+  EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kChiSquareSamples, 3), testing::kChiSquareAlpha);
 }
 
 TEST(Warp, UniformHemisphere) {
@@ -44,7 +44,7 @@ TEST(Warp, UniformHemisphere) {
   expect_pdf_integrates_to_one([](const Vec3& w) { return uniform_hemisphere_pdf(w); });
   auto sample = [](Vec2 u) { return square_to_uniform_hemisphere(u); };
   auto pdf = [](const Vec3& w) { return uniform_hemisphere_pdf(w); };
-  EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 4), testing::kChiSquareAlpha);
+  EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kChiSquareSamples, 4), testing::kChiSquareAlpha);
 }
 
 TEST(Warp, CosineHemisphere) {
@@ -57,7 +57,7 @@ TEST(Warp, CosineHemisphere) {
   expect_pdf_integrates_to_one([](const Vec3& w) { return cosine_hemisphere_pdf(w); });
   auto sample = [](Vec2 u) { return square_to_cosine_hemisphere(u); };
   auto pdf = [](const Vec3& w) { return cosine_hemisphere_pdf(w); };
-  EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 5), testing::kChiSquareAlpha);
+  EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kChiSquareSamples, 5), testing::kChiSquareAlpha);
 }
 
 TEST(Warp, UniformCone) {
@@ -68,7 +68,8 @@ TEST(Warp, UniformCone) {
     expect_pdf_integrates_to_one([&](const Vec3& w) { return w.z >= cos_max ? uniform_cone_pdf(cos_max) : 0.0f; });
     auto sample = [&](Vec2 u) { return square_to_uniform_cone(u, cos_max); };
     auto pdf = [&](const Vec3& w) { return w.z >= cos_max ? uniform_cone_pdf(cos_max) : 0.0f; };
-    EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 6, cos_max), testing::kChiSquareAlpha) << "cos_max " << cos_max;
+    EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kChiSquareSamples, 6, cos_max), testing::kChiSquareAlpha)
+        << "cos_max " << cos_max;
   }
 }
 
@@ -78,7 +79,8 @@ TEST(Warp, PhongLobe) {
     auto sample = [&](Vec2 u) { return square_to_phong_lobe(u, n); };
     auto pdf = [&](const Vec3& w) { return phong_lobe_pdf(w.z, n); };
     float z_min = n > 50 ? 0.9f : -1.0f;  // resolve the narrow lobe
-    EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 7, z_min), testing::kChiSquareAlpha) << "exponent " << n;
+    EXPECT_GT(testing::spherical_chi_square_p_value(sample, pdf, kChiSquareSamples, 7, z_min), testing::kChiSquareAlpha)
+        << "exponent " << n;
   }
 }
 
@@ -86,7 +88,7 @@ TEST(Warp, ConcentricDiskIsUniform) {
   // Samples land in the unit disk, and each quadrant ring holds its share of the area.
   Rng rng(3, 4);
   int counts[4][4] = {};
-  for (int i = 0; i < kSamples; ++i) {
+  for (int i = 0; i < kChiSquareSamples; ++i) {
     Vec2 p = square_to_concentric_disk({rng.next_float(), rng.next_float()});
     float r2 = p.x * p.x + p.y * p.y;
     ASSERT_LE(r2, 1 + 1e-5f);
@@ -98,7 +100,7 @@ TEST(Warp, ConcentricDiskIsUniform) {
   for (auto& ring : counts)
     for (int c : ring) {
       observed.push_back(c);
-      expected.push_back(kSamples / 16.0);
+      expected.push_back(kChiSquareSamples / 16.0);
     }
   EXPECT_GT(testing::chi_square_p_value(observed, expected), testing::kChiSquareAlpha);
   EXPECT_FLOAT_EQ(concentric_disk_pdf({0.5f, 0.5f}), kInvPi);
@@ -133,8 +135,8 @@ TEST(Warp, ConcentricDiskMatchesShirleyChiuExactly) {
 TEST(Warp, UniformTriangle) {
   // Barycentrics are valid and uniform: split the triangle into 4 congruent sub-triangles.
   Rng rng(5, 6);
-  std::vector<double> observed(4, 0), expected(4, kSamples / 4.0);
-  for (int i = 0; i < kSamples; ++i) {
+  std::vector<double> observed(4, 0), expected(4, kChiSquareSamples / 4.0);
+  for (int i = 0; i < kChiSquareSamples; ++i) {
     Vec2 b = square_to_uniform_triangle({rng.next_float(), rng.next_float()});
     float b2 = 1 - b.x - b.y;
     ASSERT_GE(b.x, 0);
@@ -152,8 +154,9 @@ TEST(Distribution1D, SamplesProportionally) {
   EXPECT_FLOAT_EQ(d.pmf(0), 0.1f);
   EXPECT_FLOAT_EQ(d.pmf(1), 0.0f);
   Rng rng(9, 9);
-  std::vector<double> observed(4, 0), expected = {0.1 * kSamples, 0, 0.3 * kSamples, 0.6 * kSamples};
-  for (int i = 0; i < kSamples; ++i) observed[d.sample(rng.next_float())] += 1;
+  std::vector<double> observed(4, 0),
+      expected = {0.1 * kChiSquareSamples, 0, 0.3 * kChiSquareSamples, 0.6 * kChiSquareSamples};
+  for (int i = 0; i < kChiSquareSamples; ++i) observed[d.sample(rng.next_float())] += 1;
   EXPECT_EQ(observed[1], 0);
   EXPECT_GT(testing::chi_square_p_value(observed, expected), testing::kChiSquareAlpha);
 }
@@ -168,7 +171,7 @@ TEST(Warp, ChiSquareRejectsAMismatchedPdf) {
   // The test must be able to fail: uniform hemisphere samples judged against the cosine pdf.
   auto sample = [](Vec2 u) { return square_to_uniform_hemisphere(u); };
   auto pdf = [](const Vec3& w) { return cosine_hemisphere_pdf(w); };
-  EXPECT_LT(testing::spherical_chi_square_p_value(sample, pdf, kSamples, 8), 1e-6);
+  EXPECT_LT(testing::spherical_chi_square_p_value(sample, pdf, kChiSquareSamples, 8), 1e-6);
 }
 
 }  // namespace

@@ -10,7 +10,7 @@ namespace candela {
 
 namespace {
 
-constexpr int kRes = kRgbToSpectrumResolution;
+constexpr int kFitResolution = kRgbToSpectrumResolution;
 
 // The fit works on the trapezoid rule over the 5 nm samples of the tables (exact for their linear
 // interpolation), with the D65-weighted matching functions divided by the luminance integral (so
@@ -116,12 +116,12 @@ void fit(const std::array<double, 3>& rgb, std::array<double, 3>& c) {
 }  // namespace
 
 void fit_rgb_to_spectrum_row(int l, int yi, float* table) {
-  const double y = double(yi) / (kRes - 1);
-  for (int xi = 0; xi < kRes; ++xi) {
-    const double x = double(xi) / (kRes - 1);
+  const double y = double(yi) / (kFitResolution - 1);
+  for (int xi = 0; xi < kFitResolution; ++xi) {
+    const double x = double(xi) / (kFitResolution - 1);
     // Start at a middling brightness from the zero polynomial, then walk up and down in z, each fit
     // starting from its neighbour's coefficients.
-    const int start = kRes / 5;
+    const int start = kFitResolution / 5;
     auto solve_at = [&](int zi, std::array<double, 3>& c) {
       const double z = rgb_to_spectrum_z_node(zi);
       std::array<double, 3> rgb;
@@ -133,7 +133,7 @@ void fit_rgb_to_spectrum_row(int l, int yi, float* table) {
       for (int k = 0; k < 3; ++k) out[k] = float(c[size_t(k)]);
     };
     std::array<double, 3> c = {0, 0, 0};
-    for (int zi = start; zi < kRes; ++zi) solve_at(zi, c);
+    for (int zi = start; zi < kFitResolution; ++zi) solve_at(zi, c);
     c = {0, 0, 0};
     for (int zi = start; zi >= 0; --zi) solve_at(zi, c);
   }
