@@ -1,13 +1,12 @@
 #pragma once
 // How fuzz/nanovdb_reader_fuzz.cpp (and tests/fuzz_regression_test.cpp, replaying its findings)
-// turn an input into a grid file. The first byte modulo 3 picks what the rest is:
-//   0: a whole .nvdb file;
-//   1: a whole .vdb file;
-//   2: patches to a valid .nvdb file of a 2 x 2 x 2 float grid "density" (written by candela's
-//      write_grid_file), each 4 bytes of offset (little-endian, modulo the file's size), a length
-//      byte, and that many bytes written over the file there. A NanoVDB grid holds its nodes at
-//      full size (this one is 613 KB), too big for seed files, so the fuzzer reaches the internal
-//      and leaf nodes through patches.
+// turn an input into a .nvdb file. Bit 0 of the first byte clear: the rest is the whole file. Set:
+// the rest is patches to a valid file of a 2 x 2 x 2 float grid "density" (written by candela's
+// write_grid_file), each 4 bytes of offset (little-endian, modulo the file's size), a length byte,
+// and that many bytes written over the file there. A NanoVDB grid holds its nodes at full size (this
+// one is 613 KB), too big for seed files, so the fuzzer reaches the internal and leaf nodes through
+// patches.
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -15,7 +14,6 @@
 #include <iterator>
 #include <string>
 #include <string_view>
-#include <vector>
 
 #include "candela/io/grid_files.h"
 
@@ -25,12 +23,7 @@ namespace candela_fuzz {
 // reader's own limit (kMaxDenseGridSamples, 4 GiB of floats), more than libFuzzer's 2 GiB.
 inline constexpr uint64_t kMaxFuzzedDenseSamples = uint64_t(1) << 20;
 
-struct GridInput {
-  std::string bytes;
-  const char* file_name;  // input.nvdb or input.vdb
-};
-
-// The patched file of mode 2, written once into `dir` and kept in memory.
+// The file the patches apply to, written once into `dir` and kept in memory.
 inline const std::string& nanovdb_template(const std::filesystem::path& dir) {
   static const std::string bytes = [&] {
     const std::filesystem::path file = dir / "template.nvdb";
@@ -41,13 +34,10 @@ inline const std::string& nanovdb_template(const std::filesystem::path& dir) {
   return bytes;
 }
 
-inline GridInput grid_input_of(std::string_view input, const std::filesystem::path& dir) {
-  if (input.empty()) return {{}, "input.nvdb"};
+inline std::string nanovdb_file_of(std::string_view input, const std::filesystem::path& dir) {
+  if (input.empty()) return {};
   std::string_view rest = input.substr(1);
-  switch (uint8_t(input[0]) % 3) {
-    case 0: return {std::string(rest), "input.nvdb"};
-    case 1: return {std::string(rest), "input.vdb"};
-  }
+  if (!(input[0] & 1)) return std::string(rest);
   std::string file = nanovdb_template(dir);
   while (rest.size() >= 5) {
     uint32_t offset;
@@ -57,7 +47,7 @@ inline GridInput grid_input_of(std::string_view input, const std::filesystem::pa
     file.replace(offset, length, rest.substr(5, length));
     rest.remove_prefix(5 + length);
   }
-  return {std::move(file), "input.nvdb"};
+  return file;
 }
 
 }  // namespace candela_fuzz

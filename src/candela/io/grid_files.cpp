@@ -55,7 +55,8 @@ VolumeDesc densify(const std::array<int, 3>& lo, const std::array<int, 3>& hi, V
                                   extent[0], extent[1], extent[2], max_samples));
   VolumeDesc v;
   for (int a = 0; a < 3; ++a) v.resolution[a] = int(extent[a]);
-  std::vector<float> values(uint64_t(extent[0]) * uint64_t(extent[1]) * uint64_t(extent[2]));
+  const uint64_t count = uint64_t(extent[0]) * uint64_t(extent[1]) * uint64_t(extent[2]);
+  std::vector<float> values(count);
   size_t k = 0;
   // Counted from lo, not up to hi: hi may be INT_MAX, where ++x would overflow.
   for (int dz = 0; dz < v.resolution[2]; ++dz)
@@ -149,8 +150,8 @@ std::vector<NanoVdbGrid> nanovdb_grids(std::ifstream& in, const fs::path& file, 
     take(&header, sizeof header, at, "a segment header");
     if (header.magic != NANOVDB_MAGIC_NUMBER) fail(where, file, fmt::format("no NanoVDB segment at byte {}", at - sizeof header));
     if (header.version.getMajor() != NANOVDB_MAJOR_VERSION_NUMBER)
-      fail(where, file, fmt::format("it is NanoVDB version {}; candela reads {}.x", header.version.c_str(),
-                                    NANOVDB_MAJOR_VERSION_NUMBER));
+      fail(where, file, fmt::format("it is NanoVDB version {}.{}.{}; candela reads {}.x", header.version.getMajor(),
+                                    header.version.getMinor(), header.version.getPatch(), NANOVDB_MAJOR_VERSION_NUMBER));
     if (header.codec != nanovdb::io::Codec::NONE)
       fail(where, file, fmt::format("its grids are compressed (codec {}), which candela does not decode",
                                     int(header.codec)));
@@ -158,7 +159,8 @@ std::vector<NanoVdbGrid> nanovdb_grids(std::ifstream& in, const fs::path& file, 
     for (uint16_t g = 0; g < header.gridCount; ++g) {
       nanovdb::io::MetaData meta;
       take(&meta, sizeof meta, at, "a grid's metadata");
-      std::string name(meta.nameSize, '\0');
+      if (meta.nameSize > size - at) fail(where, file, fmt::format("it is cut short in a grid's name at byte {}", at));
+      std::string name(meta.nameSize, '\0');  // allocated once the file is known to hold it
       take(name.data(), meta.nameSize, at, "a grid's name");
       if (name.empty() || name.back() != '\0') fail(where, file, "a grid's name does not end in a NUL byte");
       if (meta.fileSize != meta.gridSize)

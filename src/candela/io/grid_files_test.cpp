@@ -84,8 +84,9 @@ TEST_F(GridFiles, ProblemsNameTheFile) {
 }
 
 // Found by fuzz/nanovdb_reader_fuzz.cpp (fuzz/regressions/nanovdb_reader/): NanoVDB's own reader read
-// a grid name without its NUL byte past its end (ASan: heap-buffer-overflow), and followed node
-// offsets as the file gave them. candela reads the file itself and checks both first.
+// a grid name without its NUL byte past its end (ASan: heap-buffer-overflow), allocated the sizes the
+// file declared, and followed node offsets as the file gave them. candela reads the file itself and
+// checks each first.
 TEST_F(GridFiles, NanoVdbFilesAreCheckedBeforeTheyAreRead) {
   const fs::path file = dir_ / "cloud.nvdb";
   write_grid_file(file, "density", kRes, values_, kVoxel, kOffset);
@@ -110,12 +111,16 @@ TEST_F(GridFiles, NanoVdbFilesAreCheckedBeforeTheyAreRead) {
   const size_t name_end = 16 + 176 + 7, root_offset = name_end + 1 + 672 + 24;
   ASSERT_EQ(good.compare(name_end - 7, 8, std::string("density\0", 8)), 0);
   EXPECT_EQ(error_with(name_end, "x"), prefix + "a grid's name does not end in a NUL byte");
+  // A name of 2^31 - 1 bytes (the metadata's nameSize at byte 136) was allocated before it was read.
+  EXPECT_EQ(error_with(16 + 136, "\xff\xff\xff\x7f"), prefix + "it is cut short in a grid's name at byte 192");
   EXPECT_EQ(error_with(root_offset, std::string("\0\0\0\0\0\1\0\0", 8)),
             prefix + "grid \"density\" is corrupt: its root node lies outside it");
   EXPECT_EQ(error_of(good.substr(0, good.size() - 1)),
             prefix + "grid \"density\" of " + std::to_string(good.size() - name_end - 1) +
                 " bytes runs past the end of the file");
   EXPECT_EQ(error_with(0, "NanoVDB1"), prefix + "no NanoVDB segment at byte 0");
+  // (Version::c_str() mallocs the text it returns: the message leaked it until it was formatted here.)
+  EXPECT_EQ(error_with(8, std::string(4, '\0')), prefix + "it is NanoVDB version 0.0.0; candela reads 32.x");
   EXPECT_EQ(error_of(good), "no error");
 }
 
