@@ -13,6 +13,8 @@ shift || true
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(json_reader pbrt_reader obj_reader ply_reader serialized_reader mitsuba_reader gltf_reader
   vol_reader nanovdb_reader part_reader checkpoint_reader http_request)
+# Leaks inside libraries candela cannot fix are suppressed by name (fuzz/lsan_suppressions.txt).
+export LSAN_OPTIONS="suppressions=$root/fuzz/lsan_suppressions.txt${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 for target in "${targets[@]}"; do
