@@ -26,6 +26,10 @@ inline CommandResult run_command(const std::string& command) {
   std::array<char, 4096> buf;
   while (size_t n = fread(buf.data(), 1, buf.size(), pipe)) out.append(buf.data(), n);
   int status = pclose(pipe);
+  // UBSan's reports (.ci/sanitizers) go to the program's stderr, and the program then exits with status
+  // 1, which a test that expects the program to fail would take for its error: they fail the test here.
+  // (ASan's and TSan's reports go to files that the scripts check.)
+  EXPECT_EQ(out.find(": runtime error: "), std::string::npos) << command << ":\n" << out;
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
 }
 
