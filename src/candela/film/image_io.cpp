@@ -13,6 +13,8 @@
 #include <cstring>
 #include <cmath>
 #include <cstdint>
+#include <fstream>
+#include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <vector>
@@ -147,6 +149,14 @@ void write_image_with(const std::filesystem::path& file, const Image& image,
   }
 }
 
+// OIIO::ImageInput::open after check_exr_header; throws naming the file when the file cannot be opened.
+std::unique_ptr<OIIO::ImageInput> open_image(const std::filesystem::path& file, const OIIO::ImageSpec* config = nullptr) {
+  check_exr_header(file);
+  auto in = OIIO::ImageInput::open(file.string(), config);
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
+  return in;
+}
+
 // check_image_size, and for a PFM (uncompressed) that the file holds the pixels its header claims:
 // OpenImageIO would allocate them all before finding the file cut short.
 void check_image_header(const std::filesystem::path& file, const OIIO::ImageInput& in) {
@@ -168,8 +178,7 @@ void check_image_header(const std::filesystem::path& file, const OIIO::ImageInpu
 template <typename T, typename Check>
 std::vector<std::string> read_channels(const std::filesystem::path& file, const std::string& prefix,
                                        OIIO::TypeDesc format, Check check, std::vector<T>& values) {
-  auto in = OIIO::ImageInput::open(file.string());
-  if (!in) throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
+  auto in = open_image(file);
   check_image_header(file, *in);
   const OIIO::ImageSpec& spec = in->spec();
   std::vector<std::string> names;
@@ -194,6 +203,46 @@ std::vector<std::string> read_channels(const std::filesystem::path& file, const 
 }
 
 }  // namespace
+
+int check_exr_header(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  char start[8] = {};
+  if (!in.read(start, 8) || std::memcmp(start, "\x76\x2f\x31\x01", 4) != 0) return -1;
+  std::error_code ec;
+  const uint64_t file_bytes = std::filesystem::file_size(file, ec);
+  const auto malformed = [&] {
+    throw std::runtime_error(fmt::format("{}: cannot read image: its OpenEXR header is malformed or cut short", file.string()));
+  };
+  // A name or type of at most 255 bytes (OpenEXR's long names) ended by a NUL byte; "" ends a header.
+  const auto read_string = [&] {
+    std::string text;
+    for (char c; text.size() <= 255;) {
+      if (!in.get(c)) malformed();
+      if (c == '\0') return text;
+      text += c;
+    }
+    malformed();
+    return text;
+  };
+  const int flags = uint8_t(start[5]);
+  // A multi-part file holds a header per part, then an empty one.
+  for (;;) {
+    std::string name = read_string();
+    if (name.empty()) return flags;
+    for (; !name.empty(); name = read_string()) {
+      (void)read_string();  // the attribute's type
+      int32_t size = 0;
+      if (!in.read(reinterpret_cast<char*>(&size), 4)) malformed();
+      const uint64_t left = file_bytes - uint64_t(in.tellg());
+      if (size < 0 || uint64_t(size) > left)
+        throw std::runtime_error(fmt::format("{}: cannot read image: its OpenEXR header attribute '{}' claims {} bytes, "
+                                             "more than the {} left in the file",
+                                             file.string(), name, size, left));
+      in.seekg(size, std::ios::cur);
+    }
+    if (!(flags & 0x10)) return flags;
+  }
+}
 
 void check_image_size(const std::filesystem::path& file, int64_t width, int64_t height) {
   if (width > kMaxImageSide || height > kMaxImageSide || width * height > kMaxImageTexels)
@@ -253,8 +302,7 @@ Image read_image(const std::filesystem::path& file, IntegerEncoding encoding) {
   // the stored colours are wanted.
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
-  auto in = OIIO::ImageInput::open(file.string(), &config);
-  if (!in) throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
+  auto in = open_image(file, &config);
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
     throw std::runtime_error(fmt::format("{}: cannot read image: empty image", file.string()));
@@ -297,16 +345,14 @@ FloatChannels read_float_channels(const std::filesystem::path& file, const std::
 }
 
 std::vector<std::string> read_channel_names(const std::filesystem::path& file) {
-  auto in = OIIO::ImageInput::open(file.string());
-  if (!in) throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
+  auto in = open_image(file);
   std::vector<std::string> names = in->spec().channelnames;
   in->close();
   return names;
 }
 
 std::map<std::string, std::string> read_image_metadata(const std::filesystem::path& file) {
-  auto in = OIIO::ImageInput::open(file.string());
-  if (!in) throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
+  auto in = open_image(file);
   std::map<std::string, std::string> result;
   for (const auto& attr : in->spec().extra_attribs) result[attr.name().string()] = attr.get_string();
   in->close();

@@ -63,6 +63,15 @@ inline constexpr int64_t kMaxImageTexels = int64_t(1) << 29;
 // image beyond those limits.
 void check_image_size(const std::filesystem::path& file, int64_t width, int64_t height);
 
+// OpenEXR (3.1) allocates each header attribute's declared size before it reads the value, so a
+// 500-byte file declaring a 2 GB attribute costs 2 GB and seconds before it fails. For an OpenEXR file
+// (its first bytes are OpenEXR's magic number), walks every header (name, type, 4-byte size, value) and
+// throws std::runtime_error "FILE: cannot read image: its OpenEXR header attribute 'NAME' claims N
+// bytes, more than the M left in the file" (or "...: its OpenEXR header is malformed") before anything
+// reads it. Every reader here calls it; returns the flags byte of the file's version field (0x08 deep,
+// 0x10 multi-part), or -1 for a file that is not an OpenEXR file.
+int check_exr_header(const std::filesystem::path& file);
+
 // How 8- and 16-bit pixel values become linear: the exact sRGB decoding curve, or value / max.
 // Float pixels (EXR, HDR, PFM) are linear either way, as in pbrt-v4 and Mitsuba, whose encoding
 // options also only apply to integer images.

@@ -84,35 +84,6 @@ uint64_t parse_u64(const std::filesystem::path& file, const std::string& attribu
   return value;
 }
 
-// OpenEXR (3.1) allocates each header attribute's declared size before it reads the value, so a
-// 500-byte file declaring a 2 GB attribute costs 2 GB and seconds before it fails. The header is
-// walked first: every attribute (name, type, 4-byte size, value) must fit in the file's first 64 KB
-// (a part's header takes a few KB). A part is a single-part image (write_part writes no other), so
-// multi-part and deep files are refused here too.
-void check_exr_header(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::string header(64 * 1024, '\0');
-  in.read(header.data(), std::streamsize(header.size()));
-  header.resize(size_t(in.gcount()));
-  if (header.size() < 8 || header.compare(0, 4, "\x76\x2f\x31\x01") != 0) fail_part(file, "not an OpenEXR file");
-  if (uint8_t(header[5]) & 0x18) fail_part(file, "not a candela part (a multi-part or deep OpenEXR file)");
-  const std::string cut_short = "its OpenEXR header is cut short or longer than 64 KB";
-  for (size_t at = 8;;) {
-    const size_t name_end = header.find('\0', at);
-    if (name_end == std::string::npos) fail_part(file, cut_short);
-    if (name_end == at) return;  // the empty name ends the header
-    const std::string name = header.substr(at, name_end - at);
-    const size_t type_end = header.find('\0', name_end + 1);
-    if (type_end == std::string::npos || header.size() - type_end - 1 < 4) fail_part(file, cut_short);
-    int32_t size = 0;
-    std::memcpy(&size, header.data() + type_end + 1, 4);
-    at = type_end + 5;
-    if (size < 0 || uint64_t(size) > header.size() - at)
-      fail_part(file, fmt::format("its OpenEXR header attribute '{}' claims {} bytes; {}", name, size, cut_short));
-    at += size_t(size);
-  }
-}
-
 std::string setting(const RenderFingerprint& fp, const std::string& key) {
   for (const auto& [k, v] : fp.settings)
     if (k == key) return v;
@@ -148,7 +119,11 @@ void write_part(const std::filesystem::path& file, const FilmPart& part, std::ma
 
 FilmPart read_part(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file)) fail_part(file, "no such file");
-  check_exr_header(file);
+  // A part is a single-part image (write_part writes no other); check_exr_header walks the header
+  // before OpenImageIO reads it.
+  const int exr_flags = check_exr_header(file);
+  if (exr_flags < 0) fail_part(file, "not an OpenEXR file");
+  if (exr_flags & 0x18) fail_part(file, "not a candela part (a multi-part or deep OpenEXR file)");
   std::map<std::string, std::string> metadata = read_image_metadata(file);
   FilmPart part;
   const std::string& which = attribute(metadata, file, "candela:part");

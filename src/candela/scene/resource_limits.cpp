@@ -100,6 +100,11 @@ ShapeCost shape_cost(const ShapeDesc& shape) {
 // candela reads at all (film/image_io.h), whatever the memory.
 uint64_t image_bytes(const std::string& filename, uint64_t extra_per_texel, const SourceLocation& where) {
   if (filename.empty()) return 0;
+  try {
+    check_exr_header(filename);
+  } catch (const std::runtime_error& malformed) {
+    throw_scene_error(where, "{}", malformed.what());
+  }
   auto in = OIIO::ImageInput::open(filename);
   if (!in) {
     (void)OIIO::geterror();  // reading the image later reports the problem; don't leave it pending

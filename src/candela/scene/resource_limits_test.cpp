@@ -5,8 +5,10 @@
 #include <zlib.h>
 
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <string>
 
@@ -168,6 +170,31 @@ TEST(ResourceLimits, ImagesLargerThanCandelaReadsAreRefusedFromTheirHeaders) {
     } catch (const std::runtime_error& e) {
       EXPECT_EQ(std::string(e.what()), file + ": the image is 100000 x 100000 texels, " + limit);
     }
+  }
+  // An EXR texture whose header attribute claims 1.8 GB: OpenEXR would allocate it before failing.
+  const std::string exr = (dir / "attribute.exr").string();
+  write_image(exr, Image(2, 2), {{"comment", "hello"}});
+  {
+    std::ifstream in(exr, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const size_t size_at = bytes.find(std::string("comment\0string\0", 15)) + 15;
+    ASSERT_LT(size_at, bytes.size());
+    const int32_t huge = 1800000000;
+    std::memcpy(bytes.data() + size_at, &huge, 4);
+    write("attribute.exr", bytes);
+  }
+  desc.lights.clear();
+  desc.textures.push_back(ImageTexture{.filename = exr});
+  try {
+    estimate_memory(desc);
+    ADD_FAILURE() << "not refused";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("scene.json:4:16: at /textures/wood: " + exr +
+                                              ": cannot read image: its OpenEXR header attribute 'comment' claims "
+                                              "1800000000 bytes, more than the ",
+                                          0),
+              0u)
+        << e.what();
   }
   // Within the limits, but the file holds 1200 of the 4.8 GB of pixels its header claims.
   const std::string short_pfm = write("short.pfm", "PF\n20000 20000\n-1.0\n" + std::string(1200, '\0'));

@@ -11,6 +11,8 @@
 #include <fstream>
 #include <system_error>
 
+#include "candela/film/image_io.h"
+
 namespace candela::gltf {
 
 // ---------------------------------------------------------------- images and textures
@@ -74,9 +76,19 @@ std::string GltfReader::image_file(int index, const std::string& user) {
   return result;
 }
 
+// check_exr_header (an attribute claiming more bytes than the file holds), its error at `pointer`.
+void GltfReader::checked_exr_header(const std::string& file, const std::string& pointer) const {
+  try {
+    check_exr_header(file);
+  } catch (const std::runtime_error& malformed) {
+    fail(pointer, "{}", malformed.what());
+  }
+}
+
 GltfReader::Pixels GltfReader::read_pixels(const std::string& file, const std::string& pointer) {
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
+  checked_exr_header(file, pointer);
   auto in = OIIO::ImageInput::open(file, &config);
   if (!in) fail(pointer, "cannot read image {}: {}", file, OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
@@ -95,6 +107,7 @@ GltfReader::Pixels GltfReader::read_pixels(const std::string& file, const std::s
 
 int GltfReader::image_channels(const std::string& file, const std::string& pointer) {
   if (auto found = channel_counts_.find(file); found != channel_counts_.end()) return found->second;
+  checked_exr_header(file, pointer);
   auto in = OIIO::ImageInput::open(file);
   if (!in) fail(pointer, "cannot read image {}: {}", file, OIIO::geterror());
   int channels = in->spec().nchannels;

@@ -179,6 +179,7 @@ class GltfReader {
   };
 
   Pixels read_pixels(const std::string& file, const std::string& pointer);
+  void checked_exr_header(const std::string& file, const std::string& pointer) const;
 
   int image_channels(const std::string& file, const std::string& pointer);
 

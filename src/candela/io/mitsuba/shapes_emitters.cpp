@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "candela/film/image_io.h"
 #include "candela/geometry/sdf_grid.h"
 #include "candela/io/mesh_io.h"
 
@@ -274,6 +275,7 @@ RGB Converter::constant_color(const Object& o, std::string_view name, RGB fallba
 std::pair<int, int> Converter::texture_size(int index) {
   const auto* img = std::get_if<ImageTexture>(&desc_.textures[index]);
   if (!img) return {1, 1};
+  check_exr_header(img->filename);
   auto in = OIIO::ImageInput::open(img->filename);
   if (!in) return {1, 1};
   const OIIO::ImageSpec& spec = in->spec();
