@@ -16,7 +16,6 @@ import argparse
 import json
 import pathlib
 import re
-import socket
 import statistics
 import subprocess
 import sys
@@ -25,6 +24,8 @@ import time
 import urllib.request
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "tests" / "browser"))
+from slowloris import SlowClients  # noqa: E402
 SCENE = ROOT / "scenes" / "cornell-box.json"
 
 
@@ -71,35 +72,13 @@ def poll_like_the_page(url, stop):
 
 
 def slow_clients(url, count, stop):
-    """`count` connections that each send a header byte a second and never finish their request."""
-    port = int(re.search(r":(\d+)/", url).group(1))
-    clients, next_byte = [], 0.0
+    """`count` slowloris connections (tests/browser/slowloris.py) until `stop`."""
+    clients = SlowClients(int(re.search(r":(\d+)/", url).group(1)), count)
     while not stop.is_set():
-        clients = [c for c in clients if c is not None]
-        while len(clients) < count:
-            try:
-                c = socket.create_connection(("127.0.0.1", port), timeout=1)
-            except OSError:
-                break
-            c.setblocking(False)
-            c.send(f"GET /status HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n".encode())
-            clients.append(c)
-        if time.time() >= next_byte:
-            next_byte = time.time() + 1
-            for i, c in enumerate(clients):
-                try:
-                    c.send(b"X")
-                    if c.recv(4096) == b"":
-                        raise OSError
-                except BlockingIOError:
-                    pass
-                except OSError:
-                    c.close()
-                    clients[i] = None
+        clients.refill()
+        clients.drip()
         stop.wait(0.5)
-    for c in clients:
-        if c is not None:
-            c.close()
+    clients.close()
 
 
 def browser(headless_size="1100,760"):

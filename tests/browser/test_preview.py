@@ -23,6 +23,7 @@ import pytest
 from selenium import webdriver
 from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.by import By
+from slowloris import SlowClients
 
 CLI = os.environ.get("CANDELA_CLI", "candela")
 CORNELL_BOX = str(Path(os.environ.get("CANDELA_SOURCE_DIR", Path(__file__).parents[2])) / "scenes" / "cornell-box.json")
@@ -287,34 +288,13 @@ def test_slow_clients_neither_stop_the_render_nor_take_its_time(tmp_path):
     memory and the server's threads stay bounded. The render's wall-time ratio is measured in bench/preview_overhead.py."""
     args = [CORNELL_BOX, "--resolution", "96x72", "--spp", "512", "--threads", "1"]
     render = Render(args + ["-o", str(tmp_path / "attacked.exr")])
-    clients, peak = [], 0
+    clients, peak = SlowClients(render.port, 200), 0
     answered, slowest, ticks, server_threads = 0, 0.0, None, 0
     try:
         end = time.time() + 60
-        next_byte = time.time()
         while render.proc.poll() is None and time.time() < end:
-            # Keep 200 connections open, each with an unfinished request.
-            clients = [c for c in clients if c is not None]
-            while len(clients) < 200:
-                try:
-                    c = socket.create_connection(("127.0.0.1", render.port), timeout=1)
-                    c.setblocking(False)
-                    c.send(f"GET /status HTTP/1.1\r\nHost: 127.0.0.1:{render.port}\r\n".encode())
-                    clients.append(c)
-                except OSError:
-                    break
-            if time.time() >= next_byte:
-                next_byte = time.time() + 1
-                for i, c in enumerate(clients):
-                    try:
-                        c.send(b"X")
-                        if c.recv(4096) == b"":
-                            raise OSError("closed")
-                    except BlockingIOError:
-                        pass
-                    except OSError:
-                        c.close()
-                        clients[i] = None
+            clients.refill()
+            if clients.drip():
                 # Meanwhile a viewer with the token is answered at once.
                 asked = time.time()
                 try:
@@ -330,9 +310,7 @@ def test_slow_clients_neither_stop_the_render_nor_take_its_time(tmp_path):
             time.sleep(0.05)
         code, stderr = render.finish(60)
     finally:
-        for c in clients:
-            if c is not None:
-                c.close()
+        clients.close()
         render.kill()
     assert code == 0, stderr
     assert "stopped" not in stderr and "interrupted" not in stderr
