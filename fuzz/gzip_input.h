@@ -9,6 +9,7 @@
 // `expected` is the text when the data is undamaged, which gunzip must then return exactly.
 #include <zlib.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <optional>

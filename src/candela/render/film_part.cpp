@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <charconv>
 #include <cstring>
-#include <fstream>
 #include <stdexcept>
 
 #include "candela/film/image_io.h"
