@@ -6,6 +6,8 @@
 # peak RSS, result. The executions of earlier clean lines count towards RUNS, so a campaign killed with
 # its session loses one chunk at most and the next call goes on where it stopped. A crashing input stays
 # in CAMPAIGN_DIR/artifacts-<target>/ and ends that target's campaign. docs/reliability.md records them.
+# TIMEOUT (default 60 s, CI has 10) is per input in wall time: generous, as a campaign runs at nice 19
+# beside builds, where a 0.5 s input can take 30 s of wall time.
 # Usage: fuzz/campaign.sh [RUNS] [TARGET...]   (targets as in fuzz/run.sh; build them with fuzz/build.sh)
 set -uo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -31,7 +33,7 @@ for target in "${targets[@]}"; do
     this_run=$(( runs - done_so_far < chunk ? runs - done_so_far : chunk ))
     start=$(date +%s)
     # A random seed per run (libFuzzer picks one).
-    "$build/fuzz_$target" -runs="$this_run" -timeout=10 -rss_limit_mb=2048 -dict="$root/fuzz/${target%_reader}.dict" \
+    "$build/fuzz_$target" -runs="$this_run" -timeout="${TIMEOUT:-60}" -rss_limit_mb=2048 -dict="$root/fuzz/${target%_reader}.dict" \
       -artifact_prefix="$artifacts/" -print_final_stats=1 "$corpus" "$root/fuzz/corpus/$target" > "$log" 2>&1
     rc=$?
     seconds=$(( $(date +%s) - start ))
