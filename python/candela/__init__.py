@@ -14,18 +14,87 @@ way; docs/python.md walks through the rest.
 from __future__ import annotations
 
 import collections.abc
+import importlib.machinery
 import json
 import numbers
 import operator
 import os
+import platform
 import re
+import shlex
 import sys
 import time
 import warnings
 
-import numpy as np
 
-from . import _candela
+def _same_file(a: str, b: str) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except (OSError, ValueError):
+        return False
+
+
+def _interpreter_error(problem: str, build_info, numpy_missing: bool = False) -> ImportError:
+    """An ImportError that names the interpreter the package was built for, the one running, and the
+    commands that build it for the one running (docs/python.md, "Building for your interpreter")."""
+    this = sys.executable or "python3"
+    source = getattr(build_info, "source_dir", None) or "<candela's source directory>"
+    build = getattr(build_info, "build_dir", None) or os.path.join(source, "build")
+    if build_info is not None:
+        built_for = f"{build_info.executable} (Python {build_info.version})"
+    else:
+        built_for = "unknown (candela/_build_info.py, which CMake writes beside the package, is missing)"
+    q = shlex.quote
+    lines = [f"candela cannot be imported: {problem}",
+             f"  built for:   {built_for}",
+             f"  running now: {this} (Python {platform.python_version()})"]
+    same = build_info is not None and _same_file(this, build_info.executable)
+    if same and numpy_missing:
+        debian = " or, for Debian's /usr/bin/python3, apt-get install python3-numpy" if this.startswith("/usr/bin/") else ""
+        lines.append(f"Install NumPy for it: {q(this)} -m pip install numpy{debian}.")
+    elif same:
+        lines.append("Rebuild it for this interpreter:")
+    else:
+        lines.append(f"Build candela for the interpreter running now (it needs NumPy: {q(this)} -m pip install numpy):")
+    if not (same and numpy_missing):
+        lines += [f"  cmake -S {q(source)} -B {q(build)} -DPython_EXECUTABLE={q(this)}",
+                  f"  cmake --build {q(build)}",
+                  f"then run with PYTHONPATH={q(os.path.join(build, 'python'))}, or install it into this "
+                  f"interpreter's site-packages with: cmake --install {q(build)}"]
+    if build_info is not None and not same:
+        lines.append(f"Or run the interpreter it was built for: {build_info.executable}")
+    return ImportError("\n".join(lines), name=__name__)
+
+
+def _check_interpreter():
+    """Raises _interpreter_error where the extension module cannot load in this interpreter (another
+    Python version or ABI than the build's), before an import fails with a message that says less."""
+    try:
+        from . import _build_info
+    except ImportError:
+        return None
+    built = tuple(int(part) for part in _build_info.version.split(".")[:2])
+    abi_tag = _build_info.extension[len("_candela"):]  # e.g. .cpython-311-x86_64-linux-gnu.so
+    if built != sys.version_info[:2]:
+        raise _interpreter_error(f"its extension module {_build_info.extension} is for Python "
+                                 f"{built[0]}.{built[1]}, and this interpreter is Python "
+                                 f"{sys.version_info[0]}.{sys.version_info[1]}", _build_info) from None
+    if abi_tag not in importlib.machinery.EXTENSION_SUFFIXES:
+        raise _interpreter_error(f"its extension module {_build_info.extension} is not for this interpreter's ABI "
+                                 f"(it loads {', '.join(importlib.machinery.EXTENSION_SUFFIXES)})",
+                                 _build_info) from None
+    return _build_info
+
+
+_build_info = _check_interpreter()
+try:
+    import numpy as np
+except ImportError as e:
+    raise _interpreter_error(f"NumPy is not installed for this interpreter ({e})", _build_info, numpy_missing=True) from e
+try:
+    from . import _candela
+except ImportError as e:
+    raise _interpreter_error(f"its extension module _candela does not load ({e})", _build_info) from e
 
 __version__ = _candela.version
 __all__ = ["Image", "Scene", "SceneError", "SceneParameters", "SceneWarning", "UsageError", "builtin_scene",
