@@ -308,11 +308,13 @@ PYBIND11_MODULE(_candela, m) {
       PyErr_SetString(g_scene_error.ptr(), e.what());
     } catch (const FileContentError& e) {
       PyErr_SetString(g_scene_error.ptr(), e.what());
+    } catch (const UnknownParameterError& e) {  // scene parameters: an unknown name
+      PyErr_SetString(PyExc_KeyError, e.what());
     } catch (const UsageError& e) {
       PyErr_SetString(g_usage_error.ptr(), e.what());
-    } catch (const std::invalid_argument& e) {  // scene parameters: an unknown name
-      PyErr_SetString(PyExc_KeyError, e.what());
-    }
+    } catch (const OutputError& e) {  // an image that cannot be written (docs/python.md)
+      PyErr_SetString(PyExc_RuntimeError, e.what());
+    }  // InternalError and other exceptions: pybind11's own translation (RuntimeError for most)
   });
 
   py::class_<PyScene>(m, "Scene")

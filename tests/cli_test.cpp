@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 
+#include "candela/base/error.h"
 #include "candela/film/image_io.h"
 #include "candela/testing/command_line.h"
 #include "candela/testing/gzip_bytes.h"
@@ -331,6 +332,39 @@ TEST_F(CommandLine, ConvertRefusesOtherOutputsAndBadScenes) {
   EXPECT_EQ(kept, "previous");
 }
 
+// One exit status per kind of error (base/error.h, docs/cli.md "Exit status"), with the one-line message.
+TEST_F(CommandLine, ExitStatusNamesTheKindOfError) {
+  const std::string scene = write("good.json", kGoodJson);
+  const std::string render = "render " + scene + " -o " + out() + " -q";
+  // 1: the scene (or a file it names) is bad.
+  EXPECT_EQ(expect_failure("render " + write("bad.json", "{\"camera\": ") + " -o " + out(), "^candela: error: .*bad\\.json")
+                .exit_code,
+            kExitBadInput);
+  // 2: a request refused: a value out of range, flags that exclude each other, a flag CLI11 does not know or
+  // cannot read, a missing argument.
+  EXPECT_EQ(expect_failure(render + " --spp 0", "^candela: error: --spp").exit_code, kExitUsage);
+  EXPECT_EQ(expect_failure(render + " --pixel 1,1 --part 1/2", "^candela: error: --part cannot be combined with --pixel")
+                .exit_code,
+            kExitUsage);
+  RunResult unknown = run_cli(render + " --no-such-flag");
+  EXPECT_EQ(unknown.exit_code, kExitUsage) << unknown.output;
+  EXPECT_THAT_MATCHES(unknown.output, "--no-such-flag");
+  EXPECT_EQ(run_cli(render + " --spp many").exit_code, kExitUsage);
+  EXPECT_EQ(run_cli("render").exit_code, kExitUsage);
+  EXPECT_EQ(previous_output(), "previous render");
+  // 0: --help and --version are not errors.
+  EXPECT_EQ(run_cli("--help").exit_code, 0);
+  EXPECT_EQ(run_cli("render --help").exit_code, 0);
+  EXPECT_EQ(run_cli("--version").exit_code, 0);
+  // 4: a file that cannot be written once rendered: bdpt's strategy images into /sys, which takes no new
+  // files even from root (the directory itself is only checked to exist before rendering).
+  if (testing::run_command("touch /sys/candela-probe").exit_code == 0) GTEST_SKIP() << "/sys is writable here";
+  const std::string ok = (dir_ / "ok.exr").string();
+  RunResult unwritable = run_cli("render " + scene + " -o " + ok + " -q --integrator bdpt --spp 1 --bdpt-strategies /sys");
+  EXPECT_EQ(unwritable.exit_code, kExitOutput) << unwritable.output;
+  EXPECT_THAT_MATCHES(unwritable.output, "^candela: error: /sys/bdpt_d0_s0_t2\\.exr: cannot write image: ");
+}
+
 TEST_F(CommandLine, MissingSceneFile) { expect_failure("render " + (dir_ / "nope.json").string() + " -o " + out(), "nope\\.json"); }
 
 TEST_F(CommandLine, MalformedJsonNamesLine) {
@@ -390,12 +424,13 @@ TEST_F(CommandLine, UnsupportedOutputAndIntegrator) {
 // ---------------------------------------------------------------- hostile inputs
 
 // The table "Hostile inputs" of docs/reliability.md: each input is refused with one message naming the
-// file (and line) and the limit, exit status 1, no crash, and no file written or left behind.
+// file (and line) and the limit, exit status 1 (2 for a flag's value or an output refused before the
+// scene is read), no crash, and no file written or left behind.
 class HostileInput : public CommandLine {
  protected:
-  void expect_refused(const std::string& args, const std::string& pattern) {
+  void expect_refused(const std::string& args, const std::string& pattern, int exit_code = kExitBadInput) {
     const std::set<std::string> before = files();
-    EXPECT_EQ(expect_failure(args, "^candela: error: " + pattern).exit_code, 1);
+    EXPECT_EQ(expect_failure(args, "^candela: error: " + pattern).exit_code, exit_code);
     EXPECT_EQ(files(), before);
   }
   std::set<std::string> files() const {
@@ -446,7 +481,8 @@ TEST_F(HostileInput, AbsurdResolution) {
   const std::string scene = write("good.json", kGoodJson);
   expect_refused("render " + scene + " -o " + out() + " --resolution 1000000000x1000000000",
                  quoted("resolution 1000000000x1000000000 is out of range (each side 1..65536, at most 268435456 "
-                        "pixels)"));
+                        "pixels)"),
+                 kExitUsage);
   const std::string pbrt = write("wide.pbrt", "Film \"rgb\" \"integer xresolution\" 1000000000\nWorldBegin\n");
   expect_refused("render " + pbrt + " -o " + out(),
                  quoted(pbrt + ":1:12: Film \"rgb\": \"xresolution\" must be between 1 and 65536, got 1000000000"));
@@ -516,25 +552,26 @@ TEST_F(HostileInput, DamagedCheckpoint) {
 
 TEST_F(HostileInput, OutputsThatCannotBeWritten) {
   const std::string scene = write("good.json", kGoodJson);
+  // Found before the scene is read: a usage error (status 2), as any refused flag.
   expect_refused("render " + scene + " -o /dev/full/x.png",
-                 quoted("output '/dev/full/x.png': '/dev/full' is not a directory"));
+                 quoted("output '/dev/full/x.png': '/dev/full' is not a directory"), kExitUsage);
   fs::create_directory(dir_ / "folder.exr");
   const std::string folder = (dir_ / "folder.exr").string();
-  expect_refused("render " + scene + " -o " + folder, quoted("output '" + folder + "': it is a directory"));
+  expect_refused("render " + scene + " -o " + folder, quoted("output '" + folder + "': it is a directory"), kExitUsage);
   // /sys takes no new files, even from root (for whom permissions do not stop a write).
   if (testing::run_command("touch /sys/candela-probe").exit_code == 0) GTEST_SKIP() << "/sys is writable here";
   const std::string in_sys = ": cannot write in directory '/sys': .+";
-  expect_refused("render " + scene + " -o /sys/x.png", quoted("output '/sys/x.png'") + in_sys);
+  expect_refused("render " + scene + " -o /sys/x.png", quoted("output '/sys/x.png'") + in_sys, kExitUsage);
   const std::string render = "render " + scene + " -o " + out();
-  expect_refused(render + " --checkpoint /sys/x.ckpt", quoted("--checkpoint '/sys/x.ckpt'") + in_sys);
-  expect_refused(render + " --spp-map /sys/x.png", quoted("--spp-map '/sys/x.png'") + in_sys);
-  expect_refused("convert " + scene + " /sys/x.json", quoted("output '/sys/x.json'") + in_sys);
-  expect_refused("merge " + out() + " -o /sys/x.exr", quoted("output '/sys/x.exr'") + in_sys);
+  expect_refused(render + " --checkpoint /sys/x.ckpt", quoted("--checkpoint '/sys/x.ckpt'") + in_sys, kExitUsage);
+  expect_refused(render + " --spp-map /sys/x.png", quoted("--spp-map '/sys/x.png'") + in_sys, kExitUsage);
+  expect_refused("convert " + scene + " /sys/x.json", quoted("output '/sys/x.json'") + in_sys, kExitUsage);
+  expect_refused("merge " + out() + " -o /sys/x.exr", quoted("output '/sys/x.exr'") + in_sys, kExitUsage);
 }
 
 // A full disk: a 64 KiB tmpfs mounted in a mount namespace of its own (root with CAP_SYS_ADMIN only; the
-// mount goes with the namespace). The image and the checkpoint fail to write; the earlier files are
-// left as they were and no temporary file is left beside them.
+// mount goes with the namespace). The image and the checkpoint fail to write (an output error, status
+// 4); the earlier files are left as they were and no temporary file is left beside them.
 TEST_F(HostileInput, FullDisk) {
   const std::string scene = write("good.json", kGoodJson);
   const fs::path disk = dir_ / "disk";
@@ -550,11 +587,11 @@ TEST_F(HostileInput, FullDisk) {
   // 512 x 512 float RGB is 3 MiB.
   RunResult image = on_full_disk("-o out.pfm --resolution 512x512 --spp 1 -q");
   EXPECT_THAT_MATCHES(image.output, "^candela: error: out\\.pfm: cannot write image: No space left on device\n"
-                                    "status 1\nout\\.pfm\nrender\\.ckpt\npreviousprevious$");
+                                    "status 4\nout\\.pfm\nrender\\.ckpt\npreviousprevious$");
   RunResult checkpoint =
       on_full_disk("-o out.pfm --resolution 512x512 --spp 8 --checkpoint render.ckpt --checkpoint-every 0.000001 -q");
   EXPECT_THAT_MATCHES(checkpoint.output, "^candela: error: checkpoint 'render\\.ckpt': cannot write: No space left on "
-                                         "device\nstatus 1\nout\\.pfm\nrender\\.ckpt\npreviousprevious$");
+                                         "device\nstatus 4\nout\\.pfm\nrender\\.ckpt\npreviousprevious$");
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 // Every input that once crashed a fuzz target (fuzz/regressions/<target>/, docs/reliability.md) is
 // read again by the same reader, the way the fuzz target reads it: the reader must either succeed
-// or throw its documented error (SceneError; std::runtime_error for render parts and checkpoints).
+// or throw its documented error (SceneError; FileContentError for render parts and checkpoints).
 // Under the ASan+UBSan build in CI a memory error fails the test as well.
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -187,13 +187,13 @@ TEST_F(FuzzRegression, NanovdbReader) {
 }
 
 TEST_F(FuzzRegression, PartReader) {
-  expect_no_crash<std::runtime_error>("part_reader",
-                                      [&](const fs::path& input) { (void)merge_parts({copy_in(input, "input.exr")}); });
+  expect_no_crash<FileContentError>("part_reader",
+                                    [&](const fs::path& input) { (void)merge_parts({copy_in(input, "input.exr")}); });
 }
 
 TEST_F(FuzzRegression, CheckpointReader) {
   // As fuzz/checkpoint_reader_fuzz.cpp: the input made into a checkpoint by fuzz/checkpoint_input.h.
-  expect_no_crash<std::runtime_error>("checkpoint_reader", [&](const fs::path& input) {
+  expect_no_crash<FileContentError>("checkpoint_reader", [&](const fs::path& input) {
     (void)parse_checkpoint(candela_fuzz::checkpoint_bytes_of(read_bytes(input)), "fuzz.ckpt");
   });
 }

@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "candela/base/error.h"
 #include "candela/testing/command_line.h"
 #include "candela/film/image_io.h"
 
@@ -183,7 +184,9 @@ TEST_F(InterruptResume, ResumeWithAnotherSceneOrSettingsOrDamagedCheckpointIsRef
       << log();
   ASSERT_TRUE(fs::exists(ckpt));
 
-  EXPECT_EQ(run(std::vector<std::string>{"render", kScene, "-o", out, "--spp", "128", "--resume", ckpt} + common), 1);
+  // Another request than the checkpoint's: a usage error (2); a damaged checkpoint: bad input (1).
+  EXPECT_EQ(run(std::vector<std::string>{"render", kScene, "-o", out, "--spp", "128", "--resume", ckpt} + common),
+            kExitUsage);
   EXPECT_NE(log().find("settings differ: spp 100000 vs 128"), std::string::npos) << log();
 
   // A copy of the scene with one number changed.
@@ -196,7 +199,8 @@ TEST_F(InterruptResume, ResumeWithAnotherSceneOrSettingsOrDamagedCheckpointIsRef
   text[at] = text[at] == '9' ? '8' : char(text[at] + 1);
   std::string changed = path("changed.json");
   std::ofstream(changed) << text;
-  EXPECT_EQ(run(std::vector<std::string>{"render", changed, "-o", out, "--spp", "100000", "--resume", ckpt} + common), 1);
+  EXPECT_EQ(run(std::vector<std::string>{"render", changed, "-o", out, "--spp", "100000", "--resume", ckpt} + common),
+            kExitUsage);
   EXPECT_NE(log().find("scene file differs"), std::string::npos) << log();
 
   // Truncated and corrupted checkpoints.
@@ -204,17 +208,19 @@ TEST_F(InterruptResume, ResumeWithAnotherSceneOrSettingsOrDamagedCheckpointIsRef
   std::string bytes((std::istreambuf_iterator<char>(cin)), std::istreambuf_iterator<char>());
   std::string bad = path("bad.bin");
   std::ofstream(bad, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
-  EXPECT_EQ(run(std::vector<std::string>{"render", kScene, "-o", out, "--spp", "100000", "--resume", bad} + common), 1);
+  EXPECT_EQ(run(std::vector<std::string>{"render", kScene, "-o", out, "--spp", "100000", "--resume", bad} + common),
+            kExitBadInput);
   EXPECT_NE(log().find("truncated"), std::string::npos) << log();
   bytes[bytes.size() / 2] ^= 0x40;
   std::ofstream(bad, std::ios::binary) << bytes;
-  EXPECT_EQ(run(std::vector<std::string>{"render", kScene, "-o", out, "--spp", "100000", "--resume", bad} + common), 1);
+  EXPECT_EQ(run(std::vector<std::string>{"render", kScene, "-o", out, "--spp", "100000", "--resume", bad} + common),
+            kExitBadInput);
   EXPECT_NE(log().find("corrupt (checksum mismatch)"), std::string::npos) << log();
 
   // Adaptive sampling does not checkpoint.
   EXPECT_EQ(run(std::vector<std::string>{"render", kScene, "-o", out, "--adaptive-threshold", "0.1", "--checkpoint",
                                          ckpt} + common),
-            1);
+            kExitUsage);
   EXPECT_NE(log().find("adaptive"), std::string::npos) << log();
 }
 
@@ -258,7 +264,7 @@ TEST_F(InterruptResume, PixelRendersOnePixelAsInTheFullImage) {
   EXPECT_EQ(r, expected.r);
   EXPECT_EQ(g, expected.g);
   EXPECT_EQ(b, expected.b);
-  EXPECT_EQ(run(std::vector<std::string>{"render", kScene, "--pixel", "40,1"} + common), 1);
+  EXPECT_EQ(run(std::vector<std::string>{"render", kScene, "--pixel", "40,1"} + common), kExitUsage);
 }
 
 }  // namespace

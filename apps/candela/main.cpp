@@ -46,9 +46,8 @@ using namespace candela;
 
 namespace {
 
-constexpr int kExitBadInput = 1;
-constexpr int kExitInterrupted = 3;     // SIGINT/SIGTERM: the partial image (and checkpoint) written
-constexpr int kExitSecondSignal = 130;  // a second SIGINT/SIGTERM: exit at once, nothing more written
+// The exit status of each outcome (kExitBadInput, kExitUsage, kExitInterrupted, ...) is base/error.h's,
+// one per error type; docs/cli.md lists them.
 
 // What the command is doing, for the signal handler: before rendering begins nothing is worth
 // keeping, so the first SIGINT/SIGTERM leaves at once (reading a big scene file or building the BVH of
@@ -94,9 +93,10 @@ void install_signal_handlers() {
   sigaction(SIGTERM, &sa, nullptr);
 }
 // An error every rank of the job has agreed on (the lowest failing rank's): the root prints it once
-// and every rank exits with kExitBadInput.
+// and every rank exits with the exit status of that error's type.
 struct AgreedError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+  AgreedError(const std::string& message, int exit_code) : std::runtime_error(message), exit_code(exit_code) {}
+  int exit_code;
 };
 
 // Runs `step` on every rank. Whatever is read before rendering can fail on one rank only (a file
@@ -105,14 +105,16 @@ struct AgreedError : std::runtime_error {
 template <typename Step>
 void on_every_rank(Cluster& cluster, Step&& step) {
   std::string error;
+  int exit_code = 0;
   try {
     step();
   } catch (const std::exception& e) {
     error = e.what();
     if (error.empty()) error = "unknown error";
+    exit_code = exit_code_for(e);
   }
-  error = cluster.first_error(error);
-  if (!error.empty()) throw AgreedError(error);
+  const Cluster::RankError first = cluster.first_error(error, exit_code);
+  if (!first.message.empty()) throw AgreedError(first.message, first.exit_code);
 }
 
 // The render subcommand: the request (integrators/render_request.h) and what only the command line does.
@@ -261,7 +263,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
     auto parse_aov_list = [](const std::string& list, const char* where) {
       try {
         return parse_aovs(list);
-      } catch (const std::invalid_argument& e) {
+      } catch (const UsageError& e) {
         throw UsageError(fmt::format("{}: {}", where, e.what()));
       }
     };
@@ -276,7 +278,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
     if (!cmd.display_server.empty()) {
       try {
         parse_display_server_address(cmd.display_server);
-      } catch (const std::invalid_argument& e) {
+      } catch (const UsageError& e) {
         throw UsageError(fmt::format("--display-server: {}", e.what()));
       }
       if (pixel_mode) throw UsageError("--display-server shows the whole image: it cannot be combined with --pixel");
@@ -313,7 +315,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
       throw UsageError(fmt::format("--checkpoint and --resume are not supported with the {} integrator (it cannot continue a partly rendered film)", chosen.name));
     if (!chosen.single_pixel && pixel_mode)
       throw UsageError(fmt::format("--pixel cannot be used with the {} integrator (it cannot render one pixel alone)", chosen.name));
-    if (!cmd.bdpt_strategies.empty() && !fs::is_directory(cmd.bdpt_strategies))
+    if (std::error_code ec; !cmd.bdpt_strategies.empty() && !fs::is_directory(cmd.bdpt_strategies, ec))
       throw UsageError(fmt::format("--bdpt-strategies '{}': not a directory", cmd.bdpt_strategies));
     if (pixel_mode) {
       std::smatch m;
@@ -688,7 +690,7 @@ int main(int argc, char** argv) {
     cluster = join_cluster(argc, argv);
   } catch (const std::exception& e) {
     if (*e.what()) std::fprintf(stderr, "candela: error: %s\n", e.what());  // empty: another rank says it
-    return kExitBadInput;
+    return exit_code_for(e);
   }
   CLI::App app{"candela: a physically based Monte Carlo path tracer.\n"
                "With no arguments, renders the built-in Cornell box to cornell-box.png and cornell-box.exr."};
@@ -821,11 +823,15 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    // --help and --version exit 0; flags that cannot be parsed are a usage error.
+    int code;
     if (!cluster->is_root()) {  // every rank parsed the same words: the root alone says what is wrong
       std::ostringstream ignored;
-      return app.exit(e, ignored, ignored);
+      code = app.exit(e, ignored, ignored);
+    } else {
+      code = app.exit(e);
     }
-    return app.exit(e);
+    return code == 0 ? 0 : kExitUsage;
   }
   try {
     if (convert_cmd->parsed()) return cluster->is_root() ? run_convert(convert_in, convert_out) : 0;
@@ -833,15 +839,17 @@ int main(int argc, char** argv) {
     return run_render(cmd, *cluster);
   } catch (const AgreedError& e) {  // every rank has it: one message
     if (cluster->is_root()) std::fprintf(stderr, "candela: error: %s\n", e.what());
-  } catch (const std::exception& e) {  // SceneError, UsageError, image I/O: one message, no output written
+    return e.exit_code;
+  } catch (const std::exception& e) {  // a CandelaError (base/error.h), or a bug: one message
+    const int code = exit_code_for(e);
     if (!cluster->distributed()) {
       std::fprintf(stderr, "candela: error: %s\n", e.what());
     } else {
       // Past the point where the ranks agree: the others may be waiting on this one, so end the job.
       std::fprintf(stderr, "candela: error (rank %d): %s\n", cluster->rank(), e.what());
       std::fflush(stderr);
-      cluster->abort(kExitBadInput);
+      cluster->abort(code);
     }
+    return code;
   }
-  return kExitBadInput;
 }

@@ -198,11 +198,11 @@ def test_adaptive_render_shows_a_samples_per_pixel_heat_map(browser, tmp_path):
 def test_preview_address_is_loopback_unless_asked():
     r = subprocess.run([CLI, "render", CORNELL_BOX, "--preview", "0.0.0.0:0", "--spp", "1", "-o", "/tmp/never.exr"],
                        capture_output=True, text=True)
-    assert r.returncode == 1
+    assert r.returncode == 2  # a usage error (docs/cli.md, "Exit status")
     assert "--preview-public" in r.stderr and "this machine only" in r.stderr
     r = subprocess.run([CLI, "render", CORNELL_BOX, "--preview", "localhost:99999", "--spp", "1", "-o", "/tmp/never.exr"],
                        capture_output=True, text=True)
-    assert r.returncode == 1 and "PORT" in r.stderr
+    assert r.returncode == 2 and "PORT" in r.stderr
 
 
 def test_requests_without_the_token_from_a_foreign_host_or_another_origin_are_refused(browser, tmp_path):

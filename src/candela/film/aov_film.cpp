@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "candela/base/error.h"
+
 namespace candela {
 namespace {
 
@@ -54,7 +56,7 @@ std::vector<Aov> parse_aovs(std::string_view list) {
     } else {
       auto it = std::find_if(std::begin(kAllAovs), std::end(kAllAovs), [&](Aov a) { return aov_name(a) == name; });
       if (it == std::end(kAllAovs))
-        throw std::invalid_argument(name.empty() ? fmt::format("empty AOV name in '{}' (valid: {})", list, aov_names())
+        throw UsageError(name.empty() ? fmt::format("empty AOV name in '{}' (valid: {})", list, aov_names())
                                                  : fmt::format("unknown AOV '{}' (valid: {})", name, aov_names()));
       chosen[size_t(*it)] = true;
     }
@@ -125,8 +127,8 @@ void AovFilm::clear() { std::fill(sums_.begin(), sums_.end(), 0.0); }
 
 std::vector<AovLayer> AovFilm::images(const Film& film) const {
   if (film.width() != width_ || film.height() != height_)
-    throw std::invalid_argument(fmt::format("AovFilm::images: the film is {}x{}, the AOVs {}x{}", film.width(),
-                                            film.height(), width_, height_));
+    throw InternalError(fmt::format("AovFilm::images: the film is {}x{}, the AOVs {}x{}", film.width(), film.height(),
+                                    width_, height_));
   const Image variance = wants(Aov::Variance) ? film.variance_of_mean_image() : Image();
   std::vector<AovLayer> result;
   for (Aov aov : layers_) {

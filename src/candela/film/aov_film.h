@@ -36,7 +36,7 @@ std::string_view aov_name(Aov aov);
 // "albedo, normal, depth, position, spp, variance" (and "all"), for messages.
 std::string aov_names();
 // Comma-separated names (spaces around them ignored; "all" for every layer) as layers in the order
-// above, each once. Throws std::invalid_argument naming an unknown or empty name and the valid ones.
+// above, each once. Throws UsageError naming an unknown or empty name and the valid ones.
 std::vector<Aov> parse_aovs(std::string_view list);
 // The layers as a list parse_aovs reads back: "albedo,normal".
 std::string describe_aovs(const std::vector<Aov>& layers);

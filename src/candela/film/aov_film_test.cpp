@@ -11,6 +11,7 @@
 #include <regex>
 #include <stdexcept>
 
+#include "candela/base/error.h"
 #include "candela/camera/camera.h"
 #include "candela/film/image_io.h"
 #include "candela/integrators/integrator.h"
@@ -68,10 +69,10 @@ TEST(Aovs, ParsesNamesAndRefusesUnknownOnes) {
   try {
     parse_aovs("albedo,colour");
     FAIL() << "an unknown name was accepted";
-  } catch (const std::invalid_argument& e) {
+  } catch (const UsageError& e) {
     EXPECT_STREQ(e.what(), "unknown AOV 'colour' (valid: albedo, normal, depth, position, spp, variance, all)");
   }
-  EXPECT_THROW(parse_aovs("albedo,,normal"), std::invalid_argument);
+  EXPECT_THROW(parse_aovs("albedo,,normal"), UsageError);
 }
 
 // One BSDF sample of a cosine-sampled Lambertian weighs f cos / pdf = R exactly.
@@ -346,13 +347,13 @@ TEST(Aovs, CommandLineRefusesUnknownNamesAndUnkeptCombinations) {
   const std::string scene = (dir / "sphere.json").string(), out = (dir / "out.exr").string();
   std::ofstream(scene) << kSphereJson;
   testing::CommandResult r = testing::run_command(run_cli("render " + scene + " -o " + out + " --aov albedo,colour -q"));
-  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_EQ(r.exit_code, kExitUsage) << r.output;
   EXPECT_NE(r.output.find("--aov: unknown AOV 'colour' (valid: albedo, normal, depth, position, spp, variance, all)"),
             std::string::npos)
       << r.output;
   EXPECT_FALSE(fs::exists(out));
   r = testing::run_command(run_cli("render " + scene + " -o " + out + " --aov depth --part 1/2 -q"));
-  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_EQ(r.exit_code, kExitUsage) << r.output;
   EXPECT_NE(r.output.find("--aov cannot be combined with --part"), std::string::npos) << r.output;
   // A PNG gets the colour alone, with one note.
   const std::string png = (dir / "out.png").string();
@@ -378,7 +379,7 @@ TEST(Aovs, SceneSettingNamesTheLayers) {
   EXPECT_NE(std::find(names.begin(), names.end(), "Normal.X"), names.end());
   std::ofstream(scene) << std::regex_replace(json, std::regex(R"("spp": 4)"), R"("spp": 4, "aovs": "dept")");
   r = testing::run_command(run_cli("render " + scene + " -o " + out + " -q"));
-  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_EQ(r.exit_code, kExitBadInput) << r.output;
   EXPECT_NE(r.output.find("/render/aovs"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("unknown AOV 'dept'"), std::string::npos) << r.output;
   fs::remove_all(dir);

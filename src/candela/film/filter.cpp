@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "candela/base/error.h"
+
 namespace candela {
 namespace {
 
@@ -29,16 +31,17 @@ bool is_known(FilterType type) {
   return false;
 }
 
+// The scene readers refuse these values naming the place (a SceneError): one reaching here is a bug.
 void validate(const FilterDesc& desc) {
-  if (!is_known(desc.type)) throw std::invalid_argument(fmt::format("unknown filter type {}", int(desc.type)));
+  if (!is_known(desc.type)) throw InternalError(fmt::format("unknown filter type {}", int(desc.type)));
   if (!is_positive_finite(desc.radius.x) || !is_positive_finite(desc.radius.y))
-    throw std::invalid_argument(
+    throw InternalError(
         fmt::format("filter radius must be positive and finite, got ({}, {})", desc.radius.x, desc.radius.y));
   if (desc.type == FilterType::Gaussian && !is_positive_finite(desc.gaussian_sigma))
-    throw std::invalid_argument(
+    throw InternalError(
         fmt::format("gaussian filter sigma must be positive and finite, got {}", desc.gaussian_sigma));
   if (desc.type == FilterType::Mitchell && !(std::isfinite(desc.mitchell_b) && std::isfinite(desc.mitchell_c)))
-    throw std::invalid_argument(
+    throw InternalError(
         fmt::format("mitchell filter B and C must be finite, got {} and {}", desc.mitchell_b, desc.mitchell_c));
 }
 

@@ -27,8 +27,8 @@ class Filter {
     float weight;  // f(offset) / pdf(offset); the constant integral() for box and tent
   };
 
-  // Throws std::invalid_argument for a non-positive or non-finite radius or Gaussian sigma, non-finite
-  // Mitchell parameters or an unknown filter type.
+  // Throws InternalError for a non-positive or non-finite radius or Gaussian sigma, non-finite
+  // Mitchell parameters or an unknown filter type (the scene readers refuse them first).
   explicit Filter(const FilterDesc& desc);
 
   FilterType type() const { return type_; }

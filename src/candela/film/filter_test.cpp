@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "candela/base/error.h"
 #include "candela/sampling/rng.h"
 #include "candela/testing/statistics.h"
 
@@ -250,11 +251,11 @@ TEST(FilterConstruction, RejectsBadParameters) {
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   for (Vec2 radius : {Vec2{0, 1}, Vec2{1, -1}, Vec2{nan, 1}, Vec2{1, inf}})
     for (FilterType type : {FilterType::Box, FilterType::Tent, FilterType::Gaussian, FilterType::Mitchell})
-      EXPECT_THROW(Filter(make_desc(type, radius)), std::invalid_argument);
-  for (float sigma : {0.0f, -0.5f, nan, inf}) EXPECT_THROW(Filter(gaussian_desc({1, 1}, sigma)), std::invalid_argument);
-  EXPECT_THROW(Filter(mitchell_desc({2, 2}, nan, 0.5f)), std::invalid_argument);
-  EXPECT_THROW(Filter(mitchell_desc({2, 2}, 0.5f, inf)), std::invalid_argument);
-  EXPECT_THROW(Filter(make_desc(static_cast<FilterType>(42), {1, 1})), std::invalid_argument);
+      EXPECT_THROW(Filter(make_desc(type, radius)), InternalError);
+  for (float sigma : {0.0f, -0.5f, nan, inf}) EXPECT_THROW(Filter(gaussian_desc({1, 1}, sigma)), InternalError);
+  EXPECT_THROW(Filter(mitchell_desc({2, 2}, nan, 0.5f)), InternalError);
+  EXPECT_THROW(Filter(mitchell_desc({2, 2}, 0.5f, inf)), InternalError);
+  EXPECT_THROW(Filter(make_desc(static_cast<FilterType>(42), {1, 1})), InternalError);
 }
 
 TEST(FilterConstruction, IgnoresParametersOfOtherFilterTypes) {

@@ -19,6 +19,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "candela/base/error.h"
+
 namespace candela {
 namespace {
 
@@ -71,10 +73,10 @@ std::vector<unsigned char> encode_png(const Image& image) {
   std::vector<unsigned char> bytes;
   OIIO::Filesystem::IOVecOutput memory(bytes);
   auto out = OIIO::ImageOutput::create("image.png", &memory);
-  if (!out) throw std::runtime_error("cannot create a PNG writer: " + OIIO::geterror());
+  if (!out) throw InternalError("cannot create a PNG writer: " + OIIO::geterror());
   bool ok = write_png(*out, "image.png", image);
   std::string error = ok ? "" : out->geterror();
-  if (!out->close() || !ok) throw std::runtime_error("cannot encode PNG: " + (error.empty() ? out->geterror() : error));
+  if (!out->close() || !ok) throw InternalError("cannot encode PNG: " + (error.empty() ? out->geterror() : error));
   return bytes;
 }
 
@@ -129,9 +131,9 @@ std::string write_with_oiio(const std::filesystem::path& tmp, const std::string&
 void write_image_with(const std::filesystem::path& file, const Image& image,
                       const std::map<std::string, std::string>& metadata, const ExtraChannels& extra) {
   if (!extra.empty() && lower_extension(file) != ".exr")
-    throw std::runtime_error(fmt::format("{}: only .exr files keep extra channels", file.string()));
+    throw InternalError(fmt::format("{}: only .exr files keep extra channels", file.string()));
   if (!is_supported_output(file))
-    throw std::runtime_error(fmt::format("{}: unsupported image format (use .exr, .png or .pfm)", file.string()));
+    throw OutputError(fmt::format("{}: unsupported image format (use .exr, .png or .pfm)", file.string()));
   std::string ext = lower_extension(file);
   std::filesystem::path dir = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
   std::filesystem::path tmp = dir / fmt::format(".{}.{}.tmp{}", file.stem().string(), getpid(), ext);
@@ -145,7 +147,7 @@ void write_image_with(const std::filesystem::path& file, const Image& image,
   }
   if (!error.empty()) {
     std::filesystem::remove(tmp, ec);
-    throw std::runtime_error(fmt::format("{}: cannot write image: {}", file.string(), error));
+    throw OutputError(fmt::format("{}: cannot write image: {}", file.string(), error));
   }
 }
 
@@ -153,7 +155,7 @@ void write_image_with(const std::filesystem::path& file, const Image& image,
 std::unique_ptr<OIIO::ImageInput> open_image(const std::filesystem::path& file, const OIIO::ImageSpec* config = nullptr) {
   check_exr_header(file);
   auto in = OIIO::ImageInput::open(file.string(), config);
-  if (!in) throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
+  if (!in) throw FileContentError(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
   return in;
 }
 
@@ -168,7 +170,7 @@ void check_image_header(const std::filesystem::path& file, const OIIO::ImageInpu
   const uint64_t file_bytes = std::filesystem::file_size(file, ec);
   const uint64_t pixel_bytes = uint64_t(spec.width) * uint64_t(spec.height) * spec.pixel_bytes();
   if (!ec && file_bytes < pixel_bytes)
-    throw std::runtime_error(fmt::format("{}: cannot read image: the file has {} bytes, too few for the {} x {} pixels "
+    throw FileContentError(fmt::format("{}: cannot read image: the file has {} bytes, too few for the {} x {} pixels "
                                          "its header claims (cut short?)",
                                          file.string(), file_bytes, spec.width, spec.height));
 }
@@ -186,7 +188,7 @@ std::vector<std::string> read_channels(const std::filesystem::path& file, const 
   for (int c = 0; c < spec.nchannels; ++c)
     if (spec.channelnames[size_t(c)].rfind(prefix, 0) == 0) {
       if (first >= 0 && c != last + 1)
-        throw std::runtime_error(fmt::format("{}: the {}* channels are not together", file.string(), prefix));
+        throw FileContentError(fmt::format("{}: the {}* channels are not together", file.string(), prefix));
       check(spec, c);
       if (first < 0) first = c;
       last = c;
@@ -196,7 +198,7 @@ std::vector<std::string> read_channels(const std::filesystem::path& file, const 
   if (first >= 0) {
     values.resize(size_t(spec.width) * size_t(spec.height) * names.size());
     if (!in->read_image(0, 0, first, last + 1, format, values.data()))
-      throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), in->geterror()));
+      throw FileContentError(fmt::format("{}: cannot read image: {}", file.string(), in->geterror()));
   }
   in->close();
   return names;
@@ -211,7 +213,7 @@ int check_exr_header(const std::filesystem::path& file) {
   std::error_code ec;
   const uint64_t file_bytes = std::filesystem::file_size(file, ec);
   const auto malformed = [&] {
-    throw std::runtime_error(fmt::format("{}: cannot read image: its OpenEXR header is malformed or cut short", file.string()));
+    throw FileContentError(fmt::format("{}: cannot read image: its OpenEXR header is malformed or cut short", file.string()));
   };
   // A name or type of at most 255 bytes (OpenEXR's long names) ended by a NUL byte; "" ends a header.
   const auto read_string = [&] {
@@ -235,7 +237,7 @@ int check_exr_header(const std::filesystem::path& file) {
       if (!in.read(reinterpret_cast<char*>(&size), 4)) malformed();
       const uint64_t left = file_bytes - uint64_t(in.tellg());
       if (size < 0 || uint64_t(size) > left)
-        throw std::runtime_error(fmt::format("{}: cannot read image: its OpenEXR header attribute '{}' claims {} bytes, "
+        throw FileContentError(fmt::format("{}: cannot read image: its OpenEXR header attribute '{}' claims {} bytes, "
                                              "more than the {} left in the file",
                                              file.string(), name, size, left));
       in.seekg(size, std::ios::cur);
@@ -246,7 +248,7 @@ int check_exr_header(const std::filesystem::path& file) {
 
 void check_image_size(const std::filesystem::path& file, int64_t width, int64_t height) {
   if (width > kMaxImageSide || height > kMaxImageSide || width * height > kMaxImageTexels)
-    throw std::runtime_error(fmt::format("{}: the image is {} x {} texels, more than candela reads (at most {} on a "
+    throw FileContentError(fmt::format("{}: the image is {} x {} texels, more than candela reads (at most {} on a "
                                          "side and {} = 2^29 in all)",
                                          file.string(), width, height, kMaxImageSide, kMaxImageTexels));
 }
@@ -305,7 +307,7 @@ Image read_image(const std::filesystem::path& file, IntegerEncoding encoding) {
   auto in = open_image(file, &config);
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
-    throw std::runtime_error(fmt::format("{}: cannot read image: empty image", file.string()));
+    throw FileContentError(fmt::format("{}: cannot read image: empty image", file.string()));
   check_image_header(file, *in);
   Image img(spec.width, spec.height);
   bool ok;
@@ -318,7 +320,7 @@ Image read_image(const std::filesystem::path& file, IntegerEncoding encoding) {
   } else {
     ok = read_pixels<float>(*in, OIIO::TypeDesc::FLOAT, [](float v) { return v; }, img);
   }
-  if (!ok) throw std::runtime_error(fmt::format("{}: cannot read image: {}", file.string(), in->geterror()));
+  if (!ok) throw FileContentError(fmt::format("{}: cannot read image: {}", file.string(), in->geterror()));
   in->close();
   return img;
 }
@@ -331,7 +333,7 @@ ExactChannels read_exact_channels(const std::filesystem::path& file, const std::
       file, prefix, OIIO::TypeDesc::UINT32,
       [&](const OIIO::ImageSpec& spec, int c) {
         if (spec.channelformat(c) != OIIO::TypeDesc::UINT32)
-          throw std::runtime_error(fmt::format("{}: channel {} is not 32-bit unsigned integer", file.string(),
+          throw FileContentError(fmt::format("{}: channel {} is not 32-bit unsigned integer", file.string(),
                                                spec.channelnames[size_t(c)]));
       },
       result.values);

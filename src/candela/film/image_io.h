@@ -17,12 +17,13 @@ bool is_supported_output(const std::filesystem::path& file);
 
 // Writes atomically: to a temporary file beside the target, then renamed over it, so an existing
 // file is never left half-written. `metadata` goes into EXR headers (string attributes; keys such
-// as "candela:spp"). Throws std::runtime_error naming the file on failure.
+// as "candela:spp"). Throws OutputError naming the file when it cannot be written (or has an
+// extension other than is_supported_output's).
 void write_image(const std::filesystem::path& file, const Image& image,
                  const std::map<std::string, std::string>& metadata = {});
 
 // The bytes of an 8-bit sRGB PNG of `image` (as write_image writes a .png), e.g. to show it inline
-// in a notebook. Throws std::runtime_error.
+// in a notebook. Throws InternalError if OpenImageIO fails.
 std::vector<unsigned char> encode_png(const Image& image);
 
 // 32-bit unsigned integer channels kept exactly beside an EXR's RGB (a render part's sums, bit for
@@ -35,7 +36,7 @@ struct ExactChannels {
 void write_image(const std::filesystem::path& file, const Image& image, const std::map<std::string, std::string>& metadata,
                  const ExactChannels& extra);
 // The channels of `file` whose names start with `prefix`, which must be 32-bit unsigned integers
-// (an empty ExactChannels when there are none). Throws std::runtime_error naming the file.
+// (an empty ExactChannels when there are none). Throws FileContentError naming the file.
 ExactChannels read_exact_channels(const std::filesystem::path& file, const std::string& prefix);
 
 // 32-bit float channels beside an EXR's RGB, named as layers ("Albedo.R", "Depth.Z": film/aov_film.h):
@@ -48,7 +49,7 @@ struct FloatChannels {
 void write_image(const std::filesystem::path& file, const Image& image, const std::map<std::string, std::string>& metadata,
                  const FloatChannels& extra);
 // The channels of `file` whose names start with `prefix`, read as 32-bit floats (an empty
-// FloatChannels when there are none). Throws std::runtime_error naming the file.
+// FloatChannels when there are none). Throws FileContentError naming the file.
 FloatChannels read_float_channels(const std::filesystem::path& file, const std::string& prefix);
 // The names of all channels of `file`, in the order the reader gives them.
 std::vector<std::string> read_channel_names(const std::filesystem::path& file);
@@ -59,14 +60,14 @@ std::vector<std::string> read_channel_names(const std::filesystem::path& file);
 // 100000 x 100000 is refused at once.
 inline constexpr int64_t kMaxImageSide = 65536;
 inline constexpr int64_t kMaxImageTexels = int64_t(1) << 29;
-// Throws std::runtime_error "FILE: the image is W x H texels, more than candela reads (...)" for an
+// Throws FileContentError "FILE: the image is W x H texels, more than candela reads (...)" for an
 // image beyond those limits.
 void check_image_size(const std::filesystem::path& file, int64_t width, int64_t height);
 
 // OpenEXR (3.1) allocates each header attribute's declared size before it reads the value, so a
 // 500-byte file declaring a 2 GB attribute costs 2 GB and seconds before it fails. For an OpenEXR file
 // (its first bytes are OpenEXR's magic number), walks every header (name, type, 4-byte size, value) and
-// throws std::runtime_error "FILE: cannot read image: its OpenEXR header attribute 'NAME' claims N
+// throws FileContentError "FILE: cannot read image: its OpenEXR header attribute 'NAME' claims N
 // bytes, more than the M left in the file" (or "...: its OpenEXR header is malformed") before anything
 // reads it. Every reader here calls it; returns the flags byte of the file's version field (0x08 deep,
 // 0x10 multi-part), or -1 for a file that is not an OpenEXR file.
@@ -79,7 +80,7 @@ enum class IntegerEncoding { SRGB, Linear };
 
 // Reads any image OpenImageIO reads as linear RGB float, top row first. Greyscale is replicated to
 // RGB; alpha and further channels are dropped, and colours are read as stored (not premultiplied).
-// Throws std::runtime_error naming the file on failure.
+// Throws FileContentError naming the file on failure.
 Image read_image(const std::filesystem::path& file, IntegerEncoding encoding);
 // The same with 8- and 16-bit data sRGB-decoded.
 Image read_image(const std::filesystem::path& file);
@@ -91,7 +92,7 @@ Image read_image(const std::filesystem::path& file);
 // file again while its loaded scene keeps the images (python/module.cpp).
 std::shared_ptr<const Image> read_image_shared(const std::filesystem::path& file, IntegerEncoding encoding);
 
-// The metadata attributes of an image file (for tests and tools).
+// The metadata attributes of an image file (for tests and tools). Throws FileContentError.
 std::map<std::string, std::string> read_image_metadata(const std::filesystem::path& file);
 
 }  // namespace candela

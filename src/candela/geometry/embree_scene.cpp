@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "candela/base/error.h"
 #include "candela/math/vec3d.h"
 
 namespace candela {
@@ -13,7 +14,7 @@ namespace {
 
 void report_embree_error(void*, RTCError code, const char* message) {
   // Errors from Embree are programming or resource errors, not user input errors.
-  throw std::runtime_error("Embree error " + std::to_string(int(code)) + ": " + (message ? message : ""));
+  throw InternalError("Embree error " + std::to_string(int(code)) + ": " + (message ? message : ""));
 }
 
 // A ray as a user-geometry callback sees it; time is Embree's, in [0,1].
@@ -270,7 +271,7 @@ EmbreeScene::EmbreeScene(float transform_start_time, float transform_end_time, b
       time_scale_(transform_end_time > transform_start_time ? 1 / (transform_end_time - transform_start_time) : 0),
       compact_(compact) {
   device_ = rtcNewDevice(nullptr);
-  if (!device_) throw std::runtime_error("cannot create an Embree device");
+  if (!device_) throw InternalError("cannot create an Embree device");
   rtcSetDeviceErrorFunction(device_, report_embree_error, nullptr);
   scene_ = rtcNewScene(device_);
   rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
@@ -329,7 +330,7 @@ RTCGeometry EmbreeScene::new_triangle_geometry(uint32_t id, const std::vector<Po
 void EmbreeScene::add_shared_triangles(uint32_t id, const std::vector<Point3>& positions,
                                        const std::vector<uint32_t>& indices, int object) {
   if (positions.capacity() <= positions.size())
-    throw std::logic_error("EmbreeScene::add_shared_triangles: the positions need one spare element of capacity");
+    throw InternalError("EmbreeScene::add_shared_triangles: the positions need one spare element of capacity");
   RTCGeometry geom = new_triangle_geometry(id, positions, indices, /*shared=*/true);
   rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, positions.data(), 0, sizeof(Point3),
                              positions.size());
@@ -346,7 +347,7 @@ int EmbreeScene::add_object() {
 
 void EmbreeScene::add_instance(uint32_t id, int object, const Transform& to_world, const Transform* to_world_end) {
   if (!instance_ids_.empty() && id <= instance_ids_.back())
-    throw std::logic_error("EmbreeScene::add_instance: instance ids must increase");
+    throw InternalError("EmbreeScene::add_instance: instance ids must increase");
   RTCScene child = objects_.at(size_t(object));
   rtcCommitScene(child);  // idempotent: each object is built once, however many instances it has
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);

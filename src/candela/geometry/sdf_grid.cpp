@@ -13,6 +13,8 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "candela/base/error.h"
+
 namespace candela {
 namespace {
 
@@ -134,7 +136,7 @@ void write_volume_grid(const fs::path& file, const VolumeGrid& grid) {
   for (float v : grid.values) put_u32(bytes, std::bit_cast<uint32_t>(v));
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
   out.write(bytes.data(), std::streamsize(bytes.size()));
-  if (!out) throw std::runtime_error("cannot write volume grid '" + file.string() + "'");
+  if (!out) throw OutputError("cannot write volume grid '" + file.string() + "'");
 }
 
 std::string sdf_grid_problem(const SdfGridShape& grid) {

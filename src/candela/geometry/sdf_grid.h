@@ -43,7 +43,7 @@ inline constexpr uint64_t kMaxVolumeGridValues = uint64_t(1) << 31;
 // than kMaxVolumeGridValues values). Bytes after the values are ignored, as Mitsuba does.
 VolumeGrid read_volume_grid(const std::filesystem::path& file, const SourceLocation& referenced_from);
 
-// Writes `grid` as a version 3 float32 .vol file; throws std::runtime_error naming the file.
+// Writes `grid` as a version 3 float32 .vol file; throws OutputError naming the file.
 void write_volume_grid(const std::filesystem::path& file, const VolumeGrid& grid);
 
 // Why `grid` cannot be rendered as an SDF grid, or "" when it can: a resolution below 2 on an axis,

@@ -7,6 +7,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "candela/base/error.h"
 #include "candela/integrators/mlt.h"
 #include "candela/integrators/volpath.h"
 #include "candela/render/cluster.h"
@@ -45,11 +46,11 @@ std::string AutoChoice::summary() const {
 
 AutoChoice choose_integrator(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options,
                              int budget_spp) {
-  if (!settings.sampler.replicas) throw std::logic_error("choose_integrator: the pilots need the sampler's replicas");
+  if (!settings.sampler.replicas) throw InternalError("choose_integrator: the pilots need the sampler's replicas");
   Cluster& cluster = options.cluster ? *options.cluster : local_cluster();
   AutoChoice choice;
   const std::vector<const IntegratorEntry*> candidates = auto_candidates(settings, scene.has_media());
-  if (candidates.empty()) throw std::invalid_argument("--integrator auto: no integrator reads every setting the scene sets");
+  if (candidates.empty()) throw UsageError("--integrator auto: no integrator reads every setting the scene sets");
   const double time_limit = options.time_limit_seconds;
   const double slice = time_limit > 0 ? 0.1 * time_limit / double(candidates.size()) : kPilotSeconds;
 

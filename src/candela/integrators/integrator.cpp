@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "candela/base/error.h"
 #include "candela/integrators/bdpt.h"
 #include "candela/integrators/mlt.h"
 #include "candela/integrators/path_integrator.h"
@@ -83,20 +84,20 @@ std::vector<std::string_view> set_but_unread(const IntegratorEntry& integrator, 
 RenderStats render(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options) {
   const IntegratorEntry* integrator = find_integrator(settings.integrator);
   if (!integrator)
-    throw std::invalid_argument(fmt::format("unknown integrator '{}' (known: {})", settings.integrator, integrator_names()));
+    throw UsageError(fmt::format("unknown integrator '{}' (known: {})", settings.integrator, integrator_names()));
   if (settings.adaptive() && !integrator->reads_setting("adaptive"))
-    throw std::invalid_argument(fmt::format("adaptive sampling does not apply to the {} integrator", integrator->name));
+    throw UsageError(fmt::format("adaptive sampling does not apply to the {} integrator", integrator->name));
   if (scene.has_media() && !integrator->participating_media)
-    throw std::invalid_argument(fmt::format(
+    throw UsageError(fmt::format(
         "the scene has participating media, which the {} integrator does not render: use --integrator volpath",
         integrator->name));
   if (options.only_x >= 0 && !integrator->single_pixel)
-    throw std::invalid_argument(fmt::format("the {} integrator cannot render a single pixel", integrator->name));
+    throw UsageError(fmt::format("the {} integrator cannot render a single pixel", integrator->name));
   const bool started = film.total_samples() > 0 ||
                        (film.has_splats() && std::any_of(film.splats().sums().begin(), film.splats().sums().end(),
                                                          [](int64_t v) { return v != 0; }));
   if (started && !integrator->resumable)
-    throw std::invalid_argument(fmt::format("the {} integrator cannot continue a partly rendered film", integrator->name));
+    throw UsageError(fmt::format("the {} integrator cannot continue a partly rendered film", integrator->name));
   RenderStats stats = integrator->render(scene, settings, film, options);
   // Every integrator here traces its camera samples (MLT: its depth-0 pass) through CameraSampleTiles,
   // which adds the AOVs; one that does not leaves them empty, and they get a pass of their own.

@@ -67,7 +67,7 @@ std::vector<std::string_view> set_but_unread(const IntegratorEntry& integrator, 
 
 // Renders `film` (sized to the camera's resolution) with settings.integrator, after checking that
 // it can do what `options` and the film ask (adaptive sampling, one pixel, continuing a partly
-// rendered film); throws std::invalid_argument otherwise, and for an unknown integrator.
+// rendered film, a scene with media); throws UsageError otherwise, and for an unknown integrator.
 RenderStats render(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options);
 
 }  // namespace candela

@@ -7,6 +7,7 @@
 #include <string_view>
 #include <vector>
 
+#include "candela/base/error.h"
 #include "candela/testing/render_helpers.h"
 
 namespace candela {
@@ -50,20 +51,20 @@ TEST(IntegratorRegistry, RenderRefusesWhatTheIntegratorCannotDo) {
   RenderSettings settings = d.settings;
   settings.integrator = "whitted";
   Film film(d.film.width, d.film.height);
-  EXPECT_THROW(render(scene, settings, film, options), std::invalid_argument);
+  EXPECT_THROW(render(scene, settings, film, options), UsageError);
   settings.integrator = "mlt";
   settings.adaptive_threshold = 0.1f;
-  EXPECT_THROW(render(scene, settings, film, options), std::invalid_argument);
+  EXPECT_THROW(render(scene, settings, film, options), UsageError);
   settings.adaptive_threshold = 0;
   options.only_x = options.only_y = 1;
-  EXPECT_THROW(render(scene, settings, film, options), std::invalid_argument);
+  EXPECT_THROW(render(scene, settings, film, options), UsageError);
   // A film with samples: path continues it, mlt cannot.
   options.only_x = options.only_y = -1;
   settings.integrator = "path";
   settings.spp = 1;
   render(scene, settings, film, options);
   settings.integrator = "mlt";
-  EXPECT_THROW(render(scene, settings, film, options), std::invalid_argument);
+  EXPECT_THROW(render(scene, settings, film, options), UsageError);
 }
 
 }  // namespace

@@ -6,22 +6,15 @@
 #include <cstdint>
 #include <map>
 #include <optional>
-#include <stdexcept>
 #include <string>
 
+#include "candela/base/error.h"  // UsageError: what the checks below throw
 #include "candela/film/error_estimate.h"
 #include "candela/integrators/auto_integrator.h"
 #include "candela/render/render_loop.h"
 #include "candela/scene/description.h"
 
 namespace candela {
-
-// A request the renderer refuses: a value out of range, an unknown name, settings that exclude each
-// other. Messages name the flag as the command line spells it ("--spp: ..."); the Python module
-// names its keyword instead.
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 inline constexpr int kMaxResolution = 65536;       // pixels along either side
 inline constexpr long long kMaxPixels = 1LL << 28;  // pixels in all

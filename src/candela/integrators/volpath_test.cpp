@@ -14,6 +14,7 @@
 
 #include <unistd.h>
 
+#include "candela/base/error.h"
 #include "candela/integrators/integrator.h"
 #include "candela/io/scene_reader.h"
 #include "candela/sampling/rng.h"
@@ -290,7 +291,7 @@ TEST(VolPath, ThePathTracerRefusesScenesWithMedia) {
     options.progress = false;
     try {
       render(scene, settings, film, options);
-    } catch (const std::invalid_argument& e) {
+    } catch (const UsageError& e) {
       return std::string(e.what());
     }
     return std::string("rendered");

@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "candela/base/error.h"
 #include "candela/integrators/integrator.h"
 
 
@@ -493,16 +494,16 @@ void write_json_scene(const SceneDesc& scene, const fs::path& file) {
   temporary += ".tmp";
   {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error(fmt::format("{}: cannot write: {}", file.string(), std::strerror(errno)));
+    if (!out) throw OutputError(fmt::format("{}: cannot write: {}", file.string(), std::strerror(errno)));
     out << text;
     out.close();
-    if (!out) throw std::runtime_error(fmt::format("{}: write failed", file.string()));
+    if (!out) throw OutputError(fmt::format("{}: write failed", file.string()));
   }
   std::error_code ec;
   fs::rename(temporary, file, ec);
   if (ec) {
     fs::remove(temporary, ec);
-    throw std::runtime_error(fmt::format("{}: cannot write: {}", file.string(), ec.message()));
+    throw OutputError(fmt::format("{}: cannot write: {}", file.string(), ec.message()));
   }
 }
 

@@ -16,7 +16,7 @@ namespace candela {
 std::string scene_to_json(const SceneDesc& scene);
 
 // scene_to_json written to `file` atomically (a temporary file renamed over it): an existing file is
-// never left half-written. Throws std::runtime_error naming the file when it cannot be written.
+// never left half-written. Throws OutputError naming the file when it cannot be written.
 void write_json_scene(const SceneDesc& scene, const std::filesystem::path& file);
 
 }  // namespace candela

@@ -59,24 +59,30 @@ SceneDesc read_scene_file(const std::filesystem::path& file, const SceneReadOpti
     throw_scene_error(location_of_file(file), "${} is a Mitsuba scene parameter, and this is not a Mitsuba .xml file",
                       options.parameters.begin()->first);
   SceneDesc scene;
-  if (extension == ".json")
-    scene = read_json_scene(read_text_file(file), file.string(), file.parent_path());
-  else if (extension == ".pbrt")
-    scene = read_pbrt_scene(file);
-  else if (extension == ".obj")
-    scene = read_obj_scene(file);
-  else if (extension == ".ply")
-    scene = read_mesh_scene(file);
-  else if (extension == ".gltf" || extension == ".glb")
-    scene = read_gltf_scene(file);
-  else if (extension == ".xml")
-    scene = options.warnings ? read_mitsuba_scene(file, *options.warnings, MitsubaReadOptions{options.parameters})
-                             : read_mitsuba_scene(file, MitsubaReadOptions{options.parameters});
-  else
-    throw_scene_error(location_of_file(file),
-                      "unsupported scene file extension {}; supported: .json, .pbrt, .xml (Mitsuba 3), .gltf, .glb, "
-                      ".obj, .ply, and .pbrt.gz and .ply.gz gzipped",
-                      extension.empty() ? std::string("(none)") : "\"" + extension + "\"");
+  // A file system error in a reader (a file it looks for in a directory it may not search) names the
+  // path; it reaches the user as a SceneError at the scene file, not as a bare library exception.
+  try {
+    if (extension == ".json")
+      scene = read_json_scene(read_text_file(file), file.string(), file.parent_path());
+    else if (extension == ".pbrt")
+      scene = read_pbrt_scene(file);
+    else if (extension == ".obj")
+      scene = read_obj_scene(file);
+    else if (extension == ".ply")
+      scene = read_mesh_scene(file);
+    else if (extension == ".gltf" || extension == ".glb")
+      scene = read_gltf_scene(file);
+    else if (extension == ".xml")
+      scene = options.warnings ? read_mitsuba_scene(file, *options.warnings, MitsubaReadOptions{options.parameters})
+                               : read_mitsuba_scene(file, MitsubaReadOptions{options.parameters});
+    else
+      throw_scene_error(location_of_file(file),
+                        "unsupported scene file extension {}; supported: .json, .pbrt, .xml (Mitsuba 3), .gltf, .glb, "
+                        ".obj, .ply, and .pbrt.gz and .ply.gz gzipped",
+                        extension.empty() ? std::string("(none)") : "\"" + extension + "\"");
+  } catch (const std::filesystem::filesystem_error& e) {
+    throw_scene_error(location_of_file(file), "{}", e.what());
+  }
   scene.source_file = file.string();
   return scene;
 }

@@ -14,6 +14,8 @@
 
 #include <fmt/format.h>
 
+#include "candela/base/error.h"
+
 namespace candela {
 namespace {
 
@@ -132,7 +134,7 @@ GuardedHttpServer::GuardedHttpServer(const HttpLimits& limits) : limits_(limits)
   new_task_queue = [] { return new InlineTaskQueue; };
   set_payload_max_length(limits_.max_body_bytes);
   if (::pipe2(wake_pipe_, O_NONBLOCK | O_CLOEXEC) != 0)
-    throw std::runtime_error(fmt::format("--preview: cannot create a pipe: {}", std::strerror(errno)));
+    throw InternalError(fmt::format("--preview: cannot create a pipe: {}", std::strerror(errno)));
   // Named, so that a profile or a test (tests/browser/test_preview.py) can tell the server's time apart.
   gate_ = std::thread([this] {
     ::pthread_setname_np(::pthread_self(), "http-gate");

@@ -12,6 +12,8 @@
 
 #include <fmt/format.h>
 
+#include "candela/base/error.h"
+
 namespace candela {
 namespace {
 
@@ -28,7 +30,7 @@ std::string random_preview_token() {
   while (got < sizeof(bytes)) {
     const ssize_t n = ::getrandom(bytes + got, sizeof(bytes) - got, 0);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) throw std::runtime_error(fmt::format("--preview: no random bytes from the OS: {}", std::strerror(errno)));
+    if (n <= 0) throw InternalError(fmt::format("--preview: no random bytes from the OS: {}", std::strerror(errno)));
     got += size_t(n);
   }
   std::string token;

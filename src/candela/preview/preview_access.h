@@ -20,7 +20,7 @@ struct Request;
 namespace candela {
 
 // 192 bits from the OS's random source (getrandom), as 48 hexadecimal digits. Throws
-// std::runtime_error if the OS has none to give.
+// InternalError if the OS has none to give.
 std::string random_preview_token();
 
 class PreviewAccess {

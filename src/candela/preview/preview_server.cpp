@@ -14,6 +14,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "candela/base/error.h"
+
 namespace candela {
 namespace {
 
@@ -89,12 +91,12 @@ PreviewAddress parse_preview_address(const std::string& text) {
     a.host = text.substr(0, colon);
     port = text.substr(colon + 1);
     if (a.host.size() >= 2 && a.host.front() == '[' && a.host.back() == ']') a.host = a.host.substr(1, a.host.size() - 2);
-    if (a.host.empty()) throw std::invalid_argument(fmt::format("--preview '{}': expected [HOST:]PORT, and the host before ':' is empty", text));
+    if (a.host.empty()) throw UsageError(fmt::format("--preview '{}': expected [HOST:]PORT, and the host before ':' is empty", text));
   }
   const char* end = port.data() + port.size();
   auto [ptr, ec] = std::from_chars(port.data(), end, a.port);
   if (port.empty() || ec != std::errc() || ptr != end || a.port < 0 || a.port > 65535)
-    throw std::invalid_argument(
+    throw UsageError(
         fmt::format("--preview '{}': expected [HOST:]PORT with PORT from 0 to 65535 (0 = any free port)", text));
   return a;
 }
@@ -177,7 +179,7 @@ PreviewServer::PreviewServer(const PreviewAddress& address, const LiveFilm& live
 
   port_ = server.bind(address.host, address.port);
   if (port_ <= 0)
-    throw std::runtime_error(fmt::format("--preview: cannot listen on {}:{} (address in use or not on this machine)",
+    throw UsageError(fmt::format("--preview: cannot listen on {}:{} (address in use or not on this machine)",
                                          address.host, address.port));
   access_.set_port(port_);
   thread_ = std::thread([this] {

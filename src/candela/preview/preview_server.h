@@ -32,7 +32,7 @@
 namespace candela {
 
 // "[HOST:]PORT": the host (default 127.0.0.1) and port (0 = any free port). Throws
-// std::invalid_argument with a message naming `text` when it is malformed.
+// UsageError with a message naming `text` when it is malformed.
 struct PreviewAddress {
   std::string host = "127.0.0.1";
   int port = 0;
@@ -46,7 +46,7 @@ std::string_view preview_page_html();
 
 class PreviewServer {
  public:
-  // Starts serving `live` at `address` (throws std::runtime_error if it cannot bind). `on_stop` is
+  // Starts serving `live` at `address` (throws UsageError if it cannot bind). `on_stop` is
   // called (from a server thread) when a viewer presses stop. `public_access` (--preview-public): any
   // Host header is taken, for an address other machines reach by the machine's own names.
   PreviewServer(const PreviewAddress& address, const LiveFilm& live, std::function<void()> on_stop,

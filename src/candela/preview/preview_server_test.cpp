@@ -10,6 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "candela/base/error.h"
+
 namespace candela {
 namespace {
 
@@ -30,7 +32,7 @@ TEST(PreviewServer, ParsesHostAndPort) {
     try {
       parse_preview_address(bad);
       ADD_FAILURE() << "accepted '" << bad << "'";
-    } catch (const std::invalid_argument& e) {
+    } catch (const UsageError& e) {
       EXPECT_NE(std::string(e.what()).find("PORT"), std::string::npos) << e.what();
     }
   }
@@ -154,7 +156,7 @@ TEST(PreviewServer, RefusesAPortInUse) {
   try {
     PreviewServer second(parse_preview_address("127.0.0.1:" + std::to_string(first.port())), live, nullptr);
     FAIL() << "bound a port in use";
-  } catch (const std::runtime_error& e) {
+  } catch (const UsageError& e) {
     EXPECT_NE(std::string(e.what()).find("cannot listen"), std::string::npos) << e.what();
   }
 }

@@ -19,6 +19,7 @@
 
 #include <fmt/format.h>
 
+#include "candela/base/error.h"
 #include "candela/film/live_film.h"
 
 #ifndef MSG_NOSIGNAL
@@ -31,7 +32,7 @@ namespace candela {
 
 DisplayServerAddress parse_display_server_address(std::string_view address) {
   auto fail = [&](std::string_view what) {
-    throw std::invalid_argument(
+    throw UsageError(
         fmt::format("display server address '{}': {} (expected HOST:PORT, e.g. 127.0.0.1:14158)", address, what));
   };
   if (address.empty()) fail("empty");
@@ -103,7 +104,7 @@ class PacketWriter {
     }
   }
   void finish() {
-    if (out_.size() > UINT32_MAX) throw std::length_error("tev packet over 4 GiB");
+    if (out_.size() > UINT32_MAX) throw InternalError("tev packet over 4 GiB");
     const uint32_t n = uint32_t(out_.size());
     for (int i = 0; i < 4; ++i) out_[size_t(i)] = uint8_t(n >> (8 * i));
   }
@@ -137,7 +138,7 @@ size_t update_rows_packet_size(std::string_view name, int32_t width, int32_t row
 void update_rows_packet(std::vector<uint8_t>& out, std::string_view name, int32_t width, int32_t y0, int32_t y1,
                         std::span<const float> rgb) {
   if (width <= 0 || y1 <= y0 || rgb.size() != size_t(width) * size_t(y1 - y0) * 3)
-    throw std::invalid_argument("update_rows_packet: the data does not match the rows");
+    throw InternalError("update_rows_packet: the data does not match the rows");
   out.reserve(update_rows_packet_size(name, width, y1 - y0));
   PacketWriter w(out, kUpdateImageV3);
   w.boolean(false);  // grab focus: CreateImage did
@@ -187,11 +188,11 @@ TevClient::TevClient(std::string_view address, std::string image_name, const Liv
       image_name_(std::move(image_name)),
       live_(live),
       options_(std::move(options)) {
-  if (image_name_.empty()) throw std::invalid_argument("tev client: empty image name");
+  if (image_name_.empty()) throw InternalError("tev client: empty image name");
   if (image_name_.find('\0') != std::string::npos)
-    throw std::invalid_argument("tev client: the image name holds a '\\0'");
+    throw InternalError("tev client: the image name holds a '\\0'");
   const LiveStatus s = live_.status();
-  if (s.width <= 0 || s.height <= 0) throw std::invalid_argument("tev client: the film has no pixels");
+  if (s.width <= 0 || s.height <= 0) throw InternalError("tev client: the film has no pixels");
   thread_ = std::thread([this] { run(); });
 }
 

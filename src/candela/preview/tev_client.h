@@ -57,7 +57,7 @@ struct DisplayServerAddress {
   std::string host;  // without brackets
   uint16_t port = 0;
 };
-// Throws std::invalid_argument naming the address and what is wrong with it.
+// Throws UsageError naming the address and what is wrong with it.
 DisplayServerAddress parse_display_server_address(std::string_view address);
 
 // tev's packets, as bytes (the layout above).
@@ -91,8 +91,8 @@ struct TevClientOptions {
 
 class TevClient {
  public:
-  // Parses `address` (throwing std::invalid_argument if malformed, std::invalid_argument for an empty
-  // or '\0'-holding image name) and starts the client's thread, which connects and sends as above.
+  // Parses `address` (throwing UsageError if malformed, InternalError for an empty or '\0'-holding
+  // image name) and starts the client's thread, which connects and sends as above.
   // `live` must outlive the client.
   TevClient(std::string_view address, std::string image_name, const LiveFilm& live, TevClientOptions options = {});
   ~TevClient();  // stop()

@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "candela/base/error.h"
 #include "candela/film/film.h"
 #include "candela/film/live_film.h"
 
@@ -370,7 +371,7 @@ TEST(TevClient, RefusesMalformedAddresses) {
     try {
       TevClient client(bad, kName, live, fast_options());
       ADD_FAILURE() << "accepted '" << bad << "'";
-    } catch (const std::invalid_argument& e) {
+    } catch (const UsageError& e) {
       const std::string message = e.what();
       EXPECT_NE(message.find(std::string("'") + bad + "'"), std::string::npos) << message;
       EXPECT_NE(message.find("expected HOST:PORT"), std::string::npos) << message;
@@ -379,12 +380,12 @@ TEST(TevClient, RefusesMalformedAddresses) {
   try {
     parse_display_server_address("localhost:70000");
     ADD_FAILURE();
-  } catch (const std::invalid_argument& e) {
+  } catch (const UsageError& e) {
     EXPECT_STREQ(e.what(),
                  "display server address 'localhost:70000': port '70000' is not a number from 1 to 65535 "
                  "(expected HOST:PORT, e.g. 127.0.0.1:14158)");
   }
-  EXPECT_THROW(TevClient("127.0.0.1:14158", "", live, fast_options()), std::invalid_argument);
+  EXPECT_THROW(TevClient("127.0.0.1:14158", "", live, fast_options()), InternalError);
 }
 
 // The bytes of both packets, written out by hand from tev's layout.

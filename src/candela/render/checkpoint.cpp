@@ -8,6 +8,8 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "candela/base/error.h"
+
 namespace candela {
 namespace {
 
@@ -35,7 +37,7 @@ struct Reader {
   const char* end;
   std::string file;
   void raw(void* out, size_t n) {
-    if (size_t(end - p) < n) throw std::runtime_error("checkpoint '" + file + "': corrupt (payload too short)");
+    if (size_t(end - p) < n) throw FileContentError("checkpoint '" + file + "': corrupt (payload too short)");
     std::memcpy(out, p, n);
     p += n;
   }
@@ -47,16 +49,20 @@ struct Reader {
   }
   std::string str() {
     uint32_t n = get<uint32_t>();
-    if (size_t(end - p) < n) throw std::runtime_error("checkpoint '" + file + "': corrupt (payload too short)");
+    if (size_t(end - p) < n) throw FileContentError("checkpoint '" + file + "': corrupt (payload too short)");
     std::string s(p, n);
     p += n;
     return s;
   }
 };
 
+// A checkpoint that cannot be read (FileContentError) or written (OutputError), named in the message.
+template <typename Error>
 [[noreturn]] void fail(const std::filesystem::path& file, const std::string& what) {
-  throw std::runtime_error("checkpoint '" + file.string() + "': " + what);
+  throw Error("checkpoint '" + file.string() + "': " + what);
 }
+[[noreturn]] void fail_read(const std::filesystem::path& file, const std::string& what) { fail<FileContentError>(file, what); }
+[[noreturn]] void fail_write(const std::filesystem::path& file, const std::string& what) { fail<OutputError>(file, what); }
 
 }  // namespace
 
@@ -91,7 +97,8 @@ std::string RenderFingerprint::difference(const RenderFingerprint& now) const {
 }
 
 void write_checkpoint(const std::filesystem::path& file, const Checkpoint& cp) {
-  if (cp.pixels.size() != size_t(cp.width) * size_t(cp.height)) fail(file, "pixel count does not match the size");
+  if (cp.pixels.size() != size_t(cp.width) * size_t(cp.height))
+    fail<InternalError>(file, "pixel count does not match the size");
   Writer payload;
   payload.put(cp.fingerprint.scene_hash);
   payload.put(uint32_t(cp.fingerprint.settings.size()));
@@ -113,7 +120,8 @@ void write_checkpoint(const std::filesystem::path& file, const Checkpoint& cp) {
     payload.put(px.half_count);
   }
   for (const auto* splats : {&cp.splats, &cp.half_splats}) {
-    if (!splats->empty() && splats->size() != cp.pixels.size() * 3) fail(file, "splat count does not match the size");
+    if (!splats->empty() && splats->size() != cp.pixels.size() * 3)
+      fail<InternalError>(file, "splat count does not match the size");
     payload.put(uint64_t(splats->size()));
     for (int64_t v : *splats) payload.put(v);
   }
@@ -128,7 +136,7 @@ void write_checkpoint(const std::filesystem::path& file, const Checkpoint& cp) {
   std::filesystem::path tmp = file;
   tmp += ".tmp." + std::to_string(getpid());
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) fail(file, std::string("cannot create '") + tmp.string() + "': " + std::strerror(errno));
+  if (fd < 0) fail_write(file, std::string("cannot create '") + tmp.string() + "': " + std::strerror(errno));
   auto write_all = [&](const std::string& bytes) {
     const char* p = bytes.data();
     size_t left = bytes.size();
@@ -150,7 +158,7 @@ void write_checkpoint(const std::filesystem::path& file, const Checkpoint& cp) {
   if (!ok || ::rename(tmp.c_str(), file.c_str()) != 0) {
     if (ok) err = errno;
     ::unlink(tmp.c_str());
-    fail(file, std::string("cannot write: ") + std::strerror(err));
+    fail_write(file, std::string("cannot write: ") + std::strerror(err));
   }
   int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dfd >= 0) {
@@ -161,7 +169,7 @@ void write_checkpoint(const std::filesystem::path& file, const Checkpoint& cp) {
 
 std::string read_checkpoint_bytes(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
-  if (!in) fail(file, "cannot open");
+  if (!in) fail_read(file, "cannot open");
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
@@ -169,18 +177,18 @@ Checkpoint read_checkpoint(const std::filesystem::path& file) { return parse_che
 
 Checkpoint parse_checkpoint(std::string_view bytes, const std::filesystem::path& file) {
   if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
-    fail(file, "not a candela checkpoint (bad magic header)");
-  if (bytes.size() < kHeaderSize) fail(file, "truncated (header incomplete)");
+    fail_read(file, "not a candela checkpoint (bad magic header)");
+  if (bytes.size() < kHeaderSize) fail_read(file, "truncated (header incomplete)");
   Reader header{bytes.data() + sizeof kMagic, bytes.data() + kHeaderSize, file.string()};
   uint32_t version = header.get<uint32_t>();
   if (version > kVersion || version == 0)
-    fail(file, "unsupported version " + std::to_string(version) + " (this candela reads version " +
+    fail_read(file, "unsupported version " + std::to_string(version) + " (this candela reads version " +
                    std::to_string(kVersion) + ")");
   uint64_t size = header.get<uint64_t>(), hash = header.get<uint64_t>();
   if (bytes.size() - kHeaderSize < size)
-    fail(file, "truncated (" + std::to_string(bytes.size()) + " bytes, expected " + std::to_string(kHeaderSize + size) + ")");
-  if (bytes.size() - kHeaderSize > size) fail(file, "corrupt (trailing bytes after the payload)");
-  if (fnv1a64(bytes.data() + kHeaderSize, size) != hash) fail(file, "corrupt (checksum mismatch)");
+    fail_read(file, "truncated (" + std::to_string(bytes.size()) + " bytes, expected " + std::to_string(kHeaderSize + size) + ")");
+  if (bytes.size() - kHeaderSize > size) fail_read(file, "corrupt (trailing bytes after the payload)");
+  if (fnv1a64(bytes.data() + kHeaderSize, size) != hash) fail_read(file, "corrupt (checksum mismatch)");
 
   Reader r{bytes.data() + kHeaderSize, bytes.data() + bytes.size(), file.string()};
   Checkpoint cp;
@@ -202,7 +210,7 @@ Checkpoint parse_checkpoint(std::string_view bytes, const std::filesystem::path&
                     (cp.height == 0 || uint64_t(cp.width) <= left / pixel_size / uint64_t(cp.height));
   const uint64_t pixel_bytes = fits ? uint64_t(cp.width) * uint64_t(cp.height) * pixel_size : 0;
   if (!fits || (version == 1 ? left != pixel_bytes : left < pixel_bytes + 8))
-    fail(file, "corrupt (pixel data does not match the size)");
+    fail_read(file, "corrupt (pixel data does not match the size)");
   cp.pixels.resize(size_t(cp.width) * size_t(cp.height));
   for (PixelSums& px : cp.pixels) {
     r.raw(px.weighted, sizeof px.weighted);
@@ -222,7 +230,7 @@ Checkpoint parse_checkpoint(std::string_view bytes, const std::filesystem::path&
     uint64_t count = r.get<uint64_t>();
     if ((count != 0 && count != uint64_t(cp.pixels.size()) * 3) || uint64_t(r.end - r.p) < count * 8 ||
         (last && uint64_t(r.end - r.p) != count * 8))
-      fail(file, "corrupt (splat data does not match the size)");
+      fail_read(file, "corrupt (splat data does not match the size)");
     splats->resize(size_t(count));
     for (int64_t& v : *splats) v = r.get<int64_t>();
   }

@@ -48,9 +48,9 @@ struct Checkpoint {
   std::vector<int64_t> half_splats;  // Film::half_splats()'s sums, or empty
 };
 
-// Throws std::runtime_error naming the file when it cannot be written.
+// Throws OutputError naming the file when it cannot be written.
 void write_checkpoint(const std::filesystem::path& file, const Checkpoint& checkpoint);
-// Throws std::runtime_error naming the file and the problem: missing, not a checkpoint, another
+// Throws FileContentError naming the file and the problem: missing, not a checkpoint, another
 // version, truncated, or corrupt (checksum mismatch).
 Checkpoint read_checkpoint(const std::filesystem::path& file);
 // The two steps of read_checkpoint, for a checkpoint read by one rank and sent to the others: the

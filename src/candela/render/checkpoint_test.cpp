@@ -10,6 +10,8 @@
 #include <fstream>
 #include <regex>
 
+#include "candela/base/error.h"
+
 namespace candela {
 namespace {
 
@@ -48,7 +50,7 @@ struct CheckpointFile : ::testing::Test {
   std::string error() const {
     try {
       read_checkpoint(file);
-    } catch (const std::runtime_error& e) {
+    } catch (const FileContentError& e) {
       return e.what();
     }
     return "";
@@ -93,7 +95,7 @@ TEST_F(CheckpointFile, SplatSumsRoundTripAndMustMatchTheSize) {
   EXPECT_TRUE(read_checkpoint(file).splats.empty());
   // A splat array that does not fit the film is refused before anything is written.
   cp.splats.resize(5);
-  EXPECT_THROW(write_checkpoint(file, cp), std::runtime_error);
+  EXPECT_THROW(write_checkpoint(file, cp), InternalError);
 }
 
 TEST_F(CheckpointFile, TruncatedCorruptAndForeignFilesAreRefused) {
@@ -126,7 +128,7 @@ TEST_F(CheckpointFile, EveryTruncationAndBitFlipIsRefused) {
   const auto refusal = [](const std::string& damaged) {
     try {
       parse_checkpoint(damaged, "render.ckpt");
-    } catch (const std::runtime_error& e) {
+    } catch (const FileContentError& e) {
       return std::string(e.what());
     }
     return std::string("(read)");
@@ -160,7 +162,7 @@ TEST(CheckpointBytes, SizeWhosePixelBytesPass2To64IsCorrupt) {
   try {
     parse_checkpoint(bytes + payload, "big.ckpt");
     FAIL() << "read";
-  } catch (const std::runtime_error& e) {
+  } catch (const FileContentError& e) {
     EXPECT_STREQ(e.what(), "checkpoint 'big.ckpt': corrupt (pixel data does not match the size)");
   }
 }

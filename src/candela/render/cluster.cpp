@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "candela/base/error.h"
+
 namespace candela {
 
 bool Cluster::any(bool flag) {
@@ -13,14 +15,24 @@ bool Cluster::any(bool flag) {
   return false;
 }
 
-std::string Cluster::first_error(const std::string& error) {
-  std::vector<std::vector<std::byte>> all = all_gather(std::as_bytes(std::span(error.data(), error.size())));
+Cluster::RankError Cluster::first_error(const std::string& error, int exit_code) {
+  // Each rank sends nothing, or its exit code (4 bytes in the host's order: every rank runs the same
+  // build) and then its message.
+  std::string mine;
+  if (!error.empty()) {
+    const int32_t code = exit_code;
+    mine.append(reinterpret_cast<const char*>(&code), sizeof code);
+    mine += error;
+  }
+  std::vector<std::vector<std::byte>> all = all_gather(std::as_bytes(std::span(mine.data(), mine.size())));
   for (size_t r = 0; r < all.size(); ++r)
-    if (!all[r].empty()) {
-      std::string message(reinterpret_cast<const char*>(all[r].data()), all[r].size());
-      return r == 0 ? message : "rank " + std::to_string(r) + ": " + message;
+    if (all[r].size() > sizeof(int32_t)) {
+      int32_t code = 0;
+      std::memcpy(&code, all[r].data(), sizeof code);
+      std::string message(reinterpret_cast<const char*>(all[r].data()) + sizeof code, all[r].size() - sizeof code);
+      return {r == 0 ? message : "rank " + std::to_string(r) + ": " + message, code};
     }
-  return "";
+  return {};
 }
 
 void LocalCluster::share_work(uint64_t items, int, const std::function<void(const NextItem&)>& work,
@@ -67,10 +79,10 @@ const char* mpi_launcher_rank() {
 std::unique_ptr<Cluster> join_cluster(int&, char**&) {
   // Started by mpirun but unable to join: every process would render the whole image on its own.
   if (const char* rank = mpi_launcher_rank())
-    throw std::runtime_error(std::string(rank) != "0"
-                                 ? ""
-                                 : "this candela was built without MPI, but an MPI launcher started it: build it "
-                                   "where CMake finds MPI (Debian: libopenmpi-dev), or run it without mpirun");
+    throw UsageError(std::string(rank) != "0"
+                         ? ""
+                         : "this candela was built without MPI, but an MPI launcher started it: build it "
+                           "where CMake finds MPI (Debian: libopenmpi-dev), or run it without mpirun");
   return std::make_unique<LocalCluster>();
 }
 std::string mpi_support() { return "built without MPI: renders in one process"; }

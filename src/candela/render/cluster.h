@@ -94,9 +94,15 @@ class Cluster {
     std::memcpy(&value, bytes.data(), sizeof(T));
     return value;
   }
-  // "" on every rank when every rank's `error` is empty; otherwise the lowest failing rank's
-  // message, prefixed with "rank K: " when that is not the root (collective).
-  std::string first_error(const std::string& error);
+  // On every rank (collective), the lowest failing rank's error: its message, prefixed with
+  // "rank K: " when that is not the root, and its `exit_code` (base/error.h's exit_code_for), so that
+  // every rank exits as that rank's error says. An empty message (and 0) when every rank's `error`
+  // is empty.
+  struct RankError {
+    std::string message;
+    int exit_code = 0;
+  };
+  RankError first_error(const std::string& error, int exit_code);
 };
 
 // The process on its own.

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "candela/base/error.h"
 #include "candela/film/image_io.h"
 #include "candela/render/render_loop.h"
 
@@ -20,7 +21,7 @@ constexpr const char* kSplatFields[] = {"splat.R", "splat.G", "splat.B"};
 constexpr size_t kPixelWords = 2 * std::size(kPixelFields), kSplatWords = 2 * std::size(kSplatFields);
 
 [[noreturn]] void fail_part(const std::filesystem::path& file, const std::string& what) {
-  throw std::runtime_error(fmt::format("{}: {}", file.string(), what));
+  throw FileContentError(fmt::format("{}: {}", file.string(), what));
 }
 
 void put64(uint32_t* out, uint64_t v) {
@@ -74,7 +75,7 @@ RenderFingerprint without_sample_set(RenderFingerprint fp) {
   return fp;
 }
 
-// The unsigned number `text` in `base`, all of it, or a runtime_error naming the file and the attribute.
+// The unsigned number `text` in `base`, all of it, or a FileContentError naming the file and the attribute.
 uint64_t parse_u64(const std::filesystem::path& file, const std::string& attribute, const std::string& text, int base) {
   uint64_t value = 0;
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value, base);
@@ -117,7 +118,8 @@ void write_part(const std::filesystem::path& file, const FilmPart& part, std::ma
 }
 
 FilmPart read_part(const std::filesystem::path& file) {
-  if (!std::filesystem::exists(file)) fail_part(file, "no such file");
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec)) fail_part(file, ec ? ec.message() : "no such file");
   // A part is a single-part image (write_part writes no other); check_exr_header walks the header
   // before OpenImageIO reads it.
   const int exr_flags = check_exr_header(file);
@@ -178,7 +180,7 @@ FilmPart read_part(const std::filesystem::path& file) {
 }
 
 MergedRender merge_parts(const std::vector<std::filesystem::path>& files) {
-  if (files.empty()) throw std::runtime_error("merge: no parts given");
+  if (files.empty()) throw UsageError("merge: no parts given");
   std::vector<FilmPart> parts;
   for (const auto& f : files) parts.push_back(read_part(f));
 
@@ -231,8 +233,8 @@ MergedRender merge_parts(const std::vector<std::filesystem::path>& files) {
     }
     for (int k = 0; k < lead.count; ++k)  // stops at the first missing part, at most of_set.size() on
       if (!holder.contains(k))
-        throw std::runtime_error(fmt::format("merge: part {}/{} of seed {} is missing (have {})", k + 1, lead.count,
-                                             seed, files[size_t(of_set[0])].string()));
+        throw FileContentError(fmt::format("merge: part {}/{} of seed {} is missing (have {})", k + 1, lead.count,
+                                           seed, files[size_t(of_set[0])].string()));
     // This sample set's film: each tile's pixels from the part that rendered it, splats summed.
     Film set(width, height);
     for (size_t t = 0; t < tiles.size(); ++t) {

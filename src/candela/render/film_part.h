@@ -35,9 +35,9 @@ struct FilmPart {
 };
 
 // Writes `part` to an .exr (atomically, like every image), R, G, B from its film, with `metadata`
-// and the part's own attributes. Throws std::runtime_error naming the file.
+// and the part's own attributes. Throws OutputError naming the file.
 void write_part(const std::filesystem::path& file, const FilmPart& part, std::map<std::string, std::string> metadata);
-// Throws std::runtime_error naming the file when it cannot be read or is not a candela part.
+// Throws FileContentError naming the file when it cannot be read or is not a candela part.
 FilmPart read_part(const std::filesystem::path& file);
 
 struct MergedRender {
@@ -50,7 +50,8 @@ struct MergedRender {
 
 // Merges the parts in `files` (read with read_part): they must come from the same scene and
 // settings; grouped by seed, each group must hold parts 1..N of one N exactly once. Throws
-// std::runtime_error naming the file at fault (missing, duplicated or foreign part).
+// FileContentError naming the file at fault (missing, duplicated or foreign part), UsageError for no
+// files.
 MergedRender merge_parts(const std::vector<std::filesystem::path>& files);
 
 }  // namespace candela

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "candela/base/error.h"
 #include "candela/film/image_io.h"
 
 namespace candela {
@@ -37,7 +38,7 @@ struct PartFile : ::testing::Test {
   std::string merge_error() const {
     try {
       merge_parts({file});
-    } catch (const std::runtime_error& e) {
+    } catch (const FileContentError& e) {
       return e.what();
     }
     return "";
@@ -68,7 +69,7 @@ TEST_F(PartFile, HeaderAttributeLargerThanTheHeaderIsRefused) {
   try {
     (void)read_image(file);
     ADD_FAILURE() << "read";
-  } catch (const std::runtime_error& e) {
+  } catch (const FileContentError& e) {
     EXPECT_EQ(std::string(e.what()), message);
   }
 }

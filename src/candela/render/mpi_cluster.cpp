@@ -20,6 +20,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "candela/base/error.h"
 #include "candela/render/cluster.h"
 
 namespace candela {
@@ -35,7 +36,7 @@ constexpr int kTagGrant = 2;    // payload: uint64 first, uint64 count (0 = no m
 constexpr auto kPoll = std::chrono::milliseconds(1);
 
 void check(int code, const char* what) {
-  if (code != MPI_SUCCESS) throw std::runtime_error(std::string("MPI call failed: ") + what);
+  if (code != MPI_SUCCESS) throw InternalError(std::string("MPI call failed: ") + what);
 }
 
 // The items a rank has been given and not yet started, shared by its render threads.
@@ -85,7 +86,7 @@ class MpiCluster final : public Cluster {
     check(MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided), "MPI_Init_thread");
     if (provided < MPI_THREAD_FUNNELED) {
       MPI_Finalize();
-      throw std::runtime_error("the MPI library does not provide MPI_THREAD_FUNNELED");
+      throw InternalError("the MPI library does not provide MPI_THREAD_FUNNELED");
     }
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &size_);

@@ -18,6 +18,7 @@
 #include <ctime>
 #include <tuple>
 
+#include "candela/base/error.h"
 #include "candela/film/aov_film.h"
 #include "candela/film/error_estimate.h"
 #include "candela/render/film_part.h"
@@ -406,7 +407,7 @@ void exchange_items(Cluster& cluster, const std::vector<uint8_t>& mine,
     while (in < end) {
       uint64_t item;
       std::memcpy(&item, in, sizeof item);
-      if (item >= mine.size()) throw std::runtime_error("exchange_items: an item out of range came from rank " + std::to_string(r));
+      if (item >= mine.size()) throw InternalError("exchange_items: an item out of range came from rank " + std::to_string(r));
       in = read(item, in + sizeof item);
     }
   }
@@ -468,7 +469,7 @@ float relative_error(const PixelSums& pixel) {
 RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options,
                          const TileIntegrator& integrator) {
   if (options.only_x >= film.width() || options.only_y >= film.height() || (options.only_x >= 0) != (options.only_y >= 0))
-    throw std::invalid_argument("pixel to render is outside the image");
+    throw InternalError("pixel to render is outside the image");
   auto start = std::chrono::steady_clock::now();
   const bool adaptive = settings.adaptive();
   const int max_spp = adaptive ? std::max(settings.adaptive_spp_limit(), settings.adaptive_batch) : settings.spp;
@@ -607,7 +608,7 @@ RenderStats render_tiles(const Scene& scene, const RenderSettings& settings, Fil
         pass_spp = std::min(2 * pass_spp, kLongestPassSpp);
     }
   } else {
-    if (samples_before > 0) throw std::invalid_argument("adaptive sampling cannot continue a partly rendered film");
+    if (samples_before > 0) throw InternalError("adaptive sampling cannot continue a partly rendered film");
     render_adaptive(pc, tiles, arena, progress, settings, options, stop_after_pass);
   }
   progress.finish();

@@ -7,6 +7,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "candela/base/error.h"
 #include "candela/base/overloaded.h"
 
 namespace candela {
@@ -229,7 +230,7 @@ const Slot& find_slot(const std::vector<Slot>& all, const std::string& name) {
       if (common > best) best = common, near.clear();
       if (common == best && best > 0 && near.size() < 200) near += (near.empty() ? "" : ", ") + s.name;
     }
-    throw std::invalid_argument(fmt::format("no scene parameter '{}'{}", name, near.empty() ? "" : "; did you mean one of: " + near));
+    throw UnknownParameterError(fmt::format("no scene parameter '{}'{}", name, near.empty() ? "" : "; did you mean one of: " + near));
   }
   return *slot;
 }
@@ -253,28 +254,28 @@ void set_scene_parameter(SceneDesc& scene, const std::string& name, const Parame
   const Slot* slot = &find_slot(all, name);
   const ParameterValue current = value_of(*slot);
   if (value.index() != current.index())
-    throw std::domain_error(fmt::format("{}: expected {}, got {}", name, kind_name(current), kind_name(value)));
+    throw UsageError(fmt::format("{}: expected {}, got {}", name, kind_name(current), kind_name(value)));
   if (slot->number) {
     float v = std::get<float>(value);
     bool below = slot->lo_open ? !(v > slot->lo) : !(v >= slot->lo);
     bool above = slot->hi_open ? !(v < slot->hi) : !(v <= slot->hi);
     if (!std::isfinite(v) || below || above)
-      throw std::domain_error(fmt::format("{}: {} is outside its range ({})", name, v, slot->range()));
+      throw UsageError(fmt::format("{}: {} is outside its range ({})", name, v, slot->range()));
     *slot->number = v;
     if (slot->number_too) *slot->number_too = v;
   } else if (slot->color) {
     RGB c = std::get<RGB>(value);
     for (int i = 0; i < 3; ++i)
       if (!std::isfinite(c[i]) || c[i] < 0 || c[i] > slot->hi)
-        throw std::domain_error(fmt::format("{}: ({}, {}, {}) is outside its range ({})", name, c.r, c.g, c.b, slot->range()));
+        throw UsageError(fmt::format("{}: ({}, {}, {}) is outside its range ({})", name, c.r, c.g, c.b, slot->range()));
     *slot->color = c;
   } else {
     const Matrix4& m = std::get<Matrix4>(value);
     for (const auto& row : m.m)
       for (double x : row)
-        if (!std::isfinite(x)) throw std::domain_error(fmt::format("{}: the matrix has a value that is not finite", name));
+        if (!std::isfinite(x)) throw UsageError(fmt::format("{}: the matrix has a value that is not finite", name));
     std::optional<Transform> t = Transform::from_matrix(m);
-    if (!t) throw std::domain_error(fmt::format("{}: the matrix is singular (it has no inverse)", name));
+    if (!t) throw UsageError(fmt::format("{}: the matrix is singular (it has no inverse)", name));
     *slot->transform = *t;
   }
 }

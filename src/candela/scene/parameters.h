@@ -33,12 +33,12 @@ struct SceneParameter {
 // media).
 std::vector<SceneParameter> scene_parameters(const SceneDesc& scene);
 
-// The named parameter's value. Throws std::invalid_argument for an unknown name (with the closest names).
+// The named parameter's value. Throws UnknownParameterError for an unknown name (with the closest names).
 ParameterValue scene_parameter(const SceneDesc& scene, const std::string& name);
 
-// Sets the named parameter. Throws std::invalid_argument for an unknown name (with
-// the closest names), std::domain_error for a value of the wrong kind or outside its range, which
-// leaves the scene unchanged.
+// Sets the named parameter. Throws UnknownParameterError for an unknown name (with the closest
+// names), UsageError for a value of the wrong kind or outside its range, which leaves the scene
+// unchanged.
 void set_scene_parameter(SceneDesc& scene, const std::string& name, const ParameterValue& value);
 
 }  // namespace candela

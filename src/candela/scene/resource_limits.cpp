@@ -102,7 +102,7 @@ uint64_t image_bytes(const std::string& filename, uint64_t extra_per_texel, cons
   if (filename.empty()) return 0;
   try {
     check_exr_header(filename);
-  } catch (const std::runtime_error& malformed) {
+  } catch (const FileContentError& malformed) {
     throw_scene_error(where, "{}", malformed.what());
   }
   auto in = OIIO::ImageInput::open(filename);
@@ -113,7 +113,7 @@ uint64_t image_bytes(const std::string& filename, uint64_t extra_per_texel, cons
   const OIIO::ImageSpec& spec = in->spec();
   try {
     check_image_size(filename, spec.width, spec.height);
-  } catch (const std::runtime_error& too_large) {
+  } catch (const FileContentError& too_large) {
     throw_scene_error(where, "{}", too_large.what());
   }
   const uint64_t texels = mul(non_negative(spec.width), non_negative(spec.height));

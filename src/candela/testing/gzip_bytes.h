@@ -6,13 +6,15 @@
 #include <string>
 #include <string_view>
 
+#include "candela/base/error.h"
+
 namespace candela::testing {
 
 // `data` as one gzip member, as `gzip` writes it.
 inline std::string gzip_bytes(std::string_view data) {
   z_stream stream{};
   if (deflateInit2(&stream, Z_BEST_COMPRESSION, Z_DEFLATED, 16 + MAX_WBITS, 8, Z_DEFAULT_STRATEGY) != Z_OK)
-    throw std::runtime_error("deflateInit2 failed");
+    throw InternalError("deflateInit2 failed");
   std::string out(deflateBound(&stream, uLong(data.size())), '\0');
   stream.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
   stream.avail_in = uInt(data.size());
@@ -21,7 +23,7 @@ inline std::string gzip_bytes(std::string_view data) {
   const int status = deflate(&stream, Z_FINISH);
   out.resize(out.size() - stream.avail_out);
   deflateEnd(&stream);
-  if (status != Z_STREAM_END) throw std::runtime_error("deflate failed");
+  if (status != Z_STREAM_END) throw InternalError("deflate failed");
   return out;
 }
 

@@ -18,7 +18,7 @@ namespace candela {
 
 // An image texture's file read as the texture decodes it (integer texels sRGB-decoded unless the
 // texture says linear), shared with every other holder of the same file (read_image_shared).
-// Throws std::runtime_error naming the file.
+// Throws FileContentError naming the file.
 std::shared_ptr<const Image> read_texture_image(const ImageTexture& texture);
 
 // The triangle a texture is looked up on, for mesh-attribute textures: the mesh's attributes

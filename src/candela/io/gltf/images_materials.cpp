@@ -11,6 +11,7 @@
 #include <fstream>
 #include <system_error>
 
+#include "candela/base/error.h"
 #include "candela/film/image_io.h"
 
 namespace candela::gltf {
@@ -80,7 +81,7 @@ std::string GltfReader::image_file(int index, const std::string& user) {
 void GltfReader::checked_exr_header(const std::string& file, const std::string& pointer) const {
   try {
     check_exr_header(file);
-  } catch (const std::runtime_error& malformed) {
+  } catch (const FileContentError& malformed) {
     fail(pointer, "{}", malformed.what());
   }
 }

@@ -4,6 +4,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "candela/base/error.h"
 #include "candela/film/aov_film.h"
 #include "candela/integrators/integrator.h"
 
@@ -91,7 +92,7 @@ void JsonSceneReader::read_render(const Json& value, const std::string& pointer)
   if (!scene_.film.aovs.empty()) {
     try {
       parse_aovs(scene_.film.aovs);
-    } catch (const std::invalid_argument& e) {
+    } catch (const UsageError& e) {
       report_.fail(render.pointer_of("aovs"), "{}", e.what());
     }
   }
