@@ -19,7 +19,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   candela::GltfOptions options;
   options.cache_dir = candela_fuzz::scratch_dir() / "gltf-cache";
   options.film_width = 64;
-  std::vector<std::string> warnings;
+  candela::Warnings warnings;
   try {
     (void)candela::read_gltf_scene(file, warnings, options);
   } catch (const candela::SceneError& e) {

@@ -12,7 +12,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::string_view text(reinterpret_cast<const char*>(data), size);
-  std::vector<std::string> warnings;
+  candela::Warnings warnings;
   try {
     (void)candela::read_mitsuba_scene_text(text, "fuzz.xml", candela_fuzz::scratch_dir(), warnings);
   } catch (const candela::SceneError& e) {

@@ -10,7 +10,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const auto file = candela_fuzz::write_input(data, size, "input.pbrt");
-  std::vector<std::string> warnings;
+  candela::Warnings warnings;
   try {
     (void)candela::read_pbrt_scene(file, warnings);
   } catch (const candela::SceneError& e) {

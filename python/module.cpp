@@ -357,14 +357,14 @@ PYBIND11_MODULE(_candela, m) {
       });
 
   m.def("load_file", [](const std::string& path, const std::map<std::string, std::string>& parameters) {
-    std::vector<std::string> warnings;
+    Warnings warnings;
     SceneDesc desc;
     {
       py::gil_scoped_release release;
-      // Mitsuba's warnings come back to the package, which warns with them.
+      // The readers' warnings come back to the package, which warns with them.
       desc = read_scene_file(path, SceneReadOptions{parameters, &warnings});
     }
-    return py::make_tuple(make_scene(std::move(desc), path), warnings);
+    return py::make_tuple(make_scene(std::move(desc), path), warnings.lines());
   });
   m.def("load_json", [](const std::string& text, const std::string& name, const std::string& base_dir) {
     return make_scene(read_json_scene(text, name, base_dir), name);

@@ -101,7 +101,7 @@ TEST_F(FuzzRegression, JsonReader) {
 
 TEST_F(FuzzRegression, PbrtReader) {
   expect_no_crash("pbrt_reader", [&](const fs::path& input) {
-    std::vector<std::string> warnings;
+    Warnings warnings;
     (void)read_pbrt_scene(copy_in(input, "input.pbrt"), warnings);
   });
 }
@@ -147,7 +147,7 @@ TEST_F(FuzzRegression, SerializedReader) {
 
 TEST_F(FuzzRegression, MitsubaReader) {
   expect_no_crash("mitsuba_reader", [&](const fs::path& input) {
-    std::vector<std::string> warnings;
+    Warnings warnings;
     (void)read_mitsuba_scene_text(read_bytes(input), input.filename().string(), dir_, warnings);
   });
 }
@@ -156,7 +156,7 @@ TEST_F(FuzzRegression, GltfReader) {
   // As fuzz/gltf_reader_fuzz.cpp: a .glb when the input starts with "glTF", else a .gltf.
   expect_no_crash("gltf_reader", [&](const fs::path& input) {
     const std::string name = read_bytes(input).starts_with("glTF") ? "input.glb" : "input.gltf";
-    std::vector<std::string> warnings;
+    Warnings warnings;
     (void)read_gltf_scene(copy_in(input, name), warnings, GltfOptions{dir_ / "gltf-cache", 64});
   });
 }

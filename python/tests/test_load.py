@@ -37,6 +37,18 @@ def test_mitsuba_parameters_override_the_defaults():
         candela.load_file(SOURCE_DIR / "scenes/cornell-box.json", spp=4)
 
 
+def test_the_readers_warnings_become_scene_warnings(tmp_path):
+    # Every reader's warnings (io/warnings.h) come back to the package, named by their place.
+    pbrt = tmp_path / "sobol.pbrt"
+    pbrt.write_text('Sampler "sobol"\nWorldBegin\nShape "sphere"\n')
+    with pytest.warns(candela.SceneWarning, match=r"sobol\.pbrt:1:9: warning: sobol: using candela's zsobol sampler"):
+        candela.load_file(pbrt)
+    obj = tmp_path / "quad.obj"
+    obj.write_text("mtllib nowhere.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n")
+    with pytest.warns(candela.SceneWarning, match=r"material library '.*nowhere\.mtl'"):
+        candela.load_file(obj)
+
+
 def scene_format_examples():
     """Each ```json block of docs/scene-format.md, with the line it ends on."""
     examples, block, start = [], None, 0

@@ -14,11 +14,10 @@
 #include "candela/io/gltf_reader.h"
 
 #include "candela/io/gltf/reader.h"
-#include "candela/io/pbrt_reader.h"  // print_pbrt_warnings: the same one-line warnings
 
 namespace candela {
 
-SceneDesc read_gltf_scene(const std::filesystem::path& file, std::vector<std::string>& warnings,
+SceneDesc read_gltf_scene(const std::filesystem::path& file, Warnings& warnings,
                           const GltfOptions& options) {
   SceneDesc scene = gltf::GltfReader(file, warnings, options).read();
   scene.source_file = file.string();
@@ -26,15 +25,7 @@ SceneDesc read_gltf_scene(const std::filesystem::path& file, std::vector<std::st
 }
 
 SceneDesc read_gltf_scene(const std::filesystem::path& file) {
-  std::vector<std::string> warnings;
-  try {
-    SceneDesc scene = read_gltf_scene(file, warnings);
-    print_pbrt_warnings(warnings);
-    return scene;
-  } catch (const SceneError&) {
-    print_pbrt_warnings(warnings);
-    throw;
-  }
+  return read_printing_warnings([&](Warnings& warnings) { return read_gltf_scene(file, warnings); });
 }
 
 }  // namespace candela

@@ -3,10 +3,10 @@
 // in scene_reader.cpp reads the same way and prints the warnings to stderr.
 #include <filesystem>
 #include <string>
-#include <vector>
 
 #include "candela/scene/description.h"
 
+#include "candela/io/warnings.h"
 namespace candela {
 
 struct GltfOptions {
@@ -22,10 +22,10 @@ struct GltfOptions {
 // Reads a glTF 2.0 file. Each warning is appended to `warnings` as one line,
 // "file: at /json/pointer: warning: what was approximated or ignored". Throws SceneError for the
 // first error (naming the file and, where there is one, the JSON pointer of the element).
-SceneDesc read_gltf_scene(const std::filesystem::path& file, std::vector<std::string>& warnings,
+SceneDesc read_gltf_scene(const std::filesystem::path& file, Warnings& warnings,
                           const GltfOptions& options = {});
 
-// The same, printing the warnings to stderr (at most three of each kind).
+// The same, printing the warnings to stderr (Warnings::print: at most three of each kind).
 SceneDesc read_gltf_scene(const std::filesystem::path& file);
 
 }  // namespace candela

@@ -44,8 +44,8 @@ Json read_json(const fs::path& file) {
   return Json::parse(in);
 }
 
-SceneDesc load_gltf(const fs::path& file, std::vector<std::string>* warnings_out = nullptr) {
-  std::vector<std::string> warnings;
+SceneDesc load_gltf(const fs::path& file, Warnings* warnings_out = nullptr) {
+  Warnings warnings;
   SceneDesc scene = read_gltf_scene(file, warnings);
   if (warnings_out) *warnings_out = warnings;
   return scene;
@@ -214,7 +214,7 @@ TEST(GltfGeometry, TriangleWithoutIndicesIsTriangle) {
 }
 
 TEST(GltfGeometry, StripsAndFansBecomeFrontFacingTriangles) {
-  std::vector<std::string> warnings;
+  Warnings warnings;
   SceneDesc scene = load_gltf(asset("MeshPrimitiveModes"), &warnings);
   // Points and the three kinds of lines are skipped with a warning each.
   EXPECT_EQ(std::count_if(warnings.begin(), warnings.end(),
@@ -298,7 +298,7 @@ TEST(GltfTransforms, SimpleInstancingMakesOneObjectAndItsInstances) {
 // file and a JSON pointer (SceneDesc::places for the last three, parallel to their vectors).
 TEST(GltfPlaces, DescriptionsNameTheirElements) {
   Scratch scratch;
-  std::vector<std::string> warnings;
+  Warnings warnings;
   SceneDesc cube = read_gltf_scene(asset("Cube"), warnings, GltfOptions{.cache_dir = scratch.dir() / "cache"});
   EXPECT_EQ(cube.shapes.at(0).where.file, asset("Cube").string());
   EXPECT_EQ(cube.shapes[0].where.key_path, "/meshes/0/primitives/0");
@@ -365,7 +365,7 @@ TEST(GltfMaterials, TexturesMapChannelsAndColourSpaces) {
   Scratch scratch;
   GltfOptions options;
   options.cache_dir = scratch.dir() / "cache";
-  std::vector<std::string> warnings;
+  Warnings warnings;
   SceneDesc scene = read_gltf_scene(asset("Cube"), warnings, options);
   ASSERT_EQ(scene.shapes.size(), 1u);
   const auto& p = std::get<PrincipledMaterial>(scene.materials[size_t(scene.shapes[0].material)]);
@@ -386,7 +386,7 @@ TEST(GltfMaterials, TexturesMapChannelsAndColourSpaces) {
 }
 
 TEST(GltfMaterials, TextureTransformOffsetsRotatesAndScales) {
-  std::vector<std::string> warnings;
+  Warnings warnings;
   SceneDesc scene = load_gltf(asset("TextureTransformTest"), &warnings);
   Json j = read_json(asset("TextureTransformTest"));
   // Material name -> the glTF transform (offset, rotation, scale), as the file states it.
@@ -507,7 +507,7 @@ TEST(GltfLights, SpotAndDirectional) {
     "bufferViews": [{"buffer": 0, "byteLength": 36}],
     "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]
   })";
-  std::vector<std::string> warnings;
+  Warnings warnings;
   SceneDesc scene = read_gltf_scene(scratch.write("lights.gltf", gltf), warnings);
   ASSERT_EQ(scene.lights.size(), 2u);
   const auto& spot = std::get<SpotLight>(scene.lights[0]);

@@ -222,7 +222,7 @@ TEST(ConvertJson, MediaRoundTrip) {
 
 // pbrt's media convert too: a uniformgrid's samples are written inline.
 TEST(ConvertJson, PbrtMediaRoundTrip) {
-  std::vector<std::string> warnings;
+  Warnings warnings;
   SceneDesc pbrt = read_pbrt_string(
       "MakeNamedMedium \"air\" \"string type\" \"homogeneous\" \"rgb sigma_s\" [ 0.01 0.02 0.03 ] \"float g\" 0.2\n"
       "MediumInterface \"\" \"air\"\n"

@@ -28,9 +28,12 @@ struct ObjMaterial {
   std::string diffuse_map;  // map_Kd, relative to the working directory; empty = none
 };
 
+class Warnings;  // io/warnings.h
+
 // An OBJ file with the materials of its `mtllib` libraries (looked up beside the OBJ file): one mesh
 // per material that faces use; `material` indexes `materials`, -1 for faces without one. A missing
-// or unreadable library is a warning (its materials become the default), a malformed OBJ an error.
+// or unreadable library is a warning appended to `warnings` (its materials become the default), a
+// malformed OBJ an error.
 struct ObjModel {
   struct Part {
     int material = -1;
@@ -38,8 +41,7 @@ struct ObjModel {
   };
   std::vector<Part> parts;
   std::vector<ObjMaterial> materials;
-  std::vector<std::string> warnings;
 };
-ObjModel load_obj_model(const std::filesystem::path& file, const SourceLocation& referenced_from);
+ObjModel load_obj_model(const std::filesystem::path& file, const SourceLocation& referenced_from, Warnings& warnings);
 
 }  // namespace candela

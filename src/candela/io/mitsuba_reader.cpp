@@ -12,7 +12,6 @@
 #include "candela/io/mitsuba_reader.h"
 
 #include <fstream>
-#include <iostream>
 #include <sstream>
 
 #include "candela/io/mitsuba/converter.h"
@@ -23,7 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 
 SceneDesc read(std::string_view text, const std::string& file_name, const fs::path& base_dir,
-               std::vector<std::string>& warnings, const MitsubaReadOptions& options) {
+               Warnings& warnings, const MitsubaReadOptions& options) {
   const mitsuba::ObjectTree tree = mitsuba::parse_xml(text, file_name, base_dir, options);
   SceneDesc desc = mitsuba::Converter(tree, warnings).convert(*tree.root);
   desc.source_file = file_name;
@@ -33,12 +32,12 @@ SceneDesc read(std::string_view text, const std::string& file_name, const fs::pa
 }  // namespace
 
 SceneDesc read_mitsuba_scene_text(std::string_view xml, const std::string& file_name,
-                                  const std::filesystem::path& base_dir, std::vector<std::string>& warnings,
+                                  const std::filesystem::path& base_dir, Warnings& warnings,
                                   const MitsubaReadOptions& options) {
   return read(xml, file_name, base_dir, warnings, options);
 }
 
-SceneDesc read_mitsuba_scene(const std::filesystem::path& file, std::vector<std::string>& warnings,
+SceneDesc read_mitsuba_scene(const std::filesystem::path& file, Warnings& warnings,
                              const MitsubaReadOptions& options) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw_scene_error(SourceLocation{file.string(), 0, 0, {}}, "cannot open the scene file");
@@ -50,15 +49,7 @@ SceneDesc read_mitsuba_scene(const std::filesystem::path& file, std::vector<std:
 }
 
 SceneDesc read_mitsuba_scene(const std::filesystem::path& file, const MitsubaReadOptions& options) {
-  std::vector<std::string> warnings;
-  try {
-    SceneDesc scene = read_mitsuba_scene(file, warnings, options);
-    for (const std::string& w : warnings) std::cerr << w << "\n";
-    return scene;
-  } catch (...) {
-    for (const std::string& w : warnings) std::cerr << w << "\n";
-    throw;
-  }
+  return read_printing_warnings([&](Warnings& warnings) { return read_mitsuba_scene(file, warnings, options); });
 }
 
 }  // namespace candela

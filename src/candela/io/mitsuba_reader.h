@@ -4,10 +4,10 @@
 #include <map>
 #include <string>
 #include <string_view>
-#include <vector>
 
 #include "candela/scene/description.h"
 
+#include "candela/io/warnings.h"
 namespace candela {
 
 struct MitsubaReadOptions {
@@ -18,16 +18,16 @@ struct MitsubaReadOptions {
 
 // Reads a Mitsuba 3 scene file. Each warning is appended to `warnings` as one line,
 // "file:line: warning: ...". Throws SceneError ("file:line: what is wrong") for the first error.
-SceneDesc read_mitsuba_scene(const std::filesystem::path& file, std::vector<std::string>& warnings,
+SceneDesc read_mitsuba_scene(const std::filesystem::path& file, Warnings& warnings,
                              const MitsubaReadOptions& options = {});
 
 // The same for XML text; `file_name` is used in messages and relative paths are resolved against
 // `base_dir` (as if the text were a file there).
 SceneDesc read_mitsuba_scene_text(std::string_view xml, const std::string& file_name,
-                                  const std::filesystem::path& base_dir, std::vector<std::string>& warnings,
+                                  const std::filesystem::path& base_dir, Warnings& warnings,
                                   const MitsubaReadOptions& options = {});
 
-// read_mitsuba_scene printing its warnings to stderr (also those before an error).
+// read_mitsuba_scene printing its warnings to stderr (Warnings::print; also those before an error).
 SceneDesc read_mitsuba_scene(const std::filesystem::path& file, const MitsubaReadOptions& options = {});
 
 }  // namespace candela

@@ -26,7 +26,7 @@ fs::path temp_dir() {
 }
 
 SceneDesc read_text(const std::string& body, const MitsubaReadOptions& options = {}) {
-  std::vector<std::string> warnings;
+  Warnings warnings;
   return read_mitsuba_scene_text("<scene version=\"3.0.0\">\n" + body + "\n</scene>", "test.xml", temp_dir(),
                                  warnings, options);
 }
@@ -465,7 +465,7 @@ TEST(MitsubaReader, TextEntryPointNamesItsTextAndResolvesAgainstItsFolder) {
     std::ofstream f(dir / "grey.xml");
     f << R"(<bsdf type="diffuse" id="grey"><rgb name="reflectance" value="0.25"/></bsdf>)";
   }
-  std::vector<std::string> warnings;
+  Warnings warnings;
   SceneDesc s = read_mitsuba_scene_text(R"(<scene version="3.0.0"><include filename="grey.xml"/>
       <shape type="sphere"><ref id="grey"/></shape></scene>)",
                                         "in-memory.xml", dir, warnings);
@@ -522,7 +522,7 @@ TEST(MitsubaReader, RenderTestScenes) {
       if (entry.path().extension() != ".xml") continue;
       const bool media = dir.path().filename() == "participating_media" &&
                          entry.path().filename() != "test_surf_area_light_volpath.xml";
-      std::vector<std::string> warnings;
+      Warnings warnings;
       SceneDesc s = read_mitsuba_scene(entry.path(), warnings);
       EXPECT_FALSE(s.shapes.empty() && s.instances.empty()) << entry.path();
       EXPECT_EQ(!s.media.empty(), media) << entry.path();

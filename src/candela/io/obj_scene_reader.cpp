@@ -13,13 +13,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <string>
 #include <vector>
 
 #include "candela/base/error.h"
 #include "candela/io/mesh_io.h"
+#include "candela/io/warnings.h"
 
 namespace candela {
 namespace {
@@ -42,11 +42,8 @@ ColorInput diffuse_input(const ObjMaterial& m, const RGB& kd, SceneDesc& scene) 
   return scaled;
 }
 
-MaterialDesc material_of(const ObjMaterial& m, SceneDesc& scene, std::vector<std::string>& warnings,
-                         const std::string& where) {
-  auto warn = [&](const std::string& what) {
-    warnings.push_back(fmt::format("{}: warning: material \"{}\": {}", where, m.name, what));
-  };
+MaterialDesc material_of(const ObjMaterial& m, SceneDesc& scene, Warnings& warnings, const std::string& where) {
+  auto warn = [&](const std::string& what) { warnings.warn(where, fmt::format("material \"{}\": {}", m.name, what)); };
   if (!m.diffuse_map.empty() && !(m.diffuse.r == m.diffuse.g && m.diffuse.g == m.diffuse.b))
     warn("a coloured Kd with map_Kd: the map is scaled by Kd's average, Kd's hue is dropped");
   const bool glass = m.illum == 4 || m.illum == 6 || m.illum == 7 || m.dissolve < 1;
@@ -100,10 +97,9 @@ void frame_and_light(SceneDesc& scene, bool any_emitter) {
 
 }  // namespace
 
-SceneDesc read_obj_scene(const std::filesystem::path& file) {
+SceneDesc read_obj_scene(const std::filesystem::path& file, Warnings& warnings) {
   const SourceLocation where{file.string(), 0, 0, {}};
-  ObjModel model = load_obj_model(file, where);
-  std::vector<std::string> warnings = std::move(model.warnings);
+  ObjModel model = load_obj_model(file, where, warnings);
 
   SceneDesc scene;
   scene.settings.sampler.type = SamplerType::ZSobol;  // the most efficient measured (docs/performance.md)
@@ -131,8 +127,11 @@ SceneDesc read_obj_scene(const std::filesystem::path& file) {
     scene.shapes.push_back(std::move(shape));
   }
   frame_and_light(scene, any_emitter);
-  for (const std::string& w : warnings) std::fprintf(stderr, "%s\n", w.c_str());
   return scene;
+}
+
+SceneDesc read_obj_scene(const std::filesystem::path& file) {
+  return read_printing_warnings([&](Warnings& warnings) { return read_obj_scene(file, warnings); });
 }
 
 SceneDesc read_mesh_scene(const std::filesystem::path& file) {

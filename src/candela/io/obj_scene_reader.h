@@ -4,11 +4,15 @@
 #include <filesystem>
 
 #include "candela/scene/description.h"
+#include "candela/io/warnings.h"
 
 namespace candela {
 
 // Throws SceneError naming the file for a missing or malformed OBJ. Warnings (a missing MTL file,
-// material parameters that cannot be represented) are printed to stderr, as the other readers do.
+// material parameters that cannot be represented) are appended to `warnings`, one line each.
+SceneDesc read_obj_scene(const std::filesystem::path& file, Warnings& warnings);
+
+// The same, printing the warnings to stderr (Warnings::print), as the other readers do.
 SceneDesc read_obj_scene(const std::filesystem::path& file);
 
 // A PLY mesh (or any mesh file load_mesh_file reads) as a whole scene: one grey diffuse shape,

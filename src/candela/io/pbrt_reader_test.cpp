@@ -672,7 +672,7 @@ TEST(PbrtReader, TextReadsAsItsFileWouldWithNamesResolvedInTheBaseDirectory) {
   EXPECT_EQ(mesh_of(from_text.shapes[1]).positions, mesh_of(from_file.shapes[1]).positions);
 
   // Messages name the text by the name given, and the files it includes by their paths.
-  std::string message = error_of([&](std::vector<std::string>& warnings) {
+  std::string message = error_of([&](Warnings& warnings) {
     read_pbrt_string("WorldBegin\nInclude \"parts/bad.pbrt\"\n", "inline", kTestData / "include", warnings);
   });
   EXPECT_TRUE(message.starts_with((kTestData / "include/parts/bad.pbrt").string() + ":3:1: unknown directive"))

@@ -336,18 +336,6 @@ TEST(PbrtReader, AttributeSetsDefaultParametersForABlock) {
                "\"string radius\"", "parameter \"radius\" must be of type \"float\", not \"string\"");
 }
 
-TEST(PbrtReader, PrintedWarningsAreCappedPerKind) {
-  std::vector<std::string> warnings;
-  for (int line = 1; line <= 5; ++line) warnings.push_back(fmt::format("a.pbrt:{}:1: warning: same thing", line));
-  warnings.push_back("a.pbrt:9:1: warning: other thing");
-  ::testing::internal::CaptureStderr();
-  print_pbrt_warnings(warnings, 3);
-  std::string printed = ::testing::internal::GetCapturedStderr();
-  EXPECT_EQ(printed,
-            "a.pbrt:1:1: warning: same thing\na.pbrt:2:1: warning: same thing\na.pbrt:3:1: warning: same thing\n"
-            "a.pbrt:9:1: warning: other thing\n(2 more warnings like \"same thing\")\n");
-}
-
 // ---------------------------------------------------------------- the Bitterli scenes
 
 const fs::path kBitterli = fs::path(CANDELA_SHARED_DIR) / "scenes/bitterli";

@@ -50,6 +50,11 @@ std::string read_text_file(const fs::path& file) {
 }  // namespace
 
 SceneDesc read_scene_file(const std::filesystem::path& file, const SceneReadOptions& options) {
+  if (!options.warnings)  // the readers' warnings printed to stderr, also those before an error
+    return read_printing_warnings([&](Warnings& warnings) {
+      return read_scene_file(file, SceneReadOptions{options.parameters, &warnings});
+    });
+  Warnings& warnings = *options.warnings;
   check_is_readable_file(file);
   std::string extension = lowercase_extension(file);
   // As pbrt-v4, a gzipped pbrt scene or PLY mesh ("scene.pbrt.gz"): their readers decompress it (io/gzip.h).
@@ -65,16 +70,15 @@ SceneDesc read_scene_file(const std::filesystem::path& file, const SceneReadOpti
     if (extension == ".json")
       scene = read_json_scene(read_text_file(file), file.string(), file.parent_path());
     else if (extension == ".pbrt")
-      scene = read_pbrt_scene(file);
+      scene = read_pbrt_scene(file, warnings);
     else if (extension == ".obj")
-      scene = read_obj_scene(file);
+      scene = read_obj_scene(file, warnings);
     else if (extension == ".ply")
       scene = read_mesh_scene(file);
     else if (extension == ".gltf" || extension == ".glb")
-      scene = read_gltf_scene(file);
+      scene = read_gltf_scene(file, warnings);
     else if (extension == ".xml")
-      scene = options.warnings ? read_mitsuba_scene(file, *options.warnings, MitsubaReadOptions{options.parameters})
-                               : read_mitsuba_scene(file, MitsubaReadOptions{options.parameters});
+      scene = read_mitsuba_scene(file, warnings, MitsubaReadOptions{options.parameters});
     else
       throw_scene_error(location_of_file(file),
                         "unsupported scene file extension {}; supported: .json, .pbrt, .xml (Mitsuba 3), .gltf, .glb, "

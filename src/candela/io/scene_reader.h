@@ -5,10 +5,10 @@
 #include <map>
 #include <string>
 #include <string_view>
-#include <vector>
 
 #include "candela/scene/description.h"
 
+#include "candela/io/warnings.h"
 namespace candela {
 
 // Chooses the reader by extension: .json (candela's format), .pbrt (pbrt-v4), .xml (Mitsuba 3),
@@ -18,8 +18,8 @@ struct SceneReadOptions {
   // A Mitsuba scene's $parameters, over its <default> tags (Mitsuba's -D name=value); the other
   // formats have none, and giving one for them is a SceneError.
   std::map<std::string, std::string> parameters;
-  // Where the Mitsuba reader's warnings go, one line each; null: printed to stderr.
-  std::vector<std::string>* warnings = nullptr;
+  // Where the readers' warnings go (pbrt, Mitsuba, glTF, OBJ); null: printed to stderr (Warnings::print).
+  Warnings* warnings = nullptr;
 };
 SceneDesc read_scene_file(const std::filesystem::path& file, const SceneReadOptions& options = {});
 

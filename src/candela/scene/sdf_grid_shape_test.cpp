@@ -454,7 +454,7 @@ TEST(SdfGridShape, JsonWriterWritesTheFileOrTheSamplesBack) {
 }
 
 std::string mitsuba_error(const std::string& body) {
-  std::vector<std::string> warnings;
+  Warnings warnings;
   try {
     read_mitsuba_scene_text("<scene version=\"3.0.0\">\n" + body + "\n</scene>", "test.xml", temp_dir(), warnings);
   } catch (const SceneError& e) {
@@ -465,7 +465,7 @@ std::string mitsuba_error(const std::string& body) {
 
 TEST(SdfGridShape, MitsubaReadsAnSdfgridInAShapegroupAndRefusesAnEmittingOne) {
   const std::string vol = sphere_vol(9, kRadius).filename().string();
-  std::vector<std::string> warnings;
+  Warnings warnings;
   const SceneDesc d = read_mitsuba_scene_text(R"(<scene version="3.0.0">
       <shape type="shapegroup" id="group">
         <shape type="sdfgrid"><string name="filename" value=")" + vol + R"("/>

@@ -83,19 +83,20 @@ inline std::string joined(const std::vector<std::string>& lines) {
   for (const std::string& line : lines) text += line + "\n";
   return text;
 }
+inline std::string joined(const Warnings& warnings) { return joined(warnings.lines()); }
 
 // The scenes of most tests are text, read with read_pbrt_string: this is their name in messages,
 // and the files they name (ScratchFile) are looked up in scratch_dir().
 inline const std::string kSceneName = "scene.pbrt";
 
 inline SceneDesc read_lines(const std::vector<std::string>& lines) {
-  std::vector<std::string> warnings;
+  Warnings warnings;
   return read_pbrt_string(joined(lines), kSceneName, scratch_dir(), warnings);
 }
 
 struct Warned {
   SceneDesc scene;
-  std::vector<std::string> warnings;
+  Warnings warnings;
 };
 
 inline Warned read_warned(const std::vector<std::string>& lines) {
@@ -108,7 +109,7 @@ inline Warned read_warned(const std::vector<std::string>& lines) {
 template <typename Read>
 inline std::string error_of(Read read) {
   try {
-    std::vector<std::string> warnings;
+    Warnings warnings;
     read(warnings);
   } catch (const SceneError& error) {
     return error.what();
@@ -117,11 +118,11 @@ inline std::string error_of(Read read) {
 }
 
 inline std::string error_reading(const fs::path& file) {
-  return error_of([&](std::vector<std::string>& warnings) { read_pbrt_scene(file, warnings); });
+  return error_of([&](Warnings& warnings) { read_pbrt_scene(file, warnings); });
 }
 
 inline std::string error_reading_text(const std::vector<std::string>& lines) {
-  return error_of([&](std::vector<std::string>& warnings) {
+  return error_of([&](Warnings& warnings) {
     read_pbrt_string(joined(lines), kSceneName, scratch_dir(), warnings);
   });
 }
@@ -143,7 +144,7 @@ inline void expect_warning(const std::vector<std::string>& lines, int line, std:
                     std::string_view fragment) {
   size_t column = lines.at(line - 1).find(marker);
   ASSERT_NE(column, std::string::npos) << "marker " << marker << " is not in line " << line;
-  std::vector<std::string> warnings = read_warned(lines).warnings;
+  const std::vector<std::string> warnings = read_warned(lines).warnings.lines();
   ASSERT_EQ(warnings.size(), 1u) << joined(warnings);
   std::string place = fmt::format("{}:{}:{}: warning: ", kSceneName, line, column + 1);
   EXPECT_TRUE(warnings[0].starts_with(place)) << "expected the warning at " << place << "\ngot: " << warnings[0];

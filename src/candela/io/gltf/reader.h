@@ -101,7 +101,7 @@ struct ImageOp {
 
 class GltfReader {
  public:
-  GltfReader(const fs::path& file, std::vector<std::string>& warnings, const GltfOptions& options)
+  GltfReader(const fs::path& file, Warnings& warnings, const GltfOptions& options)
       : file_(file), warnings_(warnings), options_(options) {
     base_dir_ = file.parent_path();
     cache_dir_ = options.cache_dir.empty() ? fs::temp_directory_path() / "candela-gltf" : options.cache_dir;
@@ -121,8 +121,7 @@ class GltfReader {
 
   template <typename... Args>
   void warn(const std::string& pointer, fmt::format_string<Args...> format, Args&&... args) {
-    warnings_.push_back(
-        fmt::format("{}: warning: {}", at(pointer).to_string(), fmt::format(format, std::forward<Args>(args)...)));
+    warnings_.warn(at(pointer), fmt::format(format, std::forward<Args>(args)...));
   }
 
   // ------------------------------------------------------------ loading
@@ -209,7 +208,7 @@ class GltfReader {
   // ------------------------------------------------------------ state
 
   fs::path file_, base_dir_, cache_dir_;
-  std::vector<std::string>& warnings_;
+  Warnings& warnings_;
   GltfOptions options_;
   tg::Model model_;
   SceneDesc scene_;

@@ -17,6 +17,7 @@
 #include "candela/base/error.h"
 #include "candela/io/mesh/mesh_common.h"
 #include "candela/io/mesh_io.h"
+#include "candela/io/warnings.h"
 
 namespace candela::mesh {
 namespace {
@@ -241,7 +242,7 @@ namespace candela {
 
 using namespace mesh;  // the helpers above
 
-ObjModel load_obj_model(const std::filesystem::path& file, const SourceLocation& referenced_from) {
+ObjModel load_obj_model(const std::filesystem::path& file, const SourceLocation& referenced_from, Warnings& warnings) {
   return mesh::with_mesh_file_errors(file, referenced_from, [&] {
     const std::string text = read_whole_file(file);
     ObjModel model;
@@ -251,8 +252,8 @@ ObjModel load_obj_model(const std::filesystem::path& file, const SourceLocation&
       try {
         mtl_text += read_whole_file(library) + "\n";
       } catch (const FileContentError& problem) {
-        model.warnings.push_back(fmt::format("material library '{}': {}; its materials are diffuse grey",
-                                             library.string(), problem.what()));
+        warnings.add_line(fmt::format("material library '{}': {}; its materials are diffuse grey", library.string(),
+                                      problem.what()));
       }
     }
     const tinyobj::ObjReader reader = parse_obj(text, mtl_text);

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "candela/io/mitsuba/object_tree.h"
+#include "candela/io/warnings.h"
 #include "candela/scene/description.h"
 
 namespace candela::mitsuba {
@@ -33,7 +34,7 @@ enum class TextureLookup { Color, Scalar };
 
 class Converter {
  public:
-  Converter(const ObjectTree& tree, std::vector<std::string>& warnings) : tree_(tree), warnings_(warnings) {}
+  Converter(const ObjectTree& tree, Warnings& warnings) : tree_(tree), warnings_(warnings) {}
 
   SceneDesc convert(const Object& scene);
 
@@ -42,8 +43,7 @@ class Converter {
 
   template <typename... Args>
   void warn(const Where& where, fmt::format_string<Args...> format, Args&&... args) {
-    warnings_.push_back(
-        fmt::format("{}: warning: {}", where.loc().to_string(), fmt::format(format, std::forward<Args>(args)...)));
+    warnings_.warn(where.loc(), fmt::format(format, std::forward<Args>(args)...));
   }
 
   static const Property* find(const Object& o, std::string_view name);
@@ -158,7 +158,7 @@ class Converter {
   void integrator(const Object& i);
 
   const ObjectTree& tree_;
-  std::vector<std::string>& warnings_;
+  Warnings& warnings_;
   SceneDesc desc_;
   // A texture once per way it is looked up (see TextureLookup).
   std::map<std::pair<const Object*, TextureLookup>, int> texture_memo_;

@@ -29,6 +29,7 @@
 #include "candela/io/pbrt/graphics_state.h"
 #include "candela/io/pbrt/parameters.h"
 #include "candela/io/pbrt/tokenizer.h"
+#include "candela/io/warnings.h"
 #include "candela/scene/description.h"
 
 namespace candela::pbrt {
@@ -93,7 +94,7 @@ enum class Section { Options, World };
 
 class SceneParser {
  public:
-  explicit SceneParser(std::vector<std::string>& warnings) : warnings_(warnings) {}
+  explicit SceneParser(Warnings& warnings) : warnings_(warnings) {}
   SceneDesc parse(const fs::path& file);
   // pbrt text not read from a file: `name` stands for the file in messages, and relative file
   // names (Include, Import, meshes, images) are looked up in `base_dir`.
@@ -105,8 +106,7 @@ class SceneParser {
 
   template <typename... Args>
   void warn(const SourceLocation& where, fmt::format_string<Args...> format, Args&&... args) {
-    warnings_.push_back(
-        fmt::format("{}: warning: {}", where.to_string(), fmt::format(format, std::forward<Args>(args)...)));
+    warnings_.warn(where, fmt::format(format, std::forward<Args>(args)...));
   }
   // Accepts the parameter `name` if given and warns that it is ignored (silently for one an
   // Attribute set, which applies to many directives).
@@ -233,7 +233,7 @@ class SceneParser {
   MediumDesc make_nanovdb_medium(ParamList& params);
   void read_temperature_mapping(ParamList& params, MediumDesc& medium);
 
-  std::vector<std::string>& warnings_;
+  Warnings& warnings_;
   SceneDesc scene_;
   RenderDirectives options_;
   GraphicsState state_;
