@@ -20,6 +20,7 @@
 #include "candela/film/image_io.h"
 #include "candela/io/json_writer.h"
 #include "candela/io/scene_reader.h"
+#include "candela/integrators/render_option_table.h"
 #include "candela/integrators/render_request.h"
 #include "candela/scene/parameters.h"
 #include "candela/scene/resource_limits.h"
@@ -45,48 +46,12 @@ struct PyScene {
 // __init__.py. Held without reference counting: they live as long as the interpreter.
 py::handle g_scene_error, g_usage_error;
 
-// render()'s keywords: the command line's flags with '_' for '-', each with the request field it sets.
-using RequestField = std::variant<std::optional<int> RenderRequest::*, std::optional<uint64_t> RenderRequest::*,
-                                  std::optional<float> RenderRequest::*, std::optional<double> RenderRequest::*,
-                                  std::string RenderRequest::*, bool RenderRequest::*>;
-const std::map<std::string, RequestField>& request_fields() {
-  static const std::map<std::string, RequestField> fields = {
-      {"spp", &RenderRequest::spp},
-      {"threads", &RenderRequest::threads},
-      {"max_depth", &RenderRequest::max_depth},
-      {"seed", &RenderRequest::seed},
-      {"resolution", &RenderRequest::resolution},
-      {"integrator", &RenderRequest::integrator},
-      {"sampler", &RenderRequest::sampler},
-      {"filter", &RenderRequest::filter},
-      {"direction_sampling", &RenderRequest::direction_sampling},
-      {"light_selection", &RenderRequest::light_selection},
-      {"bvh", &RenderRequest::bvh},
-      {"transport", &RenderRequest::transport},
-      {"shadow_rays", &RenderRequest::shadow_rays},
-      {"max_spp", &RenderRequest::max_spp},
-      {"adaptive_batch", &RenderRequest::adaptive_batch},
-      {"adaptive_spp", &RenderRequest::adaptive_spp},
-      {"adaptive_threshold", &RenderRequest::adaptive_threshold},
-      {"no_mis", &RenderRequest::no_mis},
-      {"time_limit", &RenderRequest::time_limit},
-      {"target_error", &RenderRequest::target_error},
-      {"estimate_error", &RenderRequest::estimate_error},
-      {"clamp", &RenderRequest::clamp},
-      {"mlt_bootstrap", &RenderRequest::mlt_bootstrap},
-      {"mlt_chains", &RenderRequest::mlt_chains},
-      {"mlt_sigma", &RenderRequest::mlt_sigma},
-      {"mlt_large_step", &RenderRequest::mlt_large_step},
-      {"mlt_lens", &RenderRequest::mlt_lens},
-      {"mlt_caustic", &RenderRequest::mlt_caustic},
-  };
-  return fields;
-}
-
-// The kind of each keyword, for the package's type checks: int, uint, float, str or bool.
+// render()'s keywords, from the option table (integrators/render_option_table.h): the kind of each,
+// for the package's type checks: int, uint, float, str or bool.
 py::dict request_kinds() {
   py::dict kinds;
-  for (const auto& [name, field] : request_fields()) {
+  for (const RenderOption& option : render_options()) {
+    if (!option.python) continue;
     const char* kind = std::visit(
         [](auto member) -> const char* {
           using T = std::remove_reference_t<decltype(std::declval<RenderRequest&>().*member)>;
@@ -96,8 +61,8 @@ py::dict request_kinds() {
           else if constexpr (std::is_same_v<T, bool>) return "bool";
           else return "float";
         },
-        field);
-    kinds[py::str(name)] = kind;
+        option.field);
+    kinds[py::str(option.name)] = kind;
   }
   return kinds;
 }
@@ -107,8 +72,8 @@ RenderRequest request_from(const py::dict& keywords) {
   RenderRequest request;
   for (auto [key, value] : keywords) {
     auto name = key.cast<std::string>();
-    auto found = request_fields().find(name);
-    if (found == request_fields().end()) throw py::type_error("render() got an unexpected keyword argument '" + name + "'");
+    const RenderOption* option = find_render_option(name);
+    if (!option || !option->python) throw py::type_error("render() got an unexpected keyword argument '" + name + "'");
     std::visit(
         [&](auto member) {
           using T = std::remove_reference_t<decltype(request.*member)>;
@@ -117,7 +82,7 @@ RenderRequest request_from(const py::dict& keywords) {
           else
             request.*member = value.cast<typename T::value_type>();
         },
-        found->second);
+        option->field);
   }
   request.quiet = true;  // the package draws its own progress; notes would go past Python's stderr
   return request;
@@ -373,6 +338,13 @@ PYBIND11_MODULE(_candela, m) {
     return make_scene(read_json_scene(builtin_scene_json(), "<built-in cornell-box.json>", "."), "<built-in cornell-box.json>");
   });
   m.def("render_keywords", &request_kinds);
+  // The option table itself (keyword, flag, help, whether render() takes it), for tests and help.
+  m.def("render_options", [] {
+    py::list options;
+    for (const RenderOption& option : render_options())
+      options.append(py::make_tuple(option.name, option.flag(), option.help, option.python));
+    return options;
+  });
   m.def("render", &render_scene);
   m.def("write_image", [](const std::string& path, const py::array_t<float, py::array::c_style>& array,
                           const std::map<std::string, std::string>& metadata) {

@@ -34,6 +34,7 @@
 #include "candela/render/checkpoint.h"
 #include "candela/render/cluster.h"
 #include "candela/render/film_part.h"
+#include "candela/integrators/render_option_table.h"
 #include "candela/integrators/render_request.h"
 #include "candela/integrators/auto_integrator.h"
 #include "candela/integrators/bdpt.h"
@@ -72,14 +73,15 @@ extern "C" void on_stop_signal(int) {
   // Only atomics, write and _exit (async-signal-safe). Files are written atomically (temporary +
   // rename), so leaving at any moment never leaves a half-written image or checkpoint.
   if (g_signals.fetch_add(1) > 0) _exit(kExitSecondSignal);
-  switch (g_phase.load()) {
+  switch (Phase(g_phase.load())) {
     case kReadingScene:
       say_from_handler("candela: interrupted while reading the scene: nothing written\n");
       _exit(kExitInterrupted);
     case kBuildingScene:
       say_from_handler("candela: interrupted while building the scene (textures, BVH): nothing written\n");
       _exit(kExitInterrupted);
-    default:
+    case kRendering:
+    case kWriting:
       g_stop.store(true);
   }
 }
@@ -188,46 +190,6 @@ Image spp_heat_map(const Film& film, const fs::path& file) {
       heat.set(x, y, RGB(c.r * c.r, c.g * c.g, c.b * c.b));
     }
   return heat;
-}
-
-const char* sampler_name(SamplerType t) {
-  switch (t) {
-    case SamplerType::Independent: return "independent";
-    case SamplerType::Stratified: return "stratified";
-    case SamplerType::Poisson: return "poisson";
-    case SamplerType::ZSobol: return "zsobol";
-  }
-  return "?";
-}
-
-// What the image depends on besides the scene file: everything the command line can override.
-RenderFingerprint make_fingerprint(const std::string& scene_bytes, const SceneDesc& desc, float clamp) {
-  const RenderSettings& rs = desc.settings;
-  RenderFingerprint fp;
-  fp.scene_hash = fnv1a64(scene_bytes.data(), scene_bytes.size());
-  fp.settings = {
-      {"resolution", fmt::format("{}x{}", desc.film.width, desc.film.height)},
-      {"spp", std::to_string(rs.spp)},
-      {"seed", std::to_string(rs.seed)},
-      {"sampler", fmt::format("{}{}{}", sampler_name(rs.sampler.type), rs.sampler.jitter ? "" : " (no jitter)",
-                              rs.sampler.replicas ? " (two independent halves)" : "")},
-      {"filter", fmt::format("{} radius {},{} sigma {} b {} c {}", int(rs.filter.type), rs.filter.radius.x,
-                             rs.filter.radius.y, rs.filter.gaussian_sigma, rs.filter.mitchell_b, rs.filter.mitchell_c)},
-      {"max-depth", std::to_string(rs.max_depth)},
-      {"integrator", rs.integrator},
-      {"rr-start-depth", std::to_string(rs.rr_start_depth)},
-      {"direction-sampling", std::to_string(int(rs.path.direction_sampling))},
-      {"mis", rs.path.mis ? "on" : "off"},
-      {"transport", rs.spectral ? "spectral" : "rgb"},
-      {"light-selection", std::to_string(int(rs.light_selection))},
-      {"shadow-rays", std::to_string(rs.path.shadow_rays)},
-      {"adaptive-threshold", fmt::format("{}", rs.adaptive_threshold)},
-      {"adaptive-spp", std::to_string(rs.adaptive_spp)},
-      {"clamp", clamp > 0 ? fmt::format("{}", clamp) : "off"},
-  };
-  if (rs.integrator == "auto" || find_integrator(rs.integrator)->reads_setting("mlt"))
-    fp.settings.push_back({"mlt", rs.mlt.describe()});
-  return fp;
 }
 
 std::string read_bytes(const fs::path& file) {
@@ -378,10 +340,9 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
                                      r, cmd.scene_file, hashes[r], hashes[0]));
   });
 
-  const float clamp = cmd.clamp.value_or(0.0f);
   // What made the image, for checkpoints and parts; a checkpoint also names its part, as it resumes only that.
-  const RenderFingerprint render_fingerprint = make_fingerprint(scene_bytes, desc, clamp);
-  RenderFingerprint fingerprint = render_fingerprint;
+  const RenderFingerprint made_by = render_fingerprint(scene_bytes, desc, cmd);
+  RenderFingerprint fingerprint = made_by;
   if (part_count > 1) fingerprint.settings.push_back({"part", cmd.part});
   std::optional<Checkpoint> resumed;
   if (!cmd.resume.empty()) {
@@ -566,7 +527,7 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
                      outcome, options, cluster.size(), non_finite);
   const ErrorEstimate& error = outcome.error;
   if (!cmd.part.empty()) {
-    FilmPart part{part_index, part_count, render_fingerprint,
+    FilmPart part{part_index, part_count, made_by,
                   double(scene.camera().importance_film_pixels()), non_finite, std::move(film)};
     write_part(outputs[0], part, metadata);
     film = std::move(part.film);
@@ -702,69 +663,16 @@ int main(int argc, char** argv) {
   render_cmd->add_option("-o,--output", cmd.output,
                          "Output image; the extension picks the format: .exr (linear HDR, with metadata), "
                          ".png (sRGB 8-bit), .pfm (linear). Default: the scene's film file name, else SCENE.exr");
-  render_cmd->add_option("--spp", cmd.spp, "Samples per pixel (overrides the scene)");
-  render_cmd->add_option("--threads", cmd.threads, "Worker threads (default: all cores)");
-  render_cmd->add_option("--seed", cmd.seed, "Random seed (overrides the scene)");
-  render_cmd->add_option("--max-depth", cmd.max_depth, "Maximum number of bounces; 1 = direct light only");
-  render_cmd->add_option("--resolution", cmd.resolution, "Image size WIDTHxHEIGHT (overrides the scene)");
-  std::string integrator_help = "Integrator:";
-  for (const IntegratorEntry& entry : integrators())
-    integrator_help += fmt::format(" {} ({}){}", entry.name, entry.description, &entry == &integrators().back() ? "" : ";");
-  integrator_help += "; auto (short pilots of each measure which reaches the lowest error in the budget: "
-                     "--time-limit, --target-error, or the path tracer's time for --spp; the pilots aim at 10%)";
-  render_cmd->add_option("--integrator", cmd.integrator, integrator_help);
-  render_cmd->add_option("--bdpt-strategies", cmd.bdpt_strategies,
-                         "bdpt: also write each strategy's contribution (depth <= 5) to "
-                         "DIR/bdpt_d<depth>_s<s>_t<t>.exr");
-  render_cmd->add_flag("--bdpt-unweighted", cmd.bdpt_unweighted,
-                       "bdpt: the strategy images without their MIS weights (each then estimates the whole "
-                       "image of its depth on its own)");
-  render_cmd->add_option("--mlt-bootstrap", cmd.mlt_bootstrap, "mlt: bootstrap paths per depth (default 100000)");
-  render_cmd->add_option("--mlt-chains", cmd.mlt_chains, "mlt: independent Markov chains (default 1000)");
-  render_cmd->add_option("--mlt-sigma", cmd.mlt_sigma,
-                         "mlt: deviation of small steps in primary sample space (default 0.01)");
-  render_cmd->add_option("--mlt-large-step", cmd.mlt_large_step,
-                         "mlt: probability of a large step (default 0.3)");
-  render_cmd->add_option("--mlt-lens", cmd.mlt_lens,
-                         "mlt: probability of a lens perturbation (only the film position moves; default 0)");
-  render_cmd->add_option("--mlt-caustic", cmd.mlt_caustic,
-                         "mlt: probability of a caustic perturbation (only the direction leaving the light moves; "
-                         "default 0)");
-  render_cmd->add_option("--sampler", cmd.sampler,
-                         "Pixel sampler: random (independent), stratified (jittered, every dimension), "
-                         "poisson (Poisson-disc pixel positions), zsobol (Owen-scrambled Sobol' in Morton order)");
-  render_cmd->add_option("--filter", cmd.filter,
-                         "Reconstruction filter with pbrt-v4's default size: box (radius 0.5), tent (2), "
-                         "gaussian (1.5, sigma 0.5), mitchell (2, B = C = 1/3)");
-  render_cmd->add_option("--direction-sampling", cmd.direction_sampling,
-                         "Next-direction sampling at non-delta surfaces: bsdf (importance), cosine, uniform "
-                         "(the paper's eq. 11)");
-  render_cmd->add_option("--transport", cmd.transport,
-                         "Light transport: rgb (three colour channels) or spectral (three sampled wavelengths "
-                         "per path, RGB parameters as smooth spectra, as pbrt-v4); default: the scene's "
-                         "(spectral for pbrt-v4 files, rgb otherwise)");
-  render_cmd->add_flag("--no-mis", cmd.no_mis,
-                       "Turn off multiple importance sampling: direct light from shadow rays only");
-  render_cmd->add_option("--light-selection", cmd.light_selection,
-                         "How shadow rays pick lights: power (each ray one light, chosen by power), uniform "
-                         "(each ray one emitter, all equally likely, as Mitsuba), bvh (each ray one light, "
-                         "chosen through a light BVH by power, distance and orientation: for many lights; "
-                         "pbrt-v4's default), paper (every light a share proportional to power x projected "
-                         "solid angle, O(lights) per vertex)");
-  render_cmd->add_option("--bvh", cmd.bvh,
-                         "Acceleration structure: fast (the default) or compact (about half the memory per "
-                         "triangle, traversal about a third slower)");
-  render_cmd->add_option("--shadow-rays", cmd.shadow_rays, "Shadow rays per path vertex");
-  render_cmd->add_option("--adaptive-threshold", cmd.adaptive_threshold,
-                         "Adaptive sampling: keep adding batches to pixels whose relative standard error "
-                         "(per channel, se / sqrt(mean^2 + 0.01)) exceeds this");
-  render_cmd->add_option("--adaptive-spp", cmd.adaptive_spp,
-                         "Adaptive sampling with a budget: this many samples per pixel on average, each pixel "
-                         "getting a share proportional to its estimated relative error (lowest relMSE)");
-  render_cmd->add_option("--adaptive-batch", cmd.adaptive_batch,
-                         "Adaptive sampling: samples per batch, a power of two (default 16)");
-  render_cmd->add_option("--max-spp", cmd.max_spp,
-                         "Adaptive sampling: most samples a pixel gets (default 1024, or 8 x --adaptive-spp)");
+  // The render options, from their table (integrators/render_option_table.h); then the command's own.
+  for (const RenderOption& option : render_options())
+    std::visit(
+        [&](auto member) {
+          if constexpr (std::is_same_v<decltype(cmd.*member), bool&>)
+            render_cmd->add_flag(option.flag(), cmd.*member, option.help);
+          else
+            render_cmd->add_option(option.flag(), cmd.*member, option.help);
+        },
+        option.field);
   render_cmd->add_option("--preview", cmd.preview,
                          "Serve a page showing the render as it converges at [HOST:]PORT (default host 127.0.0.1; "
                          "port 0 = any free port, printed); open it in a browser (docs/preview.md)");
@@ -788,17 +696,6 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--resume", cmd.resume,
                          "Continue from a checkpoint made with the same scene file and settings; the result "
                          "equals an uninterrupted render bit for bit");
-  render_cmd->add_option("--time-limit", cmd.time_limit,
-                         "Stop after the pass during which this much time has passed, and write the image: "
-                         "seconds (90, 2.5) or a duration such as 90s, 10m, 2h, 1h30m");
-  render_cmd->add_option("--target-error", cmd.target_error,
-                         "Render until the image's estimated relMSE (eps 0.01, from two independent halves of the "
-                         "samples) is at most this, then stop; --spp (default 65536) and --time-limit cap it");
-  render_cmd->add_flag("--estimate-error", cmd.estimate_error,
-                       "Render every pixel's samples as two independent halves and report the image's estimated "
-                       "relMSE with a 95% interval (always done with the random sampler and with --target-error)");
-  render_cmd->add_option("--clamp", cmd.clamp,
-                         "Scale each sample so its largest RGB component is at most VALUE (biased; off by default)");
   render_cmd->add_option("--part", cmd.part,
                          "Render part K of N of the image (every N-th tile; for job arrays) and write it, with "
                          "its exact sums, to the .exr output for candela merge");

@@ -31,7 +31,9 @@ Camera::Camera(const CameraDesc& desc, int width, int height, Vec2 margin)
   switch (axis) {
     case FovAxis::X: tan_half_x_ = t; tan_half_y_ = t / aspect; break;
     case FovAxis::Y: tan_half_y_ = t; tan_half_x_ = t * aspect; break;
-    default: {  // diagonal
+    case FovAxis::Smaller:  // resolved to X or Y above
+    case FovAxis::Larger:
+    case FovAxis::Diagonal: {
       float diag = std::sqrt(aspect * aspect + 1);
       tan_half_x_ = t * aspect / diag;
       tan_half_y_ = t / diag;

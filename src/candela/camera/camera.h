@@ -14,7 +14,7 @@
 #include <optional>
 
 #include "candela/geometry/ray.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela {
 

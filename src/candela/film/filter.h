@@ -16,7 +16,7 @@
 //   mitchell  M(2x / r_x) M(2y / r_y), M the Mitchell-Netravali cubic with parameters B, C on [-2, 2]
 #include "candela/math/vec.h"
 #include "candela/sampling/distribution1d.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela {
 

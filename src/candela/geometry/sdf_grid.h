@@ -18,7 +18,7 @@
 #include "candela/base/error.h"
 #include "candela/math/transform.h"
 #include "candela/math/vec3d.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela {
 

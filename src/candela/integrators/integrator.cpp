@@ -63,21 +63,9 @@ std::string unread_setting_message(const IntegratorEntry& integrator, std::strin
 }
 
 std::vector<std::string_view> set_but_unread(const IntegratorEntry& integrator, const RenderSettings& settings) {
-  const RenderSettings defaults;
-  const PathSettings& p = settings.path;
-  auto set = [&](std::string_view key) {
-    if (key == "direction_sampling") return p.direction_sampling != defaults.path.direction_sampling;
-    if (key == "mis") return p.mis != defaults.path.mis;
-    if (key == "shadow_rays") return p.shadow_rays != defaults.path.shadow_rays;
-    if (key == "light_selection=paper") return settings.light_selection == LightSelection::Paper;
-    if (key == "rr_start_depth") return settings.rr_start_depth != defaults.rr_start_depth;
-    if (key == "adaptive") return settings.adaptive();
-    if (key == "mlt") return settings.mlt != defaults.mlt;
-    throw std::logic_error(fmt::format("set_but_unread: no check for the setting {}", key));
-  };
   std::vector<std::string_view> unread;
   for (const SelectiveSetting& s : kSelectiveSettings)
-    if (!integrator.reads_setting(s.key) && set(s.key)) unread.push_back(s.key);
+    if (!integrator.reads_setting(s.key) && s.is_set(settings)) unread.push_back(s.key);
   return unread;
 }
 

@@ -23,15 +23,24 @@ namespace candela {
 struct SelectiveSetting {
   std::string_view key;
   std::string_view what;  // for messages and docs
+  // The settings set it to something other than its default (for the note when the command line
+  // changes a scene's integrator to one that ignores it).
+  bool (*is_set)(const RenderSettings&);
 };
 inline constexpr SelectiveSetting kSelectiveSettings[] = {
-    {"direction_sampling", "the next-direction sampling strategy"},
-    {"mis", "multiple importance sampling of direct light"},
-    {"shadow_rays", "the number of shadow rays per vertex"},
-    {"light_selection=paper", "the paper's rule for choosing lights for shadow rays"},
-    {"rr_start_depth", "the depth where Russian roulette starts"},
-    {"adaptive", "adaptive sampling"},
-    {"mlt", "Metropolis light transport's parameters"},
+    {"direction_sampling", "the next-direction sampling strategy",
+     [](const RenderSettings& s) { return s.path.direction_sampling != PathSettings{}.direction_sampling; }},
+    {"mis", "multiple importance sampling of direct light",
+     [](const RenderSettings& s) { return s.path.mis != PathSettings{}.mis; }},
+    {"shadow_rays", "the number of shadow rays per vertex",
+     [](const RenderSettings& s) { return s.path.shadow_rays != PathSettings{}.shadow_rays; }},
+    {"light_selection=paper", "the paper's rule for choosing lights for shadow rays",
+     [](const RenderSettings& s) { return s.light_selection == LightSelection::Paper; }},
+    {"rr_start_depth", "the depth where Russian roulette starts",
+     [](const RenderSettings& s) { return s.rr_start_depth != RenderSettings{}.rr_start_depth; }},
+    {"adaptive", "adaptive sampling", [](const RenderSettings& s) { return s.adaptive(); }},
+    {"mlt", "Metropolis light transport's parameters",
+     [](const RenderSettings& s) { return s.mlt != MltSettings{}; }},
 };
 
 struct IntegratorEntry {

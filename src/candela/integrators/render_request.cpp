@@ -1,6 +1,7 @@
 #include "candela/integrators/render_request.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <charconv>
@@ -11,32 +12,10 @@
 #include <tuple>
 
 #include "candela/integrators/integrator.h"
+#include "candela/integrators/render_option_table.h"
 
 namespace candela {
 namespace {
-
-template <typename Enum>
-Enum parse_choice(const std::string& option, const std::string& value,
-                  std::initializer_list<std::pair<const char*, Enum>> choices) {
-  std::string names;
-  for (const auto& [name, e] : choices) {
-    if (value == name) return e;
-    names += (names.empty() ? "" : ", ") + std::string(name);
-  }
-  throw UsageError(fmt::format("{}: unknown value '{}' (expected one of: {})", option, value, names));
-}
-
-// lo <= value <= hi (NaN is outside every range).
-template <typename T>
-void check_range(const char* option, const std::optional<T>& value, double lo, double hi) {
-  if (value && !(double(*value) >= lo && double(*value) <= hi))
-    throw UsageError(fmt::format("{}: {} is out of range ({} to {})", option, *value, lo, hi));
-}
-template <typename T>
-void check_positive(const char* option, const std::optional<T>& value) {
-  if (value && !(std::isfinite(double(*value)) && *value > 0))
-    throw UsageError(fmt::format("{}: must be a positive number, got {}", option, *value));
-}
 
 // `shown` is the size as the user gave it (WIDTHxHEIGHT), for the message.
 void check_resolution_range(long long width, long long height, const std::string& shown) {
@@ -44,6 +23,36 @@ void check_resolution_range(long long width, long long height, const std::string
     throw UsageError(fmt::format("resolution {} is out of range (each side 1..{}, at most {} pixels)", shown,
                                  kMaxResolution, kMaxPixels));
 }
+
+// The option's value against its rule (render_option_table.h).
+void check_value(const RenderOption& option, const RenderRequest& request) {
+  const std::string flag = option.flag();
+  std::visit(
+      [&](auto member) {
+        const auto& value = request.*member;
+        using T = std::remove_cvref_t<decltype(value)>;
+        if constexpr (std::is_same_v<T, std::string>) {
+          if (value.empty()) return;
+          if (const auto* choice = std::get_if<ChoiceValue>(&option.rule)) {
+            if (std::find(choice->names.begin(), choice->names.end(), value) == choice->names.end())
+              throw UsageError(fmt::format("{}: unknown value '{}' (expected one of: {})", flag, value,
+                                           fmt::join(choice->names, ", ")));
+          } else if (const auto* formatted = std::get_if<FormattedValue>(&option.rule)) {
+            formatted->check(flag, value);
+          }
+        } else if constexpr (!std::is_same_v<T, bool>) {
+          if (!value) return;
+          const double x = double(*value);
+          if (const auto* range = std::get_if<ValueRange>(&option.rule); range && !(x >= range->lo && x <= range->hi))
+            throw UsageError(fmt::format("{}: {} is out of range ({} to {})", flag, *value, range->lo, range->hi));
+          if (std::holds_alternative<PositiveValue>(option.rule) && !(std::isfinite(x) && x > 0))
+            throw UsageError(fmt::format("{}: must be a positive number, got {}", flag, *value));
+        }
+      },
+      option.field);
+}
+
+}  // namespace
 
 // --resolution WIDTHxHEIGHT, in range. Sides of any number of digits are read (saturating), so that
 // 1000000000x1000000000 is out of range, not malformed.
@@ -63,27 +72,8 @@ std::pair<int, int> parse_resolution(const std::string& text) {
   return {int(width), int(height)};
 }
 
-}  // namespace
-
 void check_request_values(const RenderRequest& r) {
-  check_range("--spp", r.spp, 1, 1 << 24);
-  check_range("--threads", r.threads, 1, 4096);
-  check_range("--max-depth", r.max_depth, 1, 100000);
-  check_range("--mlt-bootstrap", r.mlt_bootstrap, 1, 100000000);
-  check_range("--mlt-chains", r.mlt_chains, 1, 100000000);
-  check_range("--mlt-sigma", r.mlt_sigma, 1e-6, 1);
-  check_range("--mlt-large-step", r.mlt_large_step, 0, 1);
-  check_range("--mlt-lens", r.mlt_lens, 0, 1);
-  check_range("--mlt-caustic", r.mlt_caustic, 0, 1);
-  check_range("--shadow-rays", r.shadow_rays, 1, 1024);
-  check_positive("--adaptive-threshold", r.adaptive_threshold);
-  check_range("--adaptive-spp", r.adaptive_spp, 1, 1 << 24);
-  check_range("--adaptive-batch", r.adaptive_batch, 1, 1 << 16);
-  check_range("--max-spp", r.max_spp, 1, 1 << 24);
-  check_positive("--target-error", r.target_error);
-  check_positive("--clamp", r.clamp);
-  if (!r.time_limit.empty()) parse_duration("--time-limit", r.time_limit);
-  if (!r.resolution.empty()) parse_resolution(r.resolution);
+  for (const RenderOption& option : render_options()) check_value(option, r);
 }
 
 namespace {
@@ -101,30 +91,10 @@ void check_integrator_flags(const RenderRequest& request, const SceneDesc& scene
   const IntegratorEntry* integrator = find_integrator(scene.settings.integrator);
   if (!integrator)
     throw UsageError(fmt::format("unknown integrator '{}' (known: {}, auto)", scene.settings.integrator, integrator_names()));
-  struct SelectiveFlag {
-    const char* flag;
-    std::string_view key;
-    bool given;
-  };
-  const SelectiveFlag flags[] = {
-      {"--direction-sampling", "direction_sampling", !request.direction_sampling.empty()},
-      {"--no-mis", "mis", request.no_mis},
-      {"--shadow-rays", "shadow_rays", request.shadow_rays.has_value()},
-      {"--light-selection paper", "light_selection=paper", request.light_selection == "paper"},
-      {"--adaptive-threshold", "adaptive", request.adaptive_threshold.has_value()},
-      {"--adaptive-spp", "adaptive", request.adaptive_spp.has_value()},
-      {"--adaptive-batch", "adaptive", request.adaptive_batch.has_value()},
-      {"--max-spp", "adaptive", request.max_spp.has_value()},
-      {"--mlt-bootstrap", "mlt", request.mlt_bootstrap.has_value()},
-      {"--mlt-chains", "mlt", request.mlt_chains.has_value()},
-      {"--mlt-sigma", "mlt", request.mlt_sigma.has_value()},
-      {"--mlt-large-step", "mlt", request.mlt_large_step.has_value()},
-      {"--mlt-lens", "mlt", request.mlt_lens.has_value()},
-      {"--mlt-caustic", "mlt", request.mlt_caustic.has_value()},
-  };
-  for (const SelectiveFlag& f : flags)
-    if (f.given && !integrator->reads_setting(f.key))
-      throw UsageError(fmt::format("{}: {}", f.flag, unread_setting_message(*integrator, f.key)));
+  for (const RenderOption& option : render_options()) {
+    if (!option.selective_in(request) || integrator->reads_setting(option.reads)) continue;
+    throw UsageError(fmt::format("{}: {}", option.flag_for_messages(), unread_setting_message(*integrator, option.reads)));
+  }
   if (!request.bdpt_strategies.empty() && !integrator->strategy_images)
     throw UsageError(fmt::format("--bdpt-strategies: the {} integrator writes no strategy images (bdpt does)",
                                  integrator->name));
@@ -137,37 +107,10 @@ void check_integrator_flags(const RenderRequest& request, const SceneDesc& scene
 
 void apply_request(const RenderRequest& request, SceneDesc& scene) {
   check_request_values(request);
-  if (request.spp) scene.settings.spp = *request.spp;
-  if (request.max_depth) scene.settings.max_depth = *request.max_depth;
-  if (request.seed) scene.settings.seed = *request.seed;
-  if (!request.integrator.empty()) scene.settings.integrator = request.integrator;
+  // Each option given sets its own field (render_option_table.cpp); then what depends on several.
+  for (const RenderOption& option : render_options())
+    if (option.apply && option.given(request)) option.apply(request, scene);
   RenderSettings& rs = scene.settings;
-  if (!request.sampler.empty())
-    rs.sampler.type = parse_choice<SamplerType>("--sampler", request.sampler,
-                                                {{"random", SamplerType::Independent},
-                                                 {"independent", SamplerType::Independent},
-                                                 {"stratified", SamplerType::Stratified},
-                                                 {"poisson", SamplerType::Poisson},
-                                                 {"zsobol", SamplerType::ZSobol}});
-  if (!request.filter.empty())
-    rs.filter = default_filter(parse_choice<FilterType>(
-        "--filter", request.filter,
-        {{"box", FilterType::Box}, {"tent", FilterType::Tent}, {"gaussian", FilterType::Gaussian},
-         {"mitchell", FilterType::Mitchell}}));
-  if (!request.direction_sampling.empty())
-    rs.path.direction_sampling = parse_choice<DirectionSampling>(
-        "--direction-sampling", request.direction_sampling,
-        {{"bsdf", DirectionSampling::Bsdf}, {"cosine", DirectionSampling::Cosine},
-         {"uniform", DirectionSampling::Uniform}});
-  if (!request.bvh.empty())
-    rs.bvh = parse_choice<BvhLayout>("--bvh", request.bvh, {{"fast", BvhLayout::Fast}, {"compact", BvhLayout::Compact}});
-  if (!request.light_selection.empty())
-    rs.light_selection = parse_choice<LightSelection>("--light-selection", request.light_selection,
-                                                      {{"power", LightSelection::Power},
-                                                       {"paper", LightSelection::Paper},
-                                                       {"uniform", LightSelection::Uniform},
-                                                       {"bvh", LightSelection::Bvh}});
-  if (request.no_mis) rs.path.mis = false;
   // An error estimate needs two independent halves of every pixel's samples; with a target the
   // spp is the most a pixel may get (--spp, or 65536).
   if (request.estimate_error || request.target_error || rs.integrator == "auto") rs.sampler.replicas = true;
@@ -175,21 +118,8 @@ void apply_request(const RenderRequest& request, SceneDesc& scene) {
   // winner can continue its pilot; the scene's or the given spp is then the budget, not the count.
   if (rs.integrator == "auto" && !request.target_error) rs.spp = kTargetErrorMaxSpp;
   if (request.target_error) rs.spp = request.spp.value_or(kTargetErrorMaxSpp);
-  if (!request.transport.empty())
-    rs.spectral = parse_choice<bool>("--transport", request.transport, {{"rgb", false}, {"spectral", true}});
-  if (request.mlt_bootstrap) rs.mlt.bootstrap = *request.mlt_bootstrap;
-  if (request.mlt_chains) rs.mlt.chains = *request.mlt_chains;
-  if (request.mlt_sigma) rs.mlt.sigma = *request.mlt_sigma;
-  if (request.mlt_large_step) rs.mlt.large_step = *request.mlt_large_step;
-  if (request.mlt_lens) rs.mlt.lens = *request.mlt_lens;
-  if (request.mlt_caustic) rs.mlt.caustic = *request.mlt_caustic;
   if (std::string problem = rs.mlt.problem(); !problem.empty())
     throw UsageError("--mlt-large-step, --mlt-lens, --mlt-caustic: " + problem);
-  if (request.shadow_rays) rs.path.shadow_rays = *request.shadow_rays;
-  if (request.adaptive_threshold) rs.adaptive_threshold = *request.adaptive_threshold;
-  if (request.adaptive_spp) rs.adaptive_spp = *request.adaptive_spp;
-  if (request.adaptive_batch) rs.adaptive_batch = *request.adaptive_batch;
-  if (request.max_spp) rs.adaptive_max_spp = *request.max_spp;
   if (rs.adaptive() && (rs.adaptive_batch & (rs.adaptive_batch - 1)) != 0)
     throw UsageError(fmt::format("--adaptive-batch: must be a power of two, got {}", rs.adaptive_batch));
   if (rs.adaptive_spp > 0 && rs.adaptive_spp < rs.adaptive_batch)
@@ -198,8 +128,6 @@ void apply_request(const RenderRequest& request, SceneDesc& scene) {
   if (rs.adaptive_spp > 0 && rs.adaptive_max_spp > 0 && rs.adaptive_max_spp < rs.adaptive_spp)
     throw UsageError(fmt::format("--max-spp ({}) must be at least --adaptive-spp ({})", rs.adaptive_max_spp,
                                  rs.adaptive_spp));
-  if (!request.resolution.empty())
-    std::tie(scene.film.width, scene.film.height) = parse_resolution(request.resolution);
   const auto& f = scene.film;
   check_resolution_range(f.width, f.height, fmt::format("{}x{}", f.width, f.height));
   if (request.target_error && rs.adaptive())

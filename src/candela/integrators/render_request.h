@@ -12,7 +12,7 @@
 #include "candela/film/error_estimate.h"
 #include "candela/integrators/auto_integrator.h"
 #include "candela/render/render_loop.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela {
 
@@ -20,9 +20,10 @@ inline constexpr int kMaxResolution = 65536;       // pixels along either side
 inline constexpr long long kMaxPixels = 1LL << 28;  // pixels in all
 inline constexpr int kTargetErrorMaxSpp = 65536;    // the spp cap of --target-error without --spp
 
-// Every field is unset by default: the scene's own value holds. The names are the flags'.
+// Every field is unset by default: the scene's own value holds. The names are the flags'; each field
+// is declared, checked and applied through its entry in integrators/render_option_table.h.
 struct RenderRequest {
-  std::optional<int> spp, threads, max_depth;
+  std::optional<int> spp, threads, max_depth, rr_start_depth;
   std::optional<uint64_t> seed;
   std::string resolution;  // "WIDTHxHEIGHT"
   std::string integrator;  // a registered name (integrators/integrator.h) or "auto"
@@ -50,6 +51,10 @@ void check_request_values(const RenderRequest& request);
 // sampling's batch and budget agree, the resolution and MLT probabilities are valid. Throws
 // UsageError. Prints a note (unless quiet) for a scene setting the chosen integrator ignores.
 void apply_request(const RenderRequest& request, SceneDesc& scene);
+
+// WIDTHxHEIGHT (--resolution), each side 1..kMaxResolution and at most kMaxPixels in all; throws
+// UsageError.
+std::pair<int, int> parse_resolution(const std::string& text);
 
 // Seconds from "90", "2.5", "90s", "10m", "2h" or "1h30m" (each part a number with a unit, largest
 // first); `option` names the flag in the UsageError.

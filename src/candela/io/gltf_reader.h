@@ -4,9 +4,9 @@
 #include <filesystem>
 #include <string>
 
-#include "candela/scene/description.h"
-
+#include "candela/description/scene_desc.h"
 #include "candela/io/warnings.h"
+
 namespace candela {
 
 struct GltfOptions {

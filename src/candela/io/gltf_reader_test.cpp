@@ -24,7 +24,7 @@
 #include "candela/base/error.h"
 #include "candela/io/gltf_reader.h"
 #include "candela/io/scene_reader.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 #include "candela/testing/render_helpers.h"
 
 namespace candela {

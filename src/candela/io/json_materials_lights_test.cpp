@@ -151,8 +151,8 @@ TEST(JsonReader, TextureErrorsNameTheirJsonPointer) {
                         "at /textures/t/wrap: unknown wrap mode \"tile\"; expected one of: repeat, clamp, black, "
                         "mirror");
   expect_textured_error(with_texture(R"({"type": "image", "filename": "checker.ppm", "encoding": "gamma"})"),
-                        "at /textures/t/encoding: unknown colour encoding \"gamma\"; expected one of: auto, srgb, "
-                        "linear");
+                        "at /textures/t/encoding: unknown colour encoding \"gamma\"; expected one of: auto, linear, "
+                        "srgb");
   expect_textured_error(with_texture(R"({"type": "image", "filename": "checker.ppm", "filter": "trilinear"})"),
                         "at /textures/t/filter: unknown texture filter \"trilinear\"; expected one of: bilinear, "
                         "nearest");

@@ -12,7 +12,7 @@
 
 #include "candela/base/error.h"
 #include "candela/geometry/sdf_grid.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 #include "candela/testing/json_reader_helpers.h"
 
 namespace candela {

@@ -61,10 +61,8 @@ Json texture_json(const TextureDesc& desc) {
       Overloaded{
           [](const ImageTexture& t) {
             Json j{{"type", "image"}, {"filename", absolute(t.filename)}};
-            static const char* kWrap[] = {"repeat", "clamp", "black", "mirror"};
-            static const char* kEncoding[] = {"auto", "linear", "srgb"};
-            j["wrap"] = kWrap[int(t.wrap)];
-            j["encoding"] = kEncoding[int(t.encoding)];
+            j["wrap"] = enum_name(t.wrap);
+            j["encoding"] = enum_name(t.encoding);
             j["filter"] = t.bilinear ? "bilinear" : "nearest";
             if (t.scale != 1) j["scale"] = t.scale;
             if (t.invert) j["invert"] = true;
@@ -98,8 +96,7 @@ void write_roughness(const Roughness& r, Json& j) {
     j["alpha_u"] = number(r.u);
     j["alpha_v"] = number(r.v);
   }
-  if (r.distribution == MicrofacetDistribution::Beckmann) j["distribution"] = "beckmann";
-  if (r.distribution == MicrofacetDistribution::GGXSeparable) j["distribution"] = "ggx_separable";
+  if (r.distribution != MicrofacetDistribution::GGX) j["distribution"] = enum_name(r.distribution);
 }
 
 Json with_options(Json j, const PerturbedNormalOptions& o) {
@@ -291,7 +288,7 @@ Json volume_json(const VolumeDesc& v) {
   // The scene's own placement; a VDB file brings its own.
   const Transform placement = v.to_world * v.file_to_world.inverse();
   if (!placement.is_identity()) j["transform"] = matrix(placement);
-  if (v.border == VolumeBorder::Zero) j["border"] = "zero";
+  if (v.border != VolumeBorder::Clamp) j["border"] = enum_name(v.border);
   return j;
 }
 
@@ -334,15 +331,6 @@ Json shape_json(const ShapeDesc& shape, const std::vector<std::string>& media) {
   return j;
 }
 
-const char* environment_mapping_name(EnvironmentMapping mapping) {
-  switch (mapping) {
-    case EnvironmentMapping::Equirectangular: return "equirectangular";
-    case EnvironmentMapping::EquirectangularPoleRows: return "equirectangular_pole_rows";
-    case EnvironmentMapping::EqualAreaOctahedral: return "equal_area";
-  }
-  return "equirectangular";
-}
-
 Json light_json(const LightDesc& light) {
   return std::visit(
       Overloaded{
@@ -365,7 +353,7 @@ Json light_json(const LightDesc& light) {
           [](const EnvironmentMap& l) {
             Json j{{"type", "environment"},
                    {"filename", absolute(l.filename)},
-                   {"mapping", environment_mapping_name(l.mapping)},
+                   {"mapping", enum_name(l.mapping)},
                    {"scale", rgb(l.scale)}};
             if (!l.to_world.is_identity()) j["transform"] = matrix(l.to_world);
             if (l.mis_compensation) j["mis_compensation"] = true;
@@ -384,8 +372,7 @@ Json light_json(const LightDesc& light) {
 
 Json camera_json(const SceneDesc& scene, const std::vector<std::string>& media) {
   const CameraDesc& c = scene.camera;
-  static const char* kAxis[] = {"x", "y", "smaller", "larger", "diagonal"};
-  Json j{{"transform", matrix(c.world_from_camera)}, {"fov", c.fov_degrees}, {"fov_axis", kAxis[int(c.fov_axis)]}};
+  Json j{{"transform", matrix(c.world_from_camera)}, {"fov", c.fov_degrees}, {"fov_axis", enum_name(c.fov_axis)}};
   if (c.projection == Projection::Orthographic) j["projection"] = "orthographic";
   if (c.near_clip != 0) j["near_clip"] = c.near_clip;
   j["width"] = scene.film.width;
@@ -409,28 +396,24 @@ Json render_json(const SceneDesc& scene) {
   auto reads = [&](std::string_view key) { return integrator && integrator->reads_setting(key); };
   if (reads("rr_start_depth")) j["rr_start_depth"] = s.rr_start_depth;
   j["transform_times"] = Json::array({scene.transform_start_time, scene.transform_end_time});
-  static const char* kSampler[] = {"independent", "stratified", "poisson", "zsobol"};
-  Json sampler{{"type", kSampler[int(s.sampler.type)]}};
+  Json sampler{{"type", enum_name(s.sampler.type)}};
   if (s.sampler.type == SamplerType::Stratified) sampler["jitter"] = s.sampler.jitter;
   j["sampler"] = std::move(sampler);
-  static const char* kFilter[] = {"box", "tent", "gaussian", "mitchell"};
-  Json filter{{"type", kFilter[int(s.filter.type)]}, {"radius", Json::array({s.filter.radius.x, s.filter.radius.y})}};
+  Json filter{{"type", enum_name(s.filter.type)}, {"radius", Json::array({s.filter.radius.x, s.filter.radius.y})}};
   if (s.filter.type == FilterType::Gaussian) filter["sigma"] = s.filter.gaussian_sigma;
   if (s.filter.type == FilterType::Mitchell) {
     filter["b"] = s.filter.mitchell_b;
     filter["c"] = s.filter.mitchell_c;
   }
   j["filter"] = std::move(filter);
-  static const char* kDirections[] = {"bsdf", "cosine", "uniform"};
-  if (reads("direction_sampling")) j["direction_sampling"] = kDirections[int(s.path.direction_sampling)];
+  if (reads("direction_sampling")) j["direction_sampling"] = enum_name(s.path.direction_sampling);
   if (reads("mis")) j["mis"] = s.path.mis;
   if (s.hide_emitters) j["hide_emitters"] = true;
   if (s.spectral) j["spectral"] = true;
-  static const char* kSelection[] = {"power", "paper", "uniform", "bvh"};
   if (s.light_selection != LightSelection::Paper || reads("light_selection=paper"))
-    j["light_selection"] = kSelection[int(s.light_selection)];
+    j["light_selection"] = enum_name(s.light_selection);
   if (reads("shadow_rays")) j["shadow_rays"] = s.path.shadow_rays;
-  j["bvh"] = s.bvh == BvhLayout::Compact ? "compact" : "fast";
+  j["bvh"] = enum_name(s.bvh);
   if (s.adaptive() && reads("adaptive")) {
     Json adaptive;
     if (s.adaptive_threshold > 0) adaptive["threshold"] = s.adaptive_threshold;

@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <string>
 
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela {
 

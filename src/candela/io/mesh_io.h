@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "candela/base/error.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela {
 

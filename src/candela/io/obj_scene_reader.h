@@ -3,7 +3,7 @@
 // Ke, and (OBJ has no cameras) a camera that frames the model. docs/obj-format.md has the mapping.
 #include <filesystem>
 
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 #include "candela/io/warnings.h"
 
 namespace candela {

@@ -11,7 +11,7 @@
 #include "candela/media/medium.h"
 #include "candela/spectral/blackbody.h"
 #include "candela/io/pbrt_reader.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 #include "candela/testing/pbrt_reader_helpers.h"
 
 namespace candela {

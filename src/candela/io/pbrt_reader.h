@@ -5,9 +5,9 @@
 #include <string>
 #include <string_view>
 
-#include "candela/scene/description.h"
-
+#include "candela/description/scene_desc.h"
 #include "candela/io/warnings.h"
+
 namespace candela {
 
 // Reads a pbrt-v4 scene. Each warning is appended to `warnings` as one line,

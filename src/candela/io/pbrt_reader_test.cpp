@@ -19,7 +19,7 @@
 #include "candela/io/named_spectra.h"
 #include "candela/io/pbrt_reader.h"
 #include "candela/io/scene_reader.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 #include "candela/spectral/cie.h"
 #include "candela/testing/command_line.h"
 #include "candela/testing/gzip_bytes.h"

@@ -6,9 +6,9 @@
 #include <string>
 #include <string_view>
 
-#include "candela/scene/description.h"
-
+#include "candela/description/scene_desc.h"
 #include "candela/io/warnings.h"
+
 namespace candela {
 
 // Chooses the reader by extension: .json (candela's format), .pbrt (pbrt-v4), .xml (Mitsuba 3),

@@ -6,7 +6,7 @@
 
 #include "candela/base/error.h"
 #include "candela/lights/light_sample.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela {
 

@@ -20,7 +20,7 @@
 #include "candela/film/image.h"
 #include "candela/lights/light_sample.h"
 #include "candela/math/transform.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela {
 

@@ -17,7 +17,7 @@
 #include "candela/lights/light_sample.h"
 #include "candela/math/transform.h"
 #include "candela/sampling/distribution2d.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 #include "candela/textures/texture.h"
 
 namespace candela {

@@ -11,7 +11,7 @@
 #include "candela/base/error.h"
 #include "candela/lights/light_sample.h"
 #include "candela/math/frame.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 #include "candela/textures/texture.h"
 
 namespace candela {

@@ -21,7 +21,7 @@
 #include "candela/materials/bsdf.h"
 #include "candela/materials/surface_bsdf.h"
 #include "candela/math/frame.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 #include "candela/textures/texture.h"
 
 namespace candela {

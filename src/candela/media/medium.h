@@ -18,7 +18,7 @@
 #include "candela/math/transform.h"
 #include "candela/media/phase.h"
 #include "candela/sampling/rng.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela {
 

@@ -10,7 +10,7 @@
 #include "candela/sampling/sampler.h"
 #include "candela/sampling/stratified_sampler.h"
 #include "candela/sampling/zsobol_sampler.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela {
 

@@ -17,7 +17,7 @@
 
 #include "candela/math/color.h"
 #include "candela/math/transform.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela {
 

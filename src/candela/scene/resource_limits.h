@@ -22,7 +22,7 @@
 #include <cstdint>
 #include <string>
 
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela {
 

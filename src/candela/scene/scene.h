@@ -12,7 +12,7 @@
 #include "candela/lights/light_sampler.h"
 #include "candela/materials/material.h"
 #include "candela/media/medium.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 #include "candela/textures/texture.h"
 
 namespace candela {

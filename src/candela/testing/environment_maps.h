@@ -2,7 +2,7 @@
 // A small non-uniform environment map for tests of environment lights: a smooth colour gradient, a
 // bright spot (which importance sampling must find) and a black patch (which it must avoid).
 #include "candela/film/image.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela::testing {
 

@@ -9,7 +9,7 @@
 
 #include "candela/base/error.h"
 #include "candela/io/scene_reader.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 // In a namespace of their own, since the pbrt reader tests have helpers of the same names.
 namespace candela::testing::json_reader {

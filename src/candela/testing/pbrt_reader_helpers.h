@@ -16,7 +16,7 @@
 
 #include "candela/base/error.h"
 #include "candela/io/pbrt_reader.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 // In a namespace of their own, since the JSON reader tests have helpers of the same names.
 namespace candela::testing::pbrt_reader {

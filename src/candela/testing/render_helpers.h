@@ -6,7 +6,7 @@
 
 #include "candela/film/film.h"
 #include "candela/integrators/integrator.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 #include "candela/scene/scene.h"
 
 namespace candela::testing {

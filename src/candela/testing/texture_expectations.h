@@ -6,7 +6,7 @@
 #include <string>
 #include <utility>
 
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela::testing {
 

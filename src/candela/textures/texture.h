@@ -12,7 +12,7 @@
 #include "candela/film/image.h"
 #include "candela/math/color.h"
 #include "candela/math/vec.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela {
 

@@ -195,6 +195,35 @@ class GltfReader {
 
   MaterialInfo make_material(int m, bool vertex_colors, bool has_vertex_colors);
 
+  // make_material's parts. `uv_set`: the material's texture coordinate set, -1 until its first
+  // texture (add_texture); the parts are called in the order their textures are added.
+
+  // The specification's default material (no material given); its index in scene_.materials.
+  int add_default_material(bool vertex_colors);
+
+  // pbrMetallicRoughness: the base colour (factor x texture or vertex colour), then metallic and
+  // roughness (factors x texture).
+  void read_base_color(const tg::PbrMetallicRoughness& pbr, RGB factor, bool vertex_colors,
+                       const std::string& pointer, PrincipledMaterial& p, int& uv_set);
+  void read_metallic_roughness(const tg::PbrMetallicRoughness& pbr, const std::string& pointer,
+                               PrincipledMaterial& p, int& uv_set);
+
+  // The KHR_materials_* extensions (transmission, ior, volume, unlit); whether the material is unlit.
+  bool read_material_extensions(const tg::Material& mat, const std::string& pointer, PrincipledMaterial& p,
+                                int& uv_set);
+  void read_transmission(const tg::Value& value, const std::string& where, PrincipledMaterial& p, int& uv_set);
+
+  // emissiveFactor x KHR_materials_emissive_strength x emissiveTexture.
+  AreaEmission read_emission(const tg::Material& mat, const std::string& pointer, int& uv_set);
+
+  // KHR_materials_unlit: a black surface emitting its base colour, into info.
+  void add_unlit_material(const tg::PbrMetallicRoughness& pbr, RGB factor, bool vertex_colors,
+                          const std::string& pointer, int& uv_set, MaterialInfo& info);
+
+  // The normal map and the alpha mode as materials wrapping `top`; the new top material.
+  int add_normal_map(const tg::Material& mat, const std::string& pointer, int top, int& uv_set);
+  int add_alpha(const tg::Material& mat, float alpha, const std::string& pointer, int top, int& uv_set);
+
   static tg::ExtensionMap texture_extensions(const tg::Value& info);
 
   ColorInput attribute_texture();

@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "candela/base/enum_names.h"
 #include "candela/io/json/source_position.h"
 #include "candela/io/parameter_usage.h"
 #include "candela/math/color.h"
@@ -68,6 +69,14 @@ E read_name(const ErrorReporter& report, const Json& value, const std::string& p
   std::vector<std::string_view> known;
   for (const auto& entry : names) known.push_back(entry.first);
   report.fail(pointer, "unknown {} \"{}\"; expected one of: {}", what, name, fmt::join(known, ", "));
+}
+
+// One of a closed set's names (base/enum_names.h), e.g. "bsdf" for DirectionSampling::Bsdf.
+template <typename E>
+E read_enum(const ErrorReporter& report, const Json& value, const std::string& pointer, std::string_view what) {
+  std::string name = read_string(report, value, pointer);
+  if (std::optional<E> e = enum_from_name<E>(name)) return *e;
+  report.fail(pointer, "unknown {} \"{}\"; expected one of: {}", what, name, enum_names_list<E>());
 }
 
 void check_is_array(const ErrorReporter& report, const Json& value, const std::string& pointer,

@@ -125,10 +125,7 @@ EnvironmentMap JsonSceneReader::read_environment(CheckedObject& light) const {
   environment.filename = existing_file(light, "filename", "environment map");
   if (const Json* mapping = light.find("mapping"))
     environment.mapping =
-        read_name<EnvironmentMapping>(report_, *mapping, light.pointer_of("mapping"), "environment mapping",
-                                      {{"equirectangular", EnvironmentMapping::Equirectangular},
-                                       {"equirectangular_pole_rows", EnvironmentMapping::EquirectangularPoleRows},
-                                       {"equal_area", EnvironmentMapping::EqualAreaOctahedral}});
+        read_enum<EnvironmentMapping>(report_, *mapping, light.pointer_of("mapping"), "environment mapping");
   environment.scale = light.rgb_or("scale", ColorKind::Emission, environment.scale);
   environment.mis_compensation = light.boolean_or("mis_compensation", environment.mis_compensation);
   environment.to_world = read_environment_orientation(light, environment.mapping);

@@ -119,11 +119,8 @@ Roughness JsonSceneReader::read_roughness(CheckedObject& m) {
   // pbrt-v4's remaproughness: the values are pbrt's "roughness", alpha = sqrt(roughness).
   roughness.remap = m.boolean_or("remap_roughness", false);
   if (const Json* distribution = m.find("distribution"))
-    roughness.distribution = read_name<MicrofacetDistribution>(
-        report_, *distribution, m.pointer_of("distribution"), "microfacet distribution",
-        {{"ggx", MicrofacetDistribution::GGX},
-         {"ggx_separable", MicrofacetDistribution::GGXSeparable},
-         {"beckmann", MicrofacetDistribution::Beckmann}});
+    roughness.distribution = read_enum<MicrofacetDistribution>(
+        report_, *distribution, m.pointer_of("distribution"), "microfacet distribution");
   return roughness;
 }
 

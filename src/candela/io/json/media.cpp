@@ -164,8 +164,7 @@ VolumeDesc JsonSceneReader::read_volume(const Json& value, const std::string& po
   volume.values = std::make_shared<const std::vector<float>>(std::move(values));
   volume.to_world = read_transform_key(v) * volume.file_to_world;
   if (const Json* border = v.find("border"))
-    volume.border = read_name<VolumeBorder>(report_, *border, v.pointer_of("border"), "grid border",
-                                            {{"clamp", VolumeBorder::Clamp}, {"zero", VolumeBorder::Zero}});
+    volume.border = read_enum<VolumeBorder>(report_, *border, v.pointer_of("border"), "grid border");
   v.finish();
   return volume;
 }

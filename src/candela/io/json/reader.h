@@ -14,7 +14,7 @@
 #include "candela/io/json/checked_object.h"
 #include "candela/io/json/source_position.h"
 #include "candela/io/named_spectra.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela::json {
 

@@ -25,18 +25,12 @@ void JsonSceneReader::read_camera(const Json& value, const std::string& pointer)
   if (!(fov > 0 && fov < 180))
     report_.fail(camera.pointer_of("fov"), "the field of view must be in (0, 180) degrees, got {}", fov);
   if (const Json* axis = camera.find("fov_axis"))
-    scene_.camera.fov_axis = read_name<FovAxis>(report_, *axis, camera.pointer_of("fov_axis"), "field of view axis",
-                                                {{"x", FovAxis::X},
-                                                 {"y", FovAxis::Y},
-                                                 {"smaller", FovAxis::Smaller},
-                                                 {"larger", FovAxis::Larger},
-                                                 {"diagonal", FovAxis::Diagonal}});
+    scene_.camera.fov_axis = read_enum<FovAxis>(report_, *axis, camera.pointer_of("fov_axis"), "field of view axis");
   else
     scene_.camera.fov_axis = FovAxis::Y;
   if (const Json* projection = camera.find("projection"))
     scene_.camera.projection =
-        read_name<Projection>(report_, *projection, camera.pointer_of("projection"), "projection",
-                              {{"perspective", Projection::Perspective}, {"orthographic", Projection::Orthographic}});
+        read_enum<Projection>(report_, *projection, camera.pointer_of("projection"), "projection");
   scene_.camera.near_clip = camera.number_or("near_clip", scene_.camera.near_clip, Bound::NonNegative);
   scene_.film.width = camera.integer_or("width", scene_.film.width, 1, kMaxResolution);
   scene_.film.height = camera.integer_or("height", scene_.film.height, 1, kMaxResolution);
@@ -157,11 +151,7 @@ void JsonSceneReader::read_transform_times(const Json& value, const std::string&
 SamplerDesc JsonSceneReader::read_sampler(const Json& value, const std::string& pointer) const {
   CheckedObject object(report_, value, pointer);
   SamplerDesc sampler;
-  sampler.type = read_name<SamplerType>(report_, object.require("type"), object.pointer_of("type"), "sampler type",
-                                        {{"independent", SamplerType::Independent},
-                                         {"stratified", SamplerType::Stratified},
-                                         {"poisson", SamplerType::Poisson},
-                                         {"zsobol", SamplerType::ZSobol}});
+  sampler.type = read_enum<SamplerType>(report_, object.require("type"), object.pointer_of("type"), "sampler type");
   if (sampler.type == SamplerType::Stratified) sampler.jitter = object.boolean_or("jitter", sampler.jitter);
   object.finish();
   return sampler;
@@ -170,11 +160,7 @@ SamplerDesc JsonSceneReader::read_sampler(const Json& value, const std::string& 
 // Each type starts from pbrt-v4's defaults; only the keys of that type's parameters are allowed.
 FilterDesc JsonSceneReader::read_filter(const Json& value, const std::string& pointer) const {
   CheckedObject object(report_, value, pointer);
-  FilterType type = read_name<FilterType>(report_, object.require("type"), object.pointer_of("type"), "filter type",
-                                          {{"box", FilterType::Box},
-                                           {"tent", FilterType::Tent},
-                                           {"gaussian", FilterType::Gaussian},
-                                           {"mitchell", FilterType::Mitchell}});
+  FilterType type = read_enum<FilterType>(report_, object.require("type"), object.pointer_of("type"), "filter type");
   FilterDesc filter = default_filter(type);
   if (const Json* radius = object.find("radius"))
     filter.radius = read_filter_radius(*radius, object.pointer_of("radius"));
@@ -200,22 +186,17 @@ Vec2 JsonSceneReader::read_filter_radius(const Json& value, const std::string& p
 
 void JsonSceneReader::read_integrator_strategies(CheckedObject& render, RenderSettings& settings) const {
   if (const Json* value = render.find("direction_sampling"))
-    settings.path.direction_sampling = read_name<DirectionSampling>(
-        report_, *value, render.pointer_of("direction_sampling"), "direction sampling",
-        {{"bsdf", DirectionSampling::Bsdf}, {"cosine", DirectionSampling::Cosine},
-         {"uniform", DirectionSampling::Uniform}});
+    settings.path.direction_sampling = read_enum<DirectionSampling>(
+        report_, *value, render.pointer_of("direction_sampling"), "direction sampling");
   settings.path.mis = render.boolean_or("mis", settings.path.mis);
   settings.hide_emitters = render.boolean_or("hide_emitters", settings.hide_emitters);
   settings.spectral = render.boolean_or("spectral", settings.spectral);
   if (const Json* value = render.find("light_selection"))
     settings.light_selection =
-        read_name<LightSelection>(report_, *value, render.pointer_of("light_selection"), "light selection",
-                                  {{"power", LightSelection::Power}, {"paper", LightSelection::Paper},
-                                   {"uniform", LightSelection::Uniform}, {"bvh", LightSelection::Bvh}});
+        read_enum<LightSelection>(report_, *value, render.pointer_of("light_selection"), "light selection");
   settings.path.shadow_rays = render.integer_or("shadow_rays", settings.path.shadow_rays, 1, std::numeric_limits<int>::max());
   if (const Json* value = render.find("bvh"))
-    settings.bvh = read_name<BvhLayout>(report_, *value, render.pointer_of("bvh"), "BVH layout",
-                                        {{"fast", BvhLayout::Fast}, {"compact", BvhLayout::Compact}});
+    settings.bvh = read_enum<BvhLayout>(report_, *value, render.pointer_of("bvh"), "BVH layout");
 }
 
 // Present = on (RenderSettings): a threshold on the pixels' relative error, a budget of samples

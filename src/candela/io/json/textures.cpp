@@ -115,15 +115,10 @@ ImageTexture JsonSceneReader::read_image_texture(CheckedObject& t) const {
   ImageTexture image;
   image.filename = existing_file(t, "filename", "image");
   if (const Json* wrap = t.find("wrap"))
-    image.wrap = read_name<TextureWrap>(report_, *wrap, t.pointer_of("wrap"), "wrap mode",
-                                        {{"repeat", TextureWrap::Repeat},
-                                         {"clamp", TextureWrap::Clamp},
-                                         {"black", TextureWrap::Black},
-                                         {"mirror", TextureWrap::Mirror}});
+    image.wrap = read_enum<TextureWrap>(report_, *wrap, t.pointer_of("wrap"), "wrap mode");
   if (const Json* encoding = t.find("encoding"))
-    image.encoding = read_name<ColorEncoding>(
-        report_, *encoding, t.pointer_of("encoding"), "colour encoding",
-        {{"auto", ColorEncoding::Auto}, {"srgb", ColorEncoding::SRGB}, {"linear", ColorEncoding::Linear}});
+    image.encoding = read_enum<ColorEncoding>(
+        report_, *encoding, t.pointer_of("encoding"), "colour encoding");
   if (const Json* filter = t.find("filter"))
     image.bilinear = read_name<bool>(report_, *filter, t.pointer_of("filter"), "texture filter",
                                      {{"bilinear", true}, {"nearest", false}});

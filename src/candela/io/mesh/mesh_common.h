@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "candela/base/error.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela::mesh {
 

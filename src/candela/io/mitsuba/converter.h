@@ -18,7 +18,7 @@
 
 #include "candela/io/mitsuba/object_tree.h"
 #include "candela/io/warnings.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela::mitsuba {
 

@@ -68,8 +68,12 @@ std::optional<ColorInput> Converter::color_input(const Object& o, std::string_vi
       c.texture = texture(t, lookup);
       return c;
     }
-    default: wrong_kind(o, *p, "a colour (rgb, spectrum, float or texture)");
+    case Property::Kind::Boolean:
+    case Property::Kind::String:
+    case Property::Kind::Vector:
+    case Property::Kind::Transform: break;
   }
+  wrong_kind(o, *p, "a colour (rgb, spectrum, float or texture)");
 }
 
 ColorInput Converter::color(const Object& o, std::string_view name, RGB fallback, bool within_emitter) {
@@ -97,7 +101,10 @@ FloatInput Converter::float_input(const Object& o, std::string_view name, float 
       f.texture = texture(t, TextureLookup::Scalar);
       return f;
     }
-    default: break;
+    case Property::Kind::Boolean:
+    case Property::Kind::String:
+    case Property::Kind::Vector:
+    case Property::Kind::Transform: break;
   }
   wrong_kind(o, *p, "a float or a texture");
 }

@@ -9,7 +9,7 @@
 
 #include "candela/base/error.h"
 #include "candela/io/pbrt/parameters.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela::pbrt {
 

@@ -13,7 +13,7 @@
 #include "candela/base/error.h"
 #include "candela/io/parameter_usage.h"
 #include "candela/io/pbrt/tokenizer.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela::pbrt {
 

@@ -30,7 +30,7 @@
 #include "candela/io/pbrt/parameters.h"
 #include "candela/io/pbrt/tokenizer.h"
 #include "candela/io/warnings.h"
-#include "candela/scene/description.h"
+#include "candela/description/scene_desc.h"
 
 namespace candela::pbrt {
 

@@ -1,0 +1,90 @@
+#pragma once
+// The camera and the film: projection, lens, shutter, image size, outputs. Part of the format-neutral scene description (description/scene_desc.h).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "candela/base/enum_names.h"
+#include "candela/base/error.h"
+#include "candela/math/color.h"
+#include "candela/math/transform.h"
+#include "candela/math/vec.h"
+
+namespace candela {
+
+enum class FovAxis { X, Y, Smaller, Larger, Diagonal };
+enum class Projection {
+  Perspective,
+  // Parallel rays along +z; the film covers camera-space x in [-1, 1] and y in [-1 / aspect,
+  // 1 / aspect] (aspect = width / height), as Mitsuba's orthographic sensor; world_from_camera
+  // scales it.
+  Orthographic
+};
+constexpr std::string_view enum_name(FovAxis v) {
+  switch (v) {
+    case FovAxis::X: return "x";
+    case FovAxis::Y: return "y";
+    case FovAxis::Smaller: return "smaller";
+    case FovAxis::Larger: return "larger";
+    case FovAxis::Diagonal: return "diagonal";
+  }
+  return {};
+}
+constexpr std::string_view enum_name(Projection v) {
+  switch (v) {
+    case Projection::Perspective: return "perspective";
+    case Projection::Orthographic: return "orthographic";
+  }
+  return {};
+}
+
+struct CameraDesc {
+  // Maps camera space (+x image right, +y image up, +z forward) to world space. It may scale
+  // (orthographic cameras); directions are normalised after it.
+  Transform world_from_camera;
+  Projection projection = Projection::Perspective;
+  // Nothing nearer than this (along +z, in camera space) is seen by camera rays (Mitsuba's near_clip).
+  float near_clip = 0;
+  float fov_degrees = 40;
+  FovAxis fov_axis = FovAxis::Y;  // JSON gives a vertical fov; pbrt-v4 gives it on the smaller axis
+  // Thin lens (depth of field): 0 = pinhole. Points at focus_distance along +z are sharp.
+  float lens_radius = 0;
+  float focus_distance = 1e6f;
+  // Each camera path gets a time uniformly in [shutter_open, shutter_close] (motion blur).
+  float shutter_open = 0, shutter_close = 1;
+  // The participating medium the camera sits in (index into SceneDesc::media; -1 = vacuum).
+  int medium = -1;
+};
+
+// For models that bring no camera (OBJ, glTF): a perspective camera looking along -z at the box
+// [lo, hi] from its +z side, up +y, `fov_degrees` across the smaller image axis, far enough back that
+// the box's bounding sphere fits, times `margin`.
+inline CameraDesc camera_framing(const Point3& lo, const Point3& hi, float fov_degrees = 40, float margin = 1) {
+  const Point3 center = (lo + hi) * 0.5f;
+  const float radius = std::max(0.5f * length(hi - lo), 1e-3f);
+  const float distance = radius / std::sin(0.5f * fov_degrees * 3.14159265f / 180) * margin;
+  CameraDesc camera;
+  camera.world_from_camera = Transform::look_at_right_handed(center + Vec3(0, 0, distance), center, {0, 1, 0});
+  camera.fov_degrees = fov_degrees;
+  camera.fov_axis = FovAxis::Smaller;
+  return camera;
+}
+
+struct FilmDesc {
+  int width = 512;
+  int height = 512;
+  std::string filename;  // empty = the command line's default
+  // The AOV layers written beside the colour in an EXR output, as --aov takes them ("albedo,normal";
+  // film/aov_film.h); empty = none. The command line's --aov replaces it.
+  std::string aovs;
+};
+
+}  // namespace candela

@@ -1,0 +1,106 @@
+#pragma once
+// Lights that are not shapes (emissive shapes are ShapeDesc::emission). Part of the format-neutral scene description (description/scene_desc.h).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "candela/base/enum_names.h"
+#include "candela/base/error.h"
+#include "candela/math/color.h"
+#include "candela/math/transform.h"
+#include "candela/math/vec.h"
+#include "candela/description/textures.h"
+
+namespace candela {
+
+struct PointLight {
+  Point3 position{0.0f};
+  RGB intensity{1.0f};  // W/sr
+};
+
+// Point light emitting into a cone around `direction`: full intensity inside cone_angle - cone_delta,
+// falling off to zero at cone_angle with pbrt-v4's smoothstep in cos(angle), or (mitsuba_falloff)
+// with Mitsuba 3's spot: linearly in the angle from beam width = cone_angle - cone_delta to cone_angle,
+// times the image `texture` projected over the cone (-1 = none), as Mitsuba defines both.
+struct SpotLight {
+  Point3 position{0.0f};
+  Vec3 direction{0, 0, 1};
+  RGB intensity{1.0f};  // W/sr on the axis
+  float cone_angle = 30;  // degrees from the axis where the light reaches zero
+  float cone_delta = 5;   // degrees over which it falls off
+  bool mitsuba_falloff = false;
+  int texture = -1;      // index into SceneDesc::textures
+  Vec3 up{0, 1, 0};      // with a texture: the image's up direction (the light frame's +y)
+};
+
+// A point light that projects an image (Mitsuba's "projector"): at the origin of to_world looking
+// along its +z with the field of view `fov_degrees` on the image's wider axis; `irradiance` is the
+// image (index into SceneDesc::textures), scaled by `scale`, as Mitsuba defines it (irradiance on a
+// surface one unit away facing the projector).
+struct ProjectorLight {
+  Transform to_world;
+  float fov_degrees = 90;
+  int irradiance = -1;
+  RGB scale{1.0f};
+};
+
+// Parallel light from infinitely far away, travelling along `direction`; `radiance` is the
+// irradiance it delivers to a surface facing it (pbrt-v4's distant "L").
+struct DistantLight {
+  Vec3 direction{0, 0, 1};
+  RGB radiance{1.0f};
+};
+
+// Light from infinitely far away in every direction. Constant when zenith == horizon == ground;
+// otherwise radiance blends linearly in cos(theta) from horizon to zenith above the horizon and is
+// `ground` below it.
+struct SkyLight {
+  RGB zenith{1.0f};
+  RGB horizon{1.0f};
+  RGB ground{1.0f};
+  Vec3 up{0, 1, 0};
+  bool is_constant() const { return zenith == horizon && horizon == ground; }
+};
+
+// How an environment image covers the sphere of directions, in the light's local frame.
+enum class EnvironmentMapping {
+  // Latitude-longitude with +y up (Mitsuba's orientation): image position (u, v) in [0,1]^2, v = 0 at
+  // the top, is the direction (sin(theta) sin(phi), cos(theta), -sin(theta) cos(phi)), phi = 2 pi u,
+  // theta = pi v. Texel (x, y) sits at ((x + 1/2) / width, (y + 1/2) / height), as most lat-long images
+  // are made.
+  Equirectangular,
+  // The same directions with Mitsuba's envmap texel placement: texel (x, y) at ((x + 1/2) / width,
+  // y / (height - 1)), so the first and last rows are the poles themselves.
+  EquirectangularPoleRows,
+  // Clarberg's equal-area octahedral square with +z up (pbrt-v4's "infinite" light with a filename).
+  EqualAreaOctahedral
+};
+constexpr std::string_view enum_name(EnvironmentMapping v) {
+  switch (v) {
+    case EnvironmentMapping::Equirectangular: return "equirectangular";
+    case EnvironmentMapping::EquirectangularPoleRows: return "equirectangular_pole_rows";
+    case EnvironmentMapping::EqualAreaOctahedral: return "equal_area";
+  }
+  return {};
+}
+
+// An environment map: radiance from every direction read from an image, importance-sampled.
+struct EnvironmentMap {
+  std::string filename;  // resolved by the reader
+  EnvironmentMapping mapping = EnvironmentMapping::Equirectangular;
+  RGB scale{1.0f};
+  Transform to_world;  // from the map's local frame to the world (rotations only are meaningful)
+  bool mis_compensation = false;  // sample by luminance minus its mean (environment_light.h)
+};
+
+using LightDesc = std::variant<PointLight, SkyLight, SpotLight, DistantLight, EnvironmentMap, ProjectorLight>;
+
+}  // namespace candela

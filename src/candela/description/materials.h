@@ -1,0 +1,214 @@
+#pragma once
+// Material descriptions, one struct per material type, and the MaterialDesc variant. Part of the format-neutral scene description (description/scene_desc.h).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "candela/base/enum_names.h"
+#include "candela/base/error.h"
+#include "candela/math/color.h"
+#include "candela/math/transform.h"
+#include "candela/math/vec.h"
+#include "candela/description/textures.h"
+
+namespace candela {
+
+// Lambertian reflector.
+struct DiffuseMaterial {
+  ColorInput reflectance{RGB(0.5f)};
+};
+
+// The paper's material model (Häkkinen 2002, sec. 4.6): a diffuse lobe, a normalised Phong lobe and
+// ideal refraction, chosen per path vertex by Russian roulette with probabilities d, s, t
+// (d + s + t <= 1; the rest absorbs). The BSDF is d*diffuse/pi + s*specular*phong + t*transmission*delta.
+struct PhongMaterial {
+  ColorInput diffuse{RGB(0.5f)};
+  ColorInput specular{RGB(1.0f)};
+  float exponent = 32;  // Phong exponent n of cos^n around the mirror direction
+  ColorInput transmission{RGB(1.0f)};
+  float ior = 1.5f;  // index of refraction inside / outside, for the transmitted part
+  float d = 1, s = 0, t = 0;
+};
+
+// Ideal specular reflector.
+struct MirrorMaterial {
+  ColorInput reflectance{RGB(1.0f)};
+};
+
+// The microfacet normal distribution: Trowbridge-Reitz (GGX, the default) or Beckmann (Mitsuba's
+// "beckmann"); alpha has the usual meaning for each (Beckmann: the RMS slope).
+// GGX with pbrt-v4's height-correlated masking-shadowing 1 / (1 + Lambda(wo) + Lambda(wi)), or with
+// Mitsuba's separable G1(wo) G1(wi) (GGXSeparable: what Mitsuba's rough BSDFs use); Beckmann (always
+// separable, as Mitsuba's).
+enum class MicrofacetDistribution { GGX, GGXSeparable, Beckmann };
+constexpr std::string_view enum_name(MicrofacetDistribution v) {
+  switch (v) {
+    case MicrofacetDistribution::GGX: return "ggx";
+    case MicrofacetDistribution::GGXSeparable: return "ggx_separable";
+    case MicrofacetDistribution::Beckmann: return "beckmann";
+  }
+  return {};
+}
+
+// Microfacet roughness: the Trowbridge-Reitz (GGX) alpha along the shading frame's u and v axes.
+// alpha < 1e-3 on both axes is treated as perfectly smooth (a delta BSDF), as pbrt-v4 does.
+// remap = true reads u, v as pbrt's "roughness" and uses alpha = sqrt(roughness) (pbrt-v4's
+// RoughnessToAlpha); false uses them as alpha directly (Mitsuba's "alpha").
+struct Roughness {
+  FloatInput u{0.0f}, v{0.0f};
+  bool remap = false;
+  MicrofacetDistribution distribution = MicrofacetDistribution::GGX;
+};
+
+// Metal: Fresnel reflection of a conductor with complex index of refraction eta + i k (per RGB
+// channel), on a GGX microfacet surface. With `reflectance` set, eta and k are ignored and the
+// normal-incidence reflectance is given instead (pbrt-v4's artist mode: eta = 1, k = 2 sqrt(r) / sqrt(1 - r)).
+// The defaults are copper (pbrt-v4's default "metal-Cu-eta" / "metal-Cu-k", as RGB).
+struct ConductorMaterial {
+  ColorInput eta{RGB(0.200438f, 0.924033f, 1.102212f)};
+  ColorInput k{RGB(3.912949f, 2.452848f, 2.142188f)};
+  std::optional<ColorInput> reflectance;
+  ColorInput specular_tint{RGB(1.0f)};  // multiplies the reflection (Mitsuba's specular_reflectance)
+  Roughness roughness;
+};
+
+// Dielectric interface (glass, water): Fresnel-weighted reflection and refraction, smooth or GGX-rough.
+// ior = n_inside / n_outside, inside being the side opposite the geometric normal.
+struct DielectricMaterial {
+  float ior = 1.5f;
+  ColorInput reflectance{RGB(1.0f)};    // tints (Mitsuba's specular_reflectance / _transmittance); 1 = physical
+  ColorInput transmittance{RGB(1.0f)};
+  Roughness roughness;
+  // A thin sheet (Mitsuba's "thindielectric"): light passes straight through without refraction,
+  // with the Fresnel reflectance of the two interfaces and their internal reflections summed
+  // (R' = R + T^2 R / (1 - R^2)); smooth only.
+  bool thin = false;
+};
+
+// Plastic / coated diffuse: a dielectric coat (smooth or GGX-rough) of index `ior` over a Lambertian
+// base. Light refracted into the coat scatters diffusely and bounces between base and coat; the
+// closed form for the infinite series of internal reflections (Mitsuba's plastic, after Weidlich and
+// Wilkie) keeps it energy-consistent.
+struct CoatedDiffuseMaterial {
+  ColorInput reflectance{RGB(0.5f)};  // the diffuse base
+  ColorInput specular{RGB(1.0f)};     // tints the coat's reflection (1 = physical)
+  float ior = 1.5f;
+  Roughness roughness;
+  bool nonlinear = false;  // Mitsuba's "nonlinear": account for the colour shift of internal bounces
+  // Mitsuba 3's roughplastic: the rough coat's transmittance and internal reflectance integrated
+  // over its microfacets and tabulated (materials/rough_coat.h) instead of the smooth Fresnel
+  // factors. Needs a constant roughness.
+  bool tabulated_coat = false;
+};
+
+// Lambertian reflection and Lambertian transmission to the other side (leaves, paper, lamp shades).
+struct DiffuseTransmissionMaterial {
+  ColorInput reflectance{RGB(0.25f)};
+  ColorInput transmittance{RGB(0.25f)};
+};
+
+// Absorbs everything: for pure emitters and light blockers.
+struct BlackMaterial {};
+
+// No surface at all: rays pass straight through without counting as a bounce (pbrt-v4's
+// "interface", Mitsuba's "null"). Marks the boundary of a participating medium, or hides a shape
+// while keeping it as an emitter.
+struct InterfaceMaterial {};
+
+// Mitsuba 3's principled BSDF (after the Disney BSDF, Burley 2015), with Mitsuba's exact definitions
+// of every lobe and of how the parameters combine; `thin` selects Mitsuba's principledthin (a thin
+// sheet: diffuse and specular transmission without refraction). glTF's metallic-roughness model is
+// this with specular 0.5 and the other lobes off.
+struct PrincipledMaterial {
+  ColorInput base_color{RGB(0.5f)};
+  FloatInput roughness{0.5f};
+  FloatInput metallic{0.0f};
+  FloatInput specular{0.5f};       // ignored where eta is given (eta_given)
+  FloatInput specular_tint{0.0f};
+  FloatInput anisotropic{0.0f};
+  FloatInput sheen{0.0f};
+  FloatInput sheen_tint{0.0f};
+  FloatInput clearcoat{0.0f};
+  FloatInput clearcoat_gloss{0.0f};
+  FloatInput spec_trans{0.0f};
+  float eta = 1.5f;
+  bool eta_given = false;
+  // principledthin only:
+  bool thin = false;
+  FloatInput diff_trans{0.0f};
+  FloatInput flatness{0.0f};
+};
+
+// Wrappers around another material (indices into SceneDesc::materials, always smaller than the
+// wrapper's own index). Mitsuba's BSDFs are one-sided unless wrapped in "twosided"; candela's are
+// two-sided, so a reader of Mitsuba scenes wraps its opaque BSDFs in OneSidedMaterial.
+
+// The material seen from the front (the side the shading normal points to); black from the back.
+struct OneSidedMaterial {
+  int material = -1;
+};
+
+// Different materials on the two sides (Mitsuba's "twosided" with two BSDFs): `front` where the
+// direction the light leaves towards (the viewer) is on the side the geometric normal points to,
+// `back` on the other side, each seen as from its own front. Chosen per hit, so it must be the
+// outermost wrapper (no mask, blend or map around it).
+struct TwoSidedMaterial {
+  int front = -1, back = -1;
+};
+
+// Alpha masking (Mitsuba's "mask"): with probability 1 - opacity the surface is not there and the
+// ray passes straight through; otherwise `material` scatters.
+struct MaskMaterial {
+  FloatInput opacity{1.0f};
+  int material = -1;
+};
+
+// f = (1 - weight) f_material0 + weight f_material1 (Mitsuba's "blendbsdf").
+struct BlendMaterial {
+  FloatInput weight{0.5f};
+  int material0 = -1, material1 = -1;
+};
+
+// What Mitsuba 3 (since 3.7.1) adds to a tilted shading normal, both off by default here (pbrt-v4
+// and glTF have neither) and on in Mitsuba scenes (its defaults):
+//   flip_invalid_normals  where the direction towards the previous vertex, wo, lies below the tilted
+//                         normal, the normal is mirrored about the original one (Schuessler et al. 2017)
+//   shadowing_function    the BSDF is scaled by a microfacet shadowing term of the sampled direction
+//                         (Conty Estevez et al. 2019) that softens the terminator of a strong tilt
+struct PerturbedNormalOptions {
+  bool flip_invalid_normals = false;
+  bool shadowing_function = false;
+};
+
+// Shading normals from a tangent-space normal map (Mitsuba's "normalmap"): the texture's RGB in
+// [0, 1], read without any colour decoding, is n = 2 rgb - 1 in the frame (dp/du, dp/dv, n).
+struct NormalMapMaterial {
+  int normal_map = -1;  // index into SceneDesc::textures
+  int material = -1;
+  PerturbedNormalOptions options;
+};
+
+// Shading normals from a height field (Mitsuba's "bumpmap"): the surface displaced by
+// scale * height(u, v) along its normal; the height texture's finite differences in u and v tilt
+// the normal.
+struct BumpMapMaterial {
+  int height = -1;  // index into SceneDesc::textures (its channel average is the height)
+  float scale = 1;
+  int material = -1;
+  PerturbedNormalOptions options;
+};
+
+using MaterialDesc = std::variant<DiffuseMaterial, PhongMaterial, MirrorMaterial, DielectricMaterial, BlackMaterial,
+                                  ConductorMaterial, CoatedDiffuseMaterial, DiffuseTransmissionMaterial,
+                                  InterfaceMaterial, PrincipledMaterial, OneSidedMaterial, MaskMaterial,
+                                  BlendMaterial, NormalMapMaterial, BumpMapMaterial, TwoSidedMaterial>;
+
+}  // namespace candela

@@ -1,0 +1,91 @@
+#pragma once
+// Participating media and their volume grids. Part of the format-neutral scene description (description/scene_desc.h).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "candela/base/enum_names.h"
+#include "candela/base/error.h"
+#include "candela/math/color.h"
+#include "candela/math/transform.h"
+#include "candela/math/vec.h"
+#include "candela/description/textures.h"
+
+namespace candela {
+
+// A quantity that varies over space (Mitsuba's volume plugins): a constant, or samples on a grid over
+// the unit cube [0,1]^3 of its own space, which to_world places in the scene. Sample (i, j, k) sits at
+// the voxel centre ((i + 0.5) / nx, (j + 0.5) / ny, (k + 0.5) / nz); values in between are trilinear,
+// and between the outermost centres and the cube's faces they are clamped (Mitsuba's gridvolume with
+// its default wrap mode "clamp") or fade to zero (pbrt-v4's grids, whose samples beyond the grid are 0).
+enum class VolumeBorder { Clamp, Zero };
+constexpr std::string_view enum_name(VolumeBorder v) {
+  switch (v) {
+    case VolumeBorder::Clamp: return "clamp";
+    case VolumeBorder::Zero: return "zero";
+  }
+  return {};
+}
+struct VolumeDesc {
+  RGB constant{1.0f};  // the value everywhere when there is no grid
+  std::array<int, 3> resolution{0, 0, 0};
+  int channels = 1;  // 1 (a scalar) or 3 (RGB)
+  // nx ny nz channels floats, a sample's channels together, x fastest, then y, then z; null = constant.
+  std::shared_ptr<const std::vector<float>> values;
+  Transform to_world;    // the grid's unit cube to world space
+  VolumeBorder border = VolumeBorder::Clamp;
+  std::string filename;  // where it was read from, for messages (empty: made in memory)
+  std::string grid_name;  // the grid within an OpenVDB or NanoVDB file
+  // The part of to_world that the file itself gives (a VDB grid's voxel placement; identity for .vol
+  // files and inline grids): to_world = the scene's own placement x file_to_world.
+  Transform file_to_world;
+  bool is_constant() const { return !values; }
+};
+
+// A participating medium (pbrt-v4's homogeneous and uniformgrid, Mitsuba 3's homogeneous and
+// heterogeneous): extinction sigma_t(p) = scale * sigma_t * density(p), of which the fraction
+// albedo(p) scatters (sigma_s = albedo sigma_t) and the rest is absorbed (sigma_a = sigma_t - sigma_s).
+// A medium whose density is a grid has no density outside the grid's cube (Mitsuba bounds a
+// heterogeneous medium by its volume's box). It emits radiance Le(p) (`emission`, or a temperature's
+// blackbody, times an emission scale) in proportion to absorption (the source term sigma_a Le, as
+// pbrt-v4 defines Le). Light scatters by Henyey-Greenstein's phase
+// function with mean cosine g in (-1, 1) (0: isotropic).
+struct MediumDesc {
+  RGB sigma_t{1.0f};    // per unit length, times density and scale
+  VolumeDesc density;   // a scalar; constant 1 = homogeneous
+  VolumeDesc albedo;    // RGB in [0, 1]
+  float scale = 1;
+  RGB emission{0.0f};
+  // Emission that varies through the medium (pbrt-v4's grid and NanoVDB media): the radiance emitted
+  // at p is emission_scale(p) times, with a temperature, pbrt-v4's peak-normalised blackbody
+  // (spectral/blackbody.h) at (temperature(p) - temperature_offset) x temperature_scale kelvin where
+  // that exceeds temperature_cutoff (nothing elsewhere), and without one `emission`.
+  VolumeDesc emission_scale;               // a scalar >= 0; constant 1 by default
+  std::optional<VolumeDesc> temperature;  // a scalar (kelvin before offset and scale)
+  float temperature_scale = 1, temperature_offset = 0, temperature_cutoff = 100;
+  float g = 0;
+  // A density grid's majorant: the largest density over cells of this many samples along each axis
+  // (at most 64 cells per axis), traversed cell by cell; 0 = one majorant for the whole grid (what
+  // Mitsuba does by default, majorant_resolution_factor = 0). Changes the noise, not the expectation.
+  int majorant_cell_samples = 4;
+  std::string name;      // for messages
+  SourceLocation where;  // where the scene file declares it
+  bool is_homogeneous() const { return density.is_constant() && albedo.is_constant(); }
+};
+
+// pbrt-v4's and JSON's way of giving a medium: absorption and scattering coefficients.
+inline void set_sigma_a_sigma_s(MediumDesc& m, const RGB& sigma_a, const RGB& sigma_s) {
+  m.sigma_t = sigma_a + sigma_s;
+  m.albedo.constant = {m.sigma_t.r > 0 ? sigma_s.r / m.sigma_t.r : 0.0f, m.sigma_t.g > 0 ? sigma_s.g / m.sigma_t.g : 0.0f,
+                       m.sigma_t.b > 0 ? sigma_s.b / m.sigma_t.b : 0.0f};
+}
+
+}  // namespace candela

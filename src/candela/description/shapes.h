@@ -1,0 +1,149 @@
+#pragma once
+// Shape descriptions: geometry, emission, media on either side; objects and their instances. Part of the format-neutral scene description (description/scene_desc.h).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "candela/base/enum_names.h"
+#include "candela/base/error.h"
+#include "candela/math/color.h"
+#include "candela/math/transform.h"
+#include "candela/math/vec.h"
+#include "candela/description/textures.h"
+
+namespace candela {
+
+struct TriangleMesh {
+  std::vector<Point3> positions;
+  std::vector<Normal3> normals;  // empty or one per position (shading normals)
+  std::vector<Vec2> uvs;         // empty or one per position
+  std::vector<uint32_t> indices;  // three per triangle
+  // Named per-vertex or per-face values (PLY's extra properties; Mitsuba's mesh_attribute), each
+  // with 1 or 3 channels: values.size() == channels * (vertex count or triangle count).
+  struct Attribute {
+    std::string name;  // without the "vertex_" / "face_" prefix
+    bool per_face = false;
+    int channels = 1;
+    std::vector<float> values;
+  };
+  std::vector<Attribute> attributes;
+  size_t triangle_count() const { return indices.size() / 3; }
+};
+
+// Sphere of `radius` around `center`, in object space (then to_world applies).
+struct SphereShape {
+  Point3 center{0.0f};
+  float radius = 1;
+};
+
+// Infinite plane through `point` with normal `normal` (object space).
+struct PlaneShape {
+  Point3 point{0.0f};
+  Normal3 normal{0, 1, 0};
+};
+
+// Axis-aligned box [lo, hi] in object space; to_world may rotate and scale it.
+struct BoxShape {
+  Point3 lo{-1.0f}, hi{1.0f};
+};
+
+// Parallelogram corner + s*edge_u + t*edge_v, (s,t) in [0,1]^2; normal = normalize(cross(edge_u, edge_v)).
+struct RectangleShape {
+  Point3 corner{-1, -1, 0};
+  Vec3 edge_u{2, 0, 0}, edge_v{0, 2, 0};
+};
+
+struct MeshShape {
+  TriangleMesh mesh;
+};
+
+// Disk of radius 1 around the origin in the z = 0 plane, normal +z (Mitsuba's "disk"); to_world
+// scales it. (u, v) = (r, phi / 2 pi), as Mitsuba parameterises it.
+struct DiskShape {};
+
+// Open tube (no caps) of `radius` around the segment p0-p1 (Mitsuba's "cylinder"), normals pointing
+// outwards; (u, v) = (phi / 2 pi, distance along the axis / its length).
+struct CylinderShape {
+  Point3 p0{0.0f}, p1{0, 0, 1};
+  float radius = 1;
+};
+
+// How an SDF grid's shading normal is found (Mitsuba's sdfgrid "normals").
+enum class SdfNormals {
+  Smooth,   // Hansson-Söderlund et al.'s blend of the gradients of the voxels around the hit, continuous
+            // across voxel faces (Mitsuba's default)
+  Analytic  // the gradient of the hit voxel's trilinear interpolant, as the geometric normal
+};
+
+// A signed distance function sampled on a grid (Mitsuba's "sdfgrid"): the surface is the zero level
+// set of the trilinear interpolation of the samples, positive outside; normals point outwards. The
+// grid spans [0,1]^3 in object space, sample (i, j, k) at (i / (nx - 1), j / (ny - 1), k / (nz - 1)).
+// It has no (u, v) (they are 0) and cannot emit light.
+struct SdfGridShape {
+  std::array<int, 3> resolution{2, 2, 2};  // samples along x, y and z, each >= 2
+  // nx * ny * nz distances, x fastest, then y, then z; shared, so that copies of a SceneDesc are cheap.
+  std::shared_ptr<const std::vector<float>> values;
+  SdfNormals normals = SdfNormals::Smooth;
+  std::string filename;  // the Mitsuba .vol file it was read from (empty: made in memory)
+};
+
+using ShapeGeometry =
+    std::variant<SphereShape, PlaneShape, BoxShape, RectangleShape, MeshShape, DiskShape, CylinderShape, SdfGridShape>;
+
+// Diffuse emission attached to a shape (an area light). One-sided: emits on the side the surface
+// normal points to, unless two_sided.
+struct AreaEmission {
+  RGB radiance{1.0f};
+  bool two_sided = false;
+  // A textured emitter (Mitsuba's area light with a texture as "radiance"): radiance *
+  // SceneDesc::textures[texture] evaluated at the hit's uv (-1 = none).
+  int texture = -1;
+};
+
+struct ShapeDesc {
+  ShapeGeometry geometry;
+  Transform to_world;
+  int material = -1;  // index into SceneDesc::materials; -1 = the default diffuse 0.5
+  std::optional<AreaEmission> emission;
+  // A moving shape: its transform at SceneDesc::transform_times[1] (to_world holds the one at
+  // transform_times[0]); in between the matrix is interpolated linearly, as Embree does.
+  std::optional<Transform> to_world_end;
+  // Flips the surface normal (pbrt's ReverseOrientation): which side a one-sided emitter lights.
+  // Independently of this, a to_world that swaps handedness keeps normals equal to the object-space
+  // normals transformed as normals (pbrt-v4's convention).
+  bool reverse_orientation = false;
+  // The participating media on either side (indices into SceneDesc::media; -1 = vacuum): interior on
+  // the side opposite the surface normal. A ray crossing a shape whose two differ enters the one on
+  // the side it goes to; where they are equal the ray keeps the medium it has (pbrt-v4's
+  // MediumInterface, Mitsuba's interior/exterior).
+  int interior_medium = -1, exterior_medium = -1;
+  bool is_medium_transition() const { return interior_medium != exterior_medium; }
+  std::string name;      // for messages
+  SourceLocation where;  // where the scene file declares it (file empty = unknown), for messages
+};
+
+// A group of shapes defined once and placed many times (pbrt's ObjectBegin/ObjectInstance): Embree
+// builds its acceleration structure once and instances share it. Emissive shapes are not allowed
+// in objects (readers expand those into ordinary shapes).
+struct ObjectDesc {
+  std::vector<ShapeDesc> shapes;  // in the object's own space; their to_world is object-relative
+  std::string name;
+  SourceLocation where;
+};
+
+struct InstanceDesc {
+  int object = 0;  // index into SceneDesc::objects
+  Transform to_world;
+  std::optional<Transform> to_world_end;  // moving instance, as ShapeDesc::to_world_end
+  SourceLocation where;
+};
+
+}  // namespace candela
