@@ -105,26 +105,32 @@ std::vector<double> box_mean(const std::vector<double>& v, int w, int h, int r) 
   for (size_t i = 0; i < v.size(); ++i) box.sums[i] = box.counts[i] > 0 ? box.sums[i] / box.counts[i] : 0;
   return box.sums;
 }
-}  // namespace
+// Per pixel and channel (3 values per pixel): the mean and the variance of the mean from the
+// pixel's two halves, NaN where a pixel has no samples (not rendered) or lacks a half; the lesser
+// of the two halves' estimates; the variance of the splats' part alone. Also how many pixels were
+// rendered and how many lack a half, and whether any mean is negative (a filter's negative lobe).
+struct HalfStatistics {
+  std::vector<double> mean, variance, lesser_half, splat_variance;
+  uint64_t missing = 0, rendered = 0;
+  bool any_negative = false;
+};
 
-ErrorEstimate estimate_error(const Film& film, double scale_relative_error, std::vector<double>* pixel_errors) {
-  ErrorEstimate e;
-  if (pixel_errors) pixel_errors->assign(size_t(film.width()) * size_t(film.height()), std::nan(""));
+HalfStatistics half_statistics(const Film& film, double scale_relative_error) {
   const bool splats = film.has_splats();
   const double scale = splats ? film.splat_scale() : 0;
   const double f_splat = splats ? film.splat_half_fraction() : 0.5;
-  if (splats && (f_splat <= 0 || f_splat >= 1)) {
-    e.why_not = "the light paths or chains are not split into two halves";
-    return e;
-  }
   const int w = film.width(), h = film.height();
   const size_t n = size_t(w) * size_t(h);
-  // Per pixel and channel: the mean and the variance of the mean from its two halves; NaN where a
-  // pixel has no samples (not rendered) or lacks a half.
-  std::vector<double> mean(3 * n, std::nan("")), variance(3 * n, std::nan("")), lesser_half(3 * n, 0);
-  std::vector<double> splat_variance(splats ? 3 * n : 0, 0);  // of the splats' part alone
-  // Rows in parallel, each writing its own pixels; per row, how many pixels were rendered and how
-  // many lack a half, and whether any mean is negative (a filter's negative lobe).
+  HalfStatistics s;
+  s.mean.assign(3 * n, std::nan(""));
+  s.variance.assign(3 * n, std::nan(""));
+  s.lesser_half.assign(3 * n, 0);
+  s.splat_variance.assign(splats ? 3 * n : 0, 0);
+  std::vector<double>& mean = s.mean;
+  std::vector<double>& variance = s.variance;
+  std::vector<double>& lesser_half = s.lesser_half;
+  std::vector<double>& splat_variance = s.splat_variance;
+  // Rows in parallel, each writing its own pixels, with its own counts.
   struct RowCounts {
     uint64_t missing = 0, rendered = 0;
     bool negative = false;
@@ -165,84 +171,93 @@ ErrorEstimate estimate_error(const Film& film, double scale_relative_error, std:
       }
     }
   });
-  uint64_t missing = 0, rendered = 0;
-  bool any_negative = false;
   for (const RowCounts& counts : row_counts) {
-    missing += counts.missing;
-    rendered += counts.rendered;
-    any_negative = any_negative || counts.negative;
+    s.missing += counts.missing;
+    s.rendered += counts.rendered;
+    s.any_negative = s.any_negative || counts.negative;
   }
-  // A few pixels may lack a half (adaptive sampling's pixels that got one batch); most may not.
-  if (rendered == 0 || missing * 100 > rendered) {
-    e.why_not = rendered == 0 ? "no pixel has samples"
-                              : fmt::format("{} of {} pixels have samples in only one of the two independent halves",
-                                            missing, rendered);
-    return e;
+  return s;
+}
+
+// The truth's square in the denominator of channel c of pixel (x, y) (at `at` = 3 i + c), from the
+// pixel's mean `s.mean`, its neighbours' and `local`, the 7 x 7 neighbourhood's mean.
+//
+// Where a rare bright path (a firefly) lifted one half, the pixel's mean is far above the truth and
+// would shrink its relative error many times over: the mean is capped by the brightest of the eight
+// neighbours' means. A pixel at the edge of a bright light has a bright neighbour, so its mean
+// stands, and a light a pixel wide has two bright halves, which floor it. The square of the mean
+// overstates the truth's square by the mean's variance, and more where the halves differ most
+// (light transport's samples are skewed, so a large difference comes with a large mean): half the
+// variance is taken off (all of it makes the denominator too noisy; on the Cornell box at 16 spp the
+// estimate came out 0.70-0.89 of the truth with none taken off, 0.80-1.10 with half, 1.07-2.2 with
+// all), but never more than half the square: in a pixel that is all noise (most paths find no
+// light, a few find much, as on veach-ajar at 16 spp) the variance exceeds the square, and the
+// lesser half, often 0, is no guide (the estimate was 35x the truth).
+// A firefly's cap, its neighbours, can be far below the truth too, where most paths have not yet
+// found the light (veach-ajar at 16 spp: a third of the pixels still black, and ten firefly
+// pixel-channels with capped truths of 0.002 against true values near 1 made 42% of an estimate
+// 3.9x the truth): a capped pixel's truth is floored by the mean of its 11 x 11 neighbourhood less
+// that neighbourhood's own fireflies (its largest 1/24). Estimate / truth on veach-ajar at 16 spp
+// 3.9-6.1 -> 1.18-1.22, at 64 spp 1.61-2.57 -> 0.98-1.20; within 0.03 elsewhere
+// (docs/error-estimates.md).
+inline double truth_squared(const HalfStatistics& s, const std::vector<double>& local, const BoxSums& firefly_box,
+                            int w, int h, int x, int y, int c, size_t at) {
+  const std::vector<double>& mean = s.mean;
+  const double own = mean[at], var = s.variance[at];
+  const double lesser = s.lesser_half[at];
+  double around[8];
+  double brightest = -std::numeric_limits<double>::infinity();
+  int k = 0;
+  for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy)
+    for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx) {
+      const size_t j = 3 * (size_t(yy) * size_t(w) + size_t(xx)) + size_t(c);
+      if ((xx == x && yy == y) || std::isnan(mean[j])) continue;
+      brightest = std::max(brightest, s.lesser_half[j]);
+      around[k++] = mean[j];
+    }
+  if (k == 0) {
+    brightest = own;  // no neighbour rendered
+  } else {
+    std::nth_element(around, around + k / 2, around + k);
+    brightest = std::max(brightest, around[k / 2]);
   }
-  // The truth in the denominator. Where a rare bright path (a firefly) lifted one half, the pixel's
-  // mean is far above the truth and would shrink its relative error many times over: the mean is
-  // capped by the brightest of the eight neighbours' means. A pixel at the edge of a bright light
-  // has a bright neighbour, so its mean stands, and a light a pixel wide has two bright halves, which
-  // floor it. The square of the mean overstates the truth's square by the mean's variance, and more
-  // where the halves differ most (light transport's samples are skewed, so a large difference comes
-  // with a large mean): half the variance is taken off (all of it makes the denominator too noisy;
-  // on the Cornell box at 16 spp the estimate came out 0.70-0.89 of the truth with none taken off,
-  // 0.80-1.10 with half, 1.07-2.2 with all), but never more than half the square: in a pixel that is
-  // all noise (most paths find no light, a few find much, as on veach-ajar at 16 spp) the variance
-  // exceeds the square, and the lesser half, often 0, is no guide (the estimate was 35x the truth).
-  // A firefly's cap, its neighbours, can be far below the truth too, where most paths have not yet
-  // found the light (veach-ajar at 16 spp: a third of the pixels still black, and ten firefly
-  // pixel-channels with capped truths of 0.002 against true values near 1 made 42% of an estimate
-  // 3.9x the truth): a capped pixel's truth is floored by the mean of its 11 x 11 neighbourhood less
-  // that neighbourhood's own fireflies (its largest 1/24). Estimate / truth on veach-ajar at 16 spp
-  // 3.9-6.1 -> 1.18-1.22, at 64 spp 1.61-2.57 -> 0.98-1.20; within 0.03 elsewhere
-  // (docs/error-estimates.md).
-  const std::vector<double> local = box_mean(mean, w, h, kLocalRadius);
-  const BoxSums firefly_box = box_sums(mean, w, h, kFireflyRadius);
+  const bool firefly = own > brightest;
+  // Where every neighbour and both halves saw nothing yet but this pixel saw something (a
+  // render so short that most paths find no light), the wider neighbourhood's mean.
+  if (brightest <= 0 && lesser <= 0) brightest = local[at];
+  const double capped = std::max(std::min(own, brightest), lesser);
+  double truth_sq = std::max({capped * capped - var / 2, capped * capped / 2, lesser * lesser});
+  if (firefly && floor_can_matter(firefly_box, at, own, s.any_negative, truth_sq)) {
+    const double floor = trimmed_local_mean(mean, firefly_box, w, h, x, y, c, kFireflyRadius);
+    truth_sq = std::max(truth_sq, floor * floor);
+  }
+  return truth_sq;
+}
+
+// The pixels' relative errors (the mean over the channels of variance / (truth^2 + epsilon)) summed,
+// with their squares and the splats' share, over the pixels that have both halves.
+struct ErrorSums {
+  double sum = 0, sum_sq = 0, splat_sum = 0;
+  uint64_t covered = 0;
+};
+
+ErrorSums sum_pixel_errors(const HalfStatistics& s, bool splats, int w, int h, std::vector<double>* pixel_errors) {
+  const std::vector<double> local = box_mean(s.mean, w, h, kLocalRadius);
+  const BoxSums firefly_box = box_sums(s.mean, w, h, kFireflyRadius);
   // Rows in parallel, their sums added in row order: the same estimate for any number of threads.
-  struct RowSums {
-    double sum = 0, sum_sq = 0, splat_sum = 0;
-    uint64_t covered = 0;
-  };
-  std::vector<RowSums> rows(static_cast<size_t>(h));
+  std::vector<ErrorSums> rows(static_cast<size_t>(h));
   tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& range) {
-    double around[8];
     for (int y = range.begin(); y < range.end(); ++y) {
-      RowSums& row = rows[size_t(y)];
+      ErrorSums& row = rows[size_t(y)];
       for (int x = 0; x < w; ++x) {
         const size_t i = size_t(y) * size_t(w) + size_t(x);
-        if (std::isnan(variance[3 * i])) continue;
+        if (std::isnan(s.variance[3 * i])) continue;
         double pixel_error = 0, splat_error = 0;
         for (int c = 0; c < 3; ++c) {
-          const double own = mean[3 * i + size_t(c)], var = variance[3 * i + size_t(c)];
-          const double lesser = lesser_half[3 * i + size_t(c)];
-          double brightest = -std::numeric_limits<double>::infinity();
-          int k = 0;
-          for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy)
-            for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx) {
-              const size_t j = 3 * (size_t(yy) * size_t(w) + size_t(xx)) + size_t(c);
-              if ((xx == x && yy == y) || std::isnan(mean[j])) continue;
-              brightest = std::max(brightest, lesser_half[j]);
-              around[k++] = mean[j];
-            }
-          if (k == 0) {
-            brightest = own;  // no neighbour rendered
-          } else {
-            std::nth_element(around, around + k / 2, around + k);
-            brightest = std::max(brightest, around[k / 2]);
-          }
-          const bool firefly = own > brightest;
-          // Where every neighbour and both halves saw nothing yet but this pixel saw something (a
-          // render so short that most paths find no light), the wider neighbourhood's mean.
-          if (brightest <= 0 && lesser <= 0) brightest = local[3 * i + size_t(c)];
-          const double capped = std::max(std::min(own, brightest), lesser);
-          double truth_sq = std::max({capped * capped - var / 2, capped * capped / 2, lesser * lesser});
-          if (firefly && floor_can_matter(firefly_box, 3 * i + size_t(c), own, any_negative, truth_sq)) {
-            const double floor = trimmed_local_mean(mean, firefly_box, w, h, x, y, c, kFireflyRadius);
-            truth_sq = std::max(truth_sq, floor * floor);
-          }
-          pixel_error += var / (truth_sq + kErrorEpsilon);
-          if (splats) splat_error += splat_variance[3 * i + size_t(c)] / (truth_sq + kErrorEpsilon);
+          const size_t at = 3 * i + size_t(c);
+          const double truth_sq = truth_squared(s, local, firefly_box, w, h, x, y, c, at);
+          pixel_error += s.variance[at] / (truth_sq + kErrorEpsilon);
+          if (splats) splat_error += s.splat_variance[at] / (truth_sq + kErrorEpsilon);
         }
         pixel_error /= 3;
         row.splat_sum += splat_error / 3;
@@ -253,23 +268,46 @@ ErrorEstimate estimate_error(const Film& film, double scale_relative_error, std:
       }
     }
   });
-  double sum = 0, sum_sq = 0, splat_sum = 0;
-  uint64_t covered = 0;
-  for (const RowSums& row : rows) {
-    sum += row.sum;
-    sum_sq += row.sum_sq;
-    splat_sum += row.splat_sum;
-    covered += row.covered;
+  ErrorSums total;
+  for (const ErrorSums& row : rows) {
+    total.sum += row.sum;
+    total.sum_sq += row.sum_sq;
+    total.splat_sum += row.splat_sum;
+    total.covered += row.covered;
   }
+  return total;
+}
+}  // namespace
+
+ErrorEstimate estimate_error(const Film& film, double scale_relative_error, std::vector<double>* pixel_errors) {
+  ErrorEstimate e;
+  if (pixel_errors) pixel_errors->assign(size_t(film.width()) * size_t(film.height()), std::nan(""));
+  const bool splats = film.has_splats();
+  const double f_splat = splats ? film.splat_half_fraction() : 0.5;
+  if (splats && (f_splat <= 0 || f_splat >= 1)) {
+    e.why_not = "the light paths or chains are not split into two halves";
+    return e;
+  }
+  // Each pixel's mean and variance from its two halves.
+  const HalfStatistics s = half_statistics(film, scale_relative_error);
+  // A few pixels may lack a half (adaptive sampling's pixels that got one batch); most may not.
+  if (s.rendered == 0 || s.missing * 100 > s.rendered) {
+    e.why_not = s.rendered == 0 ? "no pixel has samples"
+                                : fmt::format("{} of {} pixels have samples in only one of the two independent halves",
+                                              s.missing, s.rendered);
+    return e;
+  }
+  // Each pixel's relative error, its variance over its truth's square (estimated), summed.
+  const ErrorSums sums = sum_pixel_errors(s, splats, film.width(), film.height(), pixel_errors);
   e.valid = true;
-  e.pixels = covered;
-  const double count = double(covered);
-  e.relmse = sum / count;
-  e.splat_relmse = splat_sum / count;
+  e.pixels = sums.covered;
+  const double count = double(sums.covered);
+  e.relmse = sums.sum / count;
+  e.splat_relmse = sums.splat_sum / count;
   // The interval: the statistical spread of the pixels' one-draw estimates and of their actual
   // errors, and the estimator's systematic uncertainty from its denominators, measured against
   // converged references (docs/error-estimates.md): within kSystematic of the truth.
-  const double sigma = std::sqrt(4.0 / 3.0 * sum_sq) / count;
+  const double sigma = std::sqrt(4.0 / 3.0 * sums.sum_sq) / count;
   const double half_width = std::hypot(1.96 * sigma, kSystematic * e.relmse);
   e.low = std::max(0.0, e.relmse - half_width);
   e.high = e.relmse + half_width;

@@ -12,6 +12,7 @@
 #include <functional>
 #include <cstring>
 #include <limits>
+#include <optional>
 
 #include "candela/film/filter.h"
 #include "candela/integrators/bdpt.h"
@@ -212,20 +213,18 @@ Normalization estimate_normalization(const Scene& scene, const BdptIntegrator& b
   return b;
 }
 
-}  // namespace
+using Clock = std::chrono::steady_clock;
 
-RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options) {
-  auto start_time = std::chrono::steady_clock::now();
-  // Across ranks: the depth-0 pass and the bootstrap and normalisation samples are shared out and
-  // exchanged, so every rank starts the same chains; each rank then runs every size()-th chain, and
-  // the chains' splats (integer sums) are added up at the end.
-  Cluster& cluster = options.cluster ? *options.cluster : local_cluster();
-  // Depth 0, the emission that camera rays see directly, needs no Markov chain: it is rendered as the
-  // path tracer renders it (stratified camera samples of one ray each) into the film's own pixel
-  // sums, and the chains' splats of the depths >= 1 are added to it. Left to chains, the share of
-  // the film covered by small visible lights is estimated far more noisily.
-  // Under a time limit it takes at most kMltDirectTimeShare of it (but at least one pass): at 256 spp
-  // it took 3.5 s of a 15 s budget on veach-ajar, time the chains then lacked.
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+// Step 0 (mlt.h): depth 0, the emission that camera rays see directly, needs no Markov chain: it is
+// rendered as the path tracer renders it (stratified camera samples of one ray each) into the film's
+// own pixel sums, and the chains' splats of the depths >= 1 are added to it. Left to chains, the
+// share of the film covered by small visible lights is estimated far more noisily.
+// Under a time limit it takes at most kMltDirectTimeShare of it (but at least one pass): at 256 spp
+// it took 3.5 s of a 15 s budget on veach-ajar, time the chains then lacked.
+RenderStats render_depth_zero(const Scene& scene, const RenderSettings& settings, Film& film,
+                              const RenderOptions& options) {
   RenderSettings emission = settings;
   emission.max_depth = 0;
   emission.spp = mlt_direct_spp(settings.spp);
@@ -241,319 +240,437 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
                                         : render_path(scene, emission, film, emission_options);
   stats.samples = 0;
   stats.time_limited = false;  // the depth-0 pass's share of the limit, not the render's
-  stats.mlt_direct_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
-  film.enable_splats();
-  film.set_splat_scale(0);
-  if (scene.lights().empty() || settings.max_depth == 0 || stats.cancelled) {
-    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
-    return stats;
-  }
-  // Russian roulette would end subpaths short of the lengths the state asks for: off.
+  return stats;
+}
+
+// Russian roulette would end subpaths short of the lengths the state asks for: off.
+RenderSettings without_roulette(const RenderSettings& settings) {
   RenderSettings bdpt_settings = settings;
   bdpt_settings.rr_start_depth = std::numeric_limits<int>::max();
-  const BdptIntegrator bdpt(scene, bdpt_settings);
-  const MltPathSampler paths(scene, bdpt, settings.spectral);
-  const Filter filter(settings.filter);
-  const int depths = settings.max_depth + 1;
-  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
-  tbb::enumerable_thread_specific<RayCounts> ray_counts;
-  std::atomic<uint64_t> busy_nanoseconds{0};
-  const std::function<bool()> cancelled = [&] {
-    return options.cancel && options.cancel->load(std::memory_order_relaxed);
-  };
-  // Interrupted before the chains: the image is the depth-0 pass alone.
-  auto stop_cancelled = [&](ProgressBar& progress) {
-    progress.finish();
-    stats.cancelled = true;
-    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
-    return stats;
-  };
+  return bdpt_settings;
+}
 
-  const uint64_t pixels = uint64_t(film.width()) * uint64_t(film.height());
-  const uint64_t total_mutations = uint64_t(settings.spp) * pixels;
-  const uint64_t bootstrap_count = uint64_t(settings.mlt.bootstrap) * uint64_t(depths);
-  ProgressBar progress(bootstrap_count + total_mutations, options.progress, options.progress_fraction);
-  // The bootstrap grows with max_depth (one per depth): the bar says which phase it is in.
-  progress.set_label(fmt::format("MLT bootstrap ({} depths x {})", depths, settings.mlt.bootstrap));
+// One Markov chain: its sampler (the state's primary sample vector), the random numbers that decide
+// acceptance, the path of its current state and what its deposits are scaled by.
+struct Chain {
+  MltSampler sampler;
+  Rng rng;
+  PathState current;
+  int depth = 0;
+  float scale = 0;
+  float brightness = 0;  // the depth's mean luminance b_d
+  bool first_half = false;
+};
 
-  // Bootstrap: the luminance of independent states, depth by depth in turn, in blocks handed out
-  // across the ranks; every rank then has them all.
-  constexpr uint64_t kBootstrapBlock = 64;
-  std::vector<float> weights(bootstrap_count);
-  const uint64_t bootstrap_blocks = (bootstrap_count + kBootstrapBlock - 1) / kBootstrapBlock;
-  std::vector<uint8_t> bootstrap_mine = run_shared(
-      cluster, arena, bootstrap_blocks,
-      [&](uint64_t block) {
-        if (cancelled()) return;  // as in the normalisation
-        BusyTimer busy(busy_nanoseconds);
-        RayCounts& counts = ray_counts.local();
-        const uint64_t end = std::min(bootstrap_count, (block + 1) * kBootstrapBlock);
-        for (uint64_t i = block * kBootstrapBlock; i < end; ++i) {
-          if (cancelled()) return;
-          int depth = int(i % uint64_t(depths));
-          if (depth == 0) continue;  // rendered directly above
-          MltSampler sampler(settings.seed, i, settings.mlt.sigma);
-          weights[i] = paths.sample(sampler, depth, counts).luminance();
-        }
-        progress.advance(end - block * kBootstrapBlock);
-      },
-      [&](uint64_t, uint64_t count) { progress.advance(count * kBootstrapBlock); });
-  if (cluster.any(cancelled())) return stop_cancelled(progress);
-  stats.mlt_bootstrap_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count() - stats.mlt_direct_seconds;
-  if (cluster.distributed()) {
-    weights.resize(bootstrap_blocks * kBootstrapBlock);  // whole blocks to exchange
-    exchange_values(cluster, bootstrap_mine, weights, kBootstrapBlock);
-    weights.resize(bootstrap_count);
+// Steps 1-3 of the algorithm (mlt.h) after the depth-0 pass: the bootstrap and the normalization
+// constant b, the chains' set-up, the chains' rounds of mutations and the film's splat scale.
+//
+// Across ranks: the depth-0 pass and the bootstrap and normalisation samples are shared out and
+// exchanged, so every rank starts the same chains; each rank then runs every size()-th chain, and
+// the chains' splats (integer sums) are added up at the end.
+class MltRender {
+ public:
+  MltRender(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options,
+            Cluster& cluster, Clock::time_point start_time, const RenderStats& direct_stats)
+      : scene_(scene),
+        settings_(settings),
+        film_(film),
+        options_(options),
+        cluster_(cluster),
+        start_time_(start_time),
+        stats_(direct_stats),
+        bdpt_settings_(without_roulette(settings)),
+        bdpt_(scene, bdpt_settings_),
+        paths_(scene, bdpt_, settings.spectral),
+        filter_(settings.filter),
+        depths_(settings.max_depth + 1),
+        arena_(options.threads > 0 ? options.threads : tbb::task_arena::automatic),
+        cancelled_([&options] { return options.cancel && options.cancel->load(std::memory_order_relaxed); }),
+        total_mutations_(uint64_t(settings.spp) * uint64_t(film.width()) * uint64_t(film.height())),
+        bootstrap_count_(uint64_t(settings.mlt.bootstrap) * uint64_t(depths_)),
+        progress_(bootstrap_count_ + total_mutations_, options.progress, options.progress_fraction) {}
+
+  RenderStats run() {
+    std::vector<float> weights;
+    if (!generate_bootstrap_samples(weights)) return stop_cancelled();
+    double sum = 0;
+    for (float w : weights) sum += w;
+    std::optional<Normalization> normalization = compute_normalization();
+    if (!normalization) return stop_cancelled();
+    if (!(normalization->value > 0) || !(sum > 0)) return stop_without_chains();
+
+    progress_.set_label("MLT chains");
+    stats_.setup_seconds = seconds_since(start_time_);
+    if (!start_chains(weights, *normalization)) return stop_without_chains();
+    const uint64_t mutations_per_chain = run_markov_chains(normalization->relative_error);
+    return finish(mutations_per_chain);
   }
-  double sum = 0;
-  for (float w : weights) sum += w;
-  // The chains' deposits are scaled by b, the image's mean luminance, from its own estimator (the
-  // bootstrap's mean would do in principle, but with far more noise).
+
+ private:
+  // Interrupted before the chains: the image is the depth-0 pass alone.
+  RenderStats stop_cancelled() {
+    progress_.finish();
+    stats_.cancelled = true;
+    stats_.seconds = seconds_since(start_time_);
+    return stats_;
+  }
+
+  // Nothing for the chains to render (no light found, no lit depth): the image is the depth-0 pass.
+  RenderStats stop_without_chains() {
+    progress_.finish();
+    film_.set_splat_scale(0);
+    stats_.seconds = seconds_since(start_time_);
+    return stats_;
+  }
+
+  // Step 1: generate bootstrap samples, the luminance of independent states (bootstrap_count_ of
+  // them, depth by depth in turn), in blocks handed out across the ranks; every rank then has them
+  // all. False when interrupted.
+  bool generate_bootstrap_samples(std::vector<float>& weights) {
+    // The bootstrap grows with max_depth (one per depth): the bar says which phase it is in.
+    progress_.set_label(fmt::format("MLT bootstrap ({} depths x {})", depths_, settings_.mlt.bootstrap));
+    constexpr uint64_t kBootstrapBlock = 64;
+    // (What the blocks read, as locals: the lambda then reaches them without going through `this`.)
+    const uint64_t bootstrap_count = bootstrap_count_;
+    const int depths = depths_;
+    const RenderSettings& settings = settings_;
+    const MltPathSampler& paths = paths_;
+    const std::function<bool()>& cancelled = cancelled_;
+    weights.assign(bootstrap_count, 0.0f);
+    const uint64_t bootstrap_blocks = (bootstrap_count + kBootstrapBlock - 1) / kBootstrapBlock;
+    std::vector<uint8_t> bootstrap_mine = run_shared(
+        cluster_, arena_, bootstrap_blocks,
+        [&](uint64_t block) {
+          if (cancelled()) return;  // as in the normalisation
+          BusyTimer busy(busy_nanoseconds_);
+          RayCounts& counts = ray_counts_.local();
+          const uint64_t end = std::min(bootstrap_count, (block + 1) * kBootstrapBlock);
+          for (uint64_t i = block * kBootstrapBlock; i < end; ++i) {
+            if (cancelled()) return;
+            int depth = int(i % uint64_t(depths));
+            if (depth == 0) continue;  // rendered directly (step 0)
+            MltSampler sampler(settings.seed, i, settings.mlt.sigma);
+            weights[i] = paths.sample(sampler, depth, counts).luminance();
+          }
+          progress_.advance(end - block * kBootstrapBlock);
+        },
+        [&](uint64_t, uint64_t count) { progress_.advance(count * kBootstrapBlock); });
+    if (cluster_.any(cancelled_())) return false;
+    stats_.mlt_bootstrap_seconds = seconds_since(start_time_) - stats_.mlt_direct_seconds;
+    if (cluster_.distributed()) {
+      weights.resize(bootstrap_blocks * kBootstrapBlock);  // whole blocks to exchange
+      exchange_values(cluster_, bootstrap_mine, weights, kBootstrapBlock);
+      weights.resize(bootstrap_count_);
+    }
+    return true;
+  }
+
+  // Step 1: compute the normalization constant b, the image's mean luminance (and each depth's),
+  // which scales the chains' deposits, from its own estimator (the bootstrap's mean would do in
+  // principle, but with far more noise). Empty when interrupted.
   // At least mlt_bootstrap samples, more for long renders (1 per 8 mutations), so that the image's
   // brightness converges with the rest of it. The estimate is heavy-tailed where caustics are
   // found by rare paths: with 1 per 64 the glass-sphere caustic's mean came out 3% high on two
   // seeds of three (a few rare paths in the estimate); with 1 per 8 within 0.6% on all three. It
   // costs 10-15% more time on the caustic and veach-mis, 40% on the Cornell box (whose normalization
   // evaluates every strategy of paths up to 16 bounces).
-  const BdptIntegrator bdpt_with_roulette(scene, settings);
-  const uint64_t normalization_samples = std::max<uint64_t>(
-      uint64_t(settings.mlt.bootstrap), options.time_limit_seconds > 0 || options.target_error > 0 ? 0 : total_mutations / 8);
-  const auto normalization_start = std::chrono::steady_clock::now();
-  progress.set_label(fmt::format("MLT normalisation ({} paths)", normalization_samples));
-  Normalization normalization = estimate_normalization(scene, bdpt_with_roulette, settings, cluster, arena,
-                                                       ray_counts, busy_nanoseconds, normalization_samples, cancelled);
-  if (cluster.any(cancelled())) return stop_cancelled(progress);
-  // Under a time limit the number of mutations is not known: further independent batches of
-  // mlt_bootstrap samples, averaged, until the normalisation has taken about a ninth of the time
-  // (1 sample per 8 mutations costs about that much).
-  uint64_t batches = 1;
-  if (options.time_limit_seconds > 0) {
-    double sum_sq_error = std::pow(normalization.relative_error * normalization.value, 2);
-    auto elapsed = [&] {
-      return std::chrono::duration<double>(std::chrono::steady_clock::now() - normalization_start).count();
-    };
-    while (cluster.from_root(elapsed() < options.time_limit_seconds / 9) && !cluster.any(cancelled())) {
-      Normalization more = estimate_normalization(scene, bdpt_with_roulette, settings, cluster, arena, ray_counts,
-                                                  busy_nanoseconds, normalization_samples, cancelled, batches);
-      if (cluster.any(cancelled())) return stop_cancelled(progress);
-      double k = double(batches);
-      for (size_t d = 0; d < normalization.per_depth.size(); ++d)
-        normalization.per_depth[d] = (normalization.per_depth[d] * k + more.per_depth[d]) / (k + 1);
-      normalization.value = (normalization.value * k + more.value) / (k + 1);
-      sum_sq_error += std::pow(more.relative_error * more.value, 2);
-      ++batches;
+  std::optional<Normalization> compute_normalization() {
+    const BdptIntegrator bdpt_with_roulette(scene_, settings_);
+    const uint64_t normalization_samples =
+        std::max<uint64_t>(uint64_t(settings_.mlt.bootstrap),
+                           options_.time_limit_seconds > 0 || options_.target_error > 0 ? 0 : total_mutations_ / 8);
+    const auto normalization_start = Clock::now();
+    progress_.set_label(fmt::format("MLT normalisation ({} paths)", normalization_samples));
+    Normalization normalization = estimate_normalization(scene_, bdpt_with_roulette, settings_, cluster_, arena_,
+                                                         ray_counts_, busy_nanoseconds_, normalization_samples,
+                                                         cancelled_);
+    if (cluster_.any(cancelled_())) return std::nullopt;
+    // Under a time limit the number of mutations is not known: further independent batches of
+    // mlt_bootstrap samples, averaged, until the normalisation has taken about a ninth of the time
+    // (1 sample per 8 mutations costs about that much).
+    uint64_t batches = 1;
+    if (options_.time_limit_seconds > 0) {
+      double sum_sq_error = std::pow(normalization.relative_error * normalization.value, 2);
+      while (cluster_.from_root(seconds_since(normalization_start) < options_.time_limit_seconds / 9) &&
+             !cluster_.any(cancelled_())) {
+        Normalization more = estimate_normalization(scene_, bdpt_with_roulette, settings_, cluster_, arena_,
+                                                    ray_counts_, busy_nanoseconds_, normalization_samples,
+                                                    cancelled_, batches);
+        if (cluster_.any(cancelled_())) return std::nullopt;
+        double k = double(batches);
+        for (size_t d = 0; d < normalization.per_depth.size(); ++d)
+          normalization.per_depth[d] = (normalization.per_depth[d] * k + more.per_depth[d]) / (k + 1);
+        normalization.value = (normalization.value * k + more.value) / (k + 1);
+        sum_sq_error += std::pow(more.relative_error * more.value, 2);
+        ++batches;
+      }
+      normalization.relative_error =
+          normalization.value > 0 ? std::sqrt(sum_sq_error) / double(batches) / normalization.value : 0;
     }
-    normalization.relative_error =
-        normalization.value > 0 ? std::sqrt(sum_sq_error) / double(batches) / normalization.value : 0;
-  }
-  const double b = normalization.value;
-  stats.mlt_normalization = b;
-  stats.mlt_normalization_relative_error = normalization.relative_error;
-  stats.mlt_normalization_samples = normalization_samples * batches;
-  stats.mlt_normalization_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - normalization_start).count();
-  if (!(b > 0) || !(sum > 0)) {
-    progress.finish();
-    film.set_splat_scale(0);
-    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
-    return stats;
+    stats_.mlt_normalization = normalization.value;
+    stats_.mlt_normalization_relative_error = normalization.relative_error;
+    stats_.mlt_normalization_samples = normalization_samples * batches;
+    stats_.mlt_normalization_seconds = seconds_since(normalization_start);
+    return normalization;
   }
 
-  progress.set_label("MLT chains");
-  stats.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
-  // The chains: each depth gets a share of them proportional to its brightness, and at least one if
-  // it has any light (so no depth's light is lost to chance), starting from its bootstrap paths
-  // chosen proportionally to their luminance, stratified over its chains. Each depth's deposits are
-  // then scaled by its own brightness over its number of chains. Every depth has an even number of
-  // chains: its even-numbered chains deposit also into the film's first half, so the two halves are
-  // independent estimates of the image (film/error_estimate.h).
-  std::vector<uint64_t> depth_chains(size_t(depths), 0);
-  std::vector<Distribution1D> depth_bootstrap;
-  depth_bootstrap.resize(size_t(depths));
-  std::vector<bool> depth_found(size_t(depths), false);
-  for (size_t d = 0; d < size_t(depths); ++d) {
-    std::vector<float> w(size_t(settings.mlt.bootstrap));
-    for (size_t k = 0; k < w.size(); ++k) w[k] = weights[k * size_t(depths) + d];
-    depth_found[d] = std::any_of(w.begin(), w.end(), [](float x) { return x > 0; });
-    depth_bootstrap[d] = Distribution1D(w);
-  }
-  const uint64_t wanted = std::max<uint64_t>(1, std::min<uint64_t>(uint64_t(settings.mlt.chains), total_mutations));
-  double b_chains = 0;  // the brightness the chains render: every depth but 0
-  for (size_t d = 1; d < size_t(depths); ++d) b_chains += normalization.per_depth[d];
-  for (size_t d = 0; d < size_t(depths); ++d)
-    if (d > 0 && depth_found[d] && normalization.per_depth[d] > 0)
-      depth_chains[d] = 2 * std::max<uint64_t>(1, uint64_t(std::llround(double(wanted) * normalization.per_depth[d] / b_chains / 2)));
-  uint64_t chains = 0;
-  for (uint64_t n : depth_chains) chains += n;
-  if (chains == 0) {
-    progress.finish();
-    film.set_splat_scale(0);
-    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
-    return stats;
-  }
-  const uint64_t per_chain = (total_mutations + chains - 1) / chains;
-  struct Chain {
-    MltSampler sampler;
-    Rng rng;
-    PathState current;
-    int depth = 0;
-    float scale = 0;
-    float brightness = 0;  // the depth's mean luminance b_d
-    bool first_half = false;
-  };
-  const MltMutationProbabilities mutations{settings.mlt.large_step, settings.mlt.lens, settings.mlt.caustic};
-  const PerspectiveCamera& camera = scene.camera();
-  const MltPerturbedNumbers perturbed{MltPathSampler::kFilmNumber, MltPathSampler::kLightDirectionNumber,
-                                      {float(camera.width()) + 2 * camera.margin().x,
-                                       float(camera.height()) + 2 * camera.margin().y}};
-  std::vector<Chain> chain_states;
-  chain_states.reserve(chains);
-  for (size_t d = 0; d < size_t(depths); ++d)
-    for (uint64_t k = 0; k < depth_chains[d]; ++k) {
-      uint64_t c = chain_states.size();
-      Rng pick(c, hash_values(settings.seed, 0x7374617274));
-      float u = std::min((float(k) + pick.next_float()) / float(depth_chains[d]), 0x1.fffffep-1f);
-      size_t index = depth_bootstrap[d].sample(u) * size_t(depths) + d;
-      chain_states.push_back(Chain{MltSampler(settings.seed, index, settings.mlt.sigma, mutations, perturbed),
-                                   Rng(c, hash_values(settings.seed, 0x636861696e)), PathState{}, int(d), 0, 0,
-                                   k % 2 == 0});
+  // Step 2: distribute the chains over the depths. Each depth gets a share of them proportional to
+  // its brightness, and at least one if it has any light (so no depth's light is lost to chance).
+  // Every depth has an even number of chains: its even-numbered chains deposit also into the film's
+  // first half, so the two halves are independent estimates of the image (film/error_estimate.h).
+  // Also each depth's bootstrap states as a distribution proportional to their luminance.
+  std::vector<uint64_t> chains_per_depth(const std::vector<float>& weights, const Normalization& normalization,
+                                         std::vector<Distribution1D>& depth_bootstrap) const {
+    std::vector<uint64_t> depth_chains(size_t(depths_), 0);
+    depth_bootstrap.resize(size_t(depths_));
+    std::vector<bool> depth_found(size_t(depths_), false);
+    for (size_t d = 0; d < size_t(depths_); ++d) {
+      std::vector<float> w(size_t(settings_.mlt.bootstrap));
+      for (size_t k = 0; k < w.size(); ++k) w[k] = weights[k * size_t(depths_) + d];
+      depth_found[d] = std::any_of(w.begin(), w.end(), [](float x) { return x > 0; });
+      depth_bootstrap[d] = Distribution1D(w);
     }
-  // Deposits are kept near 1 (relative to the largest depth scale) for the fixed-point splat sums.
-  std::vector<double> per_chain_share(size_t(depths), 0.0);
-  double largest = 0;
-  for (size_t d = 0; d < size_t(depths); ++d)
-    if (depth_chains[d] > 0) {
-      per_chain_share[d] = normalization.per_depth[d] / double(depth_chains[d]);
-      largest = std::max(largest, per_chain_share[d]);
-    }
-  for (Chain& c : chain_states) {
-    c.scale = largest > 0 ? float(per_chain_share[size_t(c.depth)] / largest) : 0.0f;
-    c.brightness = float(normalization.per_depth[size_t(c.depth)]);
+    const uint64_t wanted =
+        std::max<uint64_t>(1, std::min<uint64_t>(uint64_t(settings_.mlt.chains), total_mutations_));
+    double b_chains = 0;  // the brightness the chains render: every depth but 0
+    for (size_t d = 1; d < size_t(depths_); ++d) b_chains += normalization.per_depth[d];
+    for (size_t d = 0; d < size_t(depths_); ++d)
+      if (d > 0 && depth_found[d] && normalization.per_depth[d] > 0)
+        depth_chains[d] = 2 * std::max<uint64_t>(
+                                  1, uint64_t(std::llround(double(wanted) * normalization.per_depth[d] / b_chains / 2)));
+    return depth_chains;
   }
-  // A chain's deposits carry its depth's mean luminance over its chains, per mutation; times the
-  // film's area they make the image.
-  auto splat_scale = [&](uint64_t mutations) {
-    return mutations > 0 ? largest * double(scene.camera().importance_film_pixels()) / double(mutations) : 0.0;
-  };
-  film.set_splat_half_fraction(0.5);
 
+  // Step 2: set up the chains, each started from a bootstrap state of its depth chosen
+  // proportionally to its luminance (no start-up bias), stratified over the depth's chains. Each
+  // depth's deposits are then scaled by its own brightness over its number of chains. False when
+  // there are none.
+  bool start_chains(const std::vector<float>& weights, const Normalization& normalization) {
+    std::vector<Distribution1D> depth_bootstrap;
+    const std::vector<uint64_t> depth_chains = chains_per_depth(weights, normalization, depth_bootstrap);
+    uint64_t chains = 0;
+    for (uint64_t n : depth_chains) chains += n;
+    if (chains == 0) return false;
+    per_chain_ = (total_mutations_ + chains - 1) / chains;
+    const MltMutationProbabilities mutations{settings_.mlt.large_step, settings_.mlt.lens, settings_.mlt.caustic};
+    const PerspectiveCamera& camera = scene_.camera();
+    const MltPerturbedNumbers perturbed{MltPathSampler::kFilmNumber, MltPathSampler::kLightDirectionNumber,
+                                        {float(camera.width()) + 2 * camera.margin().x,
+                                         float(camera.height()) + 2 * camera.margin().y}};
+    chains_.reserve(chains);
+    for (size_t d = 0; d < size_t(depths_); ++d)
+      for (uint64_t k = 0; k < depth_chains[d]; ++k) {
+        uint64_t c = chains_.size();
+        Rng pick(c, hash_values(settings_.seed, 0x7374617274));
+        float u = std::min((float(k) + pick.next_float()) / float(depth_chains[d]), 0x1.fffffep-1f);
+        size_t index = depth_bootstrap[d].sample(u) * size_t(depths_) + d;
+        chains_.push_back(Chain{MltSampler(settings_.seed, index, settings_.mlt.sigma, mutations, perturbed),
+                                Rng(c, hash_values(settings_.seed, 0x636861696e)), PathState{}, int(d), 0, 0,
+                                k % 2 == 0});
+      }
+    // Deposits are kept near 1 (relative to the largest depth scale) for the fixed-point splat sums.
+    std::vector<double> per_chain_share(size_t(depths_), 0.0);
+    for (size_t d = 0; d < size_t(depths_); ++d)
+      if (depth_chains[d] > 0) {
+        per_chain_share[d] = normalization.per_depth[d] / double(depth_chains[d]);
+        largest_ = std::max(largest_, per_chain_share[d]);
+      }
+    for (Chain& c : chains_) {
+      c.scale = largest_ > 0 ? float(per_chain_share[size_t(c.depth)] / largest_) : 0.0f;
+      c.brightness = float(normalization.per_depth[size_t(c.depth)]);
+    }
+    for (uint64_t c = uint64_t(cluster_.rank()); c < chains; c += uint64_t(cluster_.size())) my_chains_.push_back(c);
+    film_.set_splat_half_fraction(0.5);
+    return true;
+  }
+
+  // Step 3's scale: a chain's deposits carry its depth's mean luminance over its chains, per
+  // mutation; times the film's area they make the image.
+  double splat_scale(uint64_t mutations) const {
+    return mutations > 0 ? largest_ * double(scene_.camera().importance_film_pixels()) / double(mutations) : 0.0;
+  }
+
+  // Step 2: run the Markov chains (this rank's), per_chain_ mutations each unless stopped early
+  // (interrupted, time limit, error target); returns the mutations each chain made.
   // The chains advance in rounds, every chain by the same number of mutations, so that a render
   // stopped between rounds (time limit, interruption) has every depth equally far along.
   // Rounds grow towards half a second each (how a chain's mutations are cut into rounds changes
   // nothing in what it computes, so the image stays the same whatever the timing).
-  uint64_t round_length = 16;
-  uint64_t next_check = 16;  // with an error target: the next mutation count at which it is checked
-  std::atomic<uint64_t> non_finite{0};
-  uint64_t mutations_per_chain = 0;
-  bool first_round = true;
-  std::vector<uint64_t> my_chains;
-  for (uint64_t c = uint64_t(cluster.rank()); c < chains; c += uint64_t(cluster.size())) my_chains.push_back(c);
-  while (mutations_per_chain < per_chain) {
-    // With an error target, rounds also end at fixed mutation counts (16, then 1.25x each time),
-    // where the estimate is checked: where the render stops then depends on the chains, not the clock.
-    const uint64_t steps = std::min({round_length, per_chain - mutations_per_chain,
-                                     options.target_error > 0 ? next_check - mutations_per_chain : round_length});
-    const auto round_start = std::chrono::steady_clock::now();
-    arena.execute([&] {
-      tbb::parallel_for(size_t(0), my_chains.size(), [&](size_t mine) {
-        BusyTimer busy(busy_nanoseconds);
-        Chain& c = chain_states[my_chains[mine]];
-        RayCounts& counts = ray_counts.local();
-        if (first_round) c.current = paths.sample(c.sampler, c.depth, counts);
-        for (uint64_t m = 0; m < steps; ++m) {
-          c.sampler.start_iteration(c.current.lens_moves(), c.current.caustic_moves());
-          PathState proposed = paths.sample(c.sampler, c.depth, counts);
-          float y_current = c.current.luminance(), y_proposed = proposed.luminance();
-          // A small step's chance depends on the path it leaves (MltSampler::start_iteration):
-          // Hastings' ratio of those chances keeps detailed balance (1 without perturbations).
-          float accept = 1;
-          if (y_current > 0) {
-            float ratio = y_proposed / y_current;
-            if (c.sampler.mutation() == MltSampler::Mutation::Small)
-              ratio *= c.sampler.small_step_probability(proposed.lens_moves(), proposed.caustic_moves()) /
-                       c.sampler.small_step_probability(c.current.lens_moves(), c.current.caustic_moves());
-            accept = std::min(1.0f, ratio);
-          }
-          // Deposit both states, weighted by the probability that the chain moves or stays, with
-          // Kelemen et al.'s weights: a large step is also an independent sample of the film, and
-          // the two estimators are combined by their densities (p_large against f / b), so dim
-          // regions that chains seldom visit are estimated by the large steps instead.
-          float large = c.sampler.large_step() ? 1.0f : 0.0f;
-          float floor_density = settings.mlt.large_step * c.brightness;
-          auto deposit = [&](Vec2 raster, const RGB& v) {
-            if (!film.splats().add(raster, v, filter)) {
-              non_finite.fetch_add(1, std::memory_order_relaxed);
-            } else if (c.first_half) {
-              film.half_splats().add(raster, v, filter);
-            }
-          };
-          if (y_proposed > 0 && accept + large > 0)
-            deposit(proposed.raster, proposed.L * ((accept + large) * c.scale / (y_proposed + floor_density)));
-          if (accept < 1 && y_current > 0)
-            deposit(c.current.raster, c.current.L * ((1 - accept) * c.scale / (y_current + floor_density)));
-          if (c.rng.next_float() < accept) {
-            c.current = proposed;
-            c.sampler.accept();
-          } else {
-            c.sampler.reject();
-          }
-        }
-        progress.advance(steps);
+  uint64_t run_markov_chains(double normalization_relative_error) {
+    const uint64_t chains = chains_.size();
+    uint64_t round_length = 16;
+    uint64_t next_check = 16;  // with an error target: the next mutation count at which it is checked
+    uint64_t mutations_per_chain = 0;
+    bool first_round = true;
+    while (mutations_per_chain < per_chain_) {
+      // With an error target, rounds also end at fixed mutation counts (16, then 1.25x each time),
+      // where the estimate is checked: where the render stops then depends on the chains, not the clock.
+      const uint64_t steps = std::min({round_length, per_chain_ - mutations_per_chain,
+                                       options_.target_error > 0 ? next_check - mutations_per_chain : round_length});
+      const auto round_start = Clock::now();
+      arena_.execute([&] {
+        tbb::parallel_for(size_t(0), my_chains_.size(), [&](size_t mine) {
+          BusyTimer busy(busy_nanoseconds_);
+          mutate_chain(chains_[my_chains_[mine]], steps, first_round, ray_counts_.local());
+          progress_.advance(steps);
+        });
       });
-    });
-    progress.advance(steps * (chains - my_chains.size()));  // the other ranks' chains
-    first_round = false;
-    mutations_per_chain += steps;
-    // Viewers see the chains' image so far (in one process: across ranks each holds its own splats).
-    if (options.live && !cluster.distributed()) {
-      film.set_splat_scale(splat_scale(mutations_per_chain));
-      options.live->pass_done(film);
-    }
-    // The root's clock sets the rounds' length and the time limit for every rank.
-    double round_seconds =
-        cluster.from_root(std::chrono::duration<double>(std::chrono::steady_clock::now() - round_start).count());
-    double growth = round_seconds > 0 ? std::clamp(0.5 / round_seconds, 0.5, 4.0) : 4.0;
-    round_length = std::max<uint64_t>(1, uint64_t(double(round_length) * growth));
-    if (cluster.any(cancelled())) {
-      stats.cancelled = true;
-      break;
-    }
-    // With a time limit, the next round is cut to the mutations that still fit in it at this round's
-    // pace, so that the render ends at the limit, not a round past it.
-    if (mutations_per_chain < per_chain && options.time_limit_seconds > 0) {
-      const double fits = units_fitting_in_time_limit(cluster, options.time_limit_seconds, start_time, round_seconds,
-                                                      double(steps), double(round_length));
-      if (fits < 1) {
-        stats.time_limited = true;
+      progress_.advance(steps * (chains - my_chains_.size()));  // the other ranks' chains
+      first_round = false;
+      mutations_per_chain += steps;
+      // Viewers see the chains' image so far (in one process: across ranks each holds its own splats).
+      if (options_.live && !cluster_.distributed()) {
+        film_.set_splat_scale(splat_scale(mutations_per_chain));
+        options_.live->pass_done(film_);
+      }
+      // The root's clock sets the rounds' length and the time limit for every rank.
+      double round_seconds = cluster_.from_root(seconds_since(round_start));
+      double growth = round_seconds > 0 ? std::clamp(0.5 / round_seconds, 0.5, 4.0) : 4.0;
+      round_length = std::max<uint64_t>(1, uint64_t(double(round_length) * growth));
+      if (cluster_.any(cancelled_())) {
+        stats_.cancelled = true;
         break;
       }
-      round_length = std::min(round_length, uint64_t(std::min(fits, double(per_chain))));
+      // With a time limit, the next round is cut to the mutations that still fit in it at this round's
+      // pace, so that the render ends at the limit, not a round past it.
+      if (mutations_per_chain < per_chain_ && options_.time_limit_seconds > 0) {
+        const double fits = units_fitting_in_time_limit(cluster_, options_.time_limit_seconds, start_time_,
+                                                        round_seconds, double(steps), double(round_length));
+        if (fits < 1) {
+          stats_.time_limited = true;
+          break;
+        }
+        round_length = std::min(round_length, uint64_t(std::min(fits, double(per_chain_))));
+      }
+      if (options_.target_error > 0 && mutations_per_chain == next_check && mutations_per_chain < per_chain_) {
+        next_check = std::max(next_check + 1, next_check * 5 / 4);
+        film_.set_splat_scale(splat_scale(mutations_per_chain));
+        if (agreed_error_estimate(cluster_, film_, normalization_relative_error) <= options_.target_error) {
+          stats_.reached_target = true;
+          break;
+        }
+      }
     }
-    if (options.target_error > 0 && mutations_per_chain == next_check && mutations_per_chain < per_chain) {
-      next_check = std::max(next_check + 1, next_check * 5 / 4);
-      film.set_splat_scale(splat_scale(mutations_per_chain));
-      if (agreed_error_estimate(cluster, film, normalization.relative_error) <= options.target_error) {
-        stats.reached_target = true;
-        break;
+    return mutations_per_chain;
+  }
+
+  // Step 2, the hot loop: `steps` mutations of one chain (its first state drawn first in the first
+  // round), each proposal accepted or rejected by the Metropolis-Hastings ratio and both states
+  // deposited into the film's splats.
+  void mutate_chain(Chain& c, uint64_t steps, bool first_round, RayCounts& counts) {
+    // (As locals: the loop reaches them without going through `this`.)
+    Film& film = film_;
+    const Filter& filter = filter_;
+    const MltPathSampler& paths = paths_;
+    const float large_step_probability = settings_.mlt.large_step;
+    std::atomic<uint64_t>& non_finite = non_finite_;
+    if (first_round) c.current = paths.sample(c.sampler, c.depth, counts);
+    for (uint64_t m = 0; m < steps; ++m) {
+      c.sampler.start_iteration(c.current.lens_moves(), c.current.caustic_moves());
+      PathState proposed = paths.sample(c.sampler, c.depth, counts);
+      float y_current = c.current.luminance(), y_proposed = proposed.luminance();
+      // A small step's chance depends on the path it leaves (MltSampler::start_iteration):
+      // Hastings' ratio of those chances keeps detailed balance (1 without perturbations).
+      float accept = 1;
+      if (y_current > 0) {
+        float ratio = y_proposed / y_current;
+        if (c.sampler.mutation() == MltSampler::Mutation::Small)
+          ratio *= c.sampler.small_step_probability(proposed.lens_moves(), proposed.caustic_moves()) /
+                   c.sampler.small_step_probability(c.current.lens_moves(), c.current.caustic_moves());
+        accept = std::min(1.0f, ratio);
+      }
+      // Deposit both states, weighted by the probability that the chain moves or stays, with
+      // Kelemen et al.'s weights: a large step is also an independent sample of the film, and
+      // the two estimators are combined by their densities (p_large against f / b), so dim
+      // regions that chains seldom visit are estimated by the large steps instead.
+      float large = c.sampler.large_step() ? 1.0f : 0.0f;
+      float floor_density = large_step_probability * c.brightness;
+      auto deposit = [&](Vec2 raster, const RGB& v) {
+        if (!film.splats().add(raster, v, filter)) {
+          non_finite.fetch_add(1, std::memory_order_relaxed);
+        } else if (c.first_half) {
+          film.half_splats().add(raster, v, filter);
+        }
+      };
+      if (y_proposed > 0 && accept + large > 0)
+        deposit(proposed.raster, proposed.L * ((accept + large) * c.scale / (y_proposed + floor_density)));
+      if (accept < 1 && y_current > 0)
+        deposit(c.current.raster, c.current.L * ((1 - accept) * c.scale / (y_current + floor_density)));
+      if (c.rng.next_float() < accept) {
+        c.current = proposed;
+        c.sampler.accept();
+      } else {
+        c.sampler.reject();
       }
     }
   }
-  progress.finish();
-  if (cluster.distributed()) {
-    cluster.sum_int64(film.splats().sums());
-    cluster.sum_int64(film.half_splats().sums());
+
+  // Step 3: add up the ranks' splats, scale them into the image (each depth's deposits by its
+  // brightness over its number of chains, over the mutations per chain) and gather the statistics.
+  RenderStats finish(uint64_t mutations_per_chain) {
+    progress_.finish();
+    if (cluster_.distributed()) {
+      cluster_.sum_int64(film_.splats().sums());
+      cluster_.sum_int64(film_.half_splats().sums());
+    }
+    film_.set_splat_scale(splat_scale(mutations_per_chain));
+    stats_.seconds = seconds_since(start_time_);
+    stats_.samples = mutations_per_chain * chains_.size();
+    RayCounts chain_rays;
+    for (const auto& c : ray_counts_) chain_rays += c;
+    for (const RayCounts& r : cluster_.gather_values(chain_rays)) stats_.rays += r;  // added to the direct pass's
+    for (uint64_t n : cluster_.gather_values(non_finite_.load())) stats_.non_finite_samples += n;
+    std::vector<double> busy = cluster_.gather_values(double(busy_nanoseconds_.load()) * 1e-9);
+    for (size_t r = 0; r < busy.size() && r < stats_.rank_busy_seconds.size(); ++r)
+      stats_.rank_busy_seconds[r] += busy[r];
+    return stats_;
   }
-  film.set_splat_scale(splat_scale(mutations_per_chain));
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
-  stats.samples = mutations_per_chain * chains;
-  RayCounts chain_rays;
-  for (const auto& c : ray_counts) chain_rays += c;
-  for (const RayCounts& r : cluster.gather_values(chain_rays)) stats.rays += r;  // added to the direct pass's
-  for (uint64_t n : cluster.gather_values(non_finite.load())) stats.non_finite_samples += n;
-  std::vector<double> busy = cluster.gather_values(double(busy_nanoseconds.load()) * 1e-9);
-  for (size_t r = 0; r < busy.size() && r < stats.rank_busy_seconds.size(); ++r) stats.rank_busy_seconds[r] += busy[r];
-  return stats;
+
+  const Scene& scene_;
+  const RenderSettings& settings_;
+  Film& film_;
+  const RenderOptions& options_;
+  Cluster& cluster_;
+  const Clock::time_point start_time_;
+  RenderStats stats_;
+  const RenderSettings bdpt_settings_;
+  const BdptIntegrator bdpt_;
+  const MltPathSampler paths_;
+  const Filter filter_;
+  const int depths_;
+  tbb::task_arena arena_;
+  tbb::enumerable_thread_specific<RayCounts> ray_counts_;
+  std::atomic<uint64_t> busy_nanoseconds_{0};
+  const std::function<bool()> cancelled_;
+  const uint64_t total_mutations_;
+  const uint64_t bootstrap_count_;  // one per depth and bootstrap sample
+  ProgressBar progress_;
+  // The chains (step 2): all of them, in order of depth, the ones this rank runs, the mutations
+  // each makes, and the largest depth's share of the brightness per chain (the deposits' unit).
+  std::vector<Chain> chains_;
+  std::vector<uint64_t> my_chains_;
+  uint64_t per_chain_ = 0;
+  double largest_ = 0;
+  std::atomic<uint64_t> non_finite_{0};
+};
+
+}  // namespace
+
+RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options) {
+  const auto start_time = Clock::now();
+  Cluster& cluster = options.cluster ? *options.cluster : local_cluster();
+  // Step 0: render depth 0 with the path tracer.
+  RenderStats stats = render_depth_zero(scene, settings, film, options);
+  stats.mlt_direct_seconds = seconds_since(start_time);
+  film.enable_splats();
+  film.set_splat_scale(0);
+  if (scene.lights().empty() || settings.max_depth == 0 || stats.cancelled) {
+    stats.seconds = seconds_since(start_time);
+    return stats;
+  }
+  // Steps 1-3: bootstrap and normalization, chains, the splats' scale.
+  MltRender mlt(scene, settings, film, options, cluster, start_time, stats);
+  return mlt.run();
 }
 
 }  // namespace candela

@@ -266,16 +266,7 @@ MaterialInfo GltfReader::make_material(int m, bool vertex_colors, bool has_verte
   MaterialInfo info;
   info.uses_vertex_colors = vertex_colors;
   if (m < 0) {
-    // The specification's default material: white, fully metallic and rough.
-    PrincipledMaterial p;
-    p.base_color = RGB(1.0f);
-    p.metallic = 1.0f;
-    p.roughness = 1.0f;
-    p.specular = 0.5f;
-    if (vertex_colors) p.base_color = attribute_texture();
-    scene_.materials.push_back(p);
-    scene_.places.materials.push_back(SourceLocation{});
-    info.material = int(scene_.materials.size()) - 1;
+    info.material = add_default_material(vertex_colors);
     return info;
   }
   const tg::Material& mat = model_.materials[size_t(m)];
@@ -289,6 +280,46 @@ MaterialInfo GltfReader::make_material(int m, bool vertex_colors, bool has_verte
   if (has_vertex_colors && !vertex_colors)
     warn(pointer, "vertex colours (COLOR_0) are ignored where the base colour has a texture");
 
+  // The parts in the order their textures are added (the first texture sets uv_set).
+  read_base_color(pbr, factor, vertex_colors, pointer, p, uv_set);
+  read_metallic_roughness(pbr, pointer, p, uv_set);
+  const bool unlit = read_material_extensions(mat, pointer, p, uv_set);
+  const AreaEmission emission = read_emission(mat, pointer, uv_set);
+  if (unlit) {
+    add_unlit_material(pbr, factor, vertex_colors, pointer, uv_set, info);
+  } else {
+    if (emission.radiance.r > 0 || emission.radiance.g > 0 || emission.radiance.b > 0) info.emission = emission;
+    // Ambient occlusion (occlusionTexture) is what a path tracer computes; nothing to do (and no
+    // warning needed).
+    scene_.materials.push_back(p);
+    scene_.places.materials.push_back(at(pointer));
+    int top = int(scene_.materials.size()) - 1;
+    top = add_normal_map(mat, pointer, top, uv_set);
+    top = add_alpha(mat, alpha, pointer, top, uv_set);
+    // doubleSided false means back-face culling to a rasteriser; candela's surfaces are seen from
+    // both sides, so only one-sided emission depends on it.
+    info.material = top;
+  }
+  if (uv_set >= 0) material_has_textures_.insert(m);
+  info.uv_set = std::max(uv_set, 0);
+  return info;
+}
+
+int GltfReader::add_default_material(bool vertex_colors) {
+  // The specification's default material: white, fully metallic and rough.
+  PrincipledMaterial p;
+  p.base_color = RGB(1.0f);
+  p.metallic = 1.0f;
+  p.roughness = 1.0f;
+  p.specular = 0.5f;
+  if (vertex_colors) p.base_color = attribute_texture();
+  scene_.materials.push_back(p);
+  scene_.places.materials.push_back(SourceLocation{});
+  return int(scene_.materials.size()) - 1;
+}
+
+void GltfReader::read_base_color(const tg::PbrMetallicRoughness& pbr, RGB factor, bool vertex_colors,
+                                 const std::string& pointer, PrincipledMaterial& p, int& uv_set) {
   // Base colour: factor x texture (sRGB), or factor x vertex colour.
   if (pbr.baseColorTexture.index >= 0) {
     const std::string where = pointer + "/pbrMetallicRoughness/baseColorTexture";
@@ -309,7 +340,10 @@ MaterialInfo GltfReader::make_material(int m, bool vertex_colors, bool has_verte
   } else {
     p.base_color = factor;
   }
+}
 
+void GltfReader::read_metallic_roughness(const tg::PbrMetallicRoughness& pbr, const std::string& pointer,
+                                         PrincipledMaterial& p, int& uv_set) {
   // Metallic (B) and roughness (G) of the metallicRoughness texture times their factors. glTF's
   // roughness is perceptual (alpha = roughness^2), as Mitsuba's principled reads its roughness.
   p.metallic = float(pbr.metallicFactor);
@@ -329,22 +363,15 @@ MaterialInfo GltfReader::make_material(int m, bool vertex_colors, bool has_verte
     read_channel(2, pbr.metallicFactor, p.metallic);
     read_channel(1, pbr.roughnessFactor, p.roughness);
   }
+}
 
-  // Extensions.
+bool GltfReader::read_material_extensions(const tg::Material& mat, const std::string& pointer, PrincipledMaterial& p,
+                                          int& uv_set) {
   bool unlit = false, has_volume = false;
   for (const auto& [name, value] : mat.extensions) {
     const std::string where = pointer + "/extensions/" + name;
     if (name == "KHR_materials_transmission") {
-      double f = number_or(value, "transmissionFactor", 0);
-      p.spec_trans = float(f);
-      if (value.Has("transmissionTexture") && f != 0) {
-        const tg::Value& ti = value.Get("transmissionTexture");
-        ImageOp op;
-        op.channel = 0;
-        int t = add_texture(int(number_or(ti, "index", -1)), int(number_or(ti, "texCoord", 0)), texture_extensions(ti),
-                            ColorEncoding::Linear, op, float(f), where + "/transmissionTexture", uv_set);
-        if (t >= 0) p.spec_trans.texture = t;
-      }
+      read_transmission(value, where, p, uv_set);
     } else if (name == "KHR_materials_ior") {
       p.eta = float(number_or(value, "ior", 1.5));
       p.eta_given = true;
@@ -357,7 +384,7 @@ MaterialInfo GltfReader::make_material(int m, bool vertex_colors, bool has_verte
     } else if (name == "KHR_materials_volume") {
       has_volume = true;
       warn(where, "KHR_materials_volume's attenuation is ignored (clear refraction)");
-    } else if (name != "KHR_materials_emissive_strength") {
+    } else if (name != "KHR_materials_emissive_strength") {  // read with the emission
       warn(where, "material extension {} is not supported and is ignored", name);
     }
   }
@@ -366,69 +393,77 @@ MaterialInfo GltfReader::make_material(int m, bool vertex_colors, bool has_verte
       warn(pointer, "KHR_materials_transmission without KHR_materials_volume means a thin wall in glTF; candela "
                     "refracts into the surface as into a solid (Mitsuba's principled)");
   }
+  return unlit;
+}
 
+void GltfReader::read_transmission(const tg::Value& value, const std::string& where, PrincipledMaterial& p,
+                                   int& uv_set) {
+  double f = number_or(value, "transmissionFactor", 0);
+  p.spec_trans = float(f);
+  if (value.Has("transmissionTexture") && f != 0) {
+    const tg::Value& ti = value.Get("transmissionTexture");
+    ImageOp op;
+    op.channel = 0;
+    int t = add_texture(int(number_or(ti, "index", -1)), int(number_or(ti, "texCoord", 0)), texture_extensions(ti),
+                        ColorEncoding::Linear, op, float(f), where + "/transmissionTexture", uv_set);
+    if (t >= 0) p.spec_trans.texture = t;
+  }
+}
+
+AreaEmission GltfReader::read_emission(const tg::Material& mat, const std::string& pointer, int& uv_set) {
   // Emission: factor x strength x texture (sRGB), a textured area light.
   RGB emissive = rgb_of(mat.emissiveFactor, RGB(0.0f));
   if (auto it = mat.extensions.find("KHR_materials_emissive_strength"); it != mat.extensions.end())
     emissive *= float(number_or(it->second, "emissiveStrength", 1));
-  int emissive_texture = -1;
+  AreaEmission emission{emissive, mat.doubleSided};
   if (mat.emissiveTexture.index >= 0 && max_component(Vec3(emissive.r, emissive.g, emissive.b)) > 0)
-    emissive_texture = add_texture(mat.emissiveTexture.index, mat.emissiveTexture.texCoord,
+    emission.texture = add_texture(mat.emissiveTexture.index, mat.emissiveTexture.texCoord,
                                    mat.emissiveTexture.extensions, ColorEncoding::SRGB, std::nullopt, 1,
                                    pointer + "/emissiveTexture", uv_set);
-  if (unlit) {
-    // Unlit: the base colour seen whatever the lighting, which a path tracer can only show as
-    // emission (base colour factor x texture).
-    if (vertex_colors) warn(pointer, "KHR_materials_unlit: vertex colours are ignored");
-    warn(pointer, "KHR_materials_unlit: rendered as a black surface emitting its base colour (it also lights the "
-                  "rest of the scene)");
-    scene_.materials.push_back(BlackMaterial{});
-    scene_.places.materials.push_back(at(pointer));
-    info.material = int(scene_.materials.size()) - 1;
-    AreaEmission e{factor, true};
-    if (pbr.baseColorTexture.index >= 0)
-      e.texture = add_texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
-                              pbr.baseColorTexture.extensions, ColorEncoding::SRGB, std::nullopt, 1,
-                              pointer + "/pbrMetallicRoughness/baseColorTexture", uv_set);
-    info.emission = e;
-    if (uv_set >= 0) material_has_textures_.insert(m);
-    info.uv_set = std::max(uv_set, 0);
-    return info;
-  }
-  if (emissive.r > 0 || emissive.g > 0 || emissive.b > 0) {
-    info.emission = AreaEmission{emissive, mat.doubleSided};
-    info.emission->texture = emissive_texture;
-  }
+  return emission;
+}
 
-  if (mat.occlusionTexture.index >= 0) {
-    // Ambient occlusion is what a path tracer computes; nothing to do (and no warning needed).
-  }
-
-  scene_.materials.push_back(p);
+void GltfReader::add_unlit_material(const tg::PbrMetallicRoughness& pbr, RGB factor, bool vertex_colors,
+                                    const std::string& pointer, int& uv_set, MaterialInfo& info) {
+  // Unlit: the base colour seen whatever the lighting, which a path tracer can only show as
+  // emission (base colour factor x texture).
+  if (vertex_colors) warn(pointer, "KHR_materials_unlit: vertex colours are ignored");
+  warn(pointer, "KHR_materials_unlit: rendered as a black surface emitting its base colour (it also lights the "
+                "rest of the scene)");
+  scene_.materials.push_back(BlackMaterial{});
   scene_.places.materials.push_back(at(pointer));
-  int top = int(scene_.materials.size()) - 1;
+  info.material = int(scene_.materials.size()) - 1;
+  AreaEmission e{factor, true};
+  if (pbr.baseColorTexture.index >= 0)
+    e.texture = add_texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                            pbr.baseColorTexture.extensions, ColorEncoding::SRGB, std::nullopt, 1,
+                            pointer + "/pbrMetallicRoughness/baseColorTexture", uv_set);
+  info.emission = e;
+}
 
+int GltfReader::add_normal_map(const tg::Material& mat, const std::string& pointer, int top, int& uv_set) {
   // Normal map: tangent-space, +y up the image; the frame is candela's (dp/du, dp/dv) from the uvs.
-  if (mat.normalTexture.index >= 0) {
-    const std::string where = pointer + "/normalTexture";
-    std::optional<ImageOp> op;
-    if (mat.normalTexture.scale != 1) {
-      op = ImageOp{};
-      op->kind = ImageOp::NormalScale;
-      op->normal_scale = float(mat.normalTexture.scale);
-    }
-    int t = add_texture(mat.normalTexture.index, mat.normalTexture.texCoord, mat.normalTexture.extensions,
-                        ColorEncoding::Linear, op, 1, where, uv_set);
-    if (t >= 0) {
-      scene_.materials.push_back(NormalMapMaterial{t, top});
-      scene_.places.materials.push_back(at(pointer));
-      top = int(scene_.materials.size()) - 1;
-    }
+  if (mat.normalTexture.index < 0) return top;
+  const std::string where = pointer + "/normalTexture";
+  std::optional<ImageOp> op;
+  if (mat.normalTexture.scale != 1) {
+    op = ImageOp{};
+    op->kind = ImageOp::NormalScale;
+    op->normal_scale = float(mat.normalTexture.scale);
   }
+  int t = add_texture(mat.normalTexture.index, mat.normalTexture.texCoord, mat.normalTexture.extensions,
+                      ColorEncoding::Linear, op, 1, where, uv_set);
+  if (t < 0) return top;
+  scene_.materials.push_back(NormalMapMaterial{t, top});
+  scene_.places.materials.push_back(at(pointer));
+  return int(scene_.materials.size()) - 1;
+}
 
+int GltfReader::add_alpha(const tg::Material& mat, float alpha, const std::string& pointer, int top, int& uv_set) {
   // Alpha: MASK keeps the surface where alpha >= cutoff, BLEND lets light through with probability
   // 1 - alpha (stochastic transparency, which a path tracer averages into blending).
   if (mat.alphaMode == "MASK" || mat.alphaMode == "BLEND") {
+    const tg::PbrMetallicRoughness& pbr = mat.pbrMetallicRoughness;
     const bool mask = mat.alphaMode == "MASK";
     const float cutoff = float(mat.alphaCutoff);
     MaskMaterial wrapper;
@@ -444,9 +479,7 @@ MaterialInfo GltfReader::make_material(int m, bool vertex_colors, bool has_verte
                           pointer + "/pbrMetallicRoughness/baseColorTexture", uv_set);
       if (t >= 0) wrapper.opacity.texture = t;
     }
-    if (has_vertex_colors) {
-      // COLOR_0's alpha would multiply too; candela's mesh attributes carry the RGB only.
-    }
+    // COLOR_0's alpha would multiply too; candela's mesh attributes carry the RGB only.
     if (!(wrapper.opacity.is_constant() && wrapper.opacity.value >= 1)) {
       scene_.materials.push_back(wrapper);
       scene_.places.materials.push_back(at(pointer));
@@ -455,12 +488,7 @@ MaterialInfo GltfReader::make_material(int m, bool vertex_colors, bool has_verte
   } else if (mat.alphaMode != "OPAQUE" && !mat.alphaMode.empty()) {
     warn(pointer + "/alphaMode", "unknown alphaMode \"{}\" is read as OPAQUE", mat.alphaMode);
   }
-  // doubleSided false means back-face culling to a rasteriser; candela's surfaces are seen from both
-  // sides, so only one-sided emission depends on it.
-  if (uv_set >= 0) material_has_textures_.insert(m);
-  info.material = top;
-  info.uv_set = std::max(uv_set, 0);
-  return info;
+  return top;
 }
 
 // The extensions of a textureInfo inside an extension (tinygltf parses only the core ones).
