@@ -24,7 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 
 const fs::path kMeshes = fs::path(CANDELA_SHARED_DIR) / "meshes";
-const fs::path kTestData = fs::path(CANDELA_SOURCE_DIR) / "tests" / "data" / "meshes";
+const fs::path kMeshTestData = fs::path(CANDELA_SOURCE_DIR) / "tests" / "data" / "meshes";
 
 const SourceLocation kWhere{"scene.json", 0, 0, "/shapes/2/file"};
 
@@ -340,7 +340,7 @@ TEST_F(MeshIo, MalformedPlyIsAnError) {
 // ---------------------------------------------------------------- OBJ test data of this repository
 
 TEST_F(MeshIo, ObjQuadsWithNormalsAndUvs) {
-  const TriangleMesh cube = load(kTestData / "cube_quads_normals.obj");  // its .mtl is missing
+  const TriangleMesh cube = load(kMeshTestData / "cube_quads_normals.obj");  // its .mtl is missing
   expect_well_formed(cube);
   EXPECT_EQ(cube.triangle_count(), 12u);  // both objects of the file, in one mesh
   // Each corner differs from the others in normal or uv: 6 faces x 4 corners.
@@ -358,11 +358,11 @@ TEST_F(MeshIo, ObjQuadsWithNormalsAndUvs) {
 }
 
 TEST_F(MeshIo, MalformedObjIsAnError) {
-  expect_error_mentions(kTestData / "malformed.obj", {"malformed OBJ", "line 5"});
+  expect_error_mentions(kMeshTestData / "malformed.obj", {"malformed OBJ", "line 5"});
 }
 
 TEST_F(MeshIo, ObjIndexOutOfRangeIsAnError) {
-  expect_error_mentions(kTestData / "index_out_of_range.obj", {"malformed OBJ", "face 2", "vertex 9", "4 of them"});
+  expect_error_mentions(kMeshTestData / "index_out_of_range.obj", {"malformed OBJ", "face 2", "vertex 9", "4 of them"});
 }
 
 // ---------------------------------------------------------------- OBJ cases written on the fly
@@ -735,7 +735,7 @@ TEST_F(MeshIo, GzippedMeshesAreDecompressedFirst) {
 }
 
 TEST_F(MeshIo, MissingFileNamesBothPlaces) {
-  const fs::path missing = kTestData / "no_such_mesh.obj";
+  const fs::path missing = kMeshTestData / "no_such_mesh.obj";
   EXPECT_EQ(load_error(missing), "scene.json: at /shapes/2/file: cannot read mesh '" + missing.string() + "': no such file");
   const SourceLocation pbrt{"scene.pbrt", 12, 5, ""};
   try {
@@ -747,8 +747,8 @@ TEST_F(MeshIo, MissingFileNamesBothPlaces) {
 }
 
 TEST_F(MeshIo, UnsupportedExtensionListsTheSupportedOnes) {
-  expect_error_mentions(kTestData / "cow.stl", {"unsupported mesh format '.stl'", ".obj", ".ply"});
-  expect_error_mentions(kTestData / "cow", {"no extension", ".obj", ".ply"});
+  expect_error_mentions(kMeshTestData / "cow.stl", {"unsupported mesh format '.stl'", ".obj", ".ply"});
+  expect_error_mentions(kMeshTestData / "cow", {"no extension", ".obj", ".ply"});
 }
 
 TEST_F(MeshIo, DirectoryNamedLikeAMeshIsAnError) {
