@@ -420,7 +420,7 @@ def render(scene: Scene, *, progress=None, **keywords) -> Image:
     Keywords are the command line's render flags with '_' for '-' (docs/cli.md), checked as it
     checks them, and apply to this render only: spp, seed, integrator ('path', 'bdpt', 'mlt',
     'auto'), resolution ((w, h) or 'WxH'), threads, max_depth, sampler, filter, transport
-    ('rgb'/'spectral'), light_selection, direction_sampling, shadow_rays, no_mis, clamp, bvh,
+    ('rgb'/'spectral'), light_selection, direction_sampling, shadow_rays, no_mis, clamp, bvh, rr_start_depth,
     adaptive_threshold, adaptive_spp, adaptive_batch, max_spp, time_limit (seconds or '10m'),
     target_error, estimate_error, mlt_*; see render_keywords(). The same settings give the same
     bytes as `candela render`, whatever the thread count.
