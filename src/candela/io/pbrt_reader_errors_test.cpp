@@ -1,0 +1,353 @@
+// Tests of the pbrt-v4 reader's errors and warnings at file:line:column, and pbrt options mapped onto candela's.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "candela/base/error.h"
+#include "candela/io/pbrt_reader.h"
+#include "candela/description/scene_desc.h"
+#include "candela/testing/pbrt_reader_helpers.h"
+
+namespace candela {
+namespace {
+
+using namespace candela::testing::pbrt_reader;
+namespace fs = std::filesystem;
+
+// ---------------------------------------------------------------- bad input: syntax
+
+TEST(PbrtReader, UnknownDirective) {
+  expect_error({"WorldBegin", "", "  Sphere \"x\""}, 3, "Sphere", "unknown directive \"Sphere\"");
+}
+
+TEST(PbrtReader, UnknownTextureTypeIsNamed) {
+  expect_error({"WorldBegin", "Texture \"t\" \"spectrum\" \"fbm\""}, 2, "\"fbm\"",
+               "texture type \"fbm\" is not supported: candela has no such texture (supported: \"imagemap\", "
+               "\"checkerboard\", \"scale\", \"mix\", \"constant\")");
+}
+
+TEST(PbrtReader, WorldEndIsExplainedAsPbrtV3) {
+  expect_error({"WorldBegin", "WorldEnd"}, 2, "WorldEnd", "pbrt-v3");
+}
+
+TEST(PbrtReader, UnterminatedString) {
+  expect_error({"WorldBegin", "Shape \"sphere", "  \"float radius\" 1"}, 2, "\"sphere", "unterminated string");
+}
+
+TEST(PbrtReader, UnknownEscapeInString) {
+  expect_error({"WorldBegin", "Shape \"sph\\qere\""}, 2, "\\q", "unknown escape sequence");
+}
+
+TEST(PbrtReader, TooFewNumbersForATransform) {
+  expect_error({"Translate 1 2", "WorldBegin"}, 2, "WorldBegin", "Translate: expected 3 numbers, got WorldBegin");
+}
+
+TEST(PbrtReader, TransformNeedsBrackets) {
+  expect_error({"WorldBegin", "Transform 1 0 0 0"}, 2, "1", "Transform: expected \"[\"");
+}
+
+TEST(PbrtReader, SingularTransformAndZeroScale) {
+  expect_error({"WorldBegin", "Transform [ 0 0 0 0  0 1 0 0  0 0 1 0  0 0 0 1 ]"}, 2, "Transform", "singular");
+  expect_error({"WorldBegin", "Scale 1 0 1"}, 2, "Scale", "non-zero");
+}
+
+TEST(PbrtReader, DegenerateLookAt) {
+  expect_error({"LookAt 0 0 0  0 1 0  0 1 0", "WorldBegin"}, 1, "LookAt", "parallel");
+}
+
+TEST(PbrtReader, StrayStringWhereADirectiveShouldBe) {
+  expect_error({"WorldBegin", "MakeNamedMaterial \"a\" \"string type\" \"diffuse\"", "NamedMaterial \"a\" \"b\""}, 3,
+               "\"b\"", "expected a directive (such as Shape or AttributeBegin), got \"b\"");
+}
+
+// ---------------------------------------------------------------- bad input: parameters
+
+TEST(PbrtReader, UnusedParameter) {
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" 1 \"float radiu\" 2"}, 2, "\"float radiu\"",
+               "unused parameter \"float radiu\" (parameters read here: radius, zmin, zmax, phimax, alpha)");
+}
+
+TEST(PbrtReader, ParameterOfTheWrongType) {
+  expect_error({"WorldBegin", "Shape \"sphere\" \"integer radius\" 2"}, 2, "\"integer radius\"",
+               "parameter \"radius\" must be of type \"float\", not \"integer\"");
+  expect_error({"WorldBegin", "Shape \"trianglemesh\" \"float uv\" [ 0 0 1 0 0 1 ] \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ]"},
+               2, "\"float uv\"", "must be of type \"point2\"");
+}
+
+TEST(PbrtReader, WrongNumberOfValues) {
+  expect_error({"Camera \"perspective\" \"float fov\" [ 30 40 ]", "WorldBegin"}, 1, "\"float fov\"",
+               "\"float fov\" takes exactly 1 value, got 2");
+  expect_error({"WorldBegin", "Material \"diffuse\" \"rgb reflectance\" [ 0.5 0.5 ]"}, 2, "\"rgb reflectance\"",
+               "takes exactly 3 values, got 2");
+  expect_error({"WorldBegin", "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  1 0 ]"}, 2, "\"point3 P\"",
+               "needs a multiple of 3 values, got 5");
+}
+
+TEST(PbrtReader, ValuesThatDoNotMatchTheDeclaredType) {
+  expect_error({"Sampler \"zsobol\" \"integer pixelsamples\" 1.5", "WorldBegin"}, 1, "1.5",
+               "expects integers, got 1.5");
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" \"big\""}, 2, "\"big\"",
+               "expects numbers, got \"big\"");
+  expect_error({"Film \"rgb\" \"string filename\" out.exr", "WorldBegin"}, 1, "out.exr", "expects quoted strings");
+  expect_error({"WorldBegin", "AreaLightSource \"diffuse\" \"bool twosided\" 1"}, 2, "1", "expects true or false");
+}
+
+TEST(PbrtReader, MalformedParameterDeclarations) {
+  expect_error({"Camera \"perspective\" \"floot fov\" 30", "WorldBegin"}, 1, "\"floot",
+               "unknown parameter type \"floot\"");
+  expect_error({"Camera \"perspective\" \"fov\" 30", "WorldBegin"}, 1, "\"fov\"", "declared as \"type name\"");
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" [ ]"}, 2, "\"float radius\"", "has no values");
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" [ 1"}, 2, "[", "never closed");
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" 1 \"float radius\" 2"}, 2, "\"float radius\" 2",
+               "given twice");
+}
+
+TEST(PbrtReader, BadSpectrumAndTextureParameters) {
+  expect_error({"WorldBegin", "Material \"dielectric\" \"spectrum eta\" \"glass-XY\""}, 2, "\"spectrum eta\"",
+               "\"glass-XY\" is not one of pbrt-v4's glasses");
+  expect_error({"WorldBegin", "Material \"conductor\" \"spectrum eta\" \"metal-Xx-eta\""}, 2, "\"spectrum eta\"",
+               "unknown named spectrum \"metal-Xx-eta\" (spectrum files are not supported; the named spectra are "
+               "\"metal-Ag-eta\"");
+  expect_error({"WorldBegin", "Material \"diffuse\" \"texture reflectance\" \"checks\""}, 2, "\"texture reflectance\"",
+               "no spectrum texture named \"checks\" is defined (Texture must come first)");
+  expect_error({"WorldBegin", "Material \"conductor\" \"spectrum eta\" [ 400 1  300 2 ]"}, 2, "\"spectrum eta\"",
+               "the wavelengths must increase");
+  expect_error({"WorldBegin", "Material \"conductor\" \"spectrum k\" [ 400 1  500 ]"}, 2, "\"spectrum k\"",
+               "needs a multiple of 2 values, got 3");
+  expect_error({"WorldBegin", "Material \"conductor\" \"spectrum k\" [ 400 \"metal-Cu-k\" ]"}, 2, "\"metal-Cu-k\"",
+               "expects one spectrum name or (wavelength, value) pairs");
+  expect_error({"WorldBegin", "LightSource \"point\" \"spectrum I\" \"metal-Cu-k\""}, 2, "\"spectrum I\"",
+               "\"metal-Cu-k\" is a conductor's optical constant and does not fit here");
+  expect_error({"WorldBegin", "Material \"conductor\" \"spectrum eta\" \"stdillum-D65\""}, 2, "\"spectrum eta\"",
+               "\"stdillum-D65\" is an illuminant spectrum and does not fit here");
+  expect_error({"WorldBegin", "Material \"diffuse\" \"blackbody reflectance\" 3000"}, 2, "\"blackbody reflectance\"",
+               "must be of type \"rgb\", \"spectrum\" or \"texture\", not \"blackbody\"");
+  expect_error({"WorldBegin", "LightSource \"point\" \"blackbody I\" [ 3000 2 ]"}, 2, "\"blackbody I\"",
+               "takes one value, the temperature in kelvin, got 2");
+}
+
+TEST(PbrtReader, ReflectanceAboveOneOrNegativeColour) {
+  expect_error({"WorldBegin", "Material \"diffuse\" \"rgb reflectance\" [ 1.2 0.5 0.5 ]"}, 2, "\"rgb reflectance\"",
+               "must not exceed 1");
+  expect_error({"WorldBegin", "AreaLightSource \"diffuse\" \"rgb L\" [ -1 0 0 ]"}, 2, "\"rgb L\"", "negative");
+}
+
+// ---------------------------------------------------------------- bad input: values
+
+TEST(PbrtReader, BadSphereRadius) {
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" nan"}, 2, "nan", "expects numbers, got nan");
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" -1"}, 2, "\"float radius\"",
+               "Shape \"sphere\": \"radius\" must be positive, got -1");
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" 0"}, 2, "\"float radius\"", "must be positive, got 0");
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" 1e999"}, 2, "1e999", "expects numbers");
+}
+
+TEST(PbrtReader, PartialSphere) {
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float phimax\" 180"}, 2, "\"float phimax\"", "partial spheres");
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float zmax\" 0.5"}, 2, "\"float zmax\"", "partial spheres");
+}
+
+TEST(PbrtReader, BadTriangleIndices) {
+  const std::string points = "\"point3 P\" [ 0 0 0  1 0 0  0 1 0  1 1 0 ]";
+  expect_error({"WorldBegin", "Shape \"trianglemesh\" " + points + " \"integer indices\" [ 0 1 4 ]"}, 2,
+               "\"integer indices\"", "value 4 (number 3) is out of range: \"P\" has 4 points");
+  expect_error({"WorldBegin", "Shape \"trianglemesh\" " + points + " \"integer indices\" [ 0 -1 2 ]"}, 2,
+               "\"integer indices\"", "out of range");
+  expect_error({"WorldBegin", "Shape \"trianglemesh\" " + points + " \"integer indices\" [ 0 1 2 3 ]"}, 2,
+               "\"integer indices\"", "not a multiple of 3");
+  expect_error({"WorldBegin", "Shape \"trianglemesh\" " + points}, 2, "Shape", "\"indices\" is required");
+  expect_error({"WorldBegin", "Shape \"trianglemesh\""}, 2, "Shape", "\"P\" is required");
+  const std::string one_triangle = " \"integer indices\" [ 0 1 2 ] \"normal N\" [ 0 0 1 ]";
+  expect_error({"WorldBegin", "Shape \"trianglemesh\" " + points + one_triangle}, 2, "\"normal N\"",
+               "one normal per point");
+}
+
+TEST(PbrtReader, BadResolution) {
+  expect_error({"Film \"rgb\" \"integer xresolution\" 0", "WorldBegin"}, 1, "\"integer xresolution\"",
+               "\"xresolution\" must be between 1 and 65536, got 0");
+  expect_error({"Film \"rgb\" \"integer yresolution\" 70000", "WorldBegin"}, 1, "\"integer yresolution\"",
+               "must be between 1 and 65536, got 70000");
+  expect_error({"Film \"rgb\" \"integer xresolution\" 20000 \"integer yresolution\" 20000", "WorldBegin"}, 1,
+               "\"integer yresolution\"", "20000 x 20000 is too many pixels");
+}
+
+TEST(PbrtReader, BadSampleCountsAndDepth) {
+  expect_error({"Sampler \"zsobol\" \"integer pixelsamples\" 0", "WorldBegin"}, 1, "\"integer", "must be positive");
+  expect_error({"Integrator \"path\" \"integer maxdepth\" -1", "WorldBegin"}, 1, "\"integer", "must not be negative");
+}
+
+// ---------------------------------------------------------------- bad input: types
+
+TEST(PbrtReader, UnknownAndUnsupportedTypes) {
+  expect_error({"WorldBegin", "Shape \"spere\""}, 2, "\"spere\"",
+               "unknown shape type \"spere\" (supported: \"sphere\", \"trianglemesh\", \"plymesh\", \"disk\", "
+               "\"bilinearmesh\")");
+  for (std::string type : {"cylinder", "curve", "loopsubdiv"})
+    expect_error({"WorldBegin", "Shape \"" + type + "\""}, 2, "\"" + type + "\"",
+                 "shape type \"" + type + "\" is not supported: candela has no primitive or tessellation for it");
+  expect_error({"WorldBegin", "Material \"plastic\""}, 2, "\"plastic\"", "unknown material type \"plastic\"");
+  for (std::string type : {"coatedconductor", "hair", "measured", "subsurface"})
+    expect_error({"WorldBegin", "Material \"" + type + "\""}, 2, "\"" + type + "\"",
+                 "material type \"" + type + "\" is not supported: candela has no BSDF for it");
+  expect_error({"WorldBegin", "MakeNamedMaterial \"m\" \"string type\" \"hair\""}, 2, "\"string type\"",
+               "not supported");
+  expect_error({"WorldBegin", "LightSource \"sun\""}, 2, "\"sun\"", "unknown light type \"sun\"");
+  for (std::string type : {"goniometric", "projection"})
+    expect_error({"WorldBegin", "LightSource \"" + type + "\""}, 2, "\"" + type + "\"",
+                 "light type \"" + type + "\" is not supported");
+  expect_error({"Integrator \"whitted\"", "WorldBegin"}, 1, "\"whitted\"", "unknown integrator type \"whitted\"");
+  expect_error({"Accelerator \"octree\"", "WorldBegin"}, 1, "\"octree\"", "unknown accelerator type");
+  expect_error({"WorldBegin", "AreaLightSource \"glow\""}, 2, "\"glow\"", "unknown area light type");
+  expect_error({"Camera \"orthographic\"", "WorldBegin"}, 1, "\"orthographic\"", "not supported yet");
+  expect_error({"Film \"gbuffer\"", "WorldBegin"}, 1, "\"gbuffer\"", "not supported yet");
+}
+
+TEST(PbrtReader, UnsupportedFeaturesOfSupportedTypes) {
+  expect_error({"WorldBegin", "LightSource \"infinite\" \"string filename\" \"sky.exr\""}, 2, "\"string filename\"",
+               "cannot find \"sky.exr\"");
+  expect_error({"WorldBegin", "LightSource \"infinite\" \"rgb L\" [ 1 1 1 ] \"string filename\" \"sky.exr\""}, 2,
+               "\"string filename\"", "cannot be given together with \"L\"");
+  expect_error({"WorldBegin", "MakeNamedMaterial \"m\" \"rgb reflectance\" [ 1 1 1 ]"}, 2, "MakeNamedMaterial",
+               "missing the \"string type\" parameter");
+}
+
+// ---------------------------------------------------------------- bad input: structure
+
+TEST(PbrtReader, NamedMaterialMustBeDefined) {
+  expect_error({"WorldBegin", "NamedMaterial \"gold\""}, 2, "\"gold\"", "no material named \"gold\"");
+  expect_error({"WorldBegin", "MakeNamedMaterial \"a\" \"string type\" \"diffuse\"",
+                "MakeNamedMaterial \"a\" \"string type\" \"diffuse\""},
+               3, "\"a\"", "already defined");
+}
+
+TEST(PbrtReader, UnbalancedAttributeBlocks) {
+  expect_error({"WorldBegin", "AttributeEnd"}, 2, "AttributeEnd", "AttributeEnd without a matching AttributeBegin");
+  expect_error({"WorldBegin", "AttributeBegin", "Shape \"sphere\""}, 2, "AttributeBegin",
+               "AttributeBegin is never closed");
+  expect_error({"WorldBegin", "ObjectBegin \"o\"", "AttributeEnd"}, 3, "AttributeEnd",
+               "does not match the open ObjectBegin");
+  expect_error({"WorldBegin", "ObjectEnd"}, 2, "ObjectEnd", "without a matching ObjectBegin");
+}
+
+TEST(PbrtReader, DirectivesInTheWrongSection) {
+  expect_error({"Shape \"sphere\"", "WorldBegin"}, 1, "Shape", "Shape is not allowed before WorldBegin");
+  expect_error({"AttributeBegin", "AttributeEnd", "WorldBegin"}, 1, "AttributeBegin", "not allowed before WorldBegin");
+  expect_error({"WorldBegin", "Camera \"perspective\""}, 2, "Camera", "Camera is not allowed after WorldBegin");
+  expect_error({"WorldBegin", "WorldBegin"}, 2, "WorldBegin", "not allowed after WorldBegin");
+  expect_error({"Film \"rgb\"", "Shape \"sphere\""}, 2, "Shape", "not allowed before WorldBegin");
+}
+
+TEST(PbrtReader, SceneMustReachWorldBegin) {
+  // The error is at the end of the text: line 3, after the last newline.
+  EXPECT_EQ(error_reading_text({"Film \"rgb\"", "# no world"}),
+            kSceneName + ":3:1: the scene ends before WorldBegin; the shapes and lights must follow a WorldBegin");
+}
+
+TEST(PbrtReader, ObjectInstancingErrors) {
+  expect_error({"WorldBegin", "ObjectInstance \"tree\""}, 2, "\"tree\"", "no object named \"tree\"");
+  expect_error({"WorldBegin", "ObjectBegin \"a\"", "ObjectBegin \"b\""}, 3, "ObjectBegin", "cannot nest");
+  expect_error({"WorldBegin", "ObjectBegin \"a\"", "AreaLightSource \"diffuse\"", "Shape \"sphere\""}, 4, "Shape",
+               "area lights in object instances are not supported");
+  expect_error({"WorldBegin", "CoordSysTransform \"nowhere\""}, 2, "\"nowhere\"", "no coordinate system named");
+}
+
+
+TEST(PbrtReader, ShapesInsideObjectsCannotMove) {
+  expect_error({"WorldBegin", "ObjectBegin \"a\"", "ActiveTransform EndTime", "Translate 1 0 0", "Shape \"sphere\""},
+               5, "Shape", "shapes of an object cannot move");
+}
+
+TEST(PbrtReader, LightsCannotBeDefinedInsideObjects) {
+  expect_error({"WorldBegin", "ObjectBegin \"a\"", "LightSource \"point\""}, 3, "LightSource",
+               "lights cannot be part of an object definition");
+}
+
+// ---------------------------------------------------------------- samplers and integrators
+
+TEST(PbrtReader, SobolAndOtherLowDiscrepancySamplersBecomeZSobol) {
+  for (std::string type : {"sobol", "halton", "pmj02bn", "paddedsobol"}) {
+    SCOPED_TRACE(type);
+    std::vector<std::string> lines = {"Sampler \"" + type + "\" \"integer pixelsamples\" 32", "WorldBegin"};
+    expect_warning(lines, 1, "\"" + type + "\"", type + ": using candela's zsobol sampler");
+    SceneDesc scene = read_lines(lines);
+    EXPECT_EQ(scene.settings.sampler.type, SamplerType::ZSobol);
+    EXPECT_EQ(scene.settings.spp, 32);
+  }
+  expect_warning({"Sampler \"sobol\"", "WorldBegin"}, 1, "\"sobol\"",
+                 "sobol: using candela's zsobol sampler (same Owen-scrambled Sobol' points, Morton-ordered)");
+  EXPECT_EQ(read_lines({"Sampler \"halton\" \"string randomization\" \"owen\"", "WorldBegin"}).settings.spp, 16);
+}
+
+TEST(PbrtReader, BdptAndMltAreCandelasOwn) {
+  SceneDesc bdpt = read_lines({"Integrator \"bdpt\" \"integer maxdepth\" 7", "WorldBegin"});
+  EXPECT_EQ(bdpt.settings.integrator, "bdpt");
+  EXPECT_EQ(bdpt.settings.max_depth, 7);
+  expect_warning({"Integrator \"bdpt\" \"bool visualizestrategies\" true", "WorldBegin"}, 1, "\"bool visualizestrategies\"",
+                 "--bdpt-strategies");
+  // MLT's mutations per pixel are its sample count, whatever the Sampler says before or after.
+  for (bool sampler_first : {false, true}) {
+    std::vector<std::string> lines = {"Integrator \"mlt\" \"integer maxdepth\" 4 \"integer mutationsperpixel\" 40 "
+                                      "\"integer bootstrapsamples\" 500 \"integer chains\" 20 "
+                                      "\"float largestepprobability\" 0.25 \"float sigma\" 0.02",
+                                      "WorldBegin"};
+    lines.insert(lines.begin() + (sampler_first ? 0 : 1), "Sampler \"independent\" \"integer pixelsamples\" 8");
+    SceneDesc mlt = read_lines(lines);
+    EXPECT_EQ(mlt.settings.integrator, "mlt");
+    EXPECT_EQ(mlt.settings.max_depth, 4);
+    EXPECT_EQ(mlt.settings.spp, 40);
+    EXPECT_EQ(mlt.settings.mlt.bootstrap, 500);
+    EXPECT_EQ(mlt.settings.mlt.chains, 20);
+    EXPECT_FLOAT_EQ(mlt.settings.mlt.large_step, 0.25f);
+    EXPECT_FLOAT_EQ(mlt.settings.mlt.sigma, 0.02f);
+  }
+  EXPECT_EQ(read_lines({"Integrator \"mlt\"", "WorldBegin"}).settings.spp, 100);  // pbrt's default
+  EXPECT_THROW(read_lines({"Integrator \"mlt\" \"float sigma\" 0", "WorldBegin"}), SceneError);
+  EXPECT_THROW(read_lines({"Integrator \"mlt\" \"float largestepprobability\" 1.5", "WorldBegin"}), SceneError);
+  EXPECT_THROW(read_lines({"Integrator \"mlt\" \"integer chains\" 0", "WorldBegin"}), SceneError);
+}
+
+TEST(PbrtReader, OtherPbrtIntegratorsAreRenderedWithOneThatConvergesToTheSameImage) {
+  EXPECT_TRUE(read_warned({"Integrator \"path\" \"integer maxdepth\" 9", "WorldBegin"}).warnings.empty());
+  for (std::string type : {"sppm", "lightpath", "randomwalk", "simplepath"}) {
+    SCOPED_TRACE(type);
+    std::vector<std::string> lines = {"Integrator \"" + type + "\" \"integer maxdepth\" 9", "WorldBegin"};
+    expect_warning(lines, 1, "\"" + type + "\"",
+                   "Integrator \"" + type + "\": using candela's path integrator with maxdepth 9");
+    SceneDesc scene = read_lines(lines);
+    EXPECT_EQ(scene.settings.integrator, "path");
+    EXPECT_EQ(scene.settings.max_depth, 9);
+  }
+  Warned volpath = read_warned({"Integrator \"volpath\" \"integer maxdepth\" 7", "WorldBegin"});
+  EXPECT_TRUE(volpath.warnings.empty()) << joined(volpath.warnings);
+  EXPECT_EQ(volpath.scene.settings.integrator, "volpath");
+  EXPECT_EQ(volpath.scene.settings.max_depth, 7);
+  expect_warning({"Integrator \"simplevolpath\"", "WorldBegin"}, 1, "\"simplevolpath\"",
+                 "Integrator \"simplevolpath\": using candela's volpath integrator with maxdepth 5");
+  EXPECT_EQ(read_lines({"Integrator \"simplevolpath\"", "WorldBegin"}).settings.integrator, "volpath");
+  EXPECT_THROW(read_lines({"Integrator \"ambientocclusion\"", "WorldBegin"}), SceneError);
+  Warned sppm = read_warned({"Integrator \"sppm\" \"integer photonsperiteration\" 1000 \"float radius\" 0.1",
+                             "WorldBegin"});
+  ASSERT_EQ(sppm.warnings.size(), 3u) << joined(sppm.warnings);
+  EXPECT_NE(sppm.warnings[0].find("\"photonsperiteration\" is ignored"), std::string::npos) << sppm.warnings[0];
+  Warned regularized = read_warned({"Integrator \"path\" \"bool regularize\" true", "WorldBegin"});
+  ASSERT_EQ(regularized.warnings.size(), 1u);
+  EXPECT_NE(regularized.warnings[0].find(":1:19: warning: Integrator \"path\": \"regularize\" is ignored"),
+            std::string::npos)
+      << regularized.warnings[0];
+  expect_error({"Integrator \"bdpt\" \"bool visualizestrategy\" true", "WorldBegin"}, 1, "\"bool visualizestrategy\"",
+               "unused parameter");
+}
+
+TEST(PbrtReader, ColorSpaceFilmAndAcceleratorOptions) {
+  EXPECT_TRUE(read_warned({"ColorSpace \"srgb\"", "Accelerator \"bvh\" \"integer maxnodeprims\" 4", "WorldBegin"})
+                  .warnings.empty());
+  expect_warning({"ColorSpace \"aces2065-1\"", "WorldBegin"}, 1, "\"aces2065-1\"", "reads every colour as linear sRGB");
+  expect_warning({"Film \"rgb\" \"float maxcomponentvalue\" 10", "WorldBegin"}, 1, "\"float maxcomponentvalue\"",
+                 "\"maxcomponentvalue\" is ignored");
+  expect_error({"WorldBegin", "Accelerator \"bvh\""}, 2, "Accelerator", "not allowed after WorldBegin");
+}
+
+}  // namespace
+}  // namespace candela
