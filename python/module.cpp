@@ -132,10 +132,9 @@ py::tuple render_scene(PyScene& scene, const py::dict& keywords, const py::objec
   std::unique_lock busy(scene.busy, std::try_to_lock);
   if (!busy.owns_lock()) throw py::value_error("this scene is being rendered or edited by another thread");
   RequestScope scope(scene.desc);
-  const int budget_spp = request.spp.value_or(scene.desc.settings.spp);
-  apply_request(request, scene.desc);
+  const RenderPlan plan = plan_render(request, scene.desc);
   check_resources(scene.desc);
-  RenderOptions options = request_options(request);
+  RenderOptions options = plan.options();
   std::atomic<bool> cancel{false};
   std::atomic<double> fraction{0};
   options.cancel = &cancel;
@@ -152,7 +151,7 @@ py::tuple render_scene(PyScene& scene, const py::dict& keywords, const py::objec
     try {
       Scene built(scene.desc);
       Film film(scene.desc.film.width, scene.desc.film.height);
-      RenderOutcome outcome = render_requested(built, scene.desc.settings, film, options, budget_spp);
+      RenderOutcome outcome = render_requested(built, scene.desc.settings, film, plan, options);
       metadata = image_metadata(scene.name, scene.desc.settings, film, outcome, options, 1,
                                 outcome.stats.non_finite_samples);
       image = film.mean_image();

@@ -19,6 +19,7 @@
 #include <filesystem>
 
 #include "candela/integrators/bdpt.h"
+#include "candela/integrators/mlt.h"
 #include "candela/film/image_io.h"
 #include "candela/io/scene_reader.h"
 #include "candela/sampling/rng.h"
@@ -224,15 +225,18 @@ TEST(BidirectionalFurnace, MetropolisClosedSphereUnderATimeLimit) {
     RenderStats limited = render(scene, d.settings, film, options);
     options.time_limit_seconds = 0;
     EXPECT_TRUE(limited.time_limited);
-    EXPECT_GE(limited.mlt_normalization_seconds, 1.5 / 9);
-    ASSERT_EQ(single.mlt_normalization_samples, uint64_t(d.settings.mlt.bootstrap));
-    ASSERT_EQ(limited.mlt_normalization_samples % single.mlt_normalization_samples, 0u);
-    const double batches = double(limited.mlt_normalization_samples / single.mlt_normalization_samples);
-    EXPECT_NEAR(limited.mlt_normalization_relative_error * std::sqrt(batches),
-                single.mlt_normalization_relative_error, 0.35 * single.mlt_normalization_relative_error)
+    ASSERT_TRUE(mlt_stats(single) && mlt_stats(limited));
+    const MltStats& one = *mlt_stats(single);
+    const MltStats& more = *mlt_stats(limited);
+    EXPECT_GE(more.normalization_seconds, 1.5 / 9);
+    ASSERT_EQ(one.normalization_samples, uint64_t(d.settings.mlt.bootstrap));
+    ASSERT_EQ(more.normalization_samples % one.normalization_samples, 0u);
+    const double batches = double(more.normalization_samples / one.normalization_samples);
+    EXPECT_NEAR(limited.splat_scale_relative_error * std::sqrt(batches), single.splat_scale_relative_error,
+                0.35 * single.splat_scale_relative_error)
         << batches << " batches";
     if (batches >= 4) {
-      EXPECT_LT(limited.mlt_normalization_relative_error, 0.7 * single.mlt_normalization_relative_error);
+      EXPECT_LT(limited.splat_scale_relative_error, 0.7 * single.splat_scale_relative_error);
     }
     means.push_back(image_mean(film.mean_image()));
   }
@@ -266,15 +270,14 @@ SceneDesc floor_under_light() {
 
 // Every strategy's image, scaled like the light image (index BdptIntegrator::strategy_index).
 std::vector<Image> strategy_images(const SceneDesc& d, bool unweighted, int spp, uint64_t seed, Image* full) {
-  std::vector<SplatImage> images(size_t(BdptIntegrator::strategy_count(d.settings.max_depth)),
-                                 SplatImage(d.film.width, d.film.height));
+  // (Depths up to 5: every depth of this scene's.)
+  BdptStrategyImages images(d.settings, d.film.width, d.film.height, "", unweighted);
   RenderOptions options;
-  options.bdpt_strategies = &images;
-  options.bdpt_unweighted = unweighted;
+  options.integrator_outputs = &images;
   Film film = render_film(d, "bdpt", spp, seed, 0, options);
   if (full) *full = film.mean_image();
   std::vector<Image> scaled;
-  for (const auto& img : images) scaled.push_back(img.image(film.splat_scale()));
+  for (const auto& img : images.images()) scaled.push_back(img.image(film.splat_scale()));
   return scaled;
 }
 

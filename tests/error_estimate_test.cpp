@@ -46,7 +46,7 @@ Outcome measure(const SceneDesc& desc) {
   RenderOptions options;
   options.progress = false;
   RenderStats stats = render(scene, desc.settings, film, options);
-  ErrorEstimate e = estimate_error(film, stats.mlt_normalization_relative_error);
+  ErrorEstimate e = estimate_error(film, stats.splat_scale_relative_error);
   EXPECT_TRUE(e.valid) << e.why_not;
   Outcome o{e.relmse, testing::rel_mse(film.mean_image(), reference())};
   o.covered = e.low <= o.truth && o.truth <= e.high;

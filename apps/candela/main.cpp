@@ -14,10 +14,10 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
-#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -36,9 +36,6 @@
 #include "candela/render/film_part.h"
 #include "candela/integrators/render_option_table.h"
 #include "candela/integrators/render_request.h"
-#include "candela/integrators/auto_integrator.h"
-#include "candela/integrators/bdpt.h"
-#include "candela/integrators/integrator.h"
 #include "candela/scene/resource_limits.h"
 #include "candela/scene/scene.h"
 
@@ -125,8 +122,7 @@ struct RenderCommand : RenderRequest {
   std::string output, spp_map;
   std::string display_server;  // --display-server HOST:PORT of a tev viewer (preview/tev_client.h); empty = none
   std::string aov;  // --aov: the AOV layers; empty = the scene's (FilmDesc::aovs)
-  std::string checkpoint, resume, pixel, part;
-  std::optional<double> checkpoint_every;
+  std::optional<double> checkpoint_every;  // with --checkpoint (RenderRequest::checkpoint)
   std::string preview;          // [HOST:]PORT of the browser preview; empty = none
   bool preview_public = false;  // allow a preview address reachable from other machines
 };
@@ -209,385 +205,429 @@ uint64_t scene_content_hash(const std::string& scene_bytes, const SceneDesc& des
   return hash;
 }
 
-int run_render(const RenderCommand& cmd, Cluster& cluster) {
+// ---- The render subcommand, step by step: plan (read and check everything), render, report.
+
+// What the render subcommand does, resolved and checked before the scene is built: the request's
+// plan (plan_render: the integrator, the pixels, the budget, its outputs) and what only the command
+// line adds.
+struct CommandPlan {
   SceneDesc desc;
-  bool adaptive = false;
-  const bool pixel_mode = !cmd.pixel.empty();
-  int px = -1, py = -1;
-  int part_index = 0, part_count = 1;
-  int auto_budget_spp = 0;
-  std::vector<fs::path> outputs;
-  std::vector<Aov> aov_layers;
+  RenderPlan render;
+  // The scene file's bytes where something must know they are the same: the ranks of a job, a
+  // checkpoint, a part (a plain render does not read the file twice).
   std::string scene_bytes;
+  std::vector<fs::path> outputs;  // the images to write
+  std::vector<Aov> aov_layers;    // --aov, else the scene's (none with --resume or --part)
+};
+
+std::vector<Aov> parse_aov_list(const std::string& list, const char* where) {
+  try {
+    return parse_aovs(list);
+  } catch (const UsageError& e) {
+    throw UsageError(fmt::format("{}: {}", where, e.what()));
+  }
+}
+
+// The command line's own flags that can be checked before the scene is read (with the request's
+// values, so that a value out of range is said before a big scene is read).
+void check_command_flags(const RenderCommand& cmd) {
+  check_request_values(cmd);
+  const bool pixel_mode = !cmd.pixel.empty();
+  if (!cmd.aov.empty()) parse_aov_list(cmd.aov, "--aov");
+  if (!cmd.preview.empty()) {
+    const PreviewAddress address = parse_preview_address(cmd.preview);
+    if (!address.loopback() && !cmd.preview_public)
+      throw UsageError(fmt::format("--preview {}: the preview listens on this machine only (127.0.0.1) unless "
+                                   "--preview-public is given", cmd.preview));
+    if (pixel_mode) throw UsageError("--preview shows the whole image: it cannot be combined with --pixel");
+  }
+  if (!cmd.display_server.empty()) {
+    try {
+      parse_display_server_address(cmd.display_server);
+    } catch (const UsageError& e) {
+      throw UsageError(fmt::format("--display-server: {}", e.what()));
+    }
+    if (pixel_mode) throw UsageError("--display-server shows the whole image: it cannot be combined with --pixel");
+  }
+  if (cmd.checkpoint_every && !(*cmd.checkpoint_every > 0))
+    throw UsageError(fmt::format("--checkpoint-every: must be a positive number, got {}", *cmd.checkpoint_every));
+}
+
+// The AOV layers: --aov, else the scene's; checkpoints and parts do not keep them.
+std::vector<Aov> plan_aovs(const RenderCommand& cmd, const CommandPlan& plan, Cluster& cluster) {
+  const bool keeps_none = !cmd.resume.empty() || !cmd.part.empty();
+  const char* which = cmd.resume.empty() ? "--part" : "--resume";
+  if (!cmd.aov.empty() && keeps_none)
+    throw UsageError(fmt::format("--aov cannot be combined with {} (checkpoints and parts do not keep the AOVs)", which));
+  std::vector<Aov> layers;
+  if (!cmd.aov.empty()) {
+    layers = parse_aov_list(cmd.aov, "--aov");
+  } else if (!plan.desc.film.aovs.empty()) {
+    layers = parse_aov_list(plan.desc.film.aovs, "the scene's aovs");
+    if (keeps_none) {
+      if (!cmd.quiet && cluster.is_root())
+        std::fprintf(stderr, "note: the scene's AOVs are not written with %s (checkpoints and parts do not keep them)\n",
+                     which);
+      layers.clear();
+    }
+  }
+  if (!layers.empty() && !plan.render.one_pixel() && !cmd.quiet && cluster.is_root())
+    for (const fs::path& f : plan.outputs)
+      if (!is_exr(f)) {
+        std::fprintf(stderr, "note: AOVs are written into .exr outputs only: '%s' gets the colour alone\n",
+                     f.string().c_str());
+        break;
+      }
+  return layers;
+}
+
+// The files the command writes, and whether they can be: the images, the spp map, the checkpoint.
+void check_command_outputs(const RenderCommand& cmd, const CommandPlan& plan, Cluster& cluster) {
+  if (!cmd.spp_map.empty() && !is_supported_output(cmd.spp_map))
+    throw UsageError(fmt::format("--spp-map '{}': unsupported image format (use .exr, .png or .pfm)", cmd.spp_map));
+  if (!cmd.spp_map.empty() && cluster.is_root()) check_can_write(cmd.spp_map, fmt::format("--spp-map '{}'", cmd.spp_map));
+  if (cmd.checkpoint_every && cmd.checkpoint.empty()) throw UsageError("--checkpoint-every needs --checkpoint FILE");
+  if (!cmd.part.empty() && (plan.outputs.size() != 1 || plan.outputs[0].extension() != ".exr"))
+    throw UsageError("--part writes a part file for candela merge: give one output ending in .exr (-o part-K.exr)");
+  if (!plan.render.one_pixel() && cluster.is_root()) check_outputs(plan.outputs);
+  if (!cmd.checkpoint.empty() && cluster.is_root())
+    check_can_write(cmd.checkpoint, fmt::format("--checkpoint '{}'", cmd.checkpoint));
+}
+
+// The one validator of the command: reads the scene, resolves the request (plan_render, where every
+// capability of the integrator is checked) and checks what only the command line does.
+CommandPlan plan_command(const RenderCommand& cmd, Cluster& cluster) {
+  check_command_flags(cmd);
+  CommandPlan plan;
+  plan.desc = cmd.scene_file.empty() ? read_json_scene(builtin_scene_json(), "<built-in cornell-box.json>", ".")
+                                     : read_scene_file(cmd.scene_file);
+  if (cluster.distributed() || !cmd.checkpoint.empty() || !cmd.resume.empty() || !cmd.part.empty())
+    plan.scene_bytes = cmd.scene_file.empty() ? std::string(builtin_scene_json()) : read_bytes(cmd.scene_file);
+  plan.render = plan_render(cmd, plan.desc);
+  if (plan.render.one_pixel() && cluster.distributed())
+    throw UsageError("--pixel renders one pixel in one process: run it without mpirun");
+  plan.outputs = output_files(cmd, plan.desc);
+  plan.aov_layers = plan_aovs(cmd, plan, cluster);
+  check_command_outputs(cmd, plan, cluster);
+  // Refuse what cannot fit in memory before allocating the scene and the film.
+  check_resources(plan.desc);
+  return plan;
+}
+
+// Every rank must render the same scene: a file changed on one node is refused.
+void check_same_scene(Cluster& cluster, const CommandPlan& plan, const std::string& scene_file) {
+  std::vector<uint64_t> hashes = cluster.gather_values(scene_content_hash(plan.scene_bytes, plan.desc));
+  for (size_t r = 1; r < hashes.size(); ++r)
+    if (hashes[r] != hashes[0])
+      throw UsageError(fmt::format("rank {} read a different scene than rank 0 ('{}' or its meshes differ between "
+                                   "the nodes; hash {:016x} vs {:016x})",
+                                   r, scene_file, hashes[r], hashes[0]));
+}
+
+// --resume: the checkpoint, read by the root and sent to the others (only it needs to see the file),
+// made by the same scene and settings (`fingerprint`) for a film of the same size.
+Checkpoint read_resumed(const std::string& file, Cluster& cluster, const RenderFingerprint& fingerprint,
+                        const FilmDesc& film) {
+  std::string checkpoint_bytes;
   on_every_rank(cluster, [&] {
-    // A value out of range is said before a big scene is read.
-    check_request_values(cmd);
-    auto parse_aov_list = [](const std::string& list, const char* where) {
-      try {
-        return parse_aovs(list);
-      } catch (const UsageError& e) {
-        throw UsageError(fmt::format("{}: {}", where, e.what()));
-      }
-    };
-    if (!cmd.aov.empty()) aov_layers = parse_aov_list(cmd.aov, "--aov");
-    if (!cmd.preview.empty()) {
-      const PreviewAddress address = parse_preview_address(cmd.preview);
-      if (!address.loopback() && !cmd.preview_public)
-        throw UsageError(fmt::format("--preview {}: the preview listens on this machine only (127.0.0.1) unless "
-                                     "--preview-public is given", cmd.preview));
-      if (pixel_mode) throw UsageError("--preview shows the whole image: it cannot be combined with --pixel");
-    }
-    if (!cmd.display_server.empty()) {
-      try {
-        parse_display_server_address(cmd.display_server);
-      } catch (const UsageError& e) {
-        throw UsageError(fmt::format("--display-server: {}", e.what()));
-      }
-      if (pixel_mode) throw UsageError("--display-server shows the whole image: it cannot be combined with --pixel");
-    }
-    if (cmd.checkpoint_every && !(*cmd.checkpoint_every > 0))
-      throw UsageError(fmt::format("--checkpoint-every: must be a positive number, got {}", *cmd.checkpoint_every));
-    desc = cmd.scene_file.empty() ? read_json_scene(builtin_scene_json(), "<built-in cornell-box.json>", ".")
-                                  : read_scene_file(cmd.scene_file);
-    // The scene file's bytes again, for what must know they are the same: the ranks of a job, a
-    // checkpoint, a part. A plain render does not read the file twice.
-    if (cluster.distributed() || !cmd.checkpoint.empty() || !cmd.resume.empty() || !cmd.part.empty())
-      scene_bytes = cmd.scene_file.empty() ? std::string(builtin_scene_json()) : read_bytes(cmd.scene_file);
-    auto_budget_spp = cmd.spp.value_or(desc.settings.spp);
-    apply_request(cmd, desc);
-    if (!cmd.spp_map.empty() && !is_supported_output(cmd.spp_map))
-      throw UsageError(fmt::format("--spp-map '{}': unsupported image format (use .exr, .png or .pfm)", cmd.spp_map));
-    if (!cmd.spp_map.empty() && cluster.is_root())
-      check_can_write(cmd.spp_map, fmt::format("--spp-map '{}'", cmd.spp_map));
-    adaptive = desc.settings.adaptive();
-    if (cmd.checkpoint_every && cmd.checkpoint.empty()) throw UsageError("--checkpoint-every needs --checkpoint FILE");
-
-    if (adaptive && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
-      throw UsageError("--checkpoint and --resume are not supported with adaptive sampling (--adaptive-threshold, --adaptive-spp)");
-    if (pixel_mode && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
-      throw UsageError("--pixel cannot be combined with --checkpoint or --resume");
-    if (pixel_mode && cluster.distributed())
-      throw UsageError("--pixel renders one pixel in one process: run it without mpirun");
-    const bool automatic = desc.settings.integrator == "auto";
-    if (automatic && (!cmd.checkpoint.empty() || !cmd.resume.empty() || pixel_mode || !cmd.part.empty()))
-      throw UsageError("--integrator auto cannot be combined with --checkpoint, --resume, --pixel or --part (name the integrator)");
-    // With auto, the path tracer stands in for the checks below, which auto does not reach.
-    const IntegratorEntry& chosen = *find_integrator(automatic ? "path" : desc.settings.integrator);
-    if (!chosen.resumable && (!cmd.checkpoint.empty() || !cmd.resume.empty()))
-      throw UsageError(fmt::format("--checkpoint and --resume are not supported with the {} integrator (it cannot continue a partly rendered film)", chosen.name));
-    if (!chosen.single_pixel && pixel_mode)
-      throw UsageError(fmt::format("--pixel cannot be used with the {} integrator (it cannot render one pixel alone)", chosen.name));
-    if (std::error_code ec; !cmd.bdpt_strategies.empty() && !fs::is_directory(cmd.bdpt_strategies, ec))
-      throw UsageError(fmt::format("--bdpt-strategies '{}': not a directory", cmd.bdpt_strategies));
-    if (pixel_mode) {
-      std::smatch m;
-      static const std::regex pattern(R"((\d{1,9}),(\d{1,9}))");
-      if (!std::regex_match(cmd.pixel, m, pattern))
-        throw UsageError(fmt::format("--pixel: expected X,Y such as 10,20, got '{}'", cmd.pixel));
-      px = std::stoi(m[1]);
-      py = std::stoi(m[2]);
-      if (px >= desc.film.width || py >= desc.film.height)
-        throw UsageError(fmt::format("--pixel {},{} is outside the {}x{} image", px, py, desc.film.width, desc.film.height));
-    }
-    if (!cmd.part.empty()) {
-      std::smatch m;
-      static const std::regex pattern(R"((\d{1,6})/(\d{1,6}))");
-      if (!std::regex_match(cmd.part, m, pattern) || std::stoi(m[1]) < 1 || std::stoi(m[1]) > std::stoi(m[2]))
-        throw UsageError(fmt::format("--part: expected K/N with 1 <= K <= N, such as 2/8, got '{}'", cmd.part));
-      part_index = std::stoi(m[1]) - 1;
-      part_count = std::stoi(m[2]);
-      if (adaptive) throw UsageError("--part cannot be combined with adaptive sampling (its decisions look across the whole image)");
-      if (cmd.target_error) throw UsageError("--part cannot be combined with --target-error (the error is the whole image's)");
-      if (pixel_mode) throw UsageError("--part cannot be combined with --pixel");
-      if (!chosen.resumable)
-        throw UsageError(fmt::format("--part: the {} integrator does not render tile by tile (path and bdpt do)", chosen.name));
-    }
-    outputs = output_files(cmd, desc);
-    // AOVs (film/aov_film.h): --aov, else the scene's. Checkpoints and parts do not keep them.
-    if (cmd.aov.empty() && !desc.film.aovs.empty()) {
-      aov_layers = parse_aov_list(desc.film.aovs, "the scene's aovs");
-      if (!cmd.resume.empty() || !cmd.part.empty()) {
-        if (!cmd.quiet && cluster.is_root())
-          std::fprintf(stderr, "note: the scene's AOVs are not written with %s (checkpoints and parts do not keep them)\n",
-                       cmd.resume.empty() ? "--part" : "--resume");
-        aov_layers.clear();
-      }
-    }
-    if (!cmd.aov.empty() && (!cmd.resume.empty() || !cmd.part.empty()))
-      throw UsageError(fmt::format("--aov cannot be combined with {} (checkpoints and parts do not keep the AOVs)",
-                                   cmd.resume.empty() ? "--part" : "--resume"));
-    if (!aov_layers.empty() && !pixel_mode && !cmd.quiet && cluster.is_root())
-      for (const fs::path& f : outputs)
-        if (!is_exr(f)) {
-          std::fprintf(stderr, "note: AOVs are written into .exr outputs only: '%s' gets the colour alone\n", f.string().c_str());
-          break;
-        }
-    if (!cmd.part.empty() && (outputs.size() != 1 || outputs[0].extension() != ".exr"))
-      throw UsageError("--part writes a part file for candela merge: give one output ending in .exr (-o part-K.exr)");
-    if (!pixel_mode && cluster.is_root()) check_outputs(outputs);
-    // Refuse what cannot fit in memory before allocating the scene and the film.
-    check_resources(desc);
-    if (!cmd.checkpoint.empty() && cluster.is_root())
-      check_can_write(cmd.checkpoint, fmt::format("--checkpoint '{}'", cmd.checkpoint));
+    if (cluster.is_root()) checkpoint_bytes = read_checkpoint_bytes(file);
   });
-  // Every rank must render the same scene: a file changed on one node is refused.
-  if (cluster.distributed()) on_every_rank(cluster, [&] {
-    std::vector<uint64_t> hashes = cluster.gather_values(scene_content_hash(scene_bytes, desc));
-    for (size_t r = 1; r < hashes.size(); ++r)
-      if (hashes[r] != hashes[0])
-        throw UsageError(fmt::format("rank {} read a different scene than rank 0 ('{}' or its meshes differ between "
-                                     "the nodes; hash {:016x} vs {:016x})",
-                                     r, cmd.scene_file, hashes[r], hashes[0]));
+  std::vector<std::byte> shared(reinterpret_cast<const std::byte*>(checkpoint_bytes.data()),
+                                reinterpret_cast<const std::byte*>(checkpoint_bytes.data() + checkpoint_bytes.size()));
+  cluster.broadcast(shared);
+  Checkpoint resumed;
+  on_every_rank(cluster, [&] {
+    resumed = parse_checkpoint(std::string_view(reinterpret_cast<const char*>(shared.data()), shared.size()), file);
+    std::string diff = resumed.fingerprint.difference(fingerprint);
+    if (!diff.empty()) throw UsageError(fmt::format("cannot resume from '{}': {} (checkpoint vs now)", file, diff));
+    if (resumed.width != film.width || resumed.height != film.height)
+      throw UsageError(fmt::format("cannot resume from '{}': its film is {}x{}, not {}x{}", file, resumed.width,
+                                   resumed.height, film.width, film.height));
   });
+  return resumed;
+}
 
-  // What made the image, for checkpoints and parts; a checkpoint also names its part, as it resumes only that.
-  const RenderFingerprint made_by = render_fingerprint(scene_bytes, desc, cmd);
-  RenderFingerprint fingerprint = made_by;
-  if (part_count > 1) fingerprint.settings.push_back({"part", cmd.part});
-  std::optional<Checkpoint> resumed;
-  if (!cmd.resume.empty()) {
-    // The root reads the checkpoint and sends it to the others: only it needs to see the file.
-    std::string checkpoint_bytes;
-    on_every_rank(cluster, [&] {
-      if (cluster.is_root()) checkpoint_bytes = read_checkpoint_bytes(cmd.resume);
-    });
-    std::vector<std::byte> shared(reinterpret_cast<const std::byte*>(checkpoint_bytes.data()),
-                                  reinterpret_cast<const std::byte*>(checkpoint_bytes.data() + checkpoint_bytes.size()));
-    cluster.broadcast(shared);
-    on_every_rank(cluster, [&] {
-      resumed = parse_checkpoint(std::string_view(reinterpret_cast<const char*>(shared.data()), shared.size()), cmd.resume);
-      std::string diff = resumed->fingerprint.difference(fingerprint);
-      if (!diff.empty())
-        throw UsageError(fmt::format("cannot resume from '{}': {} (checkpoint vs now)", cmd.resume, diff));
-      if (resumed->width != desc.film.width || resumed->height != desc.film.height)
-        throw UsageError(fmt::format("cannot resume from '{}': its film is {}x{}, not {}x{}", cmd.resume,
-                                     resumed->width, resumed->height, desc.film.width, desc.film.height));
-    });
-  }
-
-  // The meshes move into the scene: every triangle is held once.
-  g_phase.store(kBuildingScene);
-  Scene scene(desc, Scene::MeshData::Take);
-  Film film(desc.film.width, desc.film.height);
-  uint64_t earlier_non_finite = 0;
-  if (resumed) {
-    film.pixels() = std::move(resumed->pixels);
-    // Splats and counts are sums over the ranks: the root alone carries the checkpoint's.
-    if (!resumed->splats.empty()) {
-      film.enable_splats();
-      if (cluster.is_root()) {
-        film.splats().sums() = std::move(resumed->splats);
-        if (!resumed->half_splats.empty()) film.half_splats().sums() = std::move(resumed->half_splats);
-      }
+// The film continues the checkpoint's; returns its non-finite samples (the root's alone: splats and
+// counts are sums over the ranks, so the root alone carries the checkpoint's).
+uint64_t restore(Checkpoint& resumed, Film& film, Cluster& cluster) {
+  film.pixels() = std::move(resumed.pixels);
+  if (!resumed.splats.empty()) {
+    film.enable_splats();
+    if (cluster.is_root()) {
+      film.splats().sums() = std::move(resumed.splats);
+      if (!resumed.half_splats.empty()) film.half_splats().sums() = std::move(resumed.half_splats);
     }
-    if (cluster.is_root()) earlier_non_finite = resumed->non_finite_samples;
   }
-  // Per-strategy images of bidirectional path tracing, depth by depth up to 5 (or max-depth).
-  const int strategy_depth = std::min(desc.settings.max_depth, 5);
-  std::vector<SplatImage> strategy_images;
-  if (!cmd.bdpt_strategies.empty()) {
-    strategy_images.assign(size_t(BdptIntegrator::strategy_count(strategy_depth)), SplatImage(film.width(), film.height()));
-  }
-  RenderOptions options = request_options(cmd);
-  options.threads = cmd.threads.value_or(cluster.default_threads());
-  options.progress = !cmd.quiet && cluster.is_root();
-  options.cancel = &g_stop;
-  options.cluster = &cluster;
-  options.part_index = part_index;
-  options.part_count = part_count;
-  std::optional<AovFilm> aov_film;
-  if (!aov_layers.empty() && !pixel_mode) {
-    aov_film.emplace(film.width(), film.height(), aov_layers);
-    options.aovs = &*aov_film;
-  }
-  if (!strategy_images.empty()) {
-    options.bdpt_strategies = &strategy_images;
-    options.bdpt_unweighted = cmd.bdpt_unweighted;
-  }
-  if (pixel_mode) {
-    options.only_x = px;
-    options.only_y = py;
-    options.max_reported_non_finite = 1000;
-  }
+  return cluster.is_root() ? resumed.non_finite_samples : 0;
+}
+
+// --checkpoint FILE: the film saved atomically by the root, between passes every --checkpoint-every
+// seconds and when the render stops early.
+class CheckpointWriter {
+ public:
+  CheckpointWriter(Cluster& cluster, std::string file, RenderFingerprint fingerprint, uint64_t earlier_non_finite)
+      : cluster_(cluster), file_(std::move(file)), fingerprint_(std::move(fingerprint)),
+        earlier_non_finite_(earlier_non_finite) {}
+
   // Called on every rank at the same moment; the root writes. `own_splats`: the film's splats are
   // still each rank's own (during the render), to be added up first.
-  auto save_checkpoint = [&](const Film& f, uint64_t non_finite, bool own_splats) {
+  void save(const Film& f, uint64_t non_finite, bool own_splats) {
     Checkpoint cp;
     if (f.has_splats()) {
       cp.splats = f.splats().sums();
       cp.half_splats = f.half_splats().sums();
       if (own_splats) {
-        cluster.sum_int64(cp.splats);
-        cluster.sum_int64(cp.half_splats);
+        cluster_.sum_int64(cp.splats);
+        cluster_.sum_int64(cp.half_splats);
       }
     }
-    on_every_rank(cluster, [&] {
-      if (!cluster.is_root()) return;
-      cp.fingerprint = fingerprint;
+    on_every_rank(cluster_, [&] {
+      if (!cluster_.is_root()) return;
+      cp.fingerprint = fingerprint_;
       cp.width = f.width();
       cp.height = f.height();
       cp.non_finite_samples = non_finite;
       cp.pixels = f.pixels();
-      write_checkpoint(cmd.checkpoint, cp);
+      write_checkpoint(file_, cp);
     });
-  };
-  auto last_checkpoint = std::chrono::steady_clock::now();
-  if (!cmd.checkpoint.empty() && cmd.checkpoint_every)
-    options.after_pass = [&](const Film& f, uint64_t non_finite_so_far) {
+  }
+
+  // The render loop's after_pass hook: a checkpoint when `every` seconds have passed (the root's clock).
+  std::function<void(const Film&, uint64_t)> every(double seconds) {
+    return [this, seconds](const Film& f, uint64_t non_finite_so_far) {
       auto now = std::chrono::steady_clock::now();
-      if (!cluster.from_root(std::chrono::duration<double>(now - last_checkpoint).count() >= *cmd.checkpoint_every)) return;
-      save_checkpoint(f, earlier_non_finite + non_finite_so_far, true);
-      last_checkpoint = std::chrono::steady_clock::now();
+      if (!cluster_.from_root(std::chrono::duration<double>(now - last_).count() >= seconds)) return;
+      save(f, earlier_non_finite_ + non_finite_so_far, true);
+      last_ = std::chrono::steady_clock::now();
     };
-  // Viewers of the render as it converges (the root's film: after each pass it holds every rank's tiles).
+  }
+
+ private:
+  Cluster& cluster_;
+  std::string file_;
+  RenderFingerprint fingerprint_;
+  uint64_t earlier_non_finite_;
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+// Viewers of the render as it converges (the root's film: after each pass it holds every rank's
+// tiles). They see the end once the images are written, or the command fails, before they close.
+struct Viewers {
   std::unique_ptr<LiveFilm> live;
   std::unique_ptr<PreviewServer> preview;
   std::unique_ptr<TevClient> tev;
-  LiveState live_end = LiveState::Stopped;
-  if (cluster.is_root() && (!cmd.preview.empty() || !cmd.display_server.empty()))
-    live = std::make_unique<LiveFilm>(film.width(), film.height());
-  if (live && !cmd.display_server.empty())
-    tev = std::make_unique<TevClient>(cmd.display_server, outputs.front().filename().string(), *live);
-  if (live && !cmd.preview.empty()) {
-    const PreviewAddress address = parse_preview_address(cmd.preview);
-    preview = std::make_unique<PreviewServer>(
-        address, *live,
-        [] {
-          g_stopped_from_page.store(true);
-          g_stop.store(true);
-        },
-        cmd.preview_public);
-    if (!address.loopback())
-      std::fprintf(stderr, "candela: warning: the preview listens on %s, which other machines can reach: anyone who "
-                           "sees its address (with the token) can watch the render and stop it, and it travels "
-                           "unencrypted; an SSH tunnel to a loopback preview is safer (docs/preview.md)\n",
-                   address.host.c_str());
-    std::fprintf(stderr, "candela: preview at %s\n", preview->url().c_str());
-    std::fflush(stderr);
+  LiveState end = LiveState::Stopped;
+  Viewers() = default;
+  Viewers(const Viewers&) = delete;
+  Viewers& operator=(const Viewers&) = delete;
+  ~Viewers() {
+    if (live) live->finish(end);
   }
-  if (live) {
-    options.live = live.get();
-    if (!options.progress_fraction) options.progress_fraction = &live->progress_fraction();
-    live->start(fmt::format("{} ({})", cmd.scene_file.empty() ? "built-in cornell-box.json" : cmd.scene_file,
-                            desc.settings.integrator),
-                uint64_t(!desc.settings.adaptive()          ? desc.settings.spp
-                         : desc.settings.adaptive_spp > 0 ? desc.settings.adaptive_spp
-                                                          : std::max(desc.settings.adaptive_spp_limit(), desc.settings.adaptive_batch)),
-                desc.settings.adaptive(), options.time_limit_seconds, options.target_error);
-  }
-  // The viewers see the end once the images are written (or the command fails), before they close.
-  struct EndLive {
-    LiveFilm* live;
-    const LiveState& state;
-    ~EndLive() {
-      if (live) live->finish(state);
-    }
-  } end_live{live.get(), live_end};
-  g_phase.store(kRendering);
-  RenderOutcome outcome = render_requested(scene, desc.settings, film, options, auto_budget_spp, [&](const std::string& summary) {
-    if (cluster.is_root()) std::printf("auto: %s\n", summary.c_str());
-  });
-  const RenderStats& stats = outcome.stats;
-  g_phase.store(kWriting);  // a signal from here on lets the (complete or partial) images be written
-  const uint64_t non_finite = earlier_non_finite + stats.non_finite_samples;
-  const bool stopped = stats.cancelled || stats.time_limited;
+};
 
-  auto nan_warning = [&] {
-    if (non_finite == 0) return;
-    std::string where;
-    for (const auto& n : stats.first_non_finite)
-      where += fmt::format("{}pixel ({}, {}) sample {}", where.empty() ? "" : ", ", n.x, n.y, n.sample);
-    std::fprintf(stderr, "candela: warning: %llu samples were NaN or infinite and counted as black%s%s\n",
-                 (unsigned long long)non_finite, where.empty() ? "" : "; first: ",
-                 (where + (where.empty() || pixel_mode ? "" : " (reproduce one with --pixel X,Y)")).c_str());
-  };
+void start_preview(const RenderCommand& cmd, Viewers& viewers) {
+  const PreviewAddress address = parse_preview_address(cmd.preview);
+  viewers.preview = std::make_unique<PreviewServer>(
+      address, *viewers.live,
+      [] {
+        g_stopped_from_page.store(true);
+        g_stop.store(true);
+      },
+      cmd.preview_public);
+  if (!address.loopback())
+    std::fprintf(stderr, "candela: warning: the preview listens on %s, which other machines can reach: anyone who "
+                         "sees its address (with the token) can watch the render and stop it, and it travels "
+                         "unencrypted; an SSH tunnel to a loopback preview is safer (docs/preview.md)\n",
+                 address.host.c_str());
+  std::fprintf(stderr, "candela: preview at %s\n", viewers.preview->url().c_str());
+  std::fflush(stderr);
+}
 
-  if (pixel_mode) {
-    const PixelSums& p = film.pixel(px, py);
-    RGB v = film.mean_image().at(px, py);
-    std::printf("pixel (%d, %d): %.9g %.9g %.9g (%llu samples)\n", px, py, v.r, v.g, v.b,
-                (unsigned long long)p.count);
-    std::string idx;
-    for (const auto& n : stats.first_non_finite) idx += fmt::format("{}{}", idx.empty() ? "" : " ", n.sample);
-    std::printf("non-finite samples: %s\n", idx.empty() ? "none" : idx.c_str());
-    nan_warning();
-    return stats.cancelled ? kExitInterrupted : 0;
-  }
+// Starts the viewers asked for (--preview, --display-server) and hands the render their film.
+void start_viewers(const RenderCommand& cmd, const CommandPlan& plan, const RenderOptions& options,
+                   Cluster& cluster, Viewers& viewers) {
+  if (!cluster.is_root() || (cmd.preview.empty() && cmd.display_server.empty())) return;
+  const SceneDesc& desc = plan.desc;
+  const RenderSettings& rs = desc.settings;
+  viewers.live = std::make_unique<LiveFilm>(desc.film.width, desc.film.height);
+  if (!cmd.display_server.empty())
+    viewers.tev = std::make_unique<TevClient>(cmd.display_server, plan.outputs.front().filename().string(), *viewers.live);
+  if (!cmd.preview.empty()) start_preview(cmd, viewers);
+  const uint64_t spp = uint64_t(!rs.adaptive()          ? rs.spp
+                                : rs.adaptive_spp > 0 ? rs.adaptive_spp
+                                                      : std::max(rs.adaptive_spp_limit(), rs.adaptive_batch));
+  viewers.live->start(fmt::format("{} ({})", cmd.scene_file.empty() ? "built-in cornell-box.json" : cmd.scene_file,
+                                  rs.integrator),
+                      spp, rs.adaptive(), options.time_limit_seconds, options.target_error);
+}
 
-  if (stopped && !cmd.checkpoint.empty()) save_checkpoint(film, non_finite, false);
-  // The root writes the images and reports; the other ranks are done.
-  const std::vector<Cluster::Traffic> traffic = cluster.gather_values(cluster.traffic());
-  uint64_t most_sent = 0;
-  for (const Cluster::Traffic& t : traffic) most_sent = std::max(most_sent, t.bytes_sent);
-  if (!cluster.is_root()) return stats.cancelled ? kExitInterrupted : 0;
+// The render options: the plan's, and what the command line adds (threads per rank, progress on the
+// root, the stop flag, the cluster, the AOV film, the integrator's outputs).
+RenderOptions command_options(const RenderCommand& cmd, const CommandPlan& plan, Cluster& cluster, AovFilm* aovs,
+                              IntegratorOutputs* integrator_outputs) {
+  RenderOptions options = plan.render.options();
+  options.threads = cmd.threads.value_or(cluster.default_threads());
+  options.progress = !cmd.quiet && cluster.is_root();
+  options.cancel = &g_stop;
+  options.cluster = &cluster;
+  options.aovs = aovs;
+  options.integrator_outputs = integrator_outputs;
+  return options;
+}
 
-  const auto [spp_text, spp_unit] = describe_samples(desc.settings, film, outcome);
-  const std::map<std::string, std::string> metadata =
-      image_metadata(cmd.scene_file.empty() ? "<built-in cornell-box.json>" : cmd.scene_file, desc.settings, film,
-                     outcome, options, cluster.size(), non_finite);
-  const ErrorEstimate& error = outcome.error;
+void warn_non_finite(const RenderStats& stats, uint64_t non_finite, bool pixel_mode) {
+  if (non_finite == 0) return;
+  std::string where;
+  for (const auto& n : stats.first_non_finite)
+    where += fmt::format("{}pixel ({}, {}) sample {}", where.empty() ? "" : ", ", n.x, n.y, n.sample);
+  std::fprintf(stderr, "candela: warning: %llu samples were NaN or infinite and counted as black%s%s\n",
+               (unsigned long long)non_finite, where.empty() ? "" : "; first: ",
+               (where + (where.empty() || pixel_mode ? "" : " (reproduce one with --pixel X,Y)")).c_str());
+}
+
+// --pixel: its value and its non-finite samples, instead of an image.
+int report_pixel(const RenderPlan& plan, const Film& film, const RenderStats& stats, uint64_t non_finite) {
+  const int px = plan.pixel_x, py = plan.pixel_y;
+  const PixelSums& p = film.pixel(px, py);
+  RGB v = film.mean_image().at(px, py);
+  std::printf("pixel (%d, %d): %.9g %.9g %.9g (%llu samples)\n", px, py, v.r, v.g, v.b, (unsigned long long)p.count);
+  std::string idx;
+  for (const auto& n : stats.first_non_finite) idx += fmt::format("{}{}", idx.empty() ? "" : " ", n.sample);
+  std::printf("non-finite samples: %s\n", idx.empty() ? "none" : idx.c_str());
+  warn_non_finite(stats, non_finite, true);
+  return stats.cancelled ? kExitInterrupted : 0;
+}
+
+// The images: the part file (--part), else every output (with the AOVs in .exr ones); the
+// integrator's own outputs; the spp map.
+// `made_by` and `non_finite` go into a part file.
+void write_images(const RenderCommand& cmd, const CommandPlan& plan, const Scene& scene, Film& film,
+                  const AovFilm* aov_film, const IntegratorOutputs* integrator_outputs,
+                  const RenderFingerprint& made_by, uint64_t non_finite,
+                  const std::map<std::string, std::string>& metadata) {
   if (!cmd.part.empty()) {
-    FilmPart part{part_index, part_count, made_by,
+    FilmPart part{plan.render.part_index, plan.render.part_count, made_by,
                   double(scene.camera().importance_film_pixels()), non_finite, std::move(film)};
-    write_part(outputs[0], part, metadata);
+    write_part(plan.outputs[0], part, metadata);
     film = std::move(part.film);
   } else {
     Image image = film.mean_image();
     const FloatChannels aov_channels = aov_film ? exr_channels(aov_film->images(film)) : FloatChannels{};
-    for (const auto& f : outputs) {
+    for (const auto& f : plan.outputs) {
       if (aov_channels.names.empty() || !is_exr(f))
         write_image(f, image, metadata);
       else
         write_image(f, image, metadata, aov_channels);
     }
   }
-  // One image per strategy: bdpt_d<depth>_s<s>_t<t>.exr, scaled like the light image.
-  for (int depth = 0; depth <= strategy_depth && !strategy_images.empty(); ++depth)
-    for (int s = 0; s <= depth + 1; ++s) {
-      int t = depth + 2 - s;
-      fs::path file = fs::path(cmd.bdpt_strategies) / fmt::format("bdpt_d{}_s{}_t{}.exr", depth, s, t);
-      write_image(file, strategy_images[size_t(BdptIntegrator::strategy_index(s, t))].image(film.splat_scale()), metadata);
-    }
+  if (integrator_outputs) integrator_outputs->write(film, metadata);
   if (!cmd.spp_map.empty()) write_image(cmd.spp_map, spp_heat_map(film, fs::path(cmd.spp_map)), metadata);
-  nan_warning();
+}
 
-  double seconds = std::max(stats.seconds, 1e-9);
+// The closing lines: size, samples, time and speed; the error estimate; an MPI job's efficiency.
+void print_summary(const RenderCommand& cmd, const CommandPlan& plan, const RenderOutcome& outcome,
+                   const RenderOptions& options, const SampleCountText& samples, Cluster& cluster,
+                   const std::vector<Cluster::Traffic>& traffic) {
+  const RenderStats& stats = outcome.stats;
+  const double seconds = std::max(stats.seconds, 1e-9);
   std::string written;
-  for (const auto& f : outputs) written += (written.empty() ? "" : ", ") + f.string();
-  std::printf("%dx%d, %s%s in %.2f s: %.3f Msamples/s, %.2f Mrays/s (%.3g rays/sample) -> %s\n", desc.film.width,
-              desc.film.height, spp_text.c_str(), spp_unit, stats.seconds, double(stats.samples) / seconds * 1e-6,
-              double(stats.rays.total()) / seconds * 1e-6,
+  for (const auto& f : plan.outputs) written += (written.empty() ? "" : ", ") + f.string();
+  std::printf("%dx%d, %s%s in %.2f s: %.3f Msamples/s, %.2f Mrays/s (%.3g rays/sample) -> %s\n",
+              plan.desc.film.width, plan.desc.film.height, samples.text.c_str(), samples.spp_unit, stats.seconds,
+              double(stats.samples) / seconds * 1e-6, double(stats.rays.total()) / seconds * 1e-6,
               double(stats.rays.total()) / double(std::max<uint64_t>(stats.samples, 1)), written.c_str());
-  if (error.valid || options.target_error > 0 || cmd.estimate_error)
-    std::printf("estimated error: %s%s\n", describe(error).c_str(),
+  if (outcome.error.valid || options.target_error > 0 || cmd.estimate_error)
+    std::printf("estimated error: %s%s\n", describe(outcome.error).c_str(),
                 options.target_error <= 0 ? ""
                 : stats.reached_target
                     ? fmt::format("; target {} reached", options.target_error).c_str()
                     : fmt::format("; target {} not reached (stopped at the {})", options.target_error,
                                   stats.time_limited ? "time limit" : stats.cancelled ? "interruption" : "spp limit").c_str());
-  if (cluster.mpi_job()) {
-    // The job's parallel efficiency: the thread-seconds spent rendering over all threads x wall time.
-    double busy = 0;
-    std::string per_rank;
-    for (double b : stats.rank_busy_seconds) {
-      busy += b;
-      per_rank += fmt::format("{}{:.2f}", per_rank.empty() ? "" : " ", b);
-    }
-    std::printf("%d ranks, %d threads: parallel efficiency %.1f%% (busy thread-seconds per rank: %s); "
-                "sent per rank: at most %.2f MB, rank 0 %.2f MB; rank 0 in collectives %.2f s\n",
-                cluster.size(), stats.threads, 100 * busy / (double(stats.threads) * seconds), per_rank.c_str(),
-                double(most_sent) * 1e-6, double(traffic[0].bytes_sent) * 1e-6, traffic[0].collective_seconds);
+  if (!cluster.mpi_job()) return;
+  // The job's parallel efficiency: the thread-seconds spent rendering over all threads x wall time.
+  uint64_t most_sent = 0;
+  for (const Cluster::Traffic& t : traffic) most_sent = std::max(most_sent, t.bytes_sent);
+  double busy = 0;
+  std::string per_rank;
+  for (double b : stats.rank_busy_seconds) {
+    busy += b;
+    per_rank += fmt::format("{}{:.2f}", per_rank.empty() ? "" : " ", b);
   }
-  live_end = stats.cancelled ? LiveState::Stopped : LiveState::Finished;
+  std::printf("%d ranks, %d threads: parallel efficiency %.1f%% (busy thread-seconds per rank: %s); "
+              "sent per rank: at most %.2f MB, rank 0 %.2f MB; rank 0 in collectives %.2f s\n",
+              cluster.size(), stats.threads, 100 * busy / (double(stats.threads) * seconds), per_rank.c_str(),
+              double(most_sent) * 1e-6, double(traffic[0].bytes_sent) * 1e-6, traffic[0].collective_seconds);
+}
+
+// Why the render stopped early, if it did, and the exit status.
+int finish_message(const RenderCommand& cmd, const RenderStats& stats, const SampleCountText& samples) {
   if (stats.time_limited)
-    std::fprintf(stderr, "candela: time limit reached: wrote the image with %s%s\n", spp_text.c_str(), spp_unit);
-  if (stats.cancelled) {
-    std::fprintf(stderr, "candela: %s: wrote the image with %s%s%s\n",
-                 g_stopped_from_page.load() ? "stopped from the preview page" : "interrupted", spp_text.c_str(), spp_unit,
-                 cmd.checkpoint.empty() ? "" : fmt::format(" and checkpoint {}", cmd.checkpoint).c_str());
-    return kExitInterrupted;
+    std::fprintf(stderr, "candela: time limit reached: wrote the image with %s%s\n", samples.text.c_str(),
+                 samples.spp_unit);
+  if (!stats.cancelled) return 0;
+  std::fprintf(stderr, "candela: %s: wrote the image with %s%s%s\n",
+               g_stopped_from_page.load() ? "stopped from the preview page" : "interrupted", samples.text.c_str(),
+               samples.spp_unit, cmd.checkpoint.empty() ? "" : fmt::format(" and checkpoint {}", cmd.checkpoint).c_str());
+  return kExitInterrupted;
+}
+
+int run_render(const RenderCommand& cmd, Cluster& cluster) {
+  CommandPlan plan;
+  on_every_rank(cluster, [&] { plan = plan_command(cmd, cluster); });
+  if (cluster.distributed()) on_every_rank(cluster, [&] { check_same_scene(cluster, plan, cmd.scene_file); });
+  // What made the image, for checkpoints and parts; a checkpoint also names its part, as it resumes only that.
+  const RenderFingerprint made_by = render_fingerprint(plan.scene_bytes, plan.desc, cmd);
+  RenderFingerprint fingerprint = made_by;
+  if (plan.render.part_count > 1) fingerprint.settings.push_back({"part", cmd.part});
+  std::optional<Checkpoint> resumed;
+  if (!cmd.resume.empty()) resumed = read_resumed(cmd.resume, cluster, fingerprint, plan.desc.film);
+
+  // The meshes move into the scene: every triangle is held once.
+  g_phase.store(kBuildingScene);
+  SceneDesc& desc = plan.desc;
+  Scene scene(desc, Scene::MeshData::Take);
+  Film film(desc.film.width, desc.film.height);
+  const uint64_t earlier_non_finite = resumed ? restore(*resumed, film, cluster) : 0;
+  std::optional<AovFilm> aov_film;
+  if (!plan.aov_layers.empty() && !plan.render.one_pixel()) aov_film.emplace(film.width(), film.height(), plan.aov_layers);
+  const std::unique_ptr<IntegratorOutputs> integrator_outputs =
+      plan.render.make_integrator_outputs(desc.settings, film.width(), film.height());
+  RenderOptions options =
+      command_options(cmd, plan, cluster, aov_film ? &*aov_film : nullptr, integrator_outputs.get());
+  CheckpointWriter checkpoints(cluster, cmd.checkpoint, fingerprint, earlier_non_finite);
+  if (!cmd.checkpoint.empty() && cmd.checkpoint_every) options.after_pass = checkpoints.every(*cmd.checkpoint_every);
+  Viewers viewers;
+  start_viewers(cmd, plan, options, cluster, viewers);
+  if (viewers.live) {
+    options.live = viewers.live.get();
+    if (!options.progress_fraction) options.progress_fraction = &viewers.live->progress_fraction();
   }
-  return 0;
+
+  g_phase.store(kRendering);
+  const RenderOutcome outcome =
+      render_requested(scene, desc.settings, film, plan.render, options, [&](const std::string& summary) {
+        if (cluster.is_root()) std::printf("auto: %s\n", summary.c_str());
+      });
+  const RenderStats& stats = outcome.stats;
+  g_phase.store(kWriting);  // a signal from here on lets the (complete or partial) images be written
+  const uint64_t non_finite = earlier_non_finite + stats.non_finite_samples;
+  if (plan.render.one_pixel()) return report_pixel(plan.render, film, stats, non_finite);
+
+  if ((stats.cancelled || stats.time_limited) && !cmd.checkpoint.empty()) checkpoints.save(film, non_finite, false);
+  // The root writes the images and reports; the other ranks are done.
+  const std::vector<Cluster::Traffic> traffic = cluster.gather_values(cluster.traffic());
+  if (!cluster.is_root()) return stats.cancelled ? kExitInterrupted : 0;
+
+  const SampleCountText samples = describe_samples(desc.settings, film, outcome);
+  const std::map<std::string, std::string> metadata =
+      image_metadata(cmd.scene_file.empty() ? "<built-in cornell-box.json>" : cmd.scene_file, desc.settings, film,
+                     outcome, options, cluster.size(), non_finite);
+  write_images(cmd, plan, scene, film, aov_film ? &*aov_film : nullptr, integrator_outputs.get(), made_by, non_finite,
+               metadata);
+  warn_non_finite(stats, non_finite, false);
+  print_summary(cmd, plan, outcome, options, samples, cluster, traffic);
+  viewers.end = stats.cancelled ? LiveState::Stopped : LiveState::Finished;
+  return finish_message(cmd, stats, samples);
 }
 
 // `candela convert IN OUT.json`: any scene candela reads, in its JSON format.

@@ -19,7 +19,7 @@ std::vector<const IntegratorEntry*> auto_candidates(const RenderSettings& settin
   // With media only the integrators that render them apply; without, volpath is the path tracer
   // with one shadow ray and adds nothing to compare.
   for (const IntegratorEntry& entry : integrators()) {
-    if (has_media ? !entry.participating_media : entry.render == render_volpath) continue;
+    if (entry.chooses || (has_media ? !entry.participating_media : entry.render == render_volpath)) continue;
     if (set_but_unread(entry, settings).empty()) candidates.push_back(&entry);
   }
   return candidates;
@@ -87,7 +87,8 @@ AutoChoice choose_integrator(const Scene& scene, const RenderSettings& settings,
       image_share = double((tiles + pilot.part_count - 1) / pilot.part_count) / double(tiles);
     }
     Film pilot_film(film.width(), film.height());
-    RenderStats stats = render(scene, pilot_settings, pilot_film, pilot);
+    // (Each candidate can render the scene as asked: auto_candidates.)
+    RenderStats stats = render_with(*entry, scene, pilot_settings, pilot_film, pilot);
     PilotRun run;
     run.integrator = entry;
     // The root's clock, so every rank decides alike (the films, and so the estimates, are the same).
@@ -100,14 +101,15 @@ AutoChoice choose_integrator(const Scene& scene, const RenderSettings& settings,
     if (mlt) {
       // The real depth-0 pass: its samples at the pilot's pace, but under a time limit at most its
       // share of it (and at least the pilot's one pass).
-      const double direct = cluster.from_root(stats.mlt_direct_seconds);
+      const MltStats& mlt_details = *mlt_stats(stats);
+      const double direct = cluster.from_root(mlt_details.direct_seconds);
       double full_direct = direct * direct_scale;
       if (time_limit > 0) full_direct = std::min(full_direct, std::max(direct, time_limit * kMltDirectTimeShare));
-      run.full_setup_seconds = full_direct + cluster.from_root(stats.mlt_bootstrap_seconds) * bootstrap_scale;
+      run.full_setup_seconds = full_direct + cluster.from_root(mlt_details.bootstrap_seconds) * bootstrap_scale;
     } else {
       run.full_setup_seconds = run.setup_seconds;
     }
-    run.error = estimate_error(pilot_film, stats.mlt_normalization_relative_error);
+    run.error = estimate_error(pilot_film, stats.splat_scale_relative_error);
     choice.pilot_seconds += run.seconds;
     choice.pilots.push_back(run);
     pilot_films.push_back(std::move(pilot_film));

@@ -43,11 +43,13 @@ struct AutoChoice {
   std::string summary() const;
 };
 
-// The integrators that read every selective setting `settings` sets (integrator.h).
+// The integrators that read every selective setting `settings` sets (integrator.h), and render
+// participating media when the scene has them: the registry entry "auto"'s candidates.
 std::vector<const IntegratorEntry*> auto_candidates(const RenderSettings& settings, bool has_media);
 
-// Runs the pilots (settings.integrator is ignored; settings.sampler.replicas must be on) under
-// `options` (its time limit or target error is the budget; the film must be empty) and chooses.
+// The registry entry "auto"'s choice: runs the pilots (settings.integrator is ignored;
+// settings.sampler.replicas must be on) under `options` (its time limit or target error is the
+// budget; the film must be empty) and chooses.
 // Without either, the budget is the path tracer's time for `budget_spp` samples per pixel.
 // Leaves the winner's pilot in `film` when the winner continues it, an empty film otherwise.
 AutoChoice choose_integrator(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options,

@@ -1,9 +1,14 @@
 #include "candela/integrators/bdpt.h"
 
+#include <fmt/format.h>
+
 #include <bit>
 #include <cmath>
+#include <filesystem>
 #include <stdexcept>
+#include <utility>
 
+#include "candela/film/image_io.h"
 #include "candela/integrators/mlt_sampler.h"
 #include "candela/materials/spectral_bsdf.h"
 #include "candela/render/camera_sample_tiles.h"
@@ -715,11 +720,40 @@ RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts
   return L;
 }
 
+BdptStrategyImages::BdptStrategyImages(const RenderSettings& settings, int width, int height, std::string directory,
+                                       bool unweighted)
+    : depth_(std::min(settings.max_depth, 5)),
+      directory_(std::move(directory)),
+      unweighted_(unweighted),
+      images_(size_t(BdptIntegrator::strategy_count(depth_)), SplatImage(width, height)) {}
+
+void BdptStrategyImages::sum_across(Cluster& cluster) {
+  for (SplatImage& image : images_) cluster.sum_int64(image.sums());
+}
+
+void BdptStrategyImages::write(const Film& film, const std::map<std::string, std::string>& metadata) const {
+  for (int depth = 0; depth <= depth_; ++depth)
+    for (int s = 0; s <= depth + 1; ++s) {
+      const int t = depth + 2 - s;
+      const std::filesystem::path file =
+          std::filesystem::path(directory_) / fmt::format("bdpt_d{}_s{}_t{}.exr", depth, s, t);
+      write_image(file, images_[size_t(BdptIntegrator::strategy_index(s, t))].image(film.splat_scale()), metadata);
+    }
+}
+
+std::unique_ptr<IntegratorOutputs> make_bdpt_strategy_images(const RenderSettings& settings, int width, int height,
+                                                             const std::string& directory, bool unweighted) {
+  if (directory.empty()) return nullptr;
+  return std::make_unique<BdptStrategyImages>(settings, width, height, directory, unweighted);
+}
+
 RenderStats render_bdpt(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options) {
   if (!film.has_splats()) film.enable_splats();
   const BdptIntegrator bdpt(scene, settings);
   const Filter filter(settings.filter);
-  const BdptTarget target{&film, &filter, options.bdpt_strategies, options.bdpt_unweighted};
+  auto* strategies = dynamic_cast<BdptStrategyImages*>(options.integrator_outputs);
+  const BdptTarget target{&film, &filter, strategies ? &strategies->images() : nullptr,
+                          strategies && strategies->unweighted()};
   CameraSampleTiles tiles([&](const Ray& ray, auto& sampler, RayCounts& counts, const PixelSample& pixel,
                               const Wavelengths* wl) {
     return bdpt.radiance(ray, sampler, counts, target, pixel.x, pixel.y, pixel.filter_weight, pixel.first_half, wl);

@@ -28,6 +28,9 @@
 //
 // The subpath and connection routines are templates over the sampler, shared with Metropolis light
 // transport (mlt.h), which drives them with its primary-sample-space sampler.
+#include <map>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "candela/film/film.h"
@@ -36,6 +39,7 @@
 #include "candela/integrators/path_integrator.h"
 #include "candela/materials/bsdf.h"
 #include "candela/math/frame.h"
+#include "candela/render/render_loop.h"
 #include "candela/sampling/rng.h"
 #include "candela/scene/scene.h"
 #include "candela/spectral/wavelengths.h"
@@ -172,9 +176,32 @@ class BdptIntegrator {
   bool chromatic_media_ = false;  // some medium's extinction differs between the colour channels
 };
 
+// --bdpt-strategies DIR: every strategy's (s, t) contribution of the depths up to 5 (or max_depth) in
+// an image of its own (index BdptIntegrator::strategy_index), MIS weighted or, `unweighted`, not,
+// scaled like the light image; written as DIR/bdpt_d<depth>_s<s>_t<t>.exr. What the registry's
+// entry for bdpt makes (integrators/integrator.h) and render_bdpt finds in RenderOptions::integrator_outputs.
+class BdptStrategyImages final : public IntegratorOutputs {
+ public:
+  BdptStrategyImages(const RenderSettings& settings, int width, int height, std::string directory, bool unweighted);
+  void sum_across(Cluster& cluster) override;
+  void write(const Film& film, const std::map<std::string, std::string>& metadata) const override;
+  std::vector<SplatImage>& images() { return images_; }
+  bool unweighted() const { return unweighted_; }
+
+ private:
+  int depth_;  // the deepest strategies with an image
+  std::string directory_;
+  bool unweighted_;
+  std::vector<SplatImage> images_;
+};
+
+// The registry's maker of the strategy images (null: none asked for).
+std::unique_ptr<IntegratorOutputs> make_bdpt_strategy_images(const RenderSettings& settings, int width, int height,
+                                                             const std::string& directory, bool unweighted);
+
 // Integrator "bdpt": renders `film` through the shared tile loop, one light subpath per camera
 // sample; light tracing lands in the film's splats, scaled by the importance film's area over the
-// number of light paths.
+// number of light paths. With a BdptStrategyImages in options.integrator_outputs, fills it too.
 RenderStats render_bdpt(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options);
 
 }  // namespace candela

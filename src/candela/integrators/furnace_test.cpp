@@ -148,7 +148,9 @@ TEST_P(EveryIntegrator, RendersTheFurnacesAnalyticAnswers) {
 
 std::vector<std::string> integrator_names_for_tests() {
   std::vector<std::string> names;
-  for (const IntegratorEntry& entry : integrators()) names.emplace_back(entry.name);
+  // Every one that renders (auto chooses one of them).
+  for (const IntegratorEntry& entry : integrators())
+    if (entry.render) names.emplace_back(entry.name);
   return names;
 }
 

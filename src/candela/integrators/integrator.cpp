@@ -3,9 +3,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <stdexcept>
 
 #include "candela/base/error.h"
+#include "candela/integrators/auto_integrator.h"
 #include "candela/integrators/bdpt.h"
 #include "candela/integrators/mlt.h"
 #include "candela/integrators/path_integrator.h"
@@ -13,31 +13,59 @@
 #include "candela/render/first_hit_aovs.h"
 
 namespace candela {
+namespace {
 
-const std::vector<IntegratorEntry>& integrators() {
-  static const std::vector<IntegratorEntry> table = {
-      {"path", "path tracing (Häkkinen 2002): next-event estimation, MIS, Russian roulette",
-       {"direction_sampling", "mis", "shadow_rays", "light_selection=paper", "rr_start_depth", "adaptive"},
-       /*resumable=*/true, /*single_pixel=*/true, /*strategy_images=*/false, /*samples_are_mutations=*/false,
-       render_path},
-      {"bdpt", "bidirectional path tracing: every connection strategy, MIS, light tracing splatted",
-       {"rr_start_depth", "adaptive"},
-       /*resumable=*/true, /*single_pixel=*/true, /*strategy_images=*/true, /*samples_are_mutations=*/false,
-       render_bdpt, /*participating_media=*/true},
-      {"mlt", "Metropolis light transport over bidirectional paths (--spp is then mutations per pixel)",
-       {"mlt"},
-       /*resumable=*/false, /*single_pixel=*/false, /*strategy_images=*/false, /*samples_are_mutations=*/true,
-       render_mlt, /*participating_media=*/true},
-      {"volpath", "volumetric path tracing: participating media by delta and ratio tracking, spectral MIS, NEE",
-       {"rr_start_depth", "adaptive"},
-       /*resumable=*/true, /*single_pixel=*/true, /*strategy_images=*/false, /*samples_are_mutations=*/false,
-       render_volpath, /*participating_media=*/true},
+// What runs each integrator of the traits table, by name.
+struct Binding {
+  std::string_view name;
+  RenderFunction render = nullptr;
+  decltype(IntegratorEntry::candidates) candidates = nullptr;
+  decltype(IntegratorEntry::choose) choose = nullptr;
+  decltype(IntegratorEntry::make_strategy_images) make_strategy_images = nullptr;
+};
+
+std::vector<IntegratorEntry> bind_traits() {
+  const Binding bindings[] = {
+      {.name = "path", .render = render_path},
+      {.name = "bdpt", .render = render_bdpt, .make_strategy_images = make_bdpt_strategy_images},
+      {.name = "mlt", .render = render_mlt},
+      {.name = "volpath", .render = render_volpath},
+      {.name = "auto", .candidates = auto_candidates, .choose = choose_integrator},
   };
-  return table;
+  std::vector<IntegratorEntry> entries;
+  for (const IntegratorTraits& traits : integrator_traits()) {
+    const Binding* binding = std::find_if(std::begin(bindings), std::end(bindings),
+                                          [&](const Binding& b) { return b.name == traits.name; });
+    if (binding == std::end(bindings))
+      throw InternalError(fmt::format("the integrator '{}' has traits but nothing in the registry runs it", traits.name));
+    IntegratorEntry entry;
+    static_cast<IntegratorTraits&>(entry) = traits;
+    entry.render = binding->render;
+    entry.candidates = binding->candidates;
+    entry.choose = binding->choose;
+    entry.make_strategy_images = binding->make_strategy_images;
+    entries.push_back(std::move(entry));
+  }
+  return entries;
 }
 
-bool IntegratorEntry::reads_setting(std::string_view key) const {
-  return std::find(reads.begin(), reads.end(), key) != reads.end();
+// "bdpt does", "path, bdpt, volpath do": the integrators that can, for messages.
+std::string those_that_do(bool IntegratorTraits::*capability) {
+  const std::string names = integrators_with(capability);
+  return names + (names.find(',') == std::string::npos ? " does" : " do");
+}
+
+bool film_started(const Film& film) {
+  return film.total_samples() > 0 ||
+         (film.has_splats() &&
+          std::any_of(film.splats().sums().begin(), film.splats().sums().end(), [](int64_t v) { return v != 0; }));
+}
+
+}  // namespace
+
+const std::vector<IntegratorEntry>& integrators() {
+  static const std::vector<IntegratorEntry> table = bind_traits();
+  return table;
 }
 
 const IntegratorEntry* find_integrator(std::string_view name) {
@@ -46,52 +74,64 @@ const IntegratorEntry* find_integrator(std::string_view name) {
   return nullptr;
 }
 
-std::string integrator_names() {
-  std::string names;
-  for (const IntegratorEntry& entry : integrators()) names += (names.empty() ? "" : ", ") + std::string(entry.name);
-  return names;
+void check_capabilities(const IntegratorTraits& integrator, const CapabilityNeeds& needs) {
+  const std::string_view name = integrator.name;
+  if (integrator.chooses) {
+    // What it chooses is not known before its pilots, and they render neither a part nor a pixel.
+    if (needs.continues_film || needs.one_pixel || needs.part)
+      throw UsageError(fmt::format(
+          "--integrator {} cannot be combined with --checkpoint, --resume, --pixel or --part (name the integrator)",
+          name));
+    if (needs.strategy_images)
+      throw UsageError(fmt::format("--bdpt-strategies needs --integrator {}, not {}",
+                                   integrators_with(&IntegratorTraits::strategy_images), name));
+    return;
+  }
+  if (needs.strategy_images && !integrator.strategy_images)
+    throw UsageError(fmt::format("--bdpt-strategies: the {} integrator writes no strategy images ({})", name,
+                                 those_that_do(&IntegratorTraits::strategy_images)));
+  if (needs.continues_film && !integrator.resumable)
+    throw UsageError(fmt::format(
+        "--checkpoint and --resume are not supported with the {} integrator (it cannot continue a partly rendered film)",
+        name));
+  if (needs.one_pixel && !integrator.single_pixel)
+    throw UsageError(
+        fmt::format("--pixel cannot be used with the {} integrator (it cannot render one pixel alone)", name));
+  if (needs.part && !integrator.resumable)
+    throw UsageError(fmt::format("--part: the {} integrator does not render tile by tile ({})", name,
+                                 those_that_do(&IntegratorTraits::resumable)));
+  if (needs.adaptive && !integrator.reads_setting("adaptive"))
+    throw UsageError(fmt::format("adaptive sampling does not apply to the {} integrator", name));
+  if (needs.media && !integrator.participating_media)
+    throw UsageError(fmt::format(
+        "the scene has participating media, which the {} integrator does not render: use --integrator volpath", name));
 }
 
-std::string unread_setting_message(const IntegratorEntry& integrator, std::string_view key) {
-  std::string readers;
-  for (const IntegratorEntry& entry : integrators())
-    if (entry.reads_setting(key)) readers += (readers.empty() ? "" : ", ") + std::string(entry.name);
-  std::string_view what;
-  for (const SelectiveSetting& s : kSelectiveSettings)
-    if (s.key == key) what = s.what;
-  return fmt::format("the {} integrator does not read {} ({}; read by: {})", integrator.name, key, what, readers);
-}
-
-std::vector<std::string_view> set_but_unread(const IntegratorEntry& integrator, const RenderSettings& settings) {
-  std::vector<std::string_view> unread;
-  for (const SelectiveSetting& s : kSelectiveSettings)
-    if (!integrator.reads_setting(s.key) && s.is_set(settings)) unread.push_back(s.key);
-  return unread;
+RenderStats render_with(const IntegratorEntry& integrator, const Scene& scene, const RenderSettings& settings,
+                        Film& film, const RenderOptions& options) {
+  if (!integrator.render) throw InternalError(fmt::format("the {} integrator renders nothing itself", integrator.name));
+  RenderStats stats = integrator.render(scene, settings, film, options);
+  // Every integrator here traces its camera samples (MLT: its depth-0 pass) through CameraSampleTiles,
+  // which adds the AOVs; one that does not leaves them empty, and they get a pass of their own.
+  if (options.aovs && options.aovs->has_sample_layers() && options.aovs->empty() && !stats.cancelled)
+    render_aovs(scene, settings, *options.aovs, options);
+  return stats;
 }
 
 RenderStats render(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options) {
   const IntegratorEntry* integrator = find_integrator(settings.integrator);
   if (!integrator)
     throw UsageError(fmt::format("unknown integrator '{}' (known: {})", settings.integrator, integrator_names()));
-  if (settings.adaptive() && !integrator->reads_setting("adaptive"))
-    throw UsageError(fmt::format("adaptive sampling does not apply to the {} integrator", integrator->name));
-  if (scene.has_media() && !integrator->participating_media)
-    throw UsageError(fmt::format(
-        "the scene has participating media, which the {} integrator does not render: use --integrator volpath",
-        integrator->name));
-  if (options.only_x >= 0 && !integrator->single_pixel)
-    throw UsageError(fmt::format("the {} integrator cannot render a single pixel", integrator->name));
-  const bool started = film.total_samples() > 0 ||
-                       (film.has_splats() && std::any_of(film.splats().sums().begin(), film.splats().sums().end(),
-                                                         [](int64_t v) { return v != 0; }));
-  if (started && !integrator->resumable)
-    throw UsageError(fmt::format("the {} integrator cannot continue a partly rendered film", integrator->name));
-  RenderStats stats = integrator->render(scene, settings, film, options);
-  // Every integrator here traces its camera samples (MLT: its depth-0 pass) through CameraSampleTiles,
-  // which adds the AOVs; one that does not leaves them empty, and they get a pass of their own.
-  if (options.aovs && options.aovs->has_sample_layers() && options.aovs->empty() && !stats.cancelled)
-    render_aovs(scene, settings, *options.aovs, options);
-  return stats;
+  if (integrator->chooses)
+    throw UsageError(fmt::format("the {} integrator chooses another and renders nothing itself: render it through "
+                                 "render_requested (integrators/render_request.h)",
+                                 integrator->name));
+  check_capabilities(*integrator, {.continues_film = film_started(film),
+                                   .one_pixel = options.only_x >= 0,
+                                   .part = options.part_count > 1,
+                                   .adaptive = settings.adaptive(),
+                                   .media = scene.has_media()});
+  return render_with(*integrator, scene, settings, film, options);
 }
 
 }  // namespace candela

@@ -234,7 +234,7 @@ RenderStats render_depth_zero(const Scene& scene, const RenderSettings& settings
   emission_options.after_pass = nullptr;
   emission_options.time_limit_seconds = options.time_limit_seconds * kMltDirectTimeShare;
   emission_options.target_error = 0;
-  emission_options.bdpt_strategies = nullptr;
+  emission_options.integrator_outputs = nullptr;
   // (Through media, the volumetric path tracer, which attenuates what the camera sees.)
   RenderStats stats = scene.has_media() ? render_volpath(scene, emission, film, emission_options)
                                         : render_path(scene, emission, film, emission_options);
@@ -271,7 +271,7 @@ struct Chain {
 class MltRender {
  public:
   MltRender(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options,
-            Cluster& cluster, Clock::time_point start_time, const RenderStats& direct_stats)
+            Cluster& cluster, Clock::time_point start_time, const RenderStats& direct_stats, const MltStats& details)
       : scene_(scene),
         settings_(settings),
         film_(film),
@@ -279,6 +279,7 @@ class MltRender {
         cluster_(cluster),
         start_time_(start_time),
         stats_(direct_stats),
+        details_(details),
         bdpt_settings_(without_roulette(settings)),
         bdpt_(scene, bdpt_settings_),
         paths_(scene, bdpt_, settings.spectral),
@@ -289,6 +290,8 @@ class MltRender {
         total_mutations_(uint64_t(settings.spp) * uint64_t(film.width()) * uint64_t(film.height())),
         bootstrap_count_(uint64_t(settings.mlt.bootstrap) * uint64_t(depths_)),
         progress_(bootstrap_count_ + total_mutations_, options.progress, options.progress_fraction) {}
+
+  const MltStats& details() const { return details_; }
 
   RenderStats run() {
     std::vector<float> weights;
@@ -356,7 +359,7 @@ class MltRender {
         },
         [&](uint64_t, uint64_t count) { progress_.advance(count * kBootstrapBlock); });
     if (cluster_.any(cancelled_())) return false;
-    stats_.mlt_bootstrap_seconds = seconds_since(start_time_) - stats_.mlt_direct_seconds;
+    details_.bootstrap_seconds = seconds_since(start_time_) - details_.direct_seconds;
     if (cluster_.distributed()) {
       weights.resize(bootstrap_blocks * kBootstrapBlock);  // whole blocks to exchange
       exchange_values(cluster_, bootstrap_mine, weights, kBootstrapBlock);
@@ -407,10 +410,10 @@ class MltRender {
       normalization.relative_error =
           normalization.value > 0 ? std::sqrt(sum_sq_error) / double(batches) / normalization.value : 0;
     }
-    stats_.mlt_normalization = normalization.value;
-    stats_.mlt_normalization_relative_error = normalization.relative_error;
-    stats_.mlt_normalization_samples = normalization_samples * batches;
-    stats_.mlt_normalization_seconds = seconds_since(normalization_start);
+    details_.normalization = normalization.value;
+    stats_.splat_scale_relative_error = normalization.relative_error;
+    details_.normalization_samples = normalization_samples * batches;
+    details_.normalization_seconds = seconds_since(normalization_start);
     return normalization;
   }
 
@@ -633,6 +636,7 @@ class MltRender {
   Cluster& cluster_;
   const Clock::time_point start_time_;
   RenderStats stats_;
+  MltStats details_;
   const RenderSettings bdpt_settings_;
   const BdptIntegrator bdpt_;
   const MltPathSampler paths_;
@@ -661,16 +665,20 @@ RenderStats render_mlt(const Scene& scene, const RenderSettings& settings, Film&
   Cluster& cluster = options.cluster ? *options.cluster : local_cluster();
   // Step 0: render depth 0 with the path tracer.
   RenderStats stats = render_depth_zero(scene, settings, film, options);
-  stats.mlt_direct_seconds = seconds_since(start_time);
+  MltStats details;
+  details.direct_seconds = seconds_since(start_time);
   film.enable_splats();
   film.set_splat_scale(0);
   if (scene.lights().empty() || settings.max_depth == 0 || stats.cancelled) {
     stats.seconds = seconds_since(start_time);
+    stats.details = details;
     return stats;
   }
   // Steps 1-3: bootstrap and normalization, chains, the splats' scale.
-  MltRender mlt(scene, settings, film, options, cluster, start_time, stats);
-  return mlt.run();
+  MltRender mlt(scene, settings, film, options, cluster, start_time, stats, details);
+  RenderStats result = mlt.run();
+  result.details = mlt.details();
+  return result;
 }
 
 }  // namespace candela

@@ -27,6 +27,8 @@
 // Chains are independent and their deposits are summed in fixed point, so the image is the same
 // for any number of threads.
 #include <algorithm>
+#include <any>
+#include <cstdint>
 
 #include "candela/film/film.h"
 #include "candela/render/render_loop.h"
@@ -37,6 +39,20 @@ namespace candela {
 // Depth 0's samples per pixel for `spp` mutations per pixel, and its most share of a time limit.
 inline int mlt_direct_spp(int spp) { return std::clamp(spp / 16, 16, 256); }
 inline constexpr double kMltDirectTimeShare = 1.0 / 20;
+
+// What an MLT render reports besides RenderStats (its RenderStats::details; the normalisation's
+// relative error is RenderStats::splat_scale_relative_error): the estimate of the image's mean
+// luminance that scales the chains' deposits, the samples it took and their seconds, and the
+// seconds of the depth-0 pass and of the bootstrap.
+struct MltStats {
+  double normalization = 0;
+  uint64_t normalization_samples = 0;
+  double normalization_seconds = 0;
+  double direct_seconds = 0, bootstrap_seconds = 0;
+};
+
+// The MltStats of a render by render_mlt, or null for another integrator's.
+inline const MltStats* mlt_stats(const RenderStats& stats) { return std::any_cast<MltStats>(&stats.details); }
 
 // Integrator "mlt": renders settings.spp mutations per pixel into film's splats (and sets its
 // splat scale), on top of depth 0 rendered by the path tracer into its pixel sums.

@@ -22,10 +22,9 @@ ChoiceValue choices_of(std::vector<std::string> aliases = {}) {
 
 std::string integrator_help() {
   std::string help = "Integrator:";
-  for (const IntegratorEntry& entry : integrators())
-    help += fmt::format(" {} ({}){}", entry.name, entry.description, &entry == &integrators().back() ? "" : ";");
-  return help + "; auto (short pilots of each measure which reaches the lowest error in the budget: "
-                "--time-limit, --target-error, or the path tracer's time for --spp; the pilots aim at 10%)";
+  for (const IntegratorTraits& traits : integrator_traits())
+    help += fmt::format(" {} ({}){}", traits.name, traits.description, &traits == &integrator_traits().back() ? "" : ";");
+  return help;
 }
 
 // One entry per option, in --help's order. `apply` and `fingerprint` are captureless lambdas.
@@ -58,7 +57,8 @@ std::vector<RenderOption> make_table() {
        .fingerprint = [](S d, Q) -> std::optional<std::string> {
          return fmt::format("{}x{}", d.film.width, d.film.height);
        }},
-      // Checked against the registry once the scene is read (its own integrator may be unknown too).
+      // Checked against the registry once the scene is read (its own integrator may be unknown too;
+      // plan_render).
       {.name = "integrator", .field = &R::integrator, .rule = AnyValue{}, .help = integrator_help(),
        .scene_key = "integrator", .apply = [](Q r, SceneDesc& d) { d.settings.integrator = r.integrator; },
        .fingerprint_key = "integrator",
@@ -82,8 +82,7 @@ std::vector<RenderOption> make_table() {
        // The MLT parameters go into the fingerprint as one entry, where an MLT render may happen.
        .fingerprint_key = "mlt",
        .fingerprint = [](S d, Q) -> std::optional<std::string> {
-         const std::string& name = d.settings.integrator;
-         if (name != "auto" && !find_integrator(name)->reads_setting("mlt")) return std::nullopt;
+         if (!may_read_setting(*find_integrator_traits(d.settings.integrator), "mlt")) return std::nullopt;
          return d.settings.mlt.describe();
        }},
       {.name = "mlt_chains", .field = &R::mlt_chains, .rule = ValueRange{1, 100000000},

@@ -6,7 +6,7 @@
 //   - the command line's flags (apps/candela/main.cpp): --NAME with '-' for '_', the help text;
 //   - the Python module's render() keywords (python/module.cpp) and their kinds;
 //   - check_request_values' range, choice and format checks, with the flag in every message;
-//   - apply_request's assignments to the scene (integrators/render_request.cpp);
+//   - plan_render's assignments to the scene (integrators/render_request.cpp);
 //   - the refusal of an option the chosen integrator does not read;
 //   - the fingerprint that a checkpoint or a part must match to be resumed or merged.
 // Adding an option: a RenderRequest field (render_request.h) and an entry here; nothing else

@@ -158,7 +158,7 @@ TEST(RenderOptionTable, EveryAppliedOptionChangesTheSceneOrItsFingerprint) {
     if (!option.apply && !option.fingerprint) continue;
     const RenderRequest base = enabling(option);
     SceneDesc before = scene;
-    ASSERT_NO_THROW(apply_request(base, before)) << option.flag();
+    ASSERT_NO_THROW(plan_render(base, before)) << option.flag();
     std::vector<std::string> shown;
     bool scene_changed = false, fingerprint_changed = false;
     const std::vector<RenderRequest> requests = with_valid_values(option, shown);
@@ -167,7 +167,7 @@ TEST(RenderOptionTable, EveryAppliedOptionChangesTheSceneOrItsFingerprint) {
       const RenderRequest request = combined(option, base, requests[i]);
       SceneDesc after = scene;
       try {
-        apply_request(request, after);
+        plan_render(request, after);
       } catch (const UsageError&) {
         continue;  // a rule across options (the MLT probabilities' sum), not this option's own
       }
@@ -187,7 +187,8 @@ TEST(RenderOptionTable, SelectiveOptionsAreRefusedByIntegratorsThatDoNotReadThem
   for (const RenderOption& option : render_options()) {
     if (option.reads.empty()) continue;
     for (const IntegratorEntry& entry : integrators()) {
-      if (entry.reads_setting(option.reads)) continue;
+      // (One that chooses reads what its candidates read: auto_candidates.)
+      if (entry.chooses || entry.reads_setting(option.reads)) continue;
       std::vector<std::string> shown;
       bool named = false;
       for (RenderRequest request : with_valid_values(option, shown)) {
@@ -196,7 +197,7 @@ TEST(RenderOptionTable, SelectiveOptionsAreRefusedByIntegratorsThatDoNotReadThem
         request.integrator = std::string(entry.name);
         SceneDesc scene = builtin_scene();
         try {
-          apply_request(request, scene);
+          plan_render(request, scene);
           ADD_FAILURE() << option.flag() << " was accepted by " << entry.name << ", which does not read it";
         } catch (const UsageError& e) {
           // Another rule (a batch larger than the budget) may speak first for some values.

@@ -7,6 +7,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <regex>
 #include <tuple>
@@ -78,46 +79,27 @@ void check_request_values(const RenderRequest& r) {
 
 namespace {
 
-// The chosen integrator must read every selective setting the request gives
-// (integrators/integrator.h); what the scene file sets for another integrator gets a note.
-void check_integrator_flags(const RenderRequest& request, const SceneDesc& scene) {
-  if (scene.settings.integrator == "auto") {
-    // Every candidate must read what the scene and the flags set.
-    if (auto_candidates(scene.settings, !scene.media.empty()).empty())
-      throw UsageError("--integrator auto: no integrator reads every setting given (see --help for who reads what)");
-    if (!request.bdpt_strategies.empty()) throw UsageError("--bdpt-strategies needs --integrator bdpt, not auto");
-    return;
-  }
-  const IntegratorEntry* integrator = find_integrator(scene.settings.integrator);
-  if (!integrator)
-    throw UsageError(fmt::format("unknown integrator '{}' (known: {}, auto)", scene.settings.integrator, integrator_names()));
-  for (const RenderOption& option : render_options()) {
-    if (!option.selective_in(request) || integrator->reads_setting(option.reads)) continue;
-    throw UsageError(fmt::format("{}: {}", option.flag_for_messages(), unread_setting_message(*integrator, option.reads)));
-  }
-  if (!request.bdpt_strategies.empty() && !integrator->strategy_images)
-    throw UsageError(fmt::format("--bdpt-strategies: the {} integrator writes no strategy images (bdpt does)",
-                                 integrator->name));
-  if (!request.integrator.empty() && !request.quiet)
-    for (std::string_view key : set_but_unread(*integrator, scene.settings))
-      fmt::print(stderr, "note: the scene sets {}, which --integrator {} does not read\n", key, integrator->name);
-}
-
-}  // namespace
-
-void apply_request(const RenderRequest& request, SceneDesc& scene) {
-  check_request_values(request);
-  // Each option given sets its own field (render_option_table.cpp); then what depends on several.
+// The request given to the scene's settings, each option setting its own field (render_option_table.cpp),
+// then what depends on several.
+void apply_options(const RenderRequest& request, SceneDesc& scene) {
   for (const RenderOption& option : render_options())
     if (option.apply && option.given(request)) option.apply(request, scene);
   RenderSettings& rs = scene.settings;
+  // An integrator that chooses runs pilots of the others, which measure their error, and the winner
+  // continues its pilot: they share one sampler setup, so the scene's or the given spp is then the
+  // budget, not the count.
+  const IntegratorTraits* traits = find_integrator_traits(rs.integrator);
+  const bool chooses = traits && traits->chooses;
   // An error estimate needs two independent halves of every pixel's samples; with a target the
   // spp is the most a pixel may get (--spp, or 65536).
-  if (request.estimate_error || request.target_error || rs.integrator == "auto") rs.sampler.replicas = true;
-  // --integrator auto: the pilots and the winner share one sampler setup (spp sets its sets), so the
-  // winner can continue its pilot; the scene's or the given spp is then the budget, not the count.
-  if (rs.integrator == "auto" && !request.target_error) rs.spp = kTargetErrorMaxSpp;
+  if (request.estimate_error || request.target_error || chooses) rs.sampler.replicas = true;
+  if (chooses && !request.target_error) rs.spp = kTargetErrorMaxSpp;
   if (request.target_error) rs.spp = request.spp.value_or(kTargetErrorMaxSpp);
+}
+
+// The settings as applied agree with each other.
+void check_settings(const RenderRequest& request, const SceneDesc& scene) {
+  const RenderSettings& rs = scene.settings;
   if (std::string problem = rs.mlt.problem(); !problem.empty())
     throw UsageError("--mlt-large-step, --mlt-lens, --mlt-caustic: " + problem);
   if (rs.adaptive() && (rs.adaptive_batch & (rs.adaptive_batch - 1)) != 0)
@@ -133,9 +115,134 @@ void apply_request(const RenderRequest& request, SceneDesc& scene) {
   if (request.target_error && rs.adaptive())
     throw UsageError("--target-error: adaptive sampling (--adaptive-threshold, --adaptive-spp) has its own stopping "
                      "rule; use one or the other");
-  check_integrator_flags(request, scene);
+}
+
+// The scene's integrator (as the request may have changed it), which must read every selective
+// setting the request gives (description/integrator_traits.h); what the scene file sets for another
+// integrator gets a note. One that chooses needs a candidate that reads every setting given.
+const IntegratorEntry& resolve_integrator(const RenderRequest& request, const SceneDesc& scene) {
+  const IntegratorEntry* integrator = find_integrator(scene.settings.integrator);
+  if (!integrator)
+    throw UsageError(fmt::format("unknown integrator '{}' (known: {})", scene.settings.integrator,
+                                 integrator_names(/*and_choosers=*/true)));
+  if (integrator->chooses) {
+    if (integrator->candidates(scene.settings, !scene.media.empty()).empty())
+      throw UsageError(fmt::format("--integrator {}: no integrator reads every setting given (see --help for who "
+                                   "reads what)",
+                                   integrator->name));
+    return *integrator;
+  }
+  for (const RenderOption& option : render_options()) {
+    if (!option.selective_in(request) || integrator->reads_setting(option.reads)) continue;
+    throw UsageError(fmt::format("{}: {}", option.flag_for_messages(), unread_setting_message(*integrator, option.reads)));
+  }
+  if (!request.integrator.empty() && !request.quiet)
+    for (std::string_view key : set_but_unread(*integrator, scene.settings))
+      fmt::print(stderr, "note: the scene sets {}, which --integrator {} does not read\n", key, integrator->name);
+  return *integrator;
+}
+
+// --pixel X,Y inside the image.
+std::pair<int, int> parse_pixel(const std::string& text, const FilmDesc& film) {
+  std::smatch m;
+  static const std::regex pattern(R"((\d{1,9}),(\d{1,9}))");
+  if (!std::regex_match(text, m, pattern))
+    throw UsageError(fmt::format("--pixel: expected X,Y such as 10,20, got '{}'", text));
+  const int x = std::stoi(m[1]), y = std::stoi(m[2]);
+  if (x >= film.width || y >= film.height)
+    throw UsageError(fmt::format("--pixel {},{} is outside the {}x{} image", x, y, film.width, film.height));
+  return {x, y};
+}
+
+// --part K/N: {K - 1, N}.
+std::pair<int, int> parse_part(const std::string& text) {
+  std::smatch m;
+  static const std::regex pattern(R"((\d{1,6})/(\d{1,6}))");
+  if (!std::regex_match(text, m, pattern) || std::stoi(m[1]) < 1 || std::stoi(m[1]) > std::stoi(m[2]))
+    throw UsageError(fmt::format("--part: expected K/N with 1 <= K <= N, such as 2/8, got '{}'", text));
+  return {std::stoi(m[1]) - 1, std::stoi(m[2])};
+}
+
+// Which pixels: --pixel and --part, and what they cannot be combined with.
+void plan_pixels(const RenderRequest& request, const SceneDesc& scene, RenderPlan& plan) {
+  const bool adaptive = scene.settings.adaptive();
+  const bool checkpoints = !request.checkpoint.empty() || !request.resume.empty();
+  if (adaptive && checkpoints)
+    throw UsageError("--checkpoint and --resume are not supported with adaptive sampling (--adaptive-threshold, "
+                     "--adaptive-spp)");
+  if (!request.pixel.empty() && checkpoints) throw UsageError("--pixel cannot be combined with --checkpoint or --resume");
+  if (!request.pixel.empty()) std::tie(plan.pixel_x, plan.pixel_y) = parse_pixel(request.pixel, scene.film);
+  if (!request.part.empty()) {
+    std::tie(plan.part_index, plan.part_count) = parse_part(request.part);
+    if (adaptive)
+      throw UsageError("--part cannot be combined with adaptive sampling (its decisions look across the whole image)");
+    if (request.target_error)
+      throw UsageError("--part cannot be combined with --target-error (the error is the whole image's)");
+    if (plan.one_pixel()) throw UsageError("--part cannot be combined with --pixel");
+  }
+}
+
+// The outputs besides the image, and whether they can be made.
+void plan_outputs(const RenderRequest& request, RenderPlan& plan) {
   if (request.bdpt_unweighted && request.bdpt_strategies.empty())
     throw UsageError("--bdpt-unweighted needs --bdpt-strategies DIR");
+  if (std::error_code ec; !request.bdpt_strategies.empty() && !std::filesystem::is_directory(request.bdpt_strategies, ec))
+    throw UsageError(fmt::format("--bdpt-strategies '{}': not a directory", request.bdpt_strategies));
+  plan.strategy_images = request.bdpt_strategies;
+  plan.strategy_images_unweighted = request.bdpt_unweighted;
+  plan.report_error = request.estimate_error;
+  plan.checkpoint = request.checkpoint;
+  plan.resume = request.resume;
+}
+
+}  // namespace
+
+RenderPlan plan_render(const RenderRequest& request, SceneDesc& scene) {
+  check_request_values(request);
+  RenderPlan plan;
+  // Auto's budget without a time limit or target: the spp asked for, before auto's cap replaces it.
+  plan.budget_spp = request.spp.value_or(scene.settings.spp);
+  apply_options(request, scene);
+  check_settings(request, scene);
+  plan.integrator = &resolve_integrator(request, scene);
+  plan_pixels(request, scene, plan);
+  // Everything asked of the integrator, checked in one place.
+  check_capabilities(*plan.integrator, {.continues_film = !request.checkpoint.empty() || !request.resume.empty(),
+                                        .one_pixel = plan.one_pixel(),
+                                        .part = !request.part.empty(),
+                                        .strategy_images = !request.bdpt_strategies.empty(),
+                                        .adaptive = scene.settings.adaptive(),
+                                        .media = !scene.media.empty()});
+  plan_outputs(request, plan);
+  plan.time_limit_seconds = request.time_limit.empty() ? 0 : parse_duration("--time-limit", request.time_limit);
+  plan.target_error = request.target_error.value_or(0.0);
+  plan.threads = request.threads.value_or(0);
+  plan.clamp = request.clamp.value_or(0.0f);
+  plan.quiet = request.quiet;
+  return plan;
+}
+
+RenderOptions RenderPlan::options() const {
+  RenderOptions options;
+  options.threads = threads;
+  options.progress = !quiet;
+  options.time_limit_seconds = time_limit_seconds;
+  options.target_error = target_error;
+  options.clamp = clamp;
+  options.part_index = part_index;
+  options.part_count = part_count;
+  if (one_pixel()) {
+    options.only_x = pixel_x;
+    options.only_y = pixel_y;
+    options.max_reported_non_finite = 1000;
+  }
+  return options;
+}
+
+std::unique_ptr<IntegratorOutputs> RenderPlan::make_integrator_outputs(const RenderSettings& settings, int width,
+                                                                       int height) const {
+  if (strategy_images.empty() || !integrator->make_strategy_images) return nullptr;
+  return integrator->make_strategy_images(settings, width, height, strategy_images, strategy_images_unweighted);
 }
 
 double parse_duration(const std::string& option, const std::string& text) {
@@ -156,32 +263,24 @@ double parse_duration(const std::string& option, const std::string& text) {
   return seconds;
 }
 
-RenderOptions request_options(const RenderRequest& request) {
-  RenderOptions options;
-  options.threads = request.threads.value_or(0);
-  options.progress = !request.quiet;
-  options.time_limit_seconds = request.time_limit.empty() ? 0 : parse_duration("--time-limit", request.time_limit);
-  options.target_error = request.target_error.value_or(0.0);
-  options.clamp = request.clamp.value_or(0.0f);
-  return options;
-}
-
-RenderOutcome render_requested(const Scene& scene, RenderSettings& settings, Film& film, RenderOptions options,
-                               int budget_spp, const std::function<void(const std::string&)>& announce) {
+RenderOutcome render_requested(const Scene& scene, RenderSettings& settings, Film& film, const RenderPlan& plan,
+                               RenderOptions options, const std::function<void(const std::string&)>& announce) {
   RenderOutcome outcome;
-  // --integrator auto: pilots of each integrator measure which reaches the lowest error in the budget.
-  if (settings.integrator == "auto") {
-    outcome.choice = choose_integrator(scene, settings, film, options, budget_spp);
-    settings.integrator = std::string(outcome.choice->integrator->name);
+  const IntegratorEntry* integrator = plan.integrator;
+  // One that chooses (auto): pilots of each candidate measure which reaches the lowest error in the budget.
+  if (integrator->chooses) {
+    outcome.choice = integrator->choose(scene, settings, film, options, plan.budget_spp);
+    integrator = outcome.choice->integrator;
+    settings.integrator = std::string(integrator->name);
     if (announce) announce(outcome.choice->summary());
     // The rest of the budget; a cancelled pilot leaves none.
     if (outcome.choice->budget_seconds > 0)
       options.time_limit_seconds = std::max(outcome.choice->budget_seconds - outcome.choice->pilot_seconds, 1e-3);
   }
-  outcome.stats = render(scene, settings, film, options);
+  outcome.stats = render_with(*integrator, scene, settings, film, options);
   if (outcome.choice) outcome.stats.seconds += outcome.choice->pilot_seconds;
   // How good the image is, from its own two halves (film/error_estimate.h).
-  outcome.error = estimate_error(film, outcome.stats.mlt_normalization_relative_error);
+  outcome.error = estimate_error(film, outcome.stats.splat_scale_relative_error);
   return outcome;
 }
 

@@ -4,13 +4,16 @@
 // to the scene, rendered and described here, so both accept the same values, refuse the same
 // combinations with the same messages, and make the same bytes and the same image metadata.
 #include <cstdint>
+#include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 
 #include "candela/base/error.h"  // UsageError: what the checks below throw
 #include "candela/film/error_estimate.h"
 #include "candela/integrators/auto_integrator.h"
+#include "candela/integrators/integrator.h"
 #include "candela/render/render_loop.h"
 #include "candela/description/scene_desc.h"
 
@@ -21,12 +24,12 @@ inline constexpr long long kMaxPixels = 1LL << 28;  // pixels in all
 inline constexpr int kTargetErrorMaxSpp = 65536;    // the spp cap of --target-error without --spp
 
 // Every field is unset by default: the scene's own value holds. The names are the flags'; each field
-// is declared, checked and applied through its entry in integrators/render_option_table.h.
+// before `quiet` is declared, checked and applied through its entry in integrators/render_option_table.h.
 struct RenderRequest {
   std::optional<int> spp, threads, max_depth, rr_start_depth;
   std::optional<uint64_t> seed;
   std::string resolution;  // "WIDTHxHEIGHT"
-  std::string integrator;  // a registered name (integrators/integrator.h) or "auto"
+  std::string integrator;  // a registered name (integrators/integrator.h), "auto" included
   std::string sampler, filter, direction_sampling, light_selection, bvh, transport;
   std::optional<int> shadow_rays, max_spp, adaptive_batch, adaptive_spp;
   std::optional<float> adaptive_threshold;
@@ -39,18 +42,62 @@ struct RenderRequest {
   bool bdpt_unweighted = false;
   std::optional<int> mlt_bootstrap, mlt_chains;
   std::optional<float> mlt_sigma, mlt_large_step, mlt_lens, mlt_caustic;
-  bool quiet = false;  // no progress bar, no notes
+  bool quiet = false;  // no progress bar, no notes (the command line's -q; Python renders quietly)
+  // What only the command line asks (flags of its own, no Python keywords), checked by plan_render
+  // with the rest because each asks something of the integrator.
+  std::string pixel;               // --pixel X,Y: that pixel alone
+  std::string part;                // --part K/N: every N-th tile, from the K-th
+  std::string checkpoint, resume;  // --checkpoint FILE, --resume FILE: the film is saved to be continued, or continued
+};
+
+// A request resolved against its scene, once, by plan_render: everything the render does, checked.
+// The settings it resolves stay in the scene's RenderSettings (the sampler's two independent halves
+// where an error estimate needs them, auto's spp cap), which the render reads.
+struct RenderPlan {
+  // The settings' integrator: one that renders, or one that chooses (auto), which render_requested
+  // runs first.
+  const IntegratorEntry* integrator = nullptr;
+  // The pixels: every one, those of part K of N (every N-th tile, K = part_index + 1), or one.
+  int part_index = 0, part_count = 1;
+  int pixel_x = -1, pixel_y = -1;
+  // The budget: a time limit and an error target (0: none; with a target, settings.spp caps the
+  // samples), and, without either, the spp that auto's budget is the path tracer's time for (the
+  // spp asked for, before auto's cap replaced it).
+  double time_limit_seconds = 0, target_error = 0;
+  int budget_spp = 0;
+  int threads = 0;  // 0: all cores
+  float clamp = 0;  // 0: off
+  bool quiet = false;
+  // The outputs besides the image: the error estimate's report (it is made whenever the film has
+  // halves), the film's checkpoint (empty: none) and the integrator's strategy images (a directory;
+  // empty: none), MIS weighted or not.
+  bool report_error = false;
+  std::string checkpoint, resume;
+  std::string strategy_images;
+  bool strategy_images_unweighted = false;
+
+  bool one_pixel() const { return pixel_x >= 0; }
+  // The render options the plan sets: threads, progress, the budget, the clamp, the part or pixel
+  // (the caller adds cancellation, progress reporting, the cluster, AOVs and its own hooks).
+  RenderOptions options() const;
+  // What the integrator makes besides the film for a width x height film (the strategy images), to
+  // hand to the render as RenderOptions::integrator_outputs; null when none are asked for.
+  std::unique_ptr<IntegratorOutputs> make_integrator_outputs(const RenderSettings& settings, int width,
+                                                             int height) const;
 };
 
 // Checks each value on its own (ranges, the time limit's and the resolution's form), before a scene is read.
 // Throws UsageError.
 void check_request_values(const RenderRequest& request);
 
-// Checks every value (check_request_values), applies the request to `scene` (its settings and film size) and
-// checks the result: the integrator exists and reads every selective setting given, adaptive
-// sampling's batch and budget agree, the resolution and MLT probabilities are valid. Throws
-// UsageError. Prints a note (unless quiet) for a scene setting the chosen integrator ignores.
-void apply_request(const RenderRequest& request, SceneDesc& scene);
+// The one validator of a request, for the command line and the Python module alike: checks every
+// value (check_request_values), applies the request to `scene` (its settings and film size) and checks
+// the result: adaptive sampling's batch and budget agree, the resolution and MLT probabilities are
+// valid, the integrator exists (or chooses among candidates that read what is set) and reads every
+// selective setting given, the pixel and the part are well formed and combine, and the integrator
+// can do what is asked (check_capabilities, integrator.h). Throws UsageError. Prints a note (unless
+// quiet) for a scene setting the chosen integrator ignores.
+RenderPlan plan_render(const RenderRequest& request, SceneDesc& scene);
 
 // WIDTHxHEIGHT (--resolution), each side 1..kMaxResolution and at most kMaxPixels in all; throws
 // UsageError.
@@ -60,21 +107,19 @@ std::pair<int, int> parse_resolution(const std::string& text);
 // first); `option` names the flag in the UsageError.
 double parse_duration(const std::string& option, const std::string& text);
 
-// The render options the request sets: threads, time limit, target error, clamp (the caller adds
-// cancellation, progress, the cluster and its own hooks).
-RenderOptions request_options(const RenderRequest& request);
-
 struct RenderOutcome {
   RenderStats stats;              // its seconds include auto's pilots
   std::optional<AutoChoice> choice;  // --integrator auto's pilots and choice
   ErrorEstimate error;            // from the film's halves; .valid false without them
 };
 
-// Renders `scene` into `film` as `settings` ask, --integrator auto first running its pilots and
-// choosing (then settings.integrator names the choice and `announce` gets its summary). `budget_spp`
-// is auto's budget when it has neither a time limit nor a target: the spp asked for.
-RenderOutcome render_requested(const Scene& scene, RenderSettings& settings, Film& film, RenderOptions options,
-                               int budget_spp, const std::function<void(const std::string&)>& announce = nullptr);
+// Renders `scene` into `film` as `plan` (made from the scene's description with `settings`) and
+// `options` ask, with the plan's integrator, whose capabilities the plan checked. One that chooses
+// (auto) first runs its pilots and chooses (then settings.integrator names the choice and
+// `announce` gets its summary), within the plan's budget.
+RenderOutcome render_requested(const Scene& scene, RenderSettings& settings, Film& film, const RenderPlan& plan,
+                               RenderOptions options,
+                               const std::function<void(const std::string&)>& announce = nullptr);
 
 // "64", "min 12, mean 15.20", "adaptive, 15.20 spp on average" or "1.20 mutations per pixel": the
 // samples the film holds, as the closing line and the metadata say them. `spp_unit` is " spp"

@@ -13,7 +13,7 @@
 #include <system_error>
 
 #include "candela/base/error.h"
-#include "candela/integrators/integrator.h"
+#include "candela/description/integrator_traits.h"
 
 
 namespace candela {
@@ -392,7 +392,7 @@ Json render_json(const SceneDesc& scene) {
   if (!scene.film.filename.empty()) j["output"] = scene.film.filename;
   if (!scene.film.aovs.empty()) j["aovs"] = scene.film.aovs;
   // Only the selective settings the integrator reads: the reader rejects the others.
-  const IntegratorEntry* integrator = find_integrator(s.integrator);
+  const IntegratorTraits* integrator = find_integrator_traits(s.integrator);
   auto reads = [&](std::string_view key) { return integrator && integrator->reads_setting(key); };
   if (reads("rr_start_depth")) j["rr_start_depth"] = s.rr_start_depth;
   j["transform_times"] = Json::array({scene.transform_start_time, scene.transform_end_time});

@@ -347,8 +347,7 @@ void combine_ranks(Cluster& cluster, Film& film, const RenderOptions& options, i
     cluster.sum_int64(film.splats().sums());
     cluster.sum_int64(film.half_splats().sums());
   }
-  if (options.bdpt_strategies)
-    for (SplatImage& image : *options.bdpt_strategies) cluster.sum_int64(image.sums());
+  if (options.integrator_outputs) options.integrator_outputs->sum_across(cluster);
 }
 
 }  // namespace

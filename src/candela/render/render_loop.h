@@ -17,10 +17,12 @@
 //
 // An integrator gives the loop a TileIntegrator (usually CameraSampleTiles, render/camera_sample_tiles.h,
 // around its radiance function); integrators/integrator.h chooses the integrator.
+#include <any>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -37,6 +39,19 @@
 namespace candela {
 
 class AovFilm;  // film/aov_film.h
+
+// What an integrator makes besides the film, in a form only it knows: its registry entry makes them
+// for a request that asks (integrators/integrator.h), the integrator fills them as it renders, the
+// loop adds up the ranks' shares after the last pass, and the caller writes them once the film is
+// final. Contributions are scaled like the film's splats.
+class IntegratorOutputs {
+ public:
+  virtual ~IntegratorOutputs() = default;
+  // Adds up every rank's share, called on every rank at the same point (one process: nothing to do).
+  virtual void sum_across(Cluster& cluster) = 0;
+  // Writes them, scaled as `film`'s splats are, with the image's metadata.
+  virtual void write(const Film& film, const std::map<std::string, std::string>& metadata) const = 0;
+};
 
 struct RenderOptions {
   int threads = 0;       // 0 = all cores
@@ -60,11 +75,9 @@ struct RenderOptions {
   // Across ranks it is called on every rank at the same passes; the film's splats are then this
   // rank's own (add them with Cluster::sum_int64). Not called for adaptive renders.
   std::function<void(const Film&, uint64_t non_finite_so_far)> after_pass;
-  // Integrator "bdpt": when set, every strategy's (s, t) contribution also goes to its own image
-  // (BdptIntegrator::strategy_index; sized by the caller, images beyond its size are skipped), MIS
-  // weighted or, with bdpt_unweighted, not. Scaled like the film's splats (RenderStats::splat_scale).
-  std::vector<SplatImage>* bdpt_strategies = nullptr;
-  bool bdpt_unweighted = false;
+  // When set, what the integrator makes besides the film (IntegratorOutputs below), which only that
+  // integrator fills and knows the meaning of; the loop adds it up across the ranks.
+  IntegratorOutputs* integrator_outputs = nullptr;
   // The processes rendering this image together; null = this process alone. Every rank calls the
   // render with the same scene, settings and film; after it every rank's film holds the whole image
   // (splats included), and the stats count every rank's samples, rays and non-finite values.
@@ -100,15 +113,15 @@ struct RenderStats {
   // all ranks: the job's parallel efficiency is the busy time over threads x wall time.
   std::vector<double> rank_busy_seconds;
   int threads = 1;
-  // Integrator "mlt": the estimate of the image's mean luminance that scales the chains' deposits,
-  // its standard error relative to it, the samples it took and the seconds they took.
-  double mlt_normalization = 0, mlt_normalization_relative_error = 0;
-  uint64_t mlt_normalization_samples = 0;
-  double mlt_normalization_seconds = 0;
-  double mlt_direct_seconds = 0, mlt_bootstrap_seconds = 0;  // its depth-0 pass and bootstrap
+  // The standard error, relative to it, of an estimated factor that scales the film's splats (0:
+  // the scale is exact), which the image's error estimate adds (film/error_estimate.h).
+  double splat_scale_relative_error = 0;
   // Seconds spent before the first sample that counts towards the image could be taken, which a
-  // longer render does not repeat (mlt: the direct pass, bootstrap and normalisation; else 0).
+  // longer render does not repeat (set-up such as a bootstrap; 0 for most integrators).
   double setup_seconds = 0;
+  // What the integrator reports beyond these, in a type of its own that the integrator's header
+  // declares and reads back (std::any_cast); empty for most.
+  std::any details;
 };
 
 // The relative error adaptive sampling compares with its threshold: the largest over the channels
@@ -201,8 +214,8 @@ void exchange_items(Cluster& cluster, const std::vector<uint8_t>& mine,
 // added up first (in a copy).
 double agreed_error_estimate(Cluster& cluster, const Film& film, double scale_relative_error = 0);
 
-// With a time limit started at `start`: how many more units of work (a pass's spp, MLT's mutations
-// per chain) fit in what is left of it, at the pace of the last `last_units`, which took
+// With a time limit started at `start`: how many more units of work (a pass's spp, a Markov chain's
+// mutations) fit in what is left of it, at the pace of the last `last_units`, which took
 // `last_seconds` (`if_unknown` when that took no measurable time). The root's clock decides, so that
 // every rank cuts the same pass. Below 1: none fits.
 double units_fitting_in_time_limit(Cluster& cluster, double time_limit_seconds,

@@ -6,7 +6,7 @@
 
 #include "candela/base/error.h"
 #include "candela/film/aov_film.h"
-#include "candela/integrators/integrator.h"
+#include "candela/description/integrator_traits.h"
 
 namespace candela::json {
 
@@ -107,11 +107,12 @@ void JsonSceneReader::read_render(const Json& value, const std::string& pointer)
 }
 
 // The scene's integrator must exist and read every selective setting the scene gives
-// (integrators/integrator.h), as the command line's flags must.
+// (description/integrator_traits.h), as the command line's flags must. A scene names the integrator
+// that renders it: choosing one (--integrator auto) is the command line's and the Python module's.
 void JsonSceneReader::check_integrator_reads(const Json& value, const CheckedObject& render,
                                              const RenderSettings& settings) const {
-  const IntegratorEntry* integrator = find_integrator(settings.integrator);
-  if (!integrator)
+  const IntegratorTraits* integrator = find_integrator_traits(settings.integrator);
+  if (!integrator || integrator->chooses)
     report_.fail(render.pointer_of("integrator"), "unknown integrator \"{}\" (known: {})", settings.integrator,
                  integrator_names());
   for (const SelectiveSetting& setting : kSelectiveSettings) {
