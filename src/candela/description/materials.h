@@ -1,5 +1,7 @@
 #pragma once
-// Material descriptions, one struct per material type, and the MaterialDesc variant. Part of the format-neutral scene description (description/scene_desc.h).
+// Material descriptions, one struct per material type, each with its schema (description/schema.h:
+// the parameters' keys, ranges and help, declared once for every reader, writer and editor), and the
+// MaterialDesc variant. Part of the format-neutral scene description (description/scene_desc.h).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -17,6 +19,7 @@
 #include "candela/math/color.h"
 #include "candela/math/transform.h"
 #include "candela/math/vec.h"
+#include "candela/description/schema.h"
 #include "candela/description/textures.h"
 
 namespace candela {
@@ -24,6 +27,11 @@ namespace candela {
 // Lambertian reflector.
 struct DiffuseMaterial {
   ColorInput reflectance{RGB(0.5f)};
+};
+template <>
+struct SchemaOf<DiffuseMaterial> {
+  static constexpr Field fields[] = {field<&DiffuseMaterial::reflectance>("reflectance", kAlbedo)};
+  static constexpr TypeSchema schema{.name = "diffuse", .fields = fields, .help = "Lambertian reflector"};
 };
 
 // The paper's material model (Häkkinen 2002, sec. 4.6): a diffuse lobe, a normalised Phong lobe and
@@ -37,10 +45,39 @@ struct PhongMaterial {
   float ior = 1.5f;  // index of refraction inside / outside, for the transmitted part
   float d = 1, s = 0, t = 0;
 };
+inline std::optional<SchemaViolation> check_phong(const void* object) {
+  const auto& p = *static_cast<const PhongMaterial*>(object);
+  // The probabilities of Russian roulette's diffuse, specular and transmitted choices.
+  double sum = double(p.d) + p.s + p.t;
+  if (sum <= 1 + 1e-6) return std::nullopt;
+  return SchemaViolation{"", fmt::format("d + s + t must be <= 1 (the rest is absorbed), got {} + {} + {} = {}", p.d,
+                                         p.s, p.t, float(sum))};
+}
+template <>
+struct SchemaOf<PhongMaterial> {
+  using M = PhongMaterial;
+  static constexpr Field fields[] = {
+      field<&M::diffuse>("diffuse", kAlbedo, "the diffuse lobe's albedo"),
+      field<&M::specular>("specular", kAlbedo, "the Phong lobe's albedo"),
+      field<&M::exponent>("exponent", kNonNegative, "the Phong exponent n"),
+      field<&M::transmission>("transmission", kAlbedo, "the refracted part's tint"),
+      field<&M::ior>("ior", kPositive, "index of refraction inside / outside"),
+      field<&M::d>("d", kUnitInterval, "probability of the diffuse lobe"),
+      field<&M::s>("s", kUnitInterval, "probability of the Phong lobe"),
+      field<&M::t>("t", kUnitInterval, "probability of refraction"),
+  };
+  static constexpr TypeSchema schema{.name = "phong", .fields = fields, .check = &check_phong,
+                                     .help = "the paper's diffuse + Phong + refraction model"};
+};
 
 // Ideal specular reflector.
 struct MirrorMaterial {
   ColorInput reflectance{RGB(1.0f)};
+};
+template <>
+struct SchemaOf<MirrorMaterial> {
+  static constexpr Field fields[] = {field<&MirrorMaterial::reflectance>("reflectance", kAlbedo)};
+  static constexpr TypeSchema schema{.name = "mirror", .fields = fields, .help = "ideal specular reflector"};
 };
 
 // The microfacet normal distribution: Trowbridge-Reitz (GGX, the default) or Beckmann (Mitsuba's
@@ -79,6 +116,18 @@ struct ConductorMaterial {
   ColorInput specular_tint{RGB(1.0f)};  // multiplies the reflection (Mitsuba's specular_reflectance)
   Roughness roughness;
 };
+template <>
+struct SchemaOf<ConductorMaterial> {
+  using M = ConductorMaterial;
+  static constexpr Field fields[] = {
+      field<&M::eta>("eta", kNonNegative, "index of refraction (real part), per channel").ignored_where("reflectance"),
+      field<&M::k>("k", kNonNegative, "absorption coefficient (imaginary part), per channel").ignored_where("reflectance"),
+      field<&M::reflectance>("reflectance", kAlbedo, "normal-incidence reflectance instead of eta and k"),
+      field<&M::specular_tint>("specular_tint", kAlbedo, "multiplies the reflection"),
+      roughness_field<&M::roughness>(),
+  };
+  static constexpr TypeSchema schema{.name = "conductor", .fields = fields, .help = "metal"};
+};
 
 // Dielectric interface (glass, water): Fresnel-weighted reflection and refraction, smooth or GGX-rough.
 // ior = n_inside / n_outside, inside being the side opposite the geometric normal.
@@ -91,6 +140,20 @@ struct DielectricMaterial {
   // with the Fresnel reflectance of the two interfaces and their internal reflections summed
   // (R' = R + T^2 R / (1 - R^2)); smooth only.
   bool thin = false;
+};
+template <>
+struct SchemaOf<DielectricMaterial> {
+  using M = DielectricMaterial;
+  static constexpr std::string_view aliases[] = {"glass"};
+  static constexpr Field fields[] = {
+      field<&M::ior>("ior", kPositive, "index of refraction inside / outside"),
+      field<&M::reflectance>("reflectance", kAlbedo, "tints the reflection"),
+      field<&M::transmittance>("transmittance", kAlbedo, "tints the refraction"),
+      roughness_field<&M::roughness>(),
+      field<&M::thin>("thin", kAnyValue, "a thin sheet: no refraction"),
+  };
+  static constexpr TypeSchema schema{.name = "dielectric", .aliases = aliases, .fields = fields,
+                                     .help = "glass, water"};
 };
 
 // Plastic / coated diffuse: a dielectric coat (smooth or GGX-rough) of index `ior` over a Lambertian
@@ -108,20 +171,73 @@ struct CoatedDiffuseMaterial {
   // factors. Needs a constant roughness.
   bool tabulated_coat = false;
 };
+inline std::optional<SchemaViolation> check_coated_diffuse(const void* object) {
+  const auto& c = *static_cast<const CoatedDiffuseMaterial*>(object);
+  if (c.tabulated_coat && !(c.roughness.u.is_constant() && c.roughness.v.is_constant()))
+    return SchemaViolation{"tabulated_coat", "a tabulated coat needs a constant roughness"};
+  return std::nullopt;
+}
+template <>
+struct SchemaOf<CoatedDiffuseMaterial> {
+  using M = CoatedDiffuseMaterial;
+  static constexpr std::string_view aliases[] = {"plastic"};
+  static constexpr Field fields[] = {
+      field<&M::reflectance>("reflectance", kAlbedo, "the diffuse base"),
+      field<&M::specular>("specular", kAlbedo, "tints the coat's reflection"),
+      field<&M::ior>("ior", kPositive, "the coat's index of refraction"),
+      roughness_field<&M::roughness>(),
+      field<&M::nonlinear>("nonlinear", kAnyValue, "the colour shift of internal bounces"),
+      field<&M::tabulated_coat>("tabulated_coat", kAnyValue, "Mitsuba 3's tabulated rough coat"),
+  };
+  static constexpr TypeSchema schema{.name = "coated_diffuse", .aliases = aliases, .fields = fields,
+                                     .check = &check_coated_diffuse, .help = "plastic: a dielectric coat over a diffuse base"};
+};
 
 // Lambertian reflection and Lambertian transmission to the other side (leaves, paper, lamp shades).
 struct DiffuseTransmissionMaterial {
   ColorInput reflectance{RGB(0.25f)};
   ColorInput transmittance{RGB(0.25f)};
 };
+inline std::optional<SchemaViolation> check_diffuse_transmission(const void* object) {
+  const auto& d = *static_cast<const DiffuseTransmissionMaterial*>(object);
+  // Together they may not exceed 1 (checked for constants; textures are the scene's responsibility).
+  static constexpr const char* kChannelNames[] = {"red", "green", "blue"};
+  if (d.reflectance.is_constant() && d.transmittance.is_constant())
+    for (int i = 0; i < 3; ++i)
+      if (double(d.reflectance.value[i]) + d.transmittance.value[i] > 1 + 1e-6)
+        return SchemaViolation{"", fmt::format("reflectance + transmittance must be <= 1 in each channel (more would "
+                                               "create energy), got {} + {} in the {} channel",
+                                               d.reflectance.value[i], d.transmittance.value[i], kChannelNames[i])};
+  return std::nullopt;
+}
+template <>
+struct SchemaOf<DiffuseTransmissionMaterial> {
+  using M = DiffuseTransmissionMaterial;
+  static constexpr Field fields[] = {
+      field<&M::reflectance>("reflectance", kAlbedo),
+      field<&M::transmittance>("transmittance", kAlbedo),
+  };
+  static constexpr TypeSchema schema{.name = "diffuse_transmission", .fields = fields,
+                                     .check = &check_diffuse_transmission,
+                                     .help = "Lambertian reflection and transmission"};
+};
 
 // Absorbs everything: for pure emitters and light blockers.
 struct BlackMaterial {};
+template <>
+struct SchemaOf<BlackMaterial> {
+  static constexpr TypeSchema schema{.name = "black", .help = "absorbs everything"};
+};
 
 // No surface at all: rays pass straight through without counting as a bounce (pbrt-v4's
 // "interface", Mitsuba's "null"). Marks the boundary of a participating medium, or hides a shape
 // while keeping it as an emitter.
 struct InterfaceMaterial {};
+template <>
+struct SchemaOf<InterfaceMaterial> {
+  static constexpr std::string_view aliases[] = {"null"};
+  static constexpr TypeSchema schema{.name = "interface", .aliases = aliases, .help = "no surface"};
+};
 
 // Mitsuba 3's principled BSDF (after the Disney BSDF, Burley 2015), with Mitsuba's exact definitions
 // of every lobe and of how the parameters combine; `thin` selects Mitsuba's principledthin (a thin
@@ -146,6 +262,30 @@ struct PrincipledMaterial {
   FloatInput diff_trans{0.0f};
   FloatInput flatness{0.0f};
 };
+template <>
+struct SchemaOf<PrincipledMaterial> {
+  using M = PrincipledMaterial;
+  static constexpr ValueRange kUpToTwo{.lo = 0, .hi = 2};
+  static constexpr Field fields[] = {
+      field<&M::base_color>("base_color", kAlbedo),
+      field<&M::roughness>("roughness", kUnitInterval),
+      field<&M::metallic>("metallic", kUnitInterval),
+      field<&M::specular>("specular", kUnitInterval, "ignored where eta is given"),
+      field<&M::specular_tint>("specular_tint", kUnitInterval),
+      field<&M::anisotropic>("anisotropic", kUnitInterval),
+      field<&M::sheen>("sheen", kUnitInterval),
+      field<&M::sheen_tint>("sheen_tint", kUnitInterval),
+      field<&M::clearcoat>("clearcoat", kUnitInterval),
+      field<&M::clearcoat_gloss>("clearcoat_gloss", kUnitInterval),
+      field<&M::spec_trans>("spec_trans", kUnitInterval),
+      number_if_given<&M::eta, &M::eta_given>("eta", kPositive, "index of refraction (else from specular)"),
+      field<&M::thin>("thin", kAnyValue, "Mitsuba's principledthin"),
+      field<&M::diff_trans>("diff_trans", kUpToTwo, "thin only: diffuse transmission"),
+      field<&M::flatness>("flatness", kUnitInterval),
+  };
+  static constexpr TypeSchema schema{.name = "principled", .fields = fields,
+                                     .help = "Mitsuba 3's principled BSDF (Disney)"};
+};
 
 // Wrappers around another material (indices into SceneDesc::materials, always smaller than the
 // wrapper's own index). Mitsuba's BSDFs are one-sided unless wrapped in "twosided"; candela's are
@@ -155,6 +295,11 @@ struct PrincipledMaterial {
 struct OneSidedMaterial {
   int material = -1;
 };
+template <>
+struct SchemaOf<OneSidedMaterial> {
+  static constexpr Field fields[] = {material_ref<&OneSidedMaterial::material>("material")};
+  static constexpr TypeSchema schema{.name = "one_sided", .fields = fields, .help = "black from the back"};
+};
 
 // Different materials on the two sides (Mitsuba's "twosided" with two BSDFs): `front` where the
 // direction the light leaves towards (the viewer) is on the side the geometric normal points to,
@@ -163,6 +308,12 @@ struct OneSidedMaterial {
 struct TwoSidedMaterial {
   int front = -1, back = -1;
 };
+template <>
+struct SchemaOf<TwoSidedMaterial> {
+  static constexpr Field fields[] = {material_ref<&TwoSidedMaterial::front>("front"),
+                                     material_ref<&TwoSidedMaterial::back>("back")};
+  static constexpr TypeSchema schema{.name = "two_sided", .fields = fields, .help = "a material per side"};
+};
 
 // Alpha masking (Mitsuba's "mask"): with probability 1 - opacity the surface is not there and the
 // ray passes straight through; otherwise `material` scatters.
@@ -170,11 +321,25 @@ struct MaskMaterial {
   FloatInput opacity{1.0f};
   int material = -1;
 };
+template <>
+struct SchemaOf<MaskMaterial> {
+  static constexpr Field fields[] = {field<&MaskMaterial::opacity>("opacity", kUnitInterval),
+                                     material_ref<&MaskMaterial::material>("material")};
+  static constexpr TypeSchema schema{.name = "mask", .fields = fields, .help = "alpha masking"};
+};
 
 // f = (1 - weight) f_material0 + weight f_material1 (Mitsuba's "blendbsdf").
 struct BlendMaterial {
   FloatInput weight{0.5f};
   int material0 = -1, material1 = -1;
+};
+template <>
+struct SchemaOf<BlendMaterial> {
+  static constexpr Field fields[] = {
+      field<&BlendMaterial::weight>("weight", kUnitInterval, "the second material's weight"),
+      material_pair<&BlendMaterial::material0, &BlendMaterial::material1>("materials", "[weight 0, weight 1]"),
+  };
+  static constexpr TypeSchema schema{.name = "blend", .fields = fields, .help = "a mix of two materials"};
 };
 
 // What Mitsuba 3 (since 3.7.1) adds to a tilted shading normal, both off by default here (pbrt-v4
@@ -195,6 +360,18 @@ struct NormalMapMaterial {
   int material = -1;
   PerturbedNormalOptions options;
 };
+template <>
+struct SchemaOf<NormalMapMaterial> {
+  using M = NormalMapMaterial;
+  using O = PerturbedNormalOptions;
+  static constexpr Field fields[] = {
+      texture_ref<&M::normal_map>("normal_map"),
+      material_ref<&M::material>("material"),
+      field<&M::options, &O::flip_invalid_normals>("flip_invalid_normals"),
+      field<&M::options, &O::shadowing_function>("shadowing_function"),
+  };
+  static constexpr TypeSchema schema{.name = "normal_map", .fields = fields, .help = "shading normals from an image"};
+};
 
 // Shading normals from a height field (Mitsuba's "bumpmap"): the surface displaced by
 // scale * height(u, v) along its normal; the height texture's finite differences in u and v tilt
@@ -204,6 +381,19 @@ struct BumpMapMaterial {
   float scale = 1;
   int material = -1;
   PerturbedNormalOptions options;
+};
+template <>
+struct SchemaOf<BumpMapMaterial> {
+  using M = BumpMapMaterial;
+  using O = PerturbedNormalOptions;
+  static constexpr Field fields[] = {
+      texture_ref<&M::height>("height"),
+      field<&M::scale>("scale", kAnyValue, "multiplies the height"),
+      material_ref<&M::material>("material"),
+      field<&M::options, &O::flip_invalid_normals>("flip_invalid_normals"),
+      field<&M::options, &O::shadowing_function>("shadowing_function"),
+  };
+  static constexpr TypeSchema schema{.name = "bump_map", .fields = fields, .help = "shading normals from a height field"};
 };
 
 using MaterialDesc = std::variant<DiffuseMaterial, PhongMaterial, MirrorMaterial, DielectricMaterial, BlackMaterial,

@@ -19,6 +19,7 @@
 #include <variant>
 #include <vector>
 
+#include "candela/description/schema.h"
 #include "candela/integrators/render_request.h"
 #include "candela/render/checkpoint.h"
 
@@ -31,9 +32,6 @@ using RequestField = std::variant<std::optional<int> RenderRequest::*, std::opti
 
 // The values an option takes beyond its type.
 struct AnyValue {};
-struct ValueRange {  // lo <= value <= hi (NaN is outside every range)
-  double lo, hi;
-};
 struct PositiveValue {};  // finite and > 0
 struct ChoiceValue {      // one of these names
   std::vector<std::string> names;

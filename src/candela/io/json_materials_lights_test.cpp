@@ -145,7 +145,7 @@ TEST(JsonReader, UvMatrixRotatesTextureCoordinates) {
 
 TEST(JsonReader, TextureErrorsNameTheirJsonPointer) {
   expect_textured_error(with_texture(R"({"type": "image", "filename": "checker.ppm", "wrapp": "clamp"})"),
-                        "at /textures/t/wrapp: unknown key; expected one of: type, filename, wrap, encoding, filter, "
+                        "at /textures/t/wrapp: unknown key (did you mean \"wrap\"?); expected one of: type, filename, wrap, encoding, filter, "
                         "scale, invert, luminance, uv_matrix, uv_scale, uv_offset");
   expect_textured_error(with_texture(R"({"type": "image", "filename": "checker.ppm", "wrap": "tile"})"),
                         "at /textures/t/wrap: unknown wrap mode \"tile\"; expected one of: repeat, clamp, black, "

@@ -13,6 +13,7 @@
 #include <system_error>
 
 #include "candela/base/error.h"
+#include "candela/base/overloaded.h"
 #include "candela/description/integrator_traits.h"
 
 
@@ -21,13 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
-
-template <class... Ts>
-struct Overloaded : Ts... {
-  using Ts::operator()...;
-};
-template <class... Ts>
-Overloaded(Ts...) -> Overloaded<Ts...>;
 
 Json vec3(const Vec3& v) { return Json::array({v.x, v.y, v.z}); }
 Json rgb(const RGB& c) { return Json::array({c.r, c.g, c.b}); }
@@ -58,7 +52,7 @@ void write_mapping(const UVMapping& m, Json& j) {
 
 Json texture_json(const TextureDesc& desc) {
   return std::visit(
-      Overloaded{
+      overloaded{
           [](const ImageTexture& t) {
             Json j{{"type", "image"}, {"filename", absolute(t.filename)}};
             j["wrap"] = enum_name(t.wrap);
@@ -99,106 +93,52 @@ void write_roughness(const Roughness& r, Json& j) {
   if (r.distribution != MicrofacetDistribution::GGX) j["distribution"] = enum_name(r.distribution);
 }
 
-Json with_options(Json j, const PerturbedNormalOptions& o) {
-  if (o.flip_invalid_normals) j["flip_invalid_normals"] = true;
-  if (o.shadowing_function) j["shadowing_function"] = true;
-  return j;
+// The fields of a type's schema (description/schema.h) that differ from the type's defaults, as
+// read_fields reads them; references (materials, textures) always.
+void write_fields(const TypeSchema& schema, const void* object, const void* defaults, Json& j) {
+  auto same_input = [](const auto& a, const auto& b) { return a.is_constant() && b.is_constant() && a.value == b.value; };
+  for (const Field& f : schema.fields) {
+    if (!f.unless.empty() && field_given(schema, f.unless, object)) continue;
+    switch (f.kind) {
+      case FieldKind::Color:
+        if (!same_input(field_value<ColorInput>(f, object), field_value<ColorInput>(f, defaults)))
+          j[f.key] = color(field_value<ColorInput>(f, object));
+        break;
+      case FieldKind::OptionalColor:
+        if (const auto& c = field_value<std::optional<ColorInput>>(f, object)) j[f.key] = color(*c);
+        break;
+      case FieldKind::Float:
+        if (!same_input(field_value<FloatInput>(f, object), field_value<FloatInput>(f, defaults)))
+          j[f.key] = number(field_value<FloatInput>(f, object));
+        break;
+      case FieldKind::Number:
+        if (field_value<float>(f, object) != field_value<float>(f, defaults)) j[f.key] = field_value<float>(f, object);
+        break;
+      case FieldKind::NumberIfGiven:
+        if (field_second<bool>(f, object)) j[f.key] = field_value<float>(f, object);
+        break;
+      case FieldKind::Flag:
+        if (field_value<bool>(f, object) != field_value<bool>(f, defaults)) j[f.key] = field_value<bool>(f, object);
+        break;
+      case FieldKind::Roughness: write_roughness(field_value<Roughness>(f, object), j); break;
+      case FieldKind::Material: j[f.key] = material_name(field_value<int>(f, object)); break;
+      case FieldKind::MaterialPair:
+        j[f.key] = Json::array({material_name(field_value<int>(f, object)), material_name(field_second<int>(f, object))});
+        break;
+      case FieldKind::Texture: j[f.key] = texture_name(field_value<int>(f, object)); break;
+    }
+  }
 }
 
 Json material_json(const MaterialDesc& desc) {
   return std::visit(
-      Overloaded{
-          [](const DiffuseMaterial& m) { return Json{{"type", "diffuse"}, {"reflectance", color(m.reflectance)}}; },
-          [](const PhongMaterial& m) {
-            return Json{{"type", "phong"},           {"diffuse", color(m.diffuse)},
-                        {"specular", color(m.specular)}, {"exponent", m.exponent},
-                        {"transmission", color(m.transmission)}, {"ior", m.ior},
-                        {"d", m.d},                      {"s", m.s},
-                        {"t", m.t}};
-          },
-          [](const MirrorMaterial& m) { return Json{{"type", "mirror"}, {"reflectance", color(m.reflectance)}}; },
-          [](const DielectricMaterial& m) {
-            Json j{{"type", "dielectric"}, {"ior", m.ior}, {"reflectance", color(m.reflectance)},
-                   {"transmittance", color(m.transmittance)}};
-            write_roughness(m.roughness, j);
-            if (m.thin) j["thin"] = true;
-            return j;
-          },
-          [](const BlackMaterial&) { return Json{{"type", "black"}}; },
-          [](const ConductorMaterial& m) {
-            Json j{{"type", "conductor"}};
-            if (m.reflectance) {
-              j["reflectance"] = color(*m.reflectance);
-            } else {
-              j["eta"] = color(m.eta);
-              j["k"] = color(m.k);
-            }
-            j["specular_tint"] = color(m.specular_tint);
-            write_roughness(m.roughness, j);
-            return j;
-          },
-          [](const CoatedDiffuseMaterial& m) {
-            Json j{{"type", "coated_diffuse"}, {"reflectance", color(m.reflectance)}, {"specular", color(m.specular)},
-                   {"ior", m.ior}};
-            write_roughness(m.roughness, j);
-            if (m.nonlinear) j["nonlinear"] = true;
-            if (m.tabulated_coat) j["tabulated_coat"] = true;
-            return j;
-          },
-          [](const DiffuseTransmissionMaterial& m) {
-            return Json{{"type", "diffuse_transmission"},
-                        {"reflectance", color(m.reflectance)},
-                        {"transmittance", color(m.transmittance)}};
-          },
-          [](const InterfaceMaterial&) { return Json{{"type", "interface"}}; },
-          [](const PrincipledMaterial& m) {
-            Json j{{"type", "principled"},
-                   {"base_color", color(m.base_color)},
-                   {"roughness", number(m.roughness)},
-                   {"metallic", number(m.metallic)},
-                   {"specular", number(m.specular)},
-                   {"specular_tint", number(m.specular_tint)},
-                   {"anisotropic", number(m.anisotropic)},
-                   {"sheen", number(m.sheen)},
-                   {"sheen_tint", number(m.sheen_tint)},
-                   {"clearcoat", number(m.clearcoat)},
-                   {"clearcoat_gloss", number(m.clearcoat_gloss)},
-                   {"spec_trans", number(m.spec_trans)}};
-            if (m.eta_given) j["eta"] = m.eta;
-            if (m.thin) {
-              j["thin"] = true;
-              j["diff_trans"] = number(m.diff_trans);
-              j["flatness"] = number(m.flatness);
-            } else if (!(m.flatness.is_constant() && m.flatness.value == 0)) {
-              j["flatness"] = number(m.flatness);
-            }
-            return j;
-          },
-          [](const OneSidedMaterial& m) { return Json{{"type", "one_sided"}, {"material", material_name(m.material)}}; },
-          [](const TwoSidedMaterial& m) {
-            return Json{{"type", "two_sided"}, {"front", material_name(m.front)}, {"back", material_name(m.back)}};
-          },
-          [](const MaskMaterial& m) {
-            return Json{{"type", "mask"}, {"opacity", number(m.opacity)}, {"material", material_name(m.material)}};
-          },
-          [](const BlendMaterial& m) {
-            return Json{{"type", "blend"},
-                        {"weight", number(m.weight)},
-                        {"materials", Json::array({material_name(m.material0), material_name(m.material1)})}};
-          },
-          [](const NormalMapMaterial& m) {
-            return with_options(Json{{"type", "normal_map"},
-                                     {"normal_map", texture_name(m.normal_map)},
-                                     {"material", material_name(m.material)}},
-                                m.options);
-          },
-          [](const BumpMapMaterial& m) {
-            return with_options(Json{{"type", "bump_map"},
-                                     {"height", texture_name(m.height)},
-                                     {"scale", m.scale},
-                                     {"material", material_name(m.material)}},
-                                m.options);
-          },
+      [](const auto& m) {
+        using T = std::decay_t<decltype(m)>;
+        const TypeSchema& schema = SchemaOf<T>::schema;
+        const T defaults{};
+        Json j{{"type", schema.name}};
+        write_fields(schema, &m, &defaults, j);
+        return j;
       },
       desc);
 }
@@ -231,7 +171,7 @@ Json mesh_json(const TriangleMesh& mesh) {
 
 Json geometry_json(const ShapeGeometry& geometry) {
   return std::visit(
-      Overloaded{
+      overloaded{
           [](const SphereShape& s) { return Json{{"type", "sphere"}, {"center", vec3(s.center)}, {"radius", s.radius}}; },
           [](const PlaneShape& p) { return Json{{"type", "plane"}, {"point", vec3(p.point)}, {"normal", vec3(p.normal)}}; },
           [](const BoxShape& b) { return Json{{"type", "box"}, {"min", vec3(b.lo)}, {"max", vec3(b.hi)}}; },
@@ -333,7 +273,7 @@ Json shape_json(const ShapeDesc& shape, const std::vector<std::string>& media) {
 
 Json light_json(const LightDesc& light) {
   return std::visit(
-      Overloaded{
+      overloaded{
           [](const PointLight& l) { return Json{{"type", "point"}, {"position", vec3(l.position)}, {"intensity", rgb(l.intensity)}}; },
           [](const SkyLight& l) {
             return Json{{"type", "sky"},      {"zenith", rgb(l.zenith)}, {"horizon", rgb(l.horizon)},

@@ -6,69 +6,53 @@
 namespace candela {
 namespace {
 
-bool is_constant(const ColorInput& c) { return c.is_constant(); }
-bool is_constant(const FloatInput& f) { return f.is_constant(); }
 bool is_constant(const Roughness& r) { return r.u.is_constant() && r.v.is_constant(); }
 
-// The materials that are a BSDF of their own (build()); the others wrap materials or have no surface.
-template <typename T>
-constexpr bool builds_bsdf =
-    std::is_same_v<T, DiffuseMaterial> || std::is_same_v<T, PhongMaterial> || std::is_same_v<T, MirrorMaterial> ||
-    std::is_same_v<T, DielectricMaterial> || std::is_same_v<T, BlackMaterial> ||
-    std::is_same_v<T, ConductorMaterial> || std::is_same_v<T, CoatedDiffuseMaterial> ||
-    std::is_same_v<T, DiffuseTransmissionMaterial> || std::is_same_v<T, PrincipledMaterial>;
-
-// Whether every input of the material is a constant (then its BSDF is the same at every hit).
+// Whether every input of the material is a constant (then its BSDF is the same at every hit):
+// its colours, numbers and roughness, as its schema lists them (description/materials.h). The
+// materials a wrapper wraps are checked by the caller.
 bool has_constant_inputs(const MaterialDesc& desc) {
-  return std::visit(
-      [](const auto& m) {
-        using T = std::decay_t<decltype(m)>;
-        if constexpr (std::is_same_v<T, DiffuseMaterial>) return is_constant(m.reflectance);
-        else if constexpr (std::is_same_v<T, PhongMaterial>)
-          return is_constant(m.diffuse) && is_constant(m.specular) && is_constant(m.transmission);
-        else if constexpr (std::is_same_v<T, MirrorMaterial>) return is_constant(m.reflectance);
-        else if constexpr (std::is_same_v<T, DielectricMaterial>)
-          return is_constant(m.reflectance) && is_constant(m.transmittance) && is_constant(m.roughness);
-        else if constexpr (std::is_same_v<T, ConductorMaterial>)
-          return is_constant(m.eta) && is_constant(m.k) && (!m.reflectance || is_constant(*m.reflectance)) &&
-                 is_constant(m.specular_tint) && is_constant(m.roughness);
-        else if constexpr (std::is_same_v<T, CoatedDiffuseMaterial>)
-          return is_constant(m.reflectance) && is_constant(m.specular) && is_constant(m.roughness);
-        else if constexpr (std::is_same_v<T, PrincipledMaterial>)
-          return is_constant(m.base_color) && is_constant(m.roughness) && is_constant(m.metallic) &&
-                 is_constant(m.specular) && is_constant(m.specular_tint) && is_constant(m.anisotropic) &&
-                 is_constant(m.sheen) && is_constant(m.sheen_tint) && is_constant(m.clearcoat) &&
-                 is_constant(m.clearcoat_gloss) && is_constant(m.spec_trans) && is_constant(m.diff_trans) &&
-                 is_constant(m.flatness);
-        else if constexpr (std::is_same_v<T, DiffuseTransmissionMaterial>)
-          return is_constant(m.reflectance) && is_constant(m.transmittance);
-        else if constexpr (std::is_same_v<T, MaskMaterial>) return is_constant(m.opacity);  // and what it wraps
-        else if constexpr (std::is_same_v<T, BlendMaterial>) return is_constant(m.weight);
-        // No inputs of their own: black, interfaces, and wrappers whose maps only tilt the frame
-        // (what they wrap is checked by the caller).
-        else if constexpr (std::is_same_v<T, BlackMaterial> || std::is_same_v<T, InterfaceMaterial> ||
-                           std::is_same_v<T, OneSidedMaterial> || std::is_same_v<T, TwoSidedMaterial> ||
-                           std::is_same_v<T, NormalMapMaterial> || std::is_same_v<T, BumpMapMaterial>)
-          return true;
-        else static_assert(always_false<T>, "a material must say whether its inputs are constant");
-      },
-      desc);
+  const TypeSchema& schema = schema_of(desc);
+  const void* object = std::visit([](const auto& m) -> const void* { return &m; }, desc);
+  for (const Field& f : schema.fields) {
+    switch (f.kind) {
+      case FieldKind::Color:
+        if (!field_value<ColorInput>(f, object).is_constant()) return false;
+        break;
+      case FieldKind::OptionalColor:
+        if (const auto& c = field_value<std::optional<ColorInput>>(f, object); c && !c->is_constant()) return false;
+        break;
+      case FieldKind::Float:
+        if (!field_value<FloatInput>(f, object).is_constant()) return false;
+        break;
+      case FieldKind::Roughness:
+        if (!is_constant(field_value<Roughness>(f, object))) return false;
+        break;
+      // Constant by nature; and maps only tilt the frame.
+      case FieldKind::Number:
+      case FieldKind::NumberIfGiven:
+      case FieldKind::Flag:
+      case FieldKind::Material:
+      case FieldKind::MaterialPair:
+      case FieldKind::Texture: break;
+    }
+  }
+  return true;
 }
 
-// The wrapped materials of a wrapper (none for other materials).
+// The materials a wrapper wraps, in its schema's order (none for other materials).
 std::vector<int> nested_materials(const MaterialDesc& desc) {
-  return std::visit(
-      [](const auto& m) -> std::vector<int> {
-        using T = std::decay_t<decltype(m)>;
-        if constexpr (std::is_same_v<T, BlendMaterial>) return {m.material0, m.material1};
-        else if constexpr (std::is_same_v<T, TwoSidedMaterial>) return {m.front, m.back};
-        else if constexpr (std::is_same_v<T, OneSidedMaterial> || std::is_same_v<T, MaskMaterial> ||
-                           std::is_same_v<T, NormalMapMaterial> || std::is_same_v<T, BumpMapMaterial>)
-          return {m.material};
-        else if constexpr (builds_bsdf<T> || std::is_same_v<T, InterfaceMaterial>) return {};
-        else static_assert(always_false<T>, "a material must say which materials it wraps");
-      },
-      desc);
+  const TypeSchema& schema = schema_of(desc);
+  const void* object = std::visit([](const auto& m) -> const void* { return &m; }, desc);
+  std::vector<int> nested;
+  for (const Field& f : schema.fields) {
+    if (f.kind == FieldKind::Material) nested.push_back(field_value<int>(f, object));
+    if (f.kind == FieldKind::MaterialPair) {
+      nested.push_back(field_value<int>(f, object));
+      nested.push_back(field_second<int>(f, object));
+    }
+  }
+  return nested;
 }
 
 // The microfacet distribution a roughness input gives at a hit.
@@ -178,11 +162,10 @@ void MaterialTable::collect(int material, float weight, bool one_sided, const Te
           collect(m.material, weight, one_sided, ctx, out);
         } else if constexpr (std::is_same_v<T, InterfaceMaterial>) {
           out.null_weight += weight;  // no surface: a wrapped interface lets the ray pass
-        } else if constexpr (builds_bsdf<T> || std::is_same_v<T, TwoSidedMaterial>) {
-          // (A two-sided material is never collected: it is the outermost, and a side is picked first.)
-          if (out.count < SurfaceBsdf::kMaxComponents) out.add(build(entry, ctx), weight, one_sided);
         } else {
-          static_assert(always_false<T>, "a material must say how it joins a surface's mixture");
+          // Every other material is a BSDF of its own (build()). (A two-sided material is never
+          // collected: it is the outermost, and a side is picked first.)
+          if (out.count < SurfaceBsdf::kMaxComponents) out.add(build(entry, ctx), weight, one_sided);
         }
       },
       desc);

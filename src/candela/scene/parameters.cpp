@@ -8,12 +8,11 @@
 #include <stdexcept>
 
 #include "candela/base/error.h"
+#include "candela/base/nearest_name.h"
 #include "candela/base/overloaded.h"
 
 namespace candela {
 namespace {
-
-constexpr float kInf = std::numeric_limits<float>::infinity();
 
 // Where a parameter lives in the description and what it accepts.
 struct Slot {
@@ -22,48 +21,76 @@ struct Slot {
   float* number_too = nullptr;  // set together with `number` (isotropic roughness: u and v)
   RGB* color = nullptr;
   Transform* transform = nullptr;
-  float lo = 0, hi = kInf;        // numbers: lo <= value <= hi, or lo < value where lo_open ...
-  bool lo_open = false, hi_open = false;
+  ValueRange range = kNonNegative;  // numbers; colours: each component
+  // The scene type the parameter belongs to, whose cross-field rule a new value must keep.
+  const TypeSchema* schema = nullptr;
+  void* object = nullptr;
 
-  std::string range() const {
-    if (color) return hi < kInf ? fmt::format("each component within [0, {}]", hi) : "each component finite and >= 0";
+  std::string describe_range() const {
+    if (color) return range.bounded_above() ? fmt::format("each component within [0, {}]", range.hi) : "each component finite and >= 0";
     if (transform) return "an invertible 4x4 matrix";
-    std::string text = fmt::format("{} {} {}", lo, lo_open ? "<" : "<=", name.substr(name.rfind('.') + 1));
-    if (hi < kInf) text += fmt::format(" {} {}", hi_open ? "<" : "<=", hi);
-    return text;
+    return range.inequality(name.substr(name.rfind('.') + 1));
   }
 };
 
 class Slots {
  public:
   explicit Slots(std::vector<Slot>& out) : out_(out) {}
-  void number(std::string name, float& value, float lo = 0, float hi = kInf, bool lo_open = false, bool hi_open = false) {
-    out_.push_back(Slot{std::move(name), &value, nullptr, nullptr, nullptr, lo, hi, lo_open, hi_open});
+  void number(std::string name, float& value, ValueRange range = kNonNegative) {
+    out_.push_back(Slot{.name = std::move(name), .number = &value, .range = range, .schema = schema_, .object = object_});
   }
-  void number(const std::string& name, FloatInput& input, float lo = 0, float hi = kInf) {
-    if (input.texture < 0) number(name, input.value, lo, hi);
+  void number(const std::string& name, FloatInput& input, ValueRange range = kNonNegative) {
+    if (input.texture < 0) number(name, input.value, range);
   }
-  void color(std::string name, RGB& value, float hi = kInf) {
-    out_.push_back(Slot{std::move(name), nullptr, nullptr, &value, nullptr, 0, hi});
+  void color(std::string name, RGB& value, ValueRange range = kNonNegative) {
+    out_.push_back(Slot{.name = std::move(name), .color = &value, .range = range, .schema = schema_, .object = object_});
   }
-  void color(const std::string& name, ColorInput& input) {
-    if (input.texture < 0) color(name, input.value);
+  void color(const std::string& name, ColorInput& input, ValueRange range = kNonNegative) {
+    if (input.texture < 0) color(name, input.value, range);
   }
-  void transform(std::string name, Transform& value) {
-    out_.push_back(Slot{std::move(name), nullptr, nullptr, nullptr, &value});
-  }
+  void transform(std::string name, Transform& value) { out_.push_back(Slot{.name = std::move(name), .transform = &value}); }
   // One "roughness" for isotropic constant roughness, else each constant axis on its own.
   void roughness(const std::string& prefix, Roughness& r) {
     if (r.u.texture < 0 && r.v.texture < 0 && r.u.value == r.v.value) {
-      out_.push_back(Slot{prefix + "roughness", &r.u.value, &r.v.value});
+      out_.push_back(Slot{.name = prefix + "roughness", .number = &r.u.value, .number_too = &r.v.value,
+                          .schema = schema_, .object = object_});
       return;
     }
     number(prefix + "roughness_u", r.u);
     number(prefix + "roughness_v", r.v);
   }
+  // The constant numbers and colours of an object with a schema (description/schema.h), under `prefix`.
+  void fields(const std::string& prefix, const TypeSchema& schema, void* object) {
+    schema_ = &schema;
+    object_ = object;
+    for (const Field& f : schema.fields) {
+      const std::string name = prefix + std::string(f.key);
+      switch (f.kind) {
+        case FieldKind::Color: color(name, field_value<ColorInput>(f, object), f.range); break;
+        case FieldKind::OptionalColor:
+          if (auto& c = field_value<std::optional<ColorInput>>(f, object)) color(name, *c, f.range);
+          break;
+        case FieldKind::Float: number(name, field_value<FloatInput>(f, object), f.range); break;
+        case FieldKind::Number: number(name, field_value<float>(f, object), f.range); break;
+        case FieldKind::NumberIfGiven:
+          if (field_second<bool>(f, object)) number(name, field_value<float>(f, object), f.range);
+          break;
+        case FieldKind::Roughness: roughness(prefix, field_value<Roughness>(f, object)); break;
+        // Not edited here: switches, and references to other materials and textures.
+        case FieldKind::Flag:
+        case FieldKind::Material:
+        case FieldKind::MaterialPair:
+        case FieldKind::Texture: break;
+      }
+    }
+    schema_ = nullptr;
+    object_ = nullptr;
+  }
 
  private:
   std::vector<Slot>& out_;
+  const TypeSchema* schema_ = nullptr;
+  void* object_ = nullptr;
 };
 
 // Names for the entries of a list: each entry's own name where it has one that no other entry
@@ -85,64 +112,6 @@ std::string material_name(const SceneDesc& scene, size_t i) {
   if (key.starts_with("/materials/") && key.find('/', 11) == std::string::npos) return key.substr(11);
   if (key.starts_with("newmtl ")) return key.substr(7);
   return "";
-}
-
-void material_slots(Slots& s, const std::string& p, MaterialDesc& material) {
-  std::visit(overloaded{
-                 [&](DiffuseMaterial& m) { s.color(p + "reflectance", m.reflectance); },
-                 [&](PhongMaterial& m) {
-                   s.color(p + "diffuse", m.diffuse);
-                   s.color(p + "specular", m.specular);
-                   s.number(p + "exponent", m.exponent);
-                   s.color(p + "transmission", m.transmission);
-                   s.number(p + "ior", m.ior, 0, kInf, true);
-                 },
-                 [&](MirrorMaterial& m) { s.color(p + "reflectance", m.reflectance); },
-                 [&](ConductorMaterial& m) {
-                   s.color(p + "eta", m.eta);
-                   s.color(p + "k", m.k);
-                   if (m.reflectance) s.color(p + "reflectance", *m.reflectance);
-                   s.color(p + "specular_tint", m.specular_tint);
-                   s.roughness(p, m.roughness);
-                 },
-                 [&](DielectricMaterial& m) {
-                   s.number(p + "ior", m.ior, 0, kInf, true);
-                   s.color(p + "reflectance", m.reflectance);
-                   s.color(p + "transmittance", m.transmittance);
-                   s.roughness(p, m.roughness);
-                 },
-                 [&](CoatedDiffuseMaterial& m) {
-                   s.color(p + "reflectance", m.reflectance);
-                   s.color(p + "specular", m.specular);
-                   s.number(p + "ior", m.ior, 0, kInf, true);
-                   s.roughness(p, m.roughness);
-                 },
-                 [&](DiffuseTransmissionMaterial& m) {
-                   s.color(p + "reflectance", m.reflectance);
-                   s.color(p + "transmittance", m.transmittance);
-                 },
-                 [&](PrincipledMaterial& m) {
-                   s.color(p + "base_color", m.base_color);
-                   s.number(p + "roughness", m.roughness, 0, 1);
-                   s.number(p + "metallic", m.metallic, 0, 1);
-                   s.number(p + "specular", m.specular, 0, kInf);
-                   s.number(p + "specular_tint", m.specular_tint, 0, 1);
-                   s.number(p + "anisotropic", m.anisotropic, 0, 1);
-                   s.number(p + "sheen", m.sheen, 0, kInf);
-                   s.number(p + "sheen_tint", m.sheen_tint, 0, 1);
-                   s.number(p + "clearcoat", m.clearcoat, 0, kInf);
-                   s.number(p + "clearcoat_gloss", m.clearcoat_gloss, 0, 1);
-                   s.number(p + "spec_trans", m.spec_trans, 0, 1);
-                   s.number(p + "diff_trans", m.diff_trans, 0, 2);
-                   s.number(p + "flatness", m.flatness, 0, 1);
-                 },
-                 [&](MaskMaterial& m) { s.number(p + "opacity", m.opacity, 0, 1); },
-                 [&](BlendMaterial& m) { s.number(p + "weight", m.weight, 0, 1); },
-                 // Nothing constant of their own (the materials they wrap have their own entries).
-                 [](BlackMaterial&) {}, [](InterfaceMaterial&) {}, [](OneSidedMaterial&) {},
-                 [](TwoSidedMaterial&) {}, [](NormalMapMaterial&) {}, [](BumpMapMaterial&) {},
-             },
-             material);
 }
 
 void light_slots(Slots& s, const std::string& p, LightDesc& light) {
@@ -171,14 +140,15 @@ std::vector<Slot> slots(SceneDesc& scene) {
   std::vector<Slot> out;
   Slots s(out);
   s.transform("camera.to_world", scene.camera.world_from_camera);
-  if (scene.camera.projection == Projection::Perspective) s.number("camera.fov", scene.camera.fov_degrees, 0, 180, true, true);
+  if (scene.camera.projection == Projection::Perspective) s.number("camera.fov", scene.camera.fov_degrees, ValueRange{.lo = 0, .hi = 180, .lo_open = true, .hi_open = true});
   s.number("camera.lens_radius", scene.camera.lens_radius);
-  s.number("camera.focus_distance", scene.camera.focus_distance, 0, kInf, true);
+  s.number("camera.focus_distance", scene.camera.focus_distance, kPositive);
   std::vector<std::string> names;
   for (size_t i = 0; i < scene.materials.size(); ++i) names.push_back(material_name(scene, i));
   std::vector<std::string> material_labels = labels(names);
   for (size_t i = 0; i < scene.materials.size(); ++i)
-    material_slots(s, "materials." + material_labels[i] + ".", scene.materials[i]);
+    std::visit([&](auto& m) { s.fields("materials." + material_labels[i] + ".", SchemaOf<std::decay_t<decltype(m)>>::schema, &m); },
+               scene.materials[i]);
   for (size_t i = 0; i < scene.lights.size(); ++i) light_slots(s, fmt::format("lights.{}.", i), scene.lights[i]);
   names.clear();
   for (const ShapeDesc& shape : scene.shapes) names.push_back(shape.name);
@@ -197,10 +167,10 @@ std::vector<Slot> slots(SceneDesc& scene) {
     MediumDesc& m = scene.media[i];
     const std::string p = "media." + medium_labels[i] + ".";
     s.color(p + "sigma_t", m.sigma_t);
-    if (m.albedo.is_constant()) s.color(p + "albedo", m.albedo.constant, 1);
+    if (m.albedo.is_constant()) s.color(p + "albedo", m.albedo.constant, kAlbedo);
     s.number(p + "scale", m.scale);
     s.color(p + "emission", m.emission);
-    s.number(p + "g", m.g, -1, 1, true, true);
+    s.number(p + "g", m.g, ValueRange{.lo = -1, .hi = 1, .lo_open = true, .hi_open = true});
   }
   return out;
 }
@@ -221,7 +191,11 @@ const Slot& find_slot(const std::vector<Slot>& all, const std::string& name) {
   for (const Slot& s : all)
     if (s.name == name) slot = &s;
   if (!slot) {
-    // The names that share the longest prefix with the one asked for, to point at a typo.
+    // A likely typo, else the names that share the longest prefix with the one asked for.
+    std::vector<std::string_view> names;
+    for (const Slot& s : all) names.push_back(s.name);
+    if (std::optional<std::string_view> near = nearest_name(name, names))
+      throw UnknownParameterError(fmt::format("no scene parameter '{}'; did you mean '{}'?", name, *near));
     std::string near;
     size_t best = 0;
     for (const Slot& s : all) {
@@ -235,12 +209,23 @@ const Slot& find_slot(const std::vector<Slot>& all, const std::string& name) {
   return *slot;
 }
 
+// After a change: the object's cross-field rule (Phong's d + s + t <= 1) must still hold, else the
+// change is undone and refused.
+template <typename Undo>
+void keep_schema_rule(const Slot& slot, const std::string& name, Undo undo) {
+  if (!slot.schema || !slot.schema->check) return;
+  if (std::optional<SchemaViolation> violation = slot.schema->check(slot.object)) {
+    undo();
+    throw UsageError(fmt::format("{}: {}", name, violation->message));
+  }
+}
+
 }  // namespace
 
 std::vector<SceneParameter> scene_parameters(const SceneDesc& scene) {
   std::vector<SceneParameter> out;
   for (const Slot& slot : slots(const_cast<SceneDesc&>(scene)))  // read only
-    out.push_back({slot.name, value_of(slot), slot.range()});
+    out.push_back({slot.name, value_of(slot), slot.describe_range()});
   return out;
 }
 
@@ -257,18 +242,23 @@ void set_scene_parameter(SceneDesc& scene, const std::string& name, const Parame
     throw UsageError(fmt::format("{}: expected {}, got {}", name, kind_name(current), kind_name(value)));
   if (slot->number) {
     float v = std::get<float>(value);
-    bool below = slot->lo_open ? !(v > slot->lo) : !(v >= slot->lo);
-    bool above = slot->hi_open ? !(v < slot->hi) : !(v <= slot->hi);
-    if (!std::isfinite(v) || below || above)
-      throw UsageError(fmt::format("{}: {} is outside its range ({})", name, v, slot->range()));
+    if (!std::isfinite(v) || !slot->range.contains(v))
+      throw UsageError(fmt::format("{}: {} is outside its range ({})", name, v, slot->describe_range()));
+    const float before = *slot->number;
     *slot->number = v;
     if (slot->number_too) *slot->number_too = v;
+    keep_schema_rule(*slot, name, [&] {
+      *slot->number = before;
+      if (slot->number_too) *slot->number_too = before;
+    });
   } else if (slot->color) {
     RGB c = std::get<RGB>(value);
     for (int i = 0; i < 3; ++i)
-      if (!std::isfinite(c[i]) || c[i] < 0 || c[i] > slot->hi)
-        throw UsageError(fmt::format("{}: ({}, {}, {}) is outside its range ({})", name, c.r, c.g, c.b, slot->range()));
+      if (!std::isfinite(c[i]) || c[i] < 0 || !slot->range.contains(c[i]))
+        throw UsageError(fmt::format("{}: ({}, {}, {}) is outside its range ({})", name, c.r, c.g, c.b, slot->describe_range()));
+    const RGB before = *slot->color;
     *slot->color = c;
+    keep_schema_rule(*slot, name, [&] { *slot->color = before; });
   } else {
     const Matrix4& m = std::get<Matrix4>(value);
     for (const auto& row : m.m)

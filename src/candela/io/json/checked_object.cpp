@@ -105,11 +105,9 @@ void check_is_array(const ErrorReporter& report, const Json& value, const std::s
   if (!value.is_array()) report.fail(pointer, "expected an array of {}, got {}", of_what, describe(value));
 }
 
-float check_bound(const ErrorReporter& report, float x, Bound bound, const std::string& pointer) {
-  if (bound == Bound::Positive && !(x > 0)) report.fail(pointer, "expected a positive number, got {}", x);
-  if (bound == Bound::NonNegative && !(x >= 0)) report.fail(pointer, "expected a number >= 0, got {}", x);
-  if (bound == Bound::UnitInterval && !(x >= 0 && x <= 1))
-    report.fail(pointer, "expected a number in [0, 1], got {}", x);
+float check_bound(const ErrorReporter& report, float x, const ValueRange& bound, const std::string& pointer) {
+  if (!bound.contains(x) && (bound.bounded_below() || bound.bounded_above()))
+    report.fail(pointer, "expected {}, got {}", bound.expected(), x);
   return x;
 }
 

@@ -16,6 +16,8 @@
 #include <vector>
 
 #include "candela/base/enum_names.h"
+#include "candela/base/nearest_name.h"
+#include "candela/description/schema.h"
 #include "candela/io/json/source_position.h"
 #include "candela/io/parameter_usage.h"
 #include "candela/math/color.h"
@@ -82,9 +84,13 @@ E read_enum(const ErrorReporter& report, const Json& value, const std::string& p
 void check_is_array(const ErrorReporter& report, const Json& value, const std::string& pointer,
                     std::string_view of_what);
 
-enum class Bound { Any, Positive, NonNegative, UnitInterval };
+// The ranges readers check numbers against (description/schema.h's ValueRange), by their old names.
+struct Bound {
+  static constexpr ValueRange Any = kAnyValue, Positive = kPositive, NonNegative = kNonNegative,
+                              UnitInterval = kUnitInterval;
+};
 
-float check_bound(const ErrorReporter& report, float x, Bound bound, const std::string& pointer);
+float check_bound(const ErrorReporter& report, float x, const ValueRange& bound, const std::string& pointer);
 
 // One JSON object, read key by key with type checks. finish() reports the first key that no read
 // asked for, listing the keys that were asked for (the object's schema, as far as it was read).
@@ -113,10 +119,10 @@ class CheckedObject {
     return *value;
   }
 
-  float number(std::string_view key, Bound bound = Bound::Any) {
+  float number(std::string_view key, const ValueRange& bound = kAnyValue) {
     return check_bound(report_, read_float(report_, require(key), pointer_of(key)), bound, pointer_of(key));
   }
-  float number_or(std::string_view key, float fallback, Bound bound = Bound::Any) {
+  float number_or(std::string_view key, float fallback, const ValueRange& bound = kAnyValue) {
     return has(key) ? number(key, bound) : fallback;
   }
   int integer_or(std::string_view key, int fallback, int64_t min, int64_t max) {
@@ -150,8 +156,11 @@ class CheckedObject {
 
   // "_comment" may be given in any object and is never read.
   void finish() const {
-    if (const ParameterUsage::Parameter* unused = usage_.first_unused())
-      report_.fail(unused->where.key_path, "unknown key; expected one of: {}", usage_.asked_list());
+    if (const ParameterUsage::Parameter* unused = usage_.first_unused()) {
+      std::vector<std::string_view> asked(usage_.asked().begin(), usage_.asked().end());
+      report_.fail(unused->where.key_path, "unknown key{}; expected one of: {}", did_you_mean(unused->name, asked),
+                   usage_.asked_list());
+    }
   }
 
  private:

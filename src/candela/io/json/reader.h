@@ -54,8 +54,10 @@ const NamedReader<Reader>& reader_for(const NamedReader<Reader> (&table)[N], Che
   const std::string type = object.string("type");
   for (const NamedReader<Reader>& entry : table)
     if (entry.name == type) return entry;
-  object.report().fail(object.pointer_of("type"), "unknown {} type \"{}\"; expected one of: {}{}{}", kind, type,
-                       type_names(table), also_known.empty() ? "" : ", ", also_known);
+  std::vector<std::string_view> names;
+  for (const NamedReader<Reader>& entry : table) names.push_back(entry.name);
+  object.report().fail(object.pointer_of("type"), "unknown {} type \"{}\"{}; expected one of: {}{}{}", kind, type,
+                       did_you_mean(type, names), type_names(table), also_known.empty() ? "" : ", ", also_known);
 }
 
 class JsonSceneReader {
@@ -120,27 +122,22 @@ class JsonSceneReader {
   std::optional<int> texture_reference(const Json& value, const std::string& pointer);
   ColorInput read_color_input(const Json& value, const std::string& pointer, ColorKind kind);
   ColorInput color_input_or(CheckedObject& object, std::string_view key, ColorKind kind, ColorInput fallback);
-  FloatInput read_float_input(const Json& value, const std::string& pointer, Bound bound);
-  FloatInput float_input_or(CheckedObject& object, std::string_view key, Bound bound, FloatInput fallback);
+  FloatInput read_float_input(const Json& value, const std::string& pointer, const ValueRange& bound);
+  FloatInput float_input_or(CheckedObject& object, std::string_view key, const ValueRange& bound, FloatInput fallback);
 
   // ---- materials (materials.cpp)
   void read_materials(const Json& value, const std::string& pointer);
   int add_material(MaterialDesc material, SourceLocation where);
   MaterialDesc read_material(const Json& value, const std::string& pointer);
-  PhongMaterial read_phong(CheckedObject& m);
+  // The fields of a type's schema (description/schema.h) from `m`, into `object`, then its
+  // cross-field check.
+  void read_fields(CheckedObject& m, const TypeSchema& schema, void* object);
   Roughness read_roughness(CheckedObject& m);
-  ConductorMaterial read_conductor(CheckedObject& m);
-  ComplexIor read_metal(const Json& value, const std::string& pointer) const;
-  void check_positive_color(const ColorInput& input, const Json& value, const std::string& pointer) const;
-  DielectricMaterial read_dielectric(CheckedObject& m);
-  CoatedDiffuseMaterial read_coated_diffuse(CheckedObject& m);
-  DiffuseTransmissionMaterial read_diffuse_transmission(CheckedObject& m);
+  void read_conductor_preset(CheckedObject& m, ConductorMaterial& c) const;
   int material_by_name(const std::string& name, const std::string& pointer);
   int wrapped_material(CheckedObject& m, std::string_view key);
+  std::array<int, 2> material_pair(CheckedObject& m, std::string_view key);
   int texture_reference(CheckedObject& m, std::string_view key);
-  PrincipledMaterial read_principled(CheckedObject& m);
-  static PerturbedNormalOptions read_perturbed_normal_options(CheckedObject& m);
-  BlendMaterial read_blend(CheckedObject& m);
   int black_material();
 
   // ---- shapes (shapes.cpp)

@@ -208,7 +208,7 @@ ColorInput JsonSceneReader::color_input_or(CheckedObject& object, std::string_vi
   return value ? read_color_input(*value, object.pointer_of(key), kind) : fallback;
 }
 
-FloatInput JsonSceneReader::read_float_input(const Json& value, const std::string& pointer, Bound bound) {
+FloatInput JsonSceneReader::read_float_input(const Json& value, const std::string& pointer, const ValueRange& bound) {
   FloatInput input;
   if (std::optional<int> texture = texture_reference(value, pointer))
     input.texture = *texture;
@@ -219,7 +219,7 @@ FloatInput JsonSceneReader::read_float_input(const Json& value, const std::strin
   return input;
 }
 
-FloatInput JsonSceneReader::float_input_or(CheckedObject& object, std::string_view key, Bound bound, FloatInput fallback) {
+FloatInput JsonSceneReader::float_input_or(CheckedObject& object, std::string_view key, const ValueRange& bound, FloatInput fallback) {
   const Json* value = object.find(key);
   return value ? read_float_input(*value, object.pointer_of(key), bound) : fallback;
 }

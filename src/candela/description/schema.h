@@ -1,0 +1,301 @@
+#pragma once
+// One declaration of a scene type's parameters (Mitsuba 3's traverse(), pbrt-v4's
+// ParameterDictionary): each material description (and any other type that declares a SchemaOf)
+// lists its fields once, with the key scene files use, the kind of value, the member it lives in,
+// the range it accepts and a line of help; the default is the struct's own member initializer.
+// Everything that walks a type's parameters is generated from that list:
+//   the JSON reader (io/json/materials.cpp: read_fields) and writer (io/json_writer.cpp: write_fields),
+//   so `candela convert` writes what the reader reads;
+//   the editable scene parameters of the Python module (scene/parameters.cpp);
+//   which inputs are constant and which materials a wrapper wraps (materials/material.cpp);
+//   the "unknown key; did you mean" messages (base/nearest_name.h).
+//
+// A type declares:
+//   template <> struct SchemaOf<DiffuseMaterial> {
+//     static constexpr Field fields[] = {field<&DiffuseMaterial::reflectance>("reflectance", kAlbedo, "...")};
+//     static constexpr TypeSchema schema{.name = "diffuse", .fields = fields};
+//   };
+#include <fmt/format.h>
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <variant>
+
+#include "candela/description/textures.h"
+
+namespace candela {
+
+// What a number, or each component of a colour, accepts (a scene type's field, a render option): lo <= x <= hi, or lo < x / x < hi where
+// that end is open. NaN is never inside.
+struct ValueRange {
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+  bool lo_open = false, hi_open = false;
+
+  constexpr bool contains(double x) const {
+    return (lo_open ? x > lo : x >= lo) && (hi_open ? x < hi : x <= hi);
+  }
+  constexpr bool bounded_above() const { return hi < std::numeric_limits<double>::infinity(); }
+  constexpr bool bounded_below() const { return lo > -std::numeric_limits<double>::infinity(); }
+  // "a positive number", "a number >= 0", "a number in [0, 1]": for "expected ..., got x".
+  std::string expected() const {
+    if (!bounded_below() && !bounded_above()) return "a number";
+    if (lo == 0 && lo_open && !bounded_above()) return "a positive number";
+    if (!bounded_above()) return fmt::format("a number {} {}", lo_open ? ">" : ">=", lo);
+    if (!bounded_below()) return fmt::format("a number {} {}", hi_open ? "<" : "<=", hi);
+    return fmt::format("a number in {}{}, {}{}", lo_open ? '(' : '[', lo, hi, hi_open ? ')' : ']');
+  }
+  // "0 < fov < 180", "0 <= weight <= 1": the range as an inequality on `name`.
+  std::string inequality(std::string_view name) const {
+    std::string text(name);
+    if (bounded_below()) text = fmt::format("{} {} {}", lo, lo_open ? "<" : "<=", text);
+    if (bounded_above()) text += fmt::format(" {} {}", hi_open ? "<" : "<=", hi);
+    return text;
+  }
+};
+
+inline constexpr ValueRange kAnyValue{};
+inline constexpr ValueRange kNonNegative{.lo = 0};
+inline constexpr ValueRange kPositive{.lo = 0, .lo_open = true};
+inline constexpr ValueRange kUnitInterval{.lo = 0, .hi = 1};
+// Colours: reflectances and albedos cannot exceed 1 without creating energy; other colours (an
+// index of refraction, emission) need only be >= 0.
+inline constexpr ValueRange kAlbedo = kUnitInterval;
+
+// The kind of value a field holds, which fixes the C++ type of its member.
+enum class FieldKind {
+  Color,          // ColorInput: [r, g, b], one number for grey, or a texture
+  OptionalColor,  // std::optional<ColorInput>: as Color, absent unless given
+  Float,          // FloatInput: a number or a texture
+  Number,         // float
+  NumberIfGiven,  // float, with a bool member (`flag`) that says whether it was given
+  Flag,           // bool
+  Roughness,      // Roughness: "roughness" or "alpha_u" + "alpha_v", "remap_roughness", "distribution"
+  Material,       // int: the index of a material this one wraps (given by name or inline)
+  MaterialPair,   // two ints (the member and `second`): the materials a blend mixes, as a list of two
+  Texture,        // int: the index of a texture (given by name or inline)
+};
+constexpr std::string_view enum_name(FieldKind v) {
+  switch (v) {
+    case FieldKind::Color: return "color";
+    case FieldKind::OptionalColor: return "optional_color";
+    case FieldKind::Float: return "float";
+    case FieldKind::Number: return "number";
+    case FieldKind::NumberIfGiven: return "number_if_given";
+    case FieldKind::Flag: return "flag";
+    case FieldKind::Roughness: return "roughness";
+    case FieldKind::Material: return "material";
+    case FieldKind::MaterialPair: return "material_pair";
+    case FieldKind::Texture: return "texture";
+  }
+  return {};
+}
+
+// One parameter of a scene type. `member` finds it inside an object of that type; `second` is the
+// second index of a MaterialPair, or the "given" flag of a NumberIfGiven.
+struct Field {
+  std::string_view key;
+  FieldKind kind;
+  void* (*member)(void* object) = nullptr;
+  void* (*second)(void* object) = nullptr;
+  ValueRange range{};
+  std::string_view help;
+  // The key of another field that, where given, makes this one meaningless (a conductor's eta and k
+  // where its reflectance is given): the two may not be given together, and it is not written then.
+  std::string_view unless;
+
+  constexpr Field ignored_where(std::string_view other) const {
+    Field f = *this;
+    f.unless = other;
+    return f;
+  }
+};
+
+// A cross-field rule the fields' ranges cannot say (Phong's d + s + t <= 1). Returns what is wrong,
+// with the key it is best reported at (empty: the object itself), or nothing.
+struct SchemaViolation {
+  std::string key;
+  std::string message;
+};
+using SchemaCheck = std::optional<SchemaViolation> (*)(const void* object);
+
+struct TypeSchema {
+  std::string_view name;                          // the "type" scene files give
+  std::span<const std::string_view> aliases = {};  // other names the readers accept ("glass")
+  std::span<const Field> fields = {};
+  SchemaCheck check = nullptr;
+  std::string_view help;
+
+  bool named(std::string_view type) const {
+    if (type == name) return true;
+    for (std::string_view alias : aliases)
+      if (type == alias) return true;
+    return false;
+  }
+};
+
+// Each described type specialises SchemaOf with `static constexpr TypeSchema schema`.
+template <typename T>
+struct SchemaOf;
+
+namespace schema_detail {
+
+template <typename M>
+struct MemberTraits;
+template <typename C, typename V>
+struct MemberTraits<V C::*> {
+  using Class = C;
+  using Value = V;
+};
+
+template <auto First, auto... Rest>
+constexpr auto* follow(typename MemberTraits<decltype(First)>::Class* object) {
+  auto* member = &(object->*First);
+  if constexpr (sizeof...(Rest) == 0) return member;
+  else return follow<Rest...>(member);
+}
+
+template <auto... Path>
+struct Last;
+template <auto Only>
+struct Last<Only> {
+  using Value = typename MemberTraits<decltype(Only)>::Value;
+};
+template <auto First, auto... Rest>
+struct Last<First, Rest...> : Last<Rest...> {};
+
+// The member at the end of Path (a chain of member pointers: &Outer::options, &Options::flag),
+// from a pointer to the outer object.
+template <auto First, auto... Rest>
+void* member_at(void* object) {
+  return follow<First, Rest...>(static_cast<typename MemberTraits<decltype(First)>::Class*>(object));
+}
+
+template <typename V>
+constexpr FieldKind kind_of() {
+  if constexpr (std::is_same_v<V, ColorInput>) return FieldKind::Color;
+  else if constexpr (std::is_same_v<V, std::optional<ColorInput>>) return FieldKind::OptionalColor;
+  else if constexpr (std::is_same_v<V, FloatInput>) return FieldKind::Float;
+  else if constexpr (std::is_same_v<V, float>) return FieldKind::Number;
+  else if constexpr (std::is_same_v<V, bool>) return FieldKind::Flag;
+  else static_assert(sizeof(V) == 0, "no field kind for this member type (indices: material_ref, texture_ref)");
+}
+
+}  // namespace schema_detail
+
+// A field whose kind follows from its member's type (ColorInput, FloatInput, float, bool, ...).
+template <auto... Path>
+constexpr Field field(std::string_view key, ValueRange range = kAnyValue, std::string_view help = {}) {
+  using V = typename schema_detail::Last<Path...>::Value;
+  return Field{.key = key, .kind = schema_detail::kind_of<V>(), .member = &schema_detail::member_at<Path...>,
+               .range = range, .help = help};
+}
+template <auto Member>
+constexpr Field roughness_field(std::string_view help = {}) {
+  return Field{.key = "roughness", .kind = FieldKind::Roughness, .member = &schema_detail::member_at<Member>,
+               .range = kNonNegative, .help = help};
+}
+template <auto Member>
+constexpr Field material_ref(std::string_view key, std::string_view help = {}) {
+  static_assert(std::is_same_v<typename schema_detail::MemberTraits<decltype(Member)>::Value, int>);
+  return Field{.key = key, .kind = FieldKind::Material, .member = &schema_detail::member_at<Member>, .help = help};
+}
+template <auto First, auto Second>
+constexpr Field material_pair(std::string_view key, std::string_view help = {}) {
+  return Field{.key = key, .kind = FieldKind::MaterialPair, .member = &schema_detail::member_at<First>,
+               .second = &schema_detail::member_at<Second>, .help = help};
+}
+template <auto Member>
+constexpr Field texture_ref(std::string_view key, std::string_view help = {}) {
+  static_assert(std::is_same_v<typename schema_detail::MemberTraits<decltype(Member)>::Value, int>);
+  return Field{.key = key, .kind = FieldKind::Texture, .member = &schema_detail::member_at<Member>, .help = help};
+}
+template <auto Value, auto Given>
+constexpr Field number_if_given(std::string_view key, ValueRange range, std::string_view help = {}) {
+  return Field{.key = key, .kind = FieldKind::NumberIfGiven, .member = &schema_detail::member_at<Value>,
+               .second = &schema_detail::member_at<Given>, .range = range, .help = help};
+}
+
+// The field's member in `object` (V must be the C++ type of the field's kind), and the second
+// member of a MaterialPair (int) or NumberIfGiven (bool).
+template <typename V>
+V& field_value(const Field& f, void* object) {
+  return *static_cast<V*>(f.member(object));
+}
+template <typename V>
+const V& field_value(const Field& f, const void* object) {
+  return *static_cast<const V*>(f.member(const_cast<void*>(object)));
+}
+template <typename V>
+V& field_second(const Field& f, void* object) {
+  return *static_cast<V*>(f.second(object));
+}
+template <typename V>
+const V& field_second(const Field& f, const void* object) {
+  return *static_cast<const V*>(f.second(const_cast<void*>(object)));
+}
+
+// Whether the object's field `key` was given: an optional colour that is set, a number whose flag
+// says so (other kinds always hold a value).
+inline bool field_given(const TypeSchema& schema, std::string_view key, const void* object) {
+  for (const Field& f : schema.fields)
+    if (f.key == key) {
+      if (f.kind == FieldKind::OptionalColor) return field_value<std::optional<ColorInput>>(f, object).has_value();
+      if (f.kind == FieldKind::NumberIfGiven) return field_second<bool>(f, object);
+      return true;
+    }
+  return false;
+}
+
+// The schema of the type a variant holds.
+template <typename... Ts>
+const TypeSchema& schema_of(const std::variant<Ts...>& value) {
+  return std::visit([](const auto& v) -> const TypeSchema& { return SchemaOf<std::decay_t<decltype(v)>>::schema; },
+                    value);
+}
+
+// The alternative of Variant whose schema is named `type` (or has it as an alias), default-constructed.
+template <typename Variant>
+std::optional<Variant> default_of_type(std::string_view type) {
+  std::optional<Variant> out;
+  [&]<size_t... I>(std::index_sequence<I...>) {
+    ((!out && SchemaOf<std::variant_alternative_t<I, Variant>>::schema.named(type)
+          ? void(out.emplace(std::in_place_index<I>))
+          : void()),
+     ...);
+  }(std::make_index_sequence<std::variant_size_v<Variant>>());
+  return out;
+}
+
+// Every type name (aliases included) of a variant's alternatives, in declaration order.
+template <typename Variant>
+std::vector<std::string_view> type_names_of() {
+  std::vector<std::string_view> names;
+  [&]<size_t... I>(std::index_sequence<I...>) {
+    auto add = [&](const TypeSchema& s) {
+      names.push_back(s.name);
+      names.insert(names.end(), s.aliases.begin(), s.aliases.end());
+    };
+    (add(SchemaOf<std::variant_alternative_t<I, Variant>>::schema), ...);
+  }(std::make_index_sequence<std::variant_size_v<Variant>>());
+  return names;
+}
+
+// The object's violation of its type's cross-field rule, if any.
+template <typename... Ts>
+std::optional<SchemaViolation> check_schema(const std::variant<Ts...>& value) {
+  return std::visit(
+      [](const auto& v) -> std::optional<SchemaViolation> {
+        const TypeSchema& s = SchemaOf<std::decay_t<decltype(v)>>::schema;
+        return s.check ? s.check(&v) : std::nullopt;
+      },
+      value);
+}
+
+}  // namespace candela

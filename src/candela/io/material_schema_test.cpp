@@ -1,0 +1,233 @@
+// The material schemas (description/materials.h) walked field by field through every front end
+// generated from them: the JSON writer and reader (so `candela convert`), the editable scene
+// parameters (scene/parameters.h), and the "did you mean" messages. A field added to a schema is
+// checked here with no other edit.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+
+#include "candela/base/error.h"
+#include "candela/base/nearest_name.h"
+#include "candela/description/scene_desc.h"
+#include "candela/io/json_writer.h"
+#include "candela/io/scene_reader.h"
+#include "candela/scene/parameters.h"
+
+namespace candela {
+namespace {
+
+// A value for the field that differs from the type's default and keeps every cross-field rule
+// (Phong's d + s + t <= 1, diffuse transmission's reflectance + transmittance <= 1): materials 0
+// and 1 and texture 0 exist in the test scene.
+void set_probe(const Field& f, void* object) {
+  const RGB color(0.125f, 0.25f, 0.375f);
+  const float number = 0.25f;
+  switch (f.kind) {
+    case FieldKind::Color: field_value<ColorInput>(f, object) = color; break;
+    case FieldKind::OptionalColor: field_value<std::optional<ColorInput>>(f, object) = ColorInput(color); break;
+    case FieldKind::Float: field_value<FloatInput>(f, object) = number; break;
+    case FieldKind::Number: field_value<float>(f, object) = number; break;
+    case FieldKind::NumberIfGiven:
+      field_value<float>(f, object) = number;
+      field_second<bool>(f, object) = true;
+      break;
+    case FieldKind::Flag: field_value<bool>(f, object) = !field_value<bool>(f, object); break;
+    case FieldKind::Roughness:
+      field_value<Roughness>(f, object) =
+          Roughness{.u = number, .v = number, .remap = true, .distribution = MicrofacetDistribution::Beckmann};
+      break;
+    case FieldKind::Material: field_value<int>(f, object) = 1; break;
+    case FieldKind::MaterialPair:
+      field_value<int>(f, object) = 1;
+      field_second<int>(f, object) = 0;
+      break;
+    case FieldKind::Texture: field_value<int>(f, object) = 0; break;
+  }
+}
+
+// Whether the field holds the same value in a and b; `what` says what differs.
+bool same_field(const Field& f, const void* a, const void* b, std::string& what) {
+  auto same_input = [](const auto& x, const auto& y) { return x.texture == y.texture && x.value == y.value; };
+  bool same = true;
+  switch (f.kind) {
+    case FieldKind::Color: same = same_input(field_value<ColorInput>(f, a), field_value<ColorInput>(f, b)); break;
+    case FieldKind::OptionalColor: {
+      const auto &x = field_value<std::optional<ColorInput>>(f, a), &y = field_value<std::optional<ColorInput>>(f, b);
+      same = bool(x) == bool(y) && (!x || same_input(*x, *y));
+      break;
+    }
+    case FieldKind::Float: same = same_input(field_value<FloatInput>(f, a), field_value<FloatInput>(f, b)); break;
+    case FieldKind::Number: same = field_value<float>(f, a) == field_value<float>(f, b); break;
+    case FieldKind::NumberIfGiven:
+      same = field_value<float>(f, a) == field_value<float>(f, b) && field_second<bool>(f, a) == field_second<bool>(f, b);
+      break;
+    case FieldKind::Flag: same = field_value<bool>(f, a) == field_value<bool>(f, b); break;
+    case FieldKind::Roughness: {
+      const Roughness &x = field_value<Roughness>(f, a), &y = field_value<Roughness>(f, b);
+      same = same_input(x.u, y.u) && same_input(x.v, y.v) && x.remap == y.remap && x.distribution == y.distribution;
+      break;
+    }
+    case FieldKind::Material:
+    case FieldKind::Texture: same = field_value<int>(f, a) == field_value<int>(f, b); break;
+    case FieldKind::MaterialPair:
+      same = field_value<int>(f, a) == field_value<int>(f, b) && field_second<int>(f, a) == field_second<int>(f, b);
+      break;
+  }
+  if (!same) what = std::string(f.key);
+  return same;
+}
+
+SceneDesc schema_test_scene() {
+  SceneDesc scene = read_json_scene(builtin_scene_json(), "builtin", ".");
+  scene.textures.push_back(CheckerboardTexture{});
+  return scene;
+}
+
+void* material_address(MaterialDesc& m) { return std::visit([](auto& x) -> void* { return &x; }, m); }
+
+// Each alternative of MaterialDesc, default-constructed.
+std::vector<MaterialDesc> every_material_type() {
+  std::vector<MaterialDesc> out;
+  [&]<size_t... I>(std::index_sequence<I...>) {
+    (out.emplace_back(std::in_place_index<I>), ...);
+  }(std::make_index_sequence<std::variant_size_v<MaterialDesc>>());
+  return out;
+}
+
+TEST(MaterialSchema, NamesAndKeysAreUnique) {
+  std::set<std::string_view> names;
+  for (std::string_view name : type_names_of<MaterialDesc>()) EXPECT_TRUE(names.insert(name).second) << name;
+  for (MaterialDesc& m : every_material_type()) {
+    const TypeSchema& schema = schema_of(m);
+    EXPECT_EQ(default_of_type<MaterialDesc>(schema.name)->index(), m.index()) << schema.name;
+    std::set<std::string_view> keys;
+    std::set<void*> members;
+    for (const Field& f : schema.fields) {
+      EXPECT_TRUE(keys.insert(f.key).second) << schema.name << "." << f.key;
+      EXPECT_TRUE(members.insert(f.member(material_address(m))).second) << schema.name << "." << f.key << " shares a member";
+    }
+  }
+}
+
+// Every field of every material, set to a value that is not its default, is written by the JSON
+// writer and read back by the JSON reader unchanged.
+TEST(MaterialSchema, EveryFieldRoundTripsThroughJson) {
+  for (MaterialDesc& probe : every_material_type()) {
+    const TypeSchema& schema = schema_of(probe);
+    for (const Field& f : schema.fields) set_probe(f, material_address(probe));
+    SceneDesc scene = schema_test_scene();
+    scene.materials.push_back(probe);
+    SceneDesc back = read_json_scene(scene_to_json(scene), "round-trip.json", ".");
+    ASSERT_EQ(back.materials.size(), scene.materials.size()) << schema.name;
+    MaterialDesc& read = back.materials.back();
+    ASSERT_EQ(read.index(), probe.index()) << schema.name;
+    for (const Field& f : schema.fields) {
+      if (!f.unless.empty() && field_given(schema, f.unless, material_address(probe))) continue;  // not written
+      std::string what;
+      EXPECT_TRUE(same_field(f, material_address(probe), material_address(read), what)) << schema.name << "." << what;
+    }
+  }
+}
+
+// Every constant number and colour of every material is an editable scene parameter, named
+// materials.<label>.<key>.
+TEST(MaterialSchema, EveryConstantInputIsAnEditableParameter) {
+  for (MaterialDesc& probe : every_material_type()) {
+    const TypeSchema& schema = schema_of(probe);
+    for (const Field& f : schema.fields) set_probe(f, material_address(probe));
+    SceneDesc scene = schema_test_scene();
+    scene.materials.push_back(probe);
+    std::set<std::string> names;
+    for (const SceneParameter& p : scene_parameters(scene)) names.insert(p.name);
+    const std::string prefix = fmt::format("materials.{}.", scene.materials.size() - 1);
+    for (const Field& f : schema.fields) {
+      const bool editable = f.kind == FieldKind::Color || f.kind == FieldKind::OptionalColor ||
+                            f.kind == FieldKind::Float || f.kind == FieldKind::Number ||
+                            f.kind == FieldKind::NumberIfGiven || f.kind == FieldKind::Roughness;
+      EXPECT_EQ(names.count(prefix + std::string(f.key)), editable ? 1u : 0u) << schema.name << "." << f.key;
+    }
+  }
+}
+
+TEST(MaterialSchema, ParameterEditsKeepTheCrossFieldRule) {
+  SceneDesc scene = schema_test_scene();
+  scene.materials.push_back(PhongMaterial{.d = 0.5f, .s = 0.25f, .t = 0});
+  const std::string d = fmt::format("materials.{}.d", scene.materials.size() - 1);
+  set_scene_parameter(scene, d, 0.75f);
+  EXPECT_EQ(std::get<float>(scene_parameter(scene, d)), 0.75f);
+  try {
+    set_scene_parameter(scene, d, 0.9f);
+    FAIL() << "d + s + t > 1 was accepted";
+  } catch (const UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("d + s + t must be <= 1"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(std::get<float>(scene_parameter(scene, d)), 0.75f);  // unchanged
+  // A reflectance is at most 1: the schema's range.
+  const std::string r = "materials.white.reflectance";
+  EXPECT_THROW(set_scene_parameter(scene, r, RGB(1.5f)), UsageError);
+}
+
+std::string material_json_error(const nlohmann::json& material) {
+  nlohmann::json scene = nlohmann::json::parse(builtin_scene_json());
+  scene["materials"]["white"] = material;
+  try {
+    read_json_scene(scene.dump(), "typo.json", ".");
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(MaterialSchema, MisspeltNamesGetADidYouMean) {
+  EXPECT_NE(material_json_error({{"type", "difuse"}}).find("did you mean \"diffuse\"?"), std::string::npos)
+      << material_json_error({{"type", "difuse"}});
+  const std::string key = material_json_error({{"type", "diffuse"}, {"reflectanse", 0.5}});
+  EXPECT_NE(key.find("/materials/white/reflectanse"), std::string::npos) << key;
+  EXPECT_NE(key.find("did you mean \"reflectance\"?"), std::string::npos) << key;
+  // Nothing close: no suggestion, the list of keys.
+  const std::string far = material_json_error({{"type", "diffuse"}, {"zzzzzzzz", 0.5}});
+  EXPECT_EQ(far.find("did you mean"), std::string::npos) << far;
+  EXPECT_NE(far.find("expected one of: "), std::string::npos) << far;
+}
+
+TEST(MaterialSchema, MisspeltParameterNamesGetADidYouMean) {
+  SceneDesc scene = schema_test_scene();
+  try {
+    scene_parameter(scene, "materials.white.reflectanse");
+    FAIL() << "a misspelt parameter was found";
+  } catch (const UnknownParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("did you mean 'materials.white.reflectance'?"), std::string::npos) << e.what();
+  }
+}
+
+// docs/scene-format.md names every material type and every key of its schema (as `name`).
+TEST(MaterialSchema, EveryTypeAndKeyIsDocumented) {
+  std::ifstream in(std::string(CANDELA_SOURCE_DIR) + "/docs/scene-format.md");
+  ASSERT_TRUE(in) << "docs/scene-format.md";
+  const std::string docs((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto documented = [&](std::string_view name) {
+    return docs.find("`" + std::string(name) + "`") != std::string::npos ||
+           docs.find("\"" + std::string(name) + "\"") != std::string::npos;
+  };
+  for (std::string_view name : type_names_of<MaterialDesc>()) EXPECT_TRUE(documented(name)) << "type " << name;
+  for (MaterialDesc& m : every_material_type())
+    for (const Field& f : schema_of(m).fields) EXPECT_TRUE(documented(f.key)) << schema_of(m).name << "." << f.key;
+}
+
+TEST(NearestName, FindsLikelyTypos) {
+  const std::string_view names[] = {"roughness", "reflectance", "ior", "specular_tint"};
+  EXPECT_EQ(nearest_name("rougness", names), "roughness");
+  EXPECT_EQ(nearest_name("Reflectance", names), "reflectance");
+  EXPECT_EQ(nearest_name("ion", names), "ior");
+  EXPECT_EQ(nearest_name("specular_tnit", names), "specular_tint");  // swapped neighbours: one edit
+  EXPECT_EQ(nearest_name("colour", names), std::nullopt);
+  EXPECT_EQ(nearest_name("", names), std::nullopt);
+  EXPECT_EQ(did_you_mean("xyz", names), "");
+}
+
+}  // namespace
+}  // namespace candela
