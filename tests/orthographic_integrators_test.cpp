@@ -47,7 +47,7 @@ SceneDesc orthographic_scene() {
   spot.intensity = RGB(3.0f, 2.5f, 2.0f);
   spot.cone_angle = 25;
   spot.cone_delta = 10;
-  spot.mitsuba_falloff = true;
+  spot.falloff = SpotFalloff::Linear;
   ProjectorLight projector;
   projector.to_world = Transform::look_at_right_handed({1, 0.5f, -3}, {0.8f, 0, 0}, {0, 1, 0});
   projector.fov_degrees = 30;

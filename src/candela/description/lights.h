@@ -1,5 +1,6 @@
 #pragma once
-// Lights that are not shapes (emissive shapes are ShapeDesc::emission). Part of the format-neutral scene description (description/scene_desc.h).
+// Lights that are not shapes (emissive shapes are ShapeDesc::emission), each with its schema
+// (description/schema.h). Part of the format-neutral scene description (description/scene_desc.h).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -17,6 +18,7 @@
 #include "candela/math/color.h"
 #include "candela/math/transform.h"
 #include "candela/math/vec.h"
+#include "candela/description/schema.h"
 #include "candela/description/textures.h"
 
 namespace candela {
@@ -25,9 +27,30 @@ struct PointLight {
   Point3 position{0.0f};
   RGB intensity{1.0f};  // W/sr
 };
+template <>
+struct SchemaOf<PointLight> {
+  static constexpr Field fields[] = {
+      point_field<&PointLight::position>("position").required_field(),
+      field<&PointLight::intensity>("intensity", kNonNegative, "W/sr").required_field(),
+  };
+  static constexpr TypeSchema schema{.name = "point", .fields = fields, .help = "a point light"};
+};
+
+// How a spot light falls off between its beam and its cutoff angle.
+enum class SpotFalloff {
+  Smoothstep,  // pbrt-v4's smoothstep in cos(angle)
+  Linear,      // Mitsuba 3's: linear in the angle
+};
+constexpr std::string_view enum_name(SpotFalloff v) {
+  switch (v) {
+    case SpotFalloff::Smoothstep: return "smoothstep";
+    case SpotFalloff::Linear: return "linear";
+  }
+  return {};
+}
 
 // Point light emitting into a cone around `direction`: full intensity inside cone_angle - cone_delta,
-// falling off to zero at cone_angle with pbrt-v4's smoothstep in cos(angle), or (mitsuba_falloff)
+// falling off to zero at cone_angle with pbrt-v4's smoothstep in cos(angle), or (SpotFalloff::Linear)
 // with Mitsuba 3's spot: linearly in the angle from beam width = cone_angle - cone_delta to cone_angle,
 // times the image `texture` projected over the cone (-1 = none), as Mitsuba defines both.
 struct SpotLight {
@@ -36,9 +59,31 @@ struct SpotLight {
   RGB intensity{1.0f};  // W/sr on the axis
   float cone_angle = 30;  // degrees from the axis where the light reaches zero
   float cone_delta = 5;   // degrees over which it falls off
-  bool mitsuba_falloff = false;
+  SpotFalloff falloff = SpotFalloff::Smoothstep;
   int texture = -1;      // index into SceneDesc::textures
   Vec3 up{0, 1, 0};      // with a texture: the image's up direction (the light frame's +y)
+};
+inline std::optional<SchemaViolation> check_spot(const void* object) {
+  const auto& spot = *static_cast<const SpotLight*>(object);
+  if (spot.cone_delta <= spot.cone_angle) return std::nullopt;
+  return SchemaViolation{"cone_delta", fmt::format("cone_delta must be in [0, cone_angle] = [0, {}] degrees, got {}",
+                                                   spot.cone_angle, spot.cone_delta)};
+}
+template <>
+struct SchemaOf<SpotLight> {
+  using L = SpotLight;
+  static constexpr Field fields[] = {
+      point_field<&L::position>("position").required_field(),
+      direction_field<&L::direction>("direction", "the cone's axis"),
+      field<&L::intensity>("intensity", kNonNegative, "W/sr on the axis").required_field(),
+      field<&L::cone_angle>("cone_angle", ValueRange{.lo = 0, .hi = 180, .lo_open = true}, "degrees to zero"),
+      field<&L::cone_delta>("cone_delta", ValueRange{.lo = 0, .hi = 180}, "degrees of falloff"),
+      enum_field<&L::falloff>("falloff"),
+      texture_ref<&L::texture>("texture", "an image projected over the cone"),
+      direction_field<&L::up>("up", "the image's up direction"),
+  };
+  static constexpr TypeSchema schema{.name = "spot", .fields = fields, .check = &check_spot,
+                                     .help = "a point light in a cone"};
 };
 
 // A point light that projects an image (Mitsuba's "projector"): at the origin of to_world looking
@@ -51,12 +96,32 @@ struct ProjectorLight {
   int irradiance = -1;
   RGB scale{1.0f};
 };
+template <>
+struct SchemaOf<ProjectorLight> {
+  using L = ProjectorLight;
+  static constexpr Field fields[] = {
+      field<&L::to_world>("transform", kAnyValue, "from the projector's frame (looking along +z) to the world"),
+      field<&L::fov_degrees>("fov", ValueRange{.lo = 0, .hi = 180, .lo_open = true, .hi_open = true},
+                             "degrees, on the image's wider axis"),
+      texture_ref<&L::irradiance>("irradiance").required_field(),
+      field<&L::scale>("scale", kNonNegative),
+  };
+  static constexpr TypeSchema schema{.name = "projector", .fields = fields, .help = "projects an image"};
+};
 
 // Parallel light from infinitely far away, travelling along `direction`; `radiance` is the
 // irradiance it delivers to a surface facing it (pbrt-v4's distant "L").
 struct DistantLight {
   Vec3 direction{0, 0, 1};
   RGB radiance{1.0f};
+};
+template <>
+struct SchemaOf<DistantLight> {
+  static constexpr Field fields[] = {
+      direction_field<&DistantLight::direction>("direction", "where the light travels").required_field(),
+      field<&DistantLight::radiance>("radiance", kNonNegative, "irradiance on a facing surface").required_field(),
+  };
+  static constexpr TypeSchema schema{.name = "distant", .fields = fields, .help = "parallel light"};
 };
 
 // Light from infinitely far away in every direction. Constant when zenith == horizon == ground;
@@ -68,6 +133,16 @@ struct SkyLight {
   RGB ground{1.0f};
   Vec3 up{0, 1, 0};
   bool is_constant() const { return zenith == horizon && horizon == ground; }
+};
+template <>
+struct SchemaOf<SkyLight> {
+  static constexpr Field fields[] = {
+      field<&SkyLight::zenith>("zenith", kNonNegative),
+      field<&SkyLight::horizon>("horizon", kNonNegative),
+      field<&SkyLight::ground>("ground", kNonNegative),
+      direction_field<&SkyLight::up>("up"),
+  };
+  static constexpr TypeSchema schema{.name = "sky", .fields = fields, .help = "a sky gradient, or constant"};
 };
 
 // How an environment image covers the sphere of directions, in the light's local frame.
@@ -99,6 +174,18 @@ struct EnvironmentMap {
   RGB scale{1.0f};
   Transform to_world;  // from the map's local frame to the world (rotations only are meaningful)
   bool mis_compensation = false;  // sample by luminance minus its mean (environment_light.h)
+};
+template <>
+struct SchemaOf<EnvironmentMap> {
+  using L = EnvironmentMap;
+  static constexpr Field fields[] = {
+      field<&L::filename>("filename", kAnyValue, "environment map").required_field(),
+      enum_field<&L::mapping>("mapping"),
+      field<&L::scale>("scale", kNonNegative),
+      field<&L::mis_compensation>("mis_compensation"),
+      field<&L::to_world>("transform", kAnyValue, "rotations only"),
+  };
+  static constexpr TypeSchema schema{.name = "environment", .fields = fields, .help = "an environment image"};
 };
 
 using LightDesc = std::variant<PointLight, SkyLight, SpotLight, DistantLight, EnvironmentMap, ProjectorLight>;

@@ -79,7 +79,13 @@ enum class FieldKind {
   Roughness,      // Roughness: "roughness" or "alpha_u" + "alpha_v", "remap_roughness", "distribution"
   Material,       // int: the index of a material this one wraps (given by name or inline)
   MaterialPair,   // two ints (the member and `second`): the materials a blend mixes, as a list of two
-  Texture,        // int: the index of a texture (given by name or inline)
+  Texture,        // int: the index of a texture (given by name or inline); -1 = none where not required
+  Rgb,            // RGB: [r, g, b] or one number for grey
+  Point,          // Point3: [x, y, z]
+  Direction,      // Vec3: [x, y, z], not zero, normalized when read
+  Transform,      // Transform: a list of transform steps (the JSON key "transform")
+  Enum,           // a closed set's enumerator, by its enum_name (base/enum_names.h)
+  File,           // std::string: a file name, resolved against the scene's folder and checked to exist
 };
 constexpr std::string_view enum_name(FieldKind v) {
   switch (v) {
@@ -93,9 +99,22 @@ constexpr std::string_view enum_name(FieldKind v) {
     case FieldKind::Material: return "material";
     case FieldKind::MaterialPair: return "material_pair";
     case FieldKind::Texture: return "texture";
+    case FieldKind::Rgb: return "rgb";
+    case FieldKind::Point: return "point";
+    case FieldKind::Direction: return "direction";
+    case FieldKind::Transform: return "transform";
+    case FieldKind::Enum: return "enum";
+    case FieldKind::File: return "file";
   }
   return {};
 }
+
+// An Enum field's names: the enumerator's name, setting it by name, and the list for messages.
+struct EnumNames {
+  std::string_view (*name_of)(const void* member);
+  bool (*set_by_name)(void* member, std::string_view name);
+  std::string (*list)();
+};
 
 // One parameter of a scene type. `member` finds it inside an object of that type; `second` is the
 // second index of a MaterialPair, or the "given" flag of a NumberIfGiven.
@@ -109,7 +128,14 @@ struct Field {
   // The key of another field that, where given, makes this one meaningless (a conductor's eta and k
   // where its reflectance is given): the two may not be given together, and it is not written then.
   std::string_view unless;
+  bool required = false;           // the readers fail without it; the writer always writes it
+  const EnumNames* names = nullptr;  // Enum fields
 
+  constexpr Field required_field() const {
+    Field f = *this;
+    f.required = true;
+    return f;
+  }
   constexpr Field ignored_where(std::string_view other) const {
     Field f = *this;
     f.unless = other;
@@ -184,8 +210,24 @@ constexpr FieldKind kind_of() {
   else if constexpr (std::is_same_v<V, FloatInput>) return FieldKind::Float;
   else if constexpr (std::is_same_v<V, float>) return FieldKind::Number;
   else if constexpr (std::is_same_v<V, bool>) return FieldKind::Flag;
-  else static_assert(sizeof(V) == 0, "no field kind for this member type (indices: material_ref, texture_ref)");
+  else if constexpr (std::is_same_v<V, RGB>) return FieldKind::Rgb;
+  else if constexpr (std::is_same_v<V, Transform>) return FieldKind::Transform;
+  else if constexpr (std::is_same_v<V, std::string>) return FieldKind::File;
+  else static_assert(sizeof(V) == 0,
+                     "no field kind for this member type (indices: material_ref, texture_ref; vectors: point_field, "
+                     "direction_field; enums: enum_field)");
 }
+
+template <typename E>
+inline constexpr EnumNames kEnumNames{
+    .name_of = [](const void* member) { return enum_name(*static_cast<const E*>(member)); },
+    .set_by_name = [](void* member, std::string_view name) {
+      std::optional<E> e = enum_from_name<E>(name);
+      if (e) *static_cast<E*>(member) = *e;
+      return e.has_value();
+    },
+    .list = [] { return enum_names_list<E>(); },
+};
 
 }  // namespace schema_detail
 
@@ -215,6 +257,20 @@ template <auto Member>
 constexpr Field texture_ref(std::string_view key, std::string_view help = {}) {
   static_assert(std::is_same_v<typename schema_detail::MemberTraits<decltype(Member)>::Value, int>);
   return Field{.key = key, .kind = FieldKind::Texture, .member = &schema_detail::member_at<Member>, .help = help};
+}
+template <auto Member>
+constexpr Field point_field(std::string_view key, std::string_view help = {}) {
+  return Field{.key = key, .kind = FieldKind::Point, .member = &schema_detail::member_at<Member>, .help = help};
+}
+template <auto Member>
+constexpr Field direction_field(std::string_view key, std::string_view help = {}) {
+  return Field{.key = key, .kind = FieldKind::Direction, .member = &schema_detail::member_at<Member>, .help = help};
+}
+template <auto Member>
+constexpr Field enum_field(std::string_view key, std::string_view help = {}) {
+  using E = typename schema_detail::MemberTraits<decltype(Member)>::Value;
+  return Field{.key = key, .kind = FieldKind::Enum, .member = &schema_detail::member_at<Member>, .help = help,
+               .names = &schema_detail::kEnumNames<E>};
 }
 template <auto Value, auto Given>
 constexpr Field number_if_given(std::string_view key, ValueRange range, std::string_view help = {}) {

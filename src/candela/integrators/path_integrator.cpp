@@ -221,10 +221,7 @@ RGB PathIntegrator::shadow_ray_estimate(const Vertex& v, size_t li, const Vec2& 
 }
 
 RenderStats render_path(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options) {
-  const PathIntegrator path(scene, settings);
-  CameraSampleTiles tiles([&path](const Ray& ray, auto& sampler, RayCounts& counts, const PixelSample&,
-                                  const Wavelengths* wl) { return path.radiance(ray, sampler, counts, wl); });
-  return render_tiles(scene, settings, film, options, tiles);
+  return render_camera_samples<PathIntegrator>(scene, settings, film, options);
 }
 
 // One instantiation per sampler type of the variant.

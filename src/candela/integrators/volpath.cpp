@@ -436,10 +436,7 @@ RGB VolPathIntegrator::transmittance(const Point3& from, const Point3& to, int m
 }
 
 RenderStats render_volpath(const Scene& scene, const RenderSettings& settings, Film& film, const RenderOptions& options) {
-  const VolPathIntegrator volpath(scene, settings);
-  CameraSampleTiles tiles([&volpath](const Ray& ray, auto& sampler, RayCounts& counts, const PixelSample&,
-                                     const Wavelengths* wl) { return volpath.radiance(ray, sampler, counts, wl); });
-  return render_tiles(scene, settings, film, options, tiles);
+  return render_camera_samples<VolPathIntegrator>(scene, settings, film, options);
 }
 
 #define CANDELA_INSTANTIATE(S) \

@@ -433,12 +433,12 @@ TEST(JsonReader, BadSpotDistantAndEnvironmentLightsAreErrors) {
                       "}");
   };
   expect_error_containing(spot(R"(, "cone_angle": 0)"),
-                          "at /lights/0/cone_angle: the cone angle must be in (0, 180] degrees, got 0");
-  expect_error_containing(spot(R"(, "cone_angle": 181)"), "must be in (0, 180] degrees, got 181");
+                          "at /lights/0/cone_angle: expected a number in (0, 180], got 0");
+  expect_error_containing(spot(R"(, "cone_angle": 181)"), "expected a number in (0, 180], got 181");
   EXPECT_NO_THROW(read(spot(R"(, "cone_angle": 180)")));
   expect_error_containing(spot(R"(, "cone_angle": 30, "cone_delta": 40)"),
                           "at /lights/0/cone_delta: cone_delta must be in [0, cone_angle] = [0, 30] degrees, got 40");
-  expect_error_containing(spot(R"(, "cone_delta": -1)"), "at /lights/0/cone_delta: cone_delta must be in");
+  expect_error_containing(spot(R"(, "cone_delta": -1)"), "at /lights/0/cone_delta: expected a number in [0, 180], got -1");
   expect_error_containing(spot(R"(, "look_at": [0, 0, 1])"),
                           "at /lights/0/look_at: a spot light takes either \"direction\" or \"look_at\", not both");
   expect_error_containing(spot(R"(, "radius": 1)"), "at /lights/0/radius: unknown key");
@@ -471,7 +471,7 @@ TEST(JsonReader, BadSpotDistantAndEnvironmentLightsAreErrors) {
       << missing;
   expect_textured_error(with_light(R"({"type": "environment"})"), "at /lights/0: missing required key \"filename\"");
   expect_environment_error(R"(, "mapping": "cube")",
-                           "at /lights/0/mapping: unknown environment mapping \"cube\"; expected one of: "
+                           "at /lights/0/mapping: unknown mapping \"cube\"; expected one of: "
                            "equirectangular, equirectangular_pole_rows, equal_area");
   expect_environment_error(R"(, "scale": -1)", "at /lights/0/scale: colour components must be >= 0");
   expect_environment_error(R"(, "scale": [1, 1e39, 1])",

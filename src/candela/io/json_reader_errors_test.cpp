@@ -249,8 +249,8 @@ TEST(JsonReader, UnknownTypesAreErrors) {
   expect_error_containing(with_material(R"({"type": "velvet"})"),
                           "at /materials/m/type: unknown material type \"velvet\"");
   expect_error_containing(with_light(R"({"type": "laser"})"),
-                          "at /lights/0/type: unknown light type \"laser\"; expected one of: point, spot, distant, "
-                          "sky, environment, sphere, rectangle");
+                          "at /lights/0/type: unknown light type \"laser\"; expected one of: point, sky, spot, "
+                          "distant, environment, projector, sphere, rectangle");
 }
 
 TEST(JsonReader, BadMaterialValuesAreErrors) {

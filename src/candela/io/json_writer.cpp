@@ -93,51 +93,50 @@ void write_roughness(const Roughness& r, Json& j) {
   if (r.distribution != MicrofacetDistribution::GGX) j["distribution"] = enum_name(r.distribution);
 }
 
-// The fields of a type's schema (description/schema.h) that differ from the type's defaults, as
-// read_fields reads them; references (materials, textures) always.
-void write_fields(const TypeSchema& schema, const void* object, const void* defaults, Json& j) {
-  auto same_input = [](const auto& a, const auto& b) { return a.is_constant() && b.is_constant() && a.value == b.value; };
+// The fields of a type's schema (description/schema.h), as read_fields reads them: every field that
+// holds a value (not an unset optional, an absent texture, or one that another given field makes
+// meaningless), defaults too, so the file says everything and shorthands that fill in missing keys
+// from others (a sky's gradient) never come into play.
+void write_fields(const TypeSchema& schema, const void* object, Json& j) {
   for (const Field& f : schema.fields) {
     if (!f.unless.empty() && field_given(schema, f.unless, object)) continue;
     switch (f.kind) {
-      case FieldKind::Color:
-        if (!same_input(field_value<ColorInput>(f, object), field_value<ColorInput>(f, defaults)))
-          j[f.key] = color(field_value<ColorInput>(f, object));
-        break;
+      case FieldKind::Color: j[f.key] = color(field_value<ColorInput>(f, object)); break;
       case FieldKind::OptionalColor:
         if (const auto& c = field_value<std::optional<ColorInput>>(f, object)) j[f.key] = color(*c);
         break;
-      case FieldKind::Float:
-        if (!same_input(field_value<FloatInput>(f, object), field_value<FloatInput>(f, defaults)))
-          j[f.key] = number(field_value<FloatInput>(f, object));
-        break;
-      case FieldKind::Number:
-        if (field_value<float>(f, object) != field_value<float>(f, defaults)) j[f.key] = field_value<float>(f, object);
-        break;
+      case FieldKind::Float: j[f.key] = number(field_value<FloatInput>(f, object)); break;
+      case FieldKind::Number: j[f.key] = field_value<float>(f, object); break;
       case FieldKind::NumberIfGiven:
         if (field_second<bool>(f, object)) j[f.key] = field_value<float>(f, object);
         break;
-      case FieldKind::Flag:
-        if (field_value<bool>(f, object) != field_value<bool>(f, defaults)) j[f.key] = field_value<bool>(f, object);
-        break;
+      case FieldKind::Flag: j[f.key] = field_value<bool>(f, object); break;
       case FieldKind::Roughness: write_roughness(field_value<Roughness>(f, object), j); break;
       case FieldKind::Material: j[f.key] = material_name(field_value<int>(f, object)); break;
       case FieldKind::MaterialPair:
         j[f.key] = Json::array({material_name(field_value<int>(f, object)), material_name(field_second<int>(f, object))});
         break;
-      case FieldKind::Texture: j[f.key] = texture_name(field_value<int>(f, object)); break;
+      case FieldKind::Texture:
+        if (f.required || field_value<int>(f, object) >= 0) j[f.key] = texture_name(field_value<int>(f, object));
+        break;
+      case FieldKind::Rgb: j[f.key] = rgb(field_value<RGB>(f, object)); break;
+      case FieldKind::Point:
+      case FieldKind::Direction: j[f.key] = vec3(field_value<Vec3>(f, object)); break;
+      case FieldKind::Transform: j[f.key] = matrix(field_value<Transform>(f, object)); break;
+      case FieldKind::Enum: j[f.key] = f.names->name_of(f.member(const_cast<void*>(object))); break;
+      case FieldKind::File: j[f.key] = absolute(field_value<std::string>(f, object)); break;
     }
   }
 }
 
-Json material_json(const MaterialDesc& desc) {
+// A description of a type with a schema: its "type" and fields.
+template <typename... Ts>
+Json schema_json(const std::variant<Ts...>& desc) {
   return std::visit(
-      [](const auto& m) {
-        using T = std::decay_t<decltype(m)>;
-        const TypeSchema& schema = SchemaOf<T>::schema;
-        const T defaults{};
+      [](const auto& d) {
+        const TypeSchema& schema = SchemaOf<std::decay_t<decltype(d)>>::schema;
         Json j{{"type", schema.name}};
-        write_fields(schema, &m, &defaults, j);
+        write_fields(schema, &d, j);
         return j;
       },
       desc);
@@ -271,45 +270,6 @@ Json shape_json(const ShapeDesc& shape, const std::vector<std::string>& media) {
   return j;
 }
 
-Json light_json(const LightDesc& light) {
-  return std::visit(
-      overloaded{
-          [](const PointLight& l) { return Json{{"type", "point"}, {"position", vec3(l.position)}, {"intensity", rgb(l.intensity)}}; },
-          [](const SkyLight& l) {
-            return Json{{"type", "sky"},      {"zenith", rgb(l.zenith)}, {"horizon", rgb(l.horizon)},
-                        {"ground", rgb(l.ground)}, {"up", vec3(l.up)}};
-          },
-          [](const SpotLight& l) {
-            Json j{{"type", "spot"},         {"position", vec3(l.position)}, {"direction", vec3(l.direction)},
-                   {"intensity", rgb(l.intensity)}, {"cone_angle", l.cone_angle},  {"cone_delta", l.cone_delta}};
-            if (l.mitsuba_falloff) j["falloff"] = "linear";
-            if (l.texture >= 0) j["texture"] = texture_name(l.texture);
-            j["up"] = vec3(l.up);
-            return j;
-          },
-          [](const DistantLight& l) {
-            return Json{{"type", "distant"}, {"direction", vec3(l.direction)}, {"radiance", rgb(l.radiance)}};
-          },
-          [](const EnvironmentMap& l) {
-            Json j{{"type", "environment"},
-                   {"filename", absolute(l.filename)},
-                   {"mapping", enum_name(l.mapping)},
-                   {"scale", rgb(l.scale)}};
-            if (!l.to_world.is_identity()) j["transform"] = matrix(l.to_world);
-            if (l.mis_compensation) j["mis_compensation"] = true;
-            return j;
-          },
-          [](const ProjectorLight& l) {
-            return Json{{"type", "projector"},
-                        {"transform", matrix(l.to_world)},
-                        {"fov", l.fov_degrees},
-                        {"irradiance", texture_name(l.irradiance)},
-                        {"scale", rgb(l.scale)}};
-          },
-      },
-      light);
-}
-
 Json camera_json(const SceneDesc& scene, const std::vector<std::string>& media) {
   const CameraDesc& c = scene.camera;
   Json j{{"transform", matrix(c.world_from_camera)}, {"fov", c.fov_degrees}, {"fov_axis", enum_name(c.fov_axis)}};
@@ -386,7 +346,7 @@ std::string scene_to_json(const SceneDesc& scene) {
   root["textures"] = std::move(textures);
   Json materials = Json::object();
   for (size_t i = 0; i < scene.materials.size(); ++i)
-    materials[material_name(int(i))] = material_json(scene.materials[i]);
+    materials[material_name(int(i))] = schema_json(scene.materials[i]);
   root["materials"] = std::move(materials);
   Json objects = Json::object();
   for (size_t i = 0; i < scene.objects.size(); ++i) {
@@ -405,7 +365,7 @@ std::string scene_to_json(const SceneDesc& scene) {
   }
   root["shapes"] = std::move(shapes);
   Json lights = Json::array();
-  for (const LightDesc& light : scene.lights) lights.push_back(light_json(light));
+  for (const LightDesc& light : scene.lights) lights.push_back(schema_json(light));
   root["lights"] = std::move(lights);
   // Shortest round-tripping numbers (nlohmann writes doubles so that they read back exactly).
   return root.dump(1) + "\n";

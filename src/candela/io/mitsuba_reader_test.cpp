@@ -385,7 +385,7 @@ TEST(MitsubaReader, Emitters) {
   EXPECT_TRUE(std::get<SkyLight>(s.lights[1]).is_constant());
   EXPECT_FLOAT_EQ(std::get<DistantLight>(s.lights[2]).radiance.g, 2);
   const auto& spot = std::get<SpotLight>(s.lights[3]);
-  EXPECT_TRUE(spot.mitsuba_falloff);
+  EXPECT_EQ(spot.falloff, SpotFalloff::Linear);
   EXPECT_FLOAT_EQ(spot.cone_angle, 30);
   EXPECT_FLOAT_EQ(spot.cone_delta, 30 - 22.5f);  // beam_width defaults to 3/4 of the cutoff
   EXPECT_NEAR(spot.direction.y, -1, 1e-5);

@@ -184,7 +184,7 @@ SpotLight mitsuba_spot_desc() {
   s.intensity = RGB(4.0f, 2.0f, 1.0f);
   s.cone_angle = 35;  // Mitsuba's cutoff_angle
   s.cone_delta = 15;  // beam_width = 20
-  s.mitsuba_falloff = true;
+  s.falloff = SpotFalloff::Linear;
   return s;
 }
 
@@ -219,7 +219,7 @@ TEST(MitsubaSpotLight, ProjectedTextureFollowsMitsubasUv) {
   desc.intensity = RGB(1.0f);
   desc.cone_angle = 40;
   desc.cone_delta = 40;  // beam 0: the ramp all the way
-  desc.mitsuba_falloff = true;
+  desc.falloff = SpotFalloff::Linear;
   desc.texture = 0;
   SpotLightSource spot = make_spot_light(desc, &textures);
   const float t = std::tan(radians(40));

@@ -116,7 +116,7 @@ inline SpotLightSource make_spot_light(const SpotLight& desc, const TextureSet* 
   s.intensity = desc.intensity;
   s.cos_falloff_start = std::cos(radians(inner));
   s.cos_falloff_end = std::cos(radians(outer));
-  s.mitsuba = desc.mitsuba_falloff;
+  s.mitsuba = desc.falloff == SpotFalloff::Linear;
   s.beam_angle = radians(inner);
   s.cutoff_angle = radians(outer);
   s.uv_factor = std::tan(s.cutoff_angle);

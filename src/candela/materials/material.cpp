@@ -34,7 +34,13 @@ bool has_constant_inputs(const MaterialDesc& desc) {
       case FieldKind::Flag:
       case FieldKind::Material:
       case FieldKind::MaterialPair:
-      case FieldKind::Texture: break;
+      case FieldKind::Texture:
+      case FieldKind::Rgb:
+      case FieldKind::Point:
+      case FieldKind::Direction:
+      case FieldKind::Transform:
+      case FieldKind::Enum:
+      case FieldKind::File: break;
     }
   }
   return true;

@@ -91,4 +91,15 @@ class CameraSampleTiles final : public TileIntegrator {
   Radiance radiance_;
 };
 
+// The render of an integrator that estimates each camera sample with
+// radiance(ray, sampler, counts, wavelengths) (path, volpath): built once, shared by every tile.
+template <typename Integrator>
+RenderStats render_camera_samples(const Scene& scene, const RenderSettings& settings, Film& film,
+                                  const RenderOptions& options) {
+  const Integrator integrator(scene, settings);
+  CameraSampleTiles tiles([&integrator](const Ray& ray, auto& sampler, RayCounts& counts, const PixelSample&,
+                                        const Wavelengths* wl) { return integrator.radiance(ray, sampler, counts, wl); });
+  return render_tiles(scene, settings, film, options, tiles);
+}
+
 }  // namespace candela

@@ -9,7 +9,6 @@
 
 #include "candela/base/error.h"
 #include "candela/base/nearest_name.h"
-#include "candela/base/overloaded.h"
 
 namespace candela {
 namespace {
@@ -76,11 +75,18 @@ class Slots {
           if (field_second<bool>(f, object)) number(name, field_value<float>(f, object), f.range);
           break;
         case FieldKind::Roughness: roughness(prefix, field_value<Roughness>(f, object)); break;
-        // Not edited here: switches, and references to other materials and textures.
+        case FieldKind::Rgb: color(name, field_value<RGB>(f, object), f.range); break;
+        case FieldKind::Transform: transform(prefix + "to_world", field_value<Transform>(f, object)); break;
+        // Not edited here: switches, names, positions and directions, and references to other
+        // materials and textures.
         case FieldKind::Flag:
         case FieldKind::Material:
         case FieldKind::MaterialPair:
-        case FieldKind::Texture: break;
+        case FieldKind::Texture:
+        case FieldKind::Point:
+        case FieldKind::Direction:
+        case FieldKind::Enum:
+        case FieldKind::File: break;
       }
     }
     schema_ = nullptr;
@@ -114,28 +120,6 @@ std::string material_name(const SceneDesc& scene, size_t i) {
   return "";
 }
 
-void light_slots(Slots& s, const std::string& p, LightDesc& light) {
-  std::visit(overloaded{
-                 [&](PointLight& l) { s.color(p + "intensity", l.intensity); },
-                 [&](SpotLight& l) { s.color(p + "intensity", l.intensity); },
-                 [&](DistantLight& l) { s.color(p + "radiance", l.radiance); },
-                 [&](SkyLight& l) {
-                   s.color(p + "zenith", l.zenith);
-                   s.color(p + "horizon", l.horizon);
-                   s.color(p + "ground", l.ground);
-                 },
-                 [&](EnvironmentMap& l) {
-                   s.color(p + "scale", l.scale);
-                   s.transform(p + "to_world", l.to_world);
-                 },
-                 [&](ProjectorLight& l) {
-                   s.color(p + "scale", l.scale);
-                   s.transform(p + "to_world", l.to_world);
-                 },
-             },
-             light);
-}
-
 std::vector<Slot> slots(SceneDesc& scene) {
   std::vector<Slot> out;
   Slots s(out);
@@ -149,7 +133,9 @@ std::vector<Slot> slots(SceneDesc& scene) {
   for (size_t i = 0; i < scene.materials.size(); ++i)
     std::visit([&](auto& m) { s.fields("materials." + material_labels[i] + ".", SchemaOf<std::decay_t<decltype(m)>>::schema, &m); },
                scene.materials[i]);
-  for (size_t i = 0; i < scene.lights.size(); ++i) light_slots(s, fmt::format("lights.{}.", i), scene.lights[i]);
+  for (size_t i = 0; i < scene.lights.size(); ++i)
+    std::visit([&](auto& l) { s.fields(fmt::format("lights.{}.", i), SchemaOf<std::decay_t<decltype(l)>>::schema, &l); },
+               scene.lights[i]);
   names.clear();
   for (const ShapeDesc& shape : scene.shapes) names.push_back(shape.name);
   std::vector<std::string> shape_labels = labels(names);

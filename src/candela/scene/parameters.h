@@ -5,7 +5,9 @@
 // without reading the scene's files again. Names:
 //   camera.to_world, camera.fov, camera.lens_radius, camera.focus_distance
 //   materials.<name>.<input>       e.g. materials.red.reflectance, materials.glass.roughness
-//   lights.<index>.<quantity>      e.g. lights.0.intensity, lights.1.scale
+//                                  (materials' and lights' numbers and colours come from their schemas,
+//                                  description/schema.h)
+//   lights.<index>.<key>           e.g. lights.0.intensity, lights.1.scale, lights.1.to_world
 //   shapes.<name>.to_world, shapes.<name>.emission
 //   instances.<index>.to_world
 //   media.<name>.sigma_t, .albedo (a constant one), .scale, .emission, .g

@@ -9,34 +9,36 @@ void JsonSceneReader::read_lights(const Json& value, const std::string& pointer)
   for (size_t i = 0; i < value.size(); ++i) read_light(value[i], child_pointer(pointer, i));
 }
 
+// Sphere and rectangle lights add an emitting shape to SceneDesc::shapes; the others, read by their
+// schema (description/lights.h) and this format's shorthands, a light to SceneDesc::lights.
 void JsonSceneReader::read_light(const Json& value, const std::string& pointer) {
   CheckedObject light(report_, value, pointer);
-  // Each adds a light to SceneDesc::lights, or (sphere, rectangle) an emitting shape to its shapes.
-  using Reader = void (*)(JsonSceneReader&, CheckedObject&);
-  using R = JsonSceneReader;
-  using L = CheckedObject;
-  static constexpr NamedReader<Reader> kLights[] = {
-      {"point",
-       [](R& r, L& light) {
-         r.scene_.lights.push_back(PointLight{light.vec3("position"), light.rgb("intensity", ColorKind::Emission)});
-       }},
-      {"spot", [](R& r, L& light) { r.scene_.lights.push_back(r.read_spot(light)); }},
-      {"distant",
-       [](R& r, L& light) {
-         r.scene_.lights.push_back(
-             DistantLight{normalize(light.direction("direction")), light.rgb("radiance", ColorKind::Emission)});
-       }},
-      {"sky", [](R& r, L& light) { r.scene_.lights.push_back(r.read_sky(light)); }},
-      {"environment", [](R& r, L& light) { r.scene_.lights.push_back(r.read_environment(light)); }},
-      {"sphere", [](R& r, L& light) { r.scene_.shapes.push_back(r.read_shape_light(light, read_sphere(light))); }},
-      {"rectangle",
-       [](R& r, L& light) { r.scene_.shapes.push_back(r.read_shape_light(light, r.read_rectangle(light))); }},
-      {"projector", [](R& r, L& light) { r.scene_.lights.push_back(r.read_projector(light)); }},
-  };
-  const NamedReader<Reader>& reader = reader_for(kLights, light, "light");
-  const size_t light_count = scene_.lights.size();
-  reader.read(*this, light);
-  if (scene_.lights.size() > light_count) scene_.places.lights.push_back(place(pointer));
+  const std::string type = light.string("type");
+  if (type == "sphere") {
+    scene_.shapes.push_back(read_shape_light(light, read_sphere(light)));
+  } else if (type == "rectangle") {
+    scene_.shapes.push_back(read_shape_light(light, read_rectangle(light)));
+  } else {
+    std::optional<LightDesc> desc = default_of_type<LightDesc>(type);
+    if (!desc) {
+      std::vector<std::string_view> names = type_names_of<LightDesc>();
+      names.insert(names.end(), {"sphere", "rectangle"});
+      report_.fail(light.pointer_of("type"), "unknown light type \"{}\"{}; expected one of: {}", type,
+                   did_you_mean(type, names), fmt::join(names, ", "));
+    }
+    std::visit(
+        [&](auto& l) {
+          using T = std::decay_t<decltype(l)>;
+          read_fields(light, SchemaOf<T>::schema, &l);
+          if constexpr (std::is_same_v<T, SpotLight>) read_spot_shorthands(light, l);
+          if constexpr (std::is_same_v<T, SkyLight>) read_sky_shorthands(light, l);
+          if constexpr (std::is_same_v<T, EnvironmentMap>) read_environment_orientation(light, l);
+          check_fields(light, SchemaOf<T>::schema, &l);
+        },
+        *desc);
+    scene_.lights.push_back(std::move(*desc));
+    scene_.places.lights.push_back(place(pointer));
+  }
   light.finish();
 }
 
@@ -53,101 +55,55 @@ ShapeDesc JsonSceneReader::read_shape_light(CheckedObject& light, ShapeGeometry 
 
 // Either one constant "radiance", or a gradient where a missing horizon takes the zenith's value,
 // a missing zenith the horizon's, and a missing ground the horizon's.
-SkyLight JsonSceneReader::read_sky(CheckedObject& light) const {
-  SkyLight sky;
-  bool constant = light.has("radiance");
-  std::optional<RGB> zenith = light.optional_rgb("zenith", ColorKind::Emission);
-  std::optional<RGB> horizon = light.optional_rgb("horizon", ColorKind::Emission);
-  std::optional<RGB> ground = light.optional_rgb("ground", ColorKind::Emission);
+void JsonSceneReader::read_sky_shorthands(CheckedObject& light, SkyLight& sky) const {
+  const bool constant = light.has("radiance");
+  const bool zenith = light.has("zenith"), horizon = light.has("horizon"), ground = light.has("ground");
   if (constant && (zenith || horizon || ground))
     report_.fail(light.pointer(), "a sky takes either \"radiance\" or \"zenith\"/\"horizon\"/\"ground\", not both");
   if (constant) {
     sky.zenith = sky.horizon = sky.ground = light.rgb("radiance", ColorKind::Emission);
-  } else {
-    if (!zenith && !horizon)
-      report_.fail(light.pointer(), "a sky needs \"radiance\", or a gradient with \"zenith\" and/or \"horizon\"");
-    sky.zenith = zenith.value_or(horizon.value_or(RGB()));
-    sky.horizon = horizon.value_or(sky.zenith);
-    sky.ground = ground.value_or(sky.horizon);
+    return;
   }
-  sky.up = normalize(light.direction_or("up", sky.up));
-  return sky;
+  if (!zenith && !horizon)
+    report_.fail(light.pointer(), "a sky needs \"radiance\", or a gradient with \"zenith\" and/or \"horizon\"");
+  if (!zenith) sky.zenith = sky.horizon;
+  if (!horizon) sky.horizon = sky.zenith;
+  if (!ground) sky.ground = sky.horizon;
 }
 
-// Mitsuba's projector: an image projected from the origin of "transform" along its +z.
-ProjectorLight JsonSceneReader::read_projector(CheckedObject& light) {
-  ProjectorLight projector;
-  projector.to_world = read_transform_key(light);
-  projector.fov_degrees = light.number_or("fov", projector.fov_degrees);
-  if (!(projector.fov_degrees > 0 && projector.fov_degrees < 180))
-    report_.fail(light.pointer_of("fov"), "the field of view must be in (0, 180) degrees, got {}",
-                 projector.fov_degrees);
-  projector.irradiance = texture_reference(light, "irradiance");
-  projector.scale = light.rgb_or("scale", ColorKind::Emission, projector.scale);
-  return projector;
-}
-
-SpotLight JsonSceneReader::read_spot(CheckedObject& light) {
-  SpotLight spot;
-  spot.position = light.vec3("position");
-  bool has_direction = light.has("direction"), has_look_at = light.has("look_at");
+// The axis as "direction" or as the point it aims at, "look_at"; cone_delta at most the cone angle
+// when not given.
+void JsonSceneReader::read_spot_shorthands(CheckedObject& light, SpotLight& spot) const {
+  const bool has_direction = light.has("direction"), has_look_at = light.has("look_at");
   if (has_direction && has_look_at)
     report_.fail(light.pointer_of("look_at"), "a spot light takes either \"direction\" or \"look_at\", not both");
-  if (has_direction) {
-    spot.direction = normalize(light.direction("direction"));
-  } else if (has_look_at) {
+  if (has_look_at) {
     Vec3 direction = light.vec3("look_at") - spot.position;
     if (length_squared(direction) == 0 || !is_finite(normalize(direction)))
       report_.fail(light.pointer_of("look_at"), "look_at must differ from position (it sets the light's direction)");
     spot.direction = normalize(direction);
-  } else {
+  } else if (!has_direction) {
     report_.fail(light.pointer(), "a spot light needs \"direction\" or \"look_at\"");
   }
-  spot.intensity = light.rgb("intensity", ColorKind::Emission);
-  spot.cone_angle = light.number_or("cone_angle", spot.cone_angle);
-  if (!(spot.cone_angle > 0 && spot.cone_angle <= 180))
-    report_.fail(light.pointer_of("cone_angle"), "the cone angle must be in (0, 180] degrees, got {}",
-                 spot.cone_angle);
-  spot.cone_delta = light.number_or("cone_delta", std::min(spot.cone_delta, spot.cone_angle));
-  if (!(spot.cone_delta >= 0 && spot.cone_delta <= spot.cone_angle))
-    report_.fail(light.pointer_of("cone_delta"), "cone_delta must be in [0, cone_angle] = [0, {}] degrees, got {}",
-                 spot.cone_angle, spot.cone_delta);
-  if (const Json* falloff = light.find("falloff"))
-    spot.mitsuba_falloff = read_name<bool>(report_, *falloff, light.pointer_of("falloff"), "spot falloff",
-                                           {{"smoothstep", false}, {"linear", true}});
-  if (light.has("texture")) spot.texture = texture_reference(light, "texture");
-  spot.up = normalize(light.direction_or("up", spot.up));
-  return spot;
+  if (!light.has("cone_delta")) spot.cone_delta = std::min(spot.cone_delta, spot.cone_angle);
 }
 
-EnvironmentMap JsonSceneReader::read_environment(CheckedObject& light) const {
-  EnvironmentMap environment;
-  environment.filename = existing_file(light, "filename", "environment map");
-  if (const Json* mapping = light.find("mapping"))
-    environment.mapping =
-        read_enum<EnvironmentMapping>(report_, *mapping, light.pointer_of("mapping"), "environment mapping");
-  environment.scale = light.rgb_or("scale", ColorKind::Emission, environment.scale);
-  environment.mis_compensation = light.boolean_or("mis_compensation", environment.mis_compensation);
-  environment.to_world = read_environment_orientation(light, environment.mapping);
-  return environment;
-}
-
-// Either "up" (where the map's own up axis points) and "rotate" (degrees about it), or a "transform".
-Transform JsonSceneReader::read_environment_orientation(CheckedObject& light, EnvironmentMapping mapping) const {
-  bool has_up = light.has("up"), has_rotate = light.has("rotate");
-  if (const Json* steps = light.find("transform")) {
-    std::string pointer = light.pointer_of("transform");
+// Either a "transform" (rotations only), or "up" (where the map's own up axis points) and "rotate"
+// (degrees about it).
+void JsonSceneReader::read_environment_orientation(CheckedObject& light, EnvironmentMap& environment) const {
+  const bool has_up = light.has("up"), has_rotate = light.has("rotate");
+  if (light.has("transform")) {
+    const std::string pointer = light.pointer_of("transform");
     if (has_up || has_rotate)
       report_.fail(pointer, "an environment map takes either \"transform\" or \"up\"/\"rotate\", not both");
-    Transform transform = read_transform(*steps, pointer);
-    check_rotation(transform, pointer);
-    return transform;
+    check_rotation(environment.to_world, pointer);
+    return;
   }
-  Vec3 local_up = mapping == EnvironmentMapping::EqualAreaOctahedral ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
+  Vec3 local_up = environment.mapping == EnvironmentMapping::EqualAreaOctahedral ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
   Vec3 up = normalize(light.direction_or("up", local_up));
   float degrees = light.number_or("rotate", 0);
   Transform spin = degrees == 0 ? Transform() : Transform::rotate(degrees, local_up);
-  return rotation_between(local_up, up) * spin;
+  environment.to_world = rotation_between(local_up, up) * spin;
 }
 
 // The rotation taking unit vector `from` to unit vector `to` about their common perpendicular.

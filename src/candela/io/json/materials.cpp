@@ -27,62 +27,15 @@ MaterialDesc JsonSceneReader::read_material(const Json& value, const std::string
                  did_you_mean(type, names), fmt::join(names, ", "));
   }
   if (auto* conductor = std::get_if<ConductorMaterial>(&*material)) read_conductor_preset(m, *conductor);
-  std::visit([&](auto& desc) { read_fields(m, SchemaOf<std::decay_t<decltype(desc)>>::schema, &desc); }, *material);
+  std::visit(
+      [&](auto& desc) {
+        const TypeSchema& schema = SchemaOf<std::decay_t<decltype(desc)>>::schema;
+        read_fields(m, schema, &desc);
+        check_fields(m, schema, &desc);
+      },
+      *material);
   m.finish();
   return *material;
-}
-
-void JsonSceneReader::read_fields(CheckedObject& m, const TypeSchema& schema, void* object) {
-  for (const Field& f : schema.fields) {
-    if (!f.unless.empty() && m.has(f.key) && m.has(f.unless))
-      report_.fail(m.pointer_of(f.key), "give either \"{}\" or \"{}\", not both", f.key, f.unless);
-    // Colours bounded above are reflectances (<= 1); the others need only be >= 0.
-    const ColorKind color_kind = f.range.bounded_above() ? ColorKind::Albedo : ColorKind::NonNegative;
-    switch (f.kind) {
-      case FieldKind::Color: {
-        auto& color = field_value<ColorInput>(f, object);
-        color = color_input_or(m, f.key, color_kind, color);
-        break;
-      }
-      case FieldKind::OptionalColor:
-        if (const Json* given = m.find(f.key))
-          field_value<std::optional<ColorInput>>(f, object) = read_color_input(*given, m.pointer_of(f.key), color_kind);
-        break;
-      case FieldKind::Float: {
-        auto& number = field_value<FloatInput>(f, object);
-        number = float_input_or(m, f.key, f.range, number);
-        break;
-      }
-      case FieldKind::Number: {
-        auto& number = field_value<float>(f, object);
-        number = m.number_or(f.key, number, f.range);
-        break;
-      }
-      case FieldKind::NumberIfGiven:
-        if (m.has(f.key)) {
-          field_value<float>(f, object) = m.number(f.key, f.range);
-          field_second<bool>(f, object) = true;
-        }
-        break;
-      case FieldKind::Flag: {
-        auto& flag = field_value<bool>(f, object);
-        flag = m.boolean_or(f.key, flag);
-        break;
-      }
-      case FieldKind::Roughness: field_value<Roughness>(f, object) = read_roughness(m); break;
-      case FieldKind::Material: field_value<int>(f, object) = wrapped_material(m, f.key); break;
-      case FieldKind::MaterialPair: {
-        std::array<int, 2> pair = material_pair(m, f.key);
-        field_value<int>(f, object) = pair[0];
-        field_second<int>(f, object) = pair[1];
-        break;
-      }
-      case FieldKind::Texture: field_value<int>(f, object) = texture_reference(m, f.key); break;
-    }
-  }
-  if (schema.check)
-    if (std::optional<SchemaViolation> violation = schema.check(object))
-      report_.fail(violation->key.empty() ? m.pointer() : m.pointer_of(violation->key), "{}", violation->message);
 }
 
 // GGX alpha (Roughness::remap = false): "roughness" for both axes, or "alpha_u" and "alpha_v".

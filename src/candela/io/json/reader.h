@@ -129,9 +129,10 @@ class JsonSceneReader {
   void read_materials(const Json& value, const std::string& pointer);
   int add_material(MaterialDesc material, SourceLocation where);
   MaterialDesc read_material(const Json& value, const std::string& pointer);
-  // The fields of a type's schema (description/schema.h) from `m`, into `object`, then its
-  // cross-field check.
+  // ---- any type with a schema (description/schema.h; schema_fields.cpp): its fields from `m` into
+  // `object`, then, once the format's shorthands have filled in the rest, its cross-field check.
   void read_fields(CheckedObject& m, const TypeSchema& schema, void* object);
+  void check_fields(CheckedObject& m, const TypeSchema& schema, const void* object) const;
   Roughness read_roughness(CheckedObject& m);
   void read_conductor_preset(CheckedObject& m, ConductorMaterial& c) const;
   int material_by_name(const std::string& name, const std::string& pointer);
@@ -182,11 +183,9 @@ class JsonSceneReader {
   void read_lights(const Json& value, const std::string& pointer);
   void read_light(const Json& value, const std::string& pointer);
   ShapeDesc read_shape_light(CheckedObject& light, ShapeGeometry geometry);
-  SkyLight read_sky(CheckedObject& light) const;
-  ProjectorLight read_projector(CheckedObject& light);
-  SpotLight read_spot(CheckedObject& light);
-  EnvironmentMap read_environment(CheckedObject& light) const;
-  Transform read_environment_orientation(CheckedObject& light, EnvironmentMapping mapping) const;
+  void read_sky_shorthands(CheckedObject& light, SkyLight& sky) const;
+  void read_spot_shorthands(CheckedObject& light, SpotLight& spot) const;
+  void read_environment_orientation(CheckedObject& light, EnvironmentMap& environment) const;
   static Transform rotation_between(Vec3 from, Vec3 to);
   void check_rotation(const Transform& transform, const std::string& pointer) const;
 

@@ -232,7 +232,7 @@ Vec3 Converter::origin_of(const Transform& t) { return t.point({0, 0, 0}); }
       throw_scene_error(e.where.loc(), "spot: needs 0 < beam_width <= cutoff_angle <= 90");
     l.cone_angle = cutoff;
     l.cone_delta = cutoff - beam;
-    l.mitsuba_falloff = true;
+    l.falloff = SpotFalloff::Linear;
     if (const Property* p = find(e, "texture"); p) {
       if (p->kind != Property::Kind::Object && p->kind != Property::Kind::Ref) wrong_kind(e, *p, "a texture");
       l.texture = texture(deref(*p));

@@ -1,4 +1,4 @@
-// The material schemas (description/materials.h) walked field by field through every front end
+// The material and light schemas (description/materials.h, lights.h) walked field by field through every front end
 // generated from them: the JSON writer and reader (so `candela convert`), the editable scene
 // parameters (scene/parameters.h), and the "did you mean" messages. A field added to a schema is
 // checked here with no other edit.
@@ -46,6 +46,17 @@ void set_probe(const Field& f, void* object) {
       field_second<int>(f, object) = 0;
       break;
     case FieldKind::Texture: field_value<int>(f, object) = 0; break;
+    case FieldKind::Rgb: field_value<RGB>(f, object) = color; break;
+    case FieldKind::Point: field_value<Point3>(f, object) = Point3(1, 2, 3); break;
+    case FieldKind::Direction: field_value<Vec3>(f, object) = Vec3(1, 0, 0); break;
+    case FieldKind::Transform: field_value<Transform>(f, object) = Transform::rotate(90, {1, 0, 0}); break;
+    case FieldKind::Enum: {
+      // The last of its names (each enum's first is its default).
+      const std::string names = f.names->list();
+      ASSERT_TRUE(f.names->set_by_name(f.member(object), names.substr(names.rfind(' ') + 1))) << names;
+      break;
+    }
+    case FieldKind::File: field_value<std::string>(f, object) = std::string(CANDELA_SOURCE_DIR) + "/tests/data/textures/sky.hdr"; break;
   }
 }
 
@@ -76,6 +87,14 @@ bool same_field(const Field& f, const void* a, const void* b, std::string& what)
     case FieldKind::MaterialPair:
       same = field_value<int>(f, a) == field_value<int>(f, b) && field_second<int>(f, a) == field_second<int>(f, b);
       break;
+    case FieldKind::Rgb: same = field_value<RGB>(f, a) == field_value<RGB>(f, b); break;
+    case FieldKind::Point:
+    case FieldKind::Direction: same = field_value<Vec3>(f, a) == field_value<Vec3>(f, b); break;
+    case FieldKind::Transform:
+      same = field_value<Transform>(f, a).matrix().m == field_value<Transform>(f, b).matrix().m;
+      break;
+    case FieldKind::Enum: same = f.names->name_of(f.member(const_cast<void*>(a))) == f.names->name_of(f.member(const_cast<void*>(b))); break;
+    case FieldKind::File: same = field_value<std::string>(f, a) == field_value<std::string>(f, b); break;
   }
   if (!same) what = std::string(f.key);
   return same;
@@ -87,16 +106,21 @@ SceneDesc schema_test_scene() {
   return scene;
 }
 
-void* material_address(MaterialDesc& m) { return std::visit([](auto& x) -> void* { return &x; }, m); }
+template <typename Variant>
+void* object_address(Variant& m) {
+  return std::visit([](auto& x) -> void* { return &x; }, m);
+}
 
-// Each alternative of MaterialDesc, default-constructed.
-std::vector<MaterialDesc> every_material_type() {
-  std::vector<MaterialDesc> out;
+// Each alternative of a variant (MaterialDesc, LightDesc), default-constructed.
+template <typename Variant>
+std::vector<Variant> every_type_of() {
+  std::vector<Variant> out;
   [&]<size_t... I>(std::index_sequence<I...>) {
     (out.emplace_back(std::in_place_index<I>), ...);
-  }(std::make_index_sequence<std::variant_size_v<MaterialDesc>>());
+  }(std::make_index_sequence<std::variant_size_v<Variant>>());
   return out;
 }
+std::vector<MaterialDesc> every_material_type() { return every_type_of<MaterialDesc>(); }
 
 TEST(MaterialSchema, NamesAndKeysAreUnique) {
   std::set<std::string_view> names;
@@ -108,49 +132,64 @@ TEST(MaterialSchema, NamesAndKeysAreUnique) {
     std::set<void*> members;
     for (const Field& f : schema.fields) {
       EXPECT_TRUE(keys.insert(f.key).second) << schema.name << "." << f.key;
-      EXPECT_TRUE(members.insert(f.member(material_address(m))).second) << schema.name << "." << f.key << " shares a member";
+      EXPECT_TRUE(members.insert(f.member(object_address(m))).second) << schema.name << "." << f.key << " shares a member";
     }
   }
 }
 
-// Every field of every material, set to a value that is not its default, is written by the JSON
-// writer and read back by the JSON reader unchanged.
-TEST(MaterialSchema, EveryFieldRoundTripsThroughJson) {
-  for (MaterialDesc& probe : every_material_type()) {
+// Every field of every alternative of the variant the scene keeps in `list` (materials, lights),
+// set to a value that is not its default, is written by the JSON writer and read back by the JSON
+// reader unchanged.
+template <typename Variant>
+void expect_every_field_round_trips(std::vector<Variant> SceneDesc::*list) {
+  for (Variant& probe : every_type_of<Variant>()) {
     const TypeSchema& schema = schema_of(probe);
-    for (const Field& f : schema.fields) set_probe(f, material_address(probe));
+    for (const Field& f : schema.fields) set_probe(f, object_address(probe));
     SceneDesc scene = schema_test_scene();
-    scene.materials.push_back(probe);
+    (scene.*list).push_back(probe);
     SceneDesc back = read_json_scene(scene_to_json(scene), "round-trip.json", ".");
-    ASSERT_EQ(back.materials.size(), scene.materials.size()) << schema.name;
-    MaterialDesc& read = back.materials.back();
+    ASSERT_EQ((back.*list).size(), (scene.*list).size()) << schema.name;
+    Variant& read = (back.*list).back();
     ASSERT_EQ(read.index(), probe.index()) << schema.name;
     for (const Field& f : schema.fields) {
-      if (!f.unless.empty() && field_given(schema, f.unless, material_address(probe))) continue;  // not written
+      if (!f.unless.empty() && field_given(schema, f.unless, object_address(probe))) continue;  // not written
       std::string what;
-      EXPECT_TRUE(same_field(f, material_address(probe), material_address(read), what)) << schema.name << "." << what;
+      EXPECT_TRUE(same_field(f, object_address(probe), object_address(read), what)) << schema.name << "." << what;
     }
   }
 }
 
-// Every constant number and colour of every material is an editable scene parameter, named
-// materials.<label>.<key>.
-TEST(MaterialSchema, EveryConstantInputIsAnEditableParameter) {
-  for (MaterialDesc& probe : every_material_type()) {
+// Every constant number and colour of every alternative is an editable scene parameter, named
+// <section>.<label>.<key> (a transform: <section>.<label>.to_world).
+template <typename Variant>
+void expect_every_constant_input_editable(std::vector<Variant> SceneDesc::*list, std::string_view section) {
+  for (Variant& probe : every_type_of<Variant>()) {
     const TypeSchema& schema = schema_of(probe);
-    for (const Field& f : schema.fields) set_probe(f, material_address(probe));
+    for (const Field& f : schema.fields) set_probe(f, object_address(probe));
     SceneDesc scene = schema_test_scene();
-    scene.materials.push_back(probe);
+    (scene.*list).push_back(probe);
     std::set<std::string> names;
     for (const SceneParameter& p : scene_parameters(scene)) names.insert(p.name);
-    const std::string prefix = fmt::format("materials.{}.", scene.materials.size() - 1);
+    const std::string prefix = fmt::format("{}.{}.", section, (scene.*list).size() - 1);
     for (const Field& f : schema.fields) {
       const bool editable = f.kind == FieldKind::Color || f.kind == FieldKind::OptionalColor ||
                             f.kind == FieldKind::Float || f.kind == FieldKind::Number ||
-                            f.kind == FieldKind::NumberIfGiven || f.kind == FieldKind::Roughness;
-      EXPECT_EQ(names.count(prefix + std::string(f.key)), editable ? 1u : 0u) << schema.name << "." << f.key;
+                            f.kind == FieldKind::NumberIfGiven || f.kind == FieldKind::Roughness ||
+                            f.kind == FieldKind::Rgb || f.kind == FieldKind::Transform;
+      const std::string name = prefix + (f.kind == FieldKind::Transform ? "to_world" : std::string(f.key));
+      EXPECT_EQ(names.count(name), editable ? 1u : 0u) << schema.name << "." << f.key;
     }
   }
+}
+
+TEST(MaterialSchema, EveryFieldRoundTripsThroughJson) { expect_every_field_round_trips(&SceneDesc::materials); }
+TEST(LightSchema, EveryFieldRoundTripsThroughJson) { expect_every_field_round_trips(&SceneDesc::lights); }
+
+TEST(MaterialSchema, EveryConstantInputIsAnEditableParameter) {
+  expect_every_constant_input_editable(&SceneDesc::materials, "materials");
+}
+TEST(LightSchema, EveryConstantInputIsAnEditableParameter) {
+  expect_every_constant_input_editable(&SceneDesc::lights, "lights");
 }
 
 TEST(MaterialSchema, ParameterEditsKeepTheCrossFieldRule) {
@@ -216,6 +255,9 @@ TEST(MaterialSchema, EveryTypeAndKeyIsDocumented) {
   for (std::string_view name : type_names_of<MaterialDesc>()) EXPECT_TRUE(documented(name)) << "type " << name;
   for (MaterialDesc& m : every_material_type())
     for (const Field& f : schema_of(m).fields) EXPECT_TRUE(documented(f.key)) << schema_of(m).name << "." << f.key;
+  for (std::string_view name : type_names_of<LightDesc>()) EXPECT_TRUE(documented(name)) << "light " << name;
+  for (LightDesc& l : every_type_of<LightDesc>())
+    for (const Field& f : schema_of(l).fields) EXPECT_TRUE(documented(f.key)) << schema_of(l).name << "." << f.key;
 }
 
 TEST(NearestName, FindsLikelyTypos) {

@@ -1,0 +1,93 @@
+// Any scene type with a schema (description/schema.h), read field by field.
+#include "candela/io/json/reader.h"
+
+namespace candela::json {
+
+void JsonSceneReader::read_fields(CheckedObject& m, const TypeSchema& schema, void* object) {
+  for (const Field& f : schema.fields) {
+    if (f.required) m.require(f.key);
+    if (!f.unless.empty() && m.has(f.key) && m.has(f.unless))
+      report_.fail(m.pointer_of(f.key), "give either \"{}\" or \"{}\", not both", f.key, f.unless);
+    // Colours bounded above are reflectances (<= 1); the others need only be >= 0.
+    const ColorKind color_kind = f.range.bounded_above() ? ColorKind::Albedo : ColorKind::NonNegative;
+    switch (f.kind) {
+      case FieldKind::Color: {
+        auto& color = field_value<ColorInput>(f, object);
+        color = color_input_or(m, f.key, color_kind, color);
+        break;
+      }
+      case FieldKind::OptionalColor:
+        if (const Json* given = m.find(f.key))
+          field_value<std::optional<ColorInput>>(f, object) = read_color_input(*given, m.pointer_of(f.key), color_kind);
+        break;
+      case FieldKind::Float: {
+        auto& number = field_value<FloatInput>(f, object);
+        number = float_input_or(m, f.key, f.range, number);
+        break;
+      }
+      case FieldKind::Number: {
+        auto& number = field_value<float>(f, object);
+        number = m.number_or(f.key, number, f.range);
+        break;
+      }
+      case FieldKind::NumberIfGiven:
+        if (m.has(f.key)) {
+          field_value<float>(f, object) = m.number(f.key, f.range);
+          field_second<bool>(f, object) = true;
+        }
+        break;
+      case FieldKind::Flag: {
+        auto& flag = field_value<bool>(f, object);
+        flag = m.boolean_or(f.key, flag);
+        break;
+      }
+      case FieldKind::Roughness: field_value<Roughness>(f, object) = read_roughness(m); break;
+      case FieldKind::Material: field_value<int>(f, object) = wrapped_material(m, f.key); break;
+      case FieldKind::MaterialPair: {
+        std::array<int, 2> pair = material_pair(m, f.key);
+        field_value<int>(f, object) = pair[0];
+        field_second<int>(f, object) = pair[1];
+        break;
+      }
+      case FieldKind::Texture:
+        if (f.required || m.has(f.key)) field_value<int>(f, object) = texture_reference(m, f.key);
+        break;
+      case FieldKind::Rgb: {
+        auto& rgb = field_value<RGB>(f, object);
+        rgb = m.rgb_or(f.key, color_kind, rgb);
+        break;
+      }
+      case FieldKind::Point: {
+        auto& point = field_value<Point3>(f, object);
+        point = m.vec3_or(f.key, point);
+        break;
+      }
+      case FieldKind::Direction: {
+        auto& direction = field_value<Vec3>(f, object);
+        direction = normalize(m.direction_or(f.key, direction));
+        break;
+      }
+      case FieldKind::Transform:
+        if (m.has(f.key)) field_value<Transform>(f, object) = read_transform_key(m);
+        break;
+      case FieldKind::Enum:
+        if (const Json* given = m.find(f.key)) {
+          std::string name = read_string(report_, *given, m.pointer_of(f.key));
+          if (!f.names->set_by_name(f.member(object), name))
+            report_.fail(m.pointer_of(f.key), "unknown {} \"{}\"; expected one of: {}", f.key, name, f.names->list());
+        }
+        break;
+      case FieldKind::File:
+        if (f.required || m.has(f.key)) field_value<std::string>(f, object) = existing_file(m, f.key, f.help);
+        break;
+    }
+  }
+}
+
+void JsonSceneReader::check_fields(CheckedObject& m, const TypeSchema& schema, const void* object) const {
+  if (schema.check)
+    if (std::optional<SchemaViolation> violation = schema.check(object))
+      report_.fail(violation->key.empty() ? m.pointer() : m.pointer_of(violation->key), "{}", violation->message);
+}
+
+}  // namespace candela::json
