@@ -44,7 +44,7 @@ void check_value(const RenderOption& option, const RenderRequest& request) {
         } else if constexpr (!std::is_same_v<T, bool>) {
           if (!value) return;
           const double x = double(*value);
-          if (const auto* range = std::get_if<ValueRange>(&option.rule); range && !(x >= range->lo && x <= range->hi))
+          if (const auto* range = std::get_if<ValueRange>(&option.rule); range && !range->contains(x))
             throw UsageError(fmt::format("{}: {} is out of range ({} to {})", flag, *value, range->lo, range->hi));
           if (std::holds_alternative<PositiveValue>(option.rule) && !(std::isfinite(x) && x > 0))
             throw UsageError(fmt::format("{}: must be a positive number, got {}", flag, *value));
