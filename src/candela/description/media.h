@@ -17,7 +17,7 @@
 #include "candela/math/color.h"
 #include "candela/math/transform.h"
 #include "candela/math/vec.h"
-#include "candela/description/textures.h"
+#include "candela/description/schema.h"
 
 namespace candela {
 
@@ -79,6 +79,31 @@ struct MediumDesc {
   std::string name;      // for messages
   SourceLocation where;  // where the scene file declares it
   bool is_homogeneous() const { return density.is_constant() && albedo.is_constant(); }
+};
+// A medium's "type" is "homogeneous" where density and albedo are constants, "grid" where either
+// varies (the readers' check; the schema has no member for it). sigma_a and sigma_s are JSON's and
+// pbrt-v4's other way of giving sigma_t and the albedo (set_sigma_a_sigma_s).
+template <>
+struct SchemaOf<MediumDesc> {
+  using T = MediumDesc;
+  static constexpr Field fields[] = {
+      field<&T::sigma_t>("sigma_t", kNonNegative, "extinction per unit length, times density and scale"),
+      volume_field<&T::albedo>("albedo", true, kAlbedo, "the fraction of extinction that scatters"),
+      volume_field<&T::density>("density", false, kNonNegative, "multiplies sigma_t; a grid for a \"grid\" medium"),
+      field<&T::scale>("scale", kNonNegative, "multiplies sigma_t"),
+      field<&T::g>("g", ValueRange{.lo = -1, .hi = 1, .lo_open = true, .hi_open = true},
+                   "Henyey-Greenstein's mean cosine"),
+      field<&T::emission>("emission", kNonNegative, "radiance emitted in proportion to absorption")
+          .ignored_where("temperature"),
+      volume_field<&T::emission_scale>("emission_scale", false, kNonNegative, "multiplies the emission"),
+      volume_field<&T::temperature>("temperature", false, kAnyValue, "kelvin: a blackbody replaces emission"),
+      field<&T::temperature_scale>("temperature_scale"),
+      field<&T::temperature_offset>("temperature_offset"),
+      field<&T::temperature_cutoff>("temperature_cutoff"),
+      field<&T::majorant_cell_samples>("majorant_cell_samples", ValueRange{.lo = 0, .hi = 1 << 20},
+                                       "a density grid's samples per majorant cell along each axis; 0: one majorant"),
+  };
+  static constexpr TypeSchema schema{.name = "homogeneous", .fields = fields, .help = "a participating medium"};
 };
 
 // pbrt-v4's and JSON's way of giving a medium: absorption and scattering coefficients.

@@ -1,10 +1,10 @@
 #pragma once
 // One declaration of a scene type's parameters (Mitsuba 3's traverse(), pbrt-v4's
-// ParameterDictionary): each material description (and any other type that declares a SchemaOf)
+// ParameterDictionary): each material, light, texture, medium and shape geometry description
 // lists its fields once, with the key scene files use, the kind of value, the member it lives in,
 // the range it accepts and a line of help; the default is the struct's own member initializer.
 // Everything that walks a type's parameters is generated from that list:
-//   the JSON reader (io/json/materials.cpp: read_fields) and writer (io/json_writer.cpp: write_fields),
+//   the JSON reader (io/json/schema_fields.cpp: read_fields) and writer (io/json_writer.cpp: write_fields),
 //   so `candela convert` writes what the reader reads;
 //   the editable scene parameters of the Python module (scene/parameters.cpp);
 //   which inputs are constant and which materials a wrapper wraps (materials/material.cpp);
@@ -26,8 +26,13 @@
 #include <string_view>
 #include <type_traits>
 #include <variant>
+#include <vector>
 
-#include "candela/description/textures.h"
+#include "candela/description/textured_input.h"
+#include "candela/math/color.h"
+#include "candela/math/transform.h"
+#include "candela/math/vec.h"
+#include "candela/base/enum_names.h"
 
 namespace candela {
 
@@ -83,9 +88,16 @@ enum class FieldKind {
   Rgb,            // RGB: [r, g, b] or one number for grey
   Point,          // Point3: [x, y, z]
   Direction,      // Vec3: [x, y, z], not zero, normalized when read
+  Vector,         // Vec3: [x, y, z], not zero, kept as given (a rectangle's edge)
   Transform,      // Transform: a list of transform steps (the JSON key "transform")
   Enum,           // a closed set's enumerator, by its enum_name (base/enum_names.h)
   File,           // std::string: a file name, resolved against the scene's folder and checked to exist
+  Text,           // std::string: a name (a mesh attribute's)
+  Integer,        // int
+  ScalarVolume,   // VolumeDesc (description/media.h): a number, or a grid of one channel (an object)
+  ColorVolume,    // VolumeDesc: [r, g, b] or one number for grey, or a grid of one or three channels
+  OptionalScalarVolume,  // std::optional<VolumeDesc>: as ScalarVolume, absent unless given
+  UvMapping,      // UVMapping: "uv_scale" and "uv_offset", or "uv_matrix" (the field's own key is not used)
 };
 constexpr std::string_view enum_name(FieldKind v) {
   switch (v) {
@@ -102,9 +114,16 @@ constexpr std::string_view enum_name(FieldKind v) {
     case FieldKind::Rgb: return "rgb";
     case FieldKind::Point: return "point";
     case FieldKind::Direction: return "direction";
+    case FieldKind::Vector: return "vector";
     case FieldKind::Transform: return "transform";
     case FieldKind::Enum: return "enum";
     case FieldKind::File: return "file";
+    case FieldKind::Text: return "text";
+    case FieldKind::Integer: return "integer";
+    case FieldKind::ScalarVolume: return "scalar_volume";
+    case FieldKind::ColorVolume: return "color_volume";
+    case FieldKind::OptionalScalarVolume: return "optional_scalar_volume";
+    case FieldKind::UvMapping: return "uv_mapping";
   }
   return {};
 }
@@ -130,6 +149,7 @@ struct Field {
   std::string_view unless;
   bool required = false;           // the readers fail without it; the writer always writes it
   const EnumNames* names = nullptr;  // Enum fields
+  bool (*given)(const void* object) = nullptr;  // OptionalScalarVolume fields: whether it holds a value
 
   constexpr Field required_field() const {
     Field f = *this;
@@ -209,6 +229,7 @@ constexpr FieldKind kind_of() {
   else if constexpr (std::is_same_v<V, std::optional<ColorInput>>) return FieldKind::OptionalColor;
   else if constexpr (std::is_same_v<V, FloatInput>) return FieldKind::Float;
   else if constexpr (std::is_same_v<V, float>) return FieldKind::Number;
+  else if constexpr (std::is_same_v<V, int>) return FieldKind::Integer;
   else if constexpr (std::is_same_v<V, bool>) return FieldKind::Flag;
   else if constexpr (std::is_same_v<V, RGB>) return FieldKind::Rgb;
   else if constexpr (std::is_same_v<V, Transform>) return FieldKind::Transform;
@@ -216,6 +237,12 @@ constexpr FieldKind kind_of() {
   else static_assert(sizeof(V) == 0,
                      "no field kind for this member type (indices: material_ref, texture_ref; vectors: point_field, "
                      "direction_field; enums: enum_field)");
+}
+
+template <auto Member>
+bool optional_has_value(const void* object) {
+  return static_cast<const typename MemberTraits<decltype(Member)>::Value*>(member_at<Member>(const_cast<void*>(object)))
+      ->has_value();
 }
 
 template <typename E>
@@ -267,10 +294,40 @@ constexpr Field direction_field(std::string_view key, std::string_view help = {}
   return Field{.key = key, .kind = FieldKind::Direction, .member = &schema_detail::member_at<Member>, .help = help};
 }
 template <auto Member>
+constexpr Field vector_field(std::string_view key, std::string_view help = {}) {
+  return Field{.key = key, .kind = FieldKind::Vector, .member = &schema_detail::member_at<Member>, .help = help};
+}
+template <auto Member>
 constexpr Field enum_field(std::string_view key, std::string_view help = {}) {
   using E = typename schema_detail::MemberTraits<decltype(Member)>::Value;
   return Field{.key = key, .kind = FieldKind::Enum, .member = &schema_detail::member_at<Member>, .help = help,
                .names = &schema_detail::kEnumNames<E>};
+}
+template <auto Member>
+constexpr Field text_field(std::string_view key, std::string_view help = {}) {
+  static_assert(std::is_same_v<typename schema_detail::MemberTraits<decltype(Member)>::Value, std::string>);
+  return Field{.key = key, .kind = FieldKind::Text, .member = &schema_detail::member_at<Member>, .help = help};
+}
+// A texture's placement on the surface (description/textures.h): written and read as uv_scale and
+// uv_offset, or uv_matrix.
+template <auto Member>
+constexpr Field uv_mapping_field(std::string_view help = {}) {
+  return Field{.key = "uv_mapping", .kind = FieldKind::UvMapping, .member = &schema_detail::member_at<Member>,
+               .help = help};
+}
+// A quantity over space (description/media.h): a constant or a grid. `color`: an RGB constant and
+// grids of one or three channels; else a number and grids of one.
+template <auto Member>
+constexpr Field volume_field(std::string_view key, bool color, ValueRange range, std::string_view help = {}) {
+  using V = typename schema_detail::MemberTraits<decltype(Member)>::Value;
+  constexpr bool optional = requires { typename V::value_type; };  // std::optional<VolumeDesc>
+  Field f{.key = key, .kind = color ? FieldKind::ColorVolume : FieldKind::ScalarVolume,
+          .member = &schema_detail::member_at<Member>, .range = range, .help = help};
+  if constexpr (optional) {
+    f.kind = FieldKind::OptionalScalarVolume;
+    f.given = &schema_detail::optional_has_value<Member>;
+  }
+  return f;
 }
 template <auto Value, auto Given>
 constexpr Field number_if_given(std::string_view key, ValueRange range, std::string_view help = {}) {
@@ -304,6 +361,7 @@ inline bool field_given(const TypeSchema& schema, std::string_view key, const vo
     if (f.key == key) {
       if (f.kind == FieldKind::OptionalColor) return field_value<std::optional<ColorInput>>(f, object).has_value();
       if (f.kind == FieldKind::NumberIfGiven) return field_second<bool>(f, object);
+      if (f.kind == FieldKind::OptionalScalarVolume) return f.given(object);
       return true;
     }
   return false;

@@ -17,7 +17,7 @@
 #include "candela/math/color.h"
 #include "candela/math/transform.h"
 #include "candela/math/vec.h"
-#include "candela/description/textures.h"
+#include "candela/description/schema.h"
 
 namespace candela {
 
@@ -38,10 +38,21 @@ struct TriangleMesh {
   size_t triangle_count() const { return indices.size() / 3; }
 };
 
+// Each geometry declares its parameters in a schema (description/schema.h). A mesh's and an SDF
+// grid's data (a file, or arrays inline) are read and written beside their schemas' fields
+// (io/json/shapes.cpp, io/json_writer.cpp).
+
 // Sphere of `radius` around `center`, in object space (then to_world applies).
 struct SphereShape {
   Point3 center{0.0f};
   float radius = 1;
+};
+template <>
+struct SchemaOf<SphereShape> {
+  using T = SphereShape;
+  static constexpr Field fields[] = {point_field<&T::center>("center").required_field(),
+                                     field<&T::radius>("radius", kPositive).required_field()};
+  static constexpr TypeSchema schema{.name = "sphere", .fields = fields, .help = "a sphere"};
 };
 
 // Infinite plane through `point` with normal `normal` (object space).
@@ -49,10 +60,32 @@ struct PlaneShape {
   Point3 point{0.0f};
   Normal3 normal{0, 1, 0};
 };
+template <>
+struct SchemaOf<PlaneShape> {
+  using T = PlaneShape;
+  static constexpr Field fields[] = {point_field<&T::point>("point").required_field(),
+                                     direction_field<&T::normal>("normal").required_field()};
+  static constexpr TypeSchema schema{.name = "plane", .fields = fields, .help = "an infinite plane"};
+};
 
 // Axis-aligned box [lo, hi] in object space; to_world may rotate and scale it.
 struct BoxShape {
   Point3 lo{-1.0f}, hi{1.0f};
+};
+inline std::optional<SchemaViolation> check_box(const void* object) {
+  const auto& box = *static_cast<const BoxShape*>(object);
+  for (int axis = 0; axis < 3; ++axis)
+    if (!(box.lo[axis] < box.hi[axis]))
+      return SchemaViolation{"max", fmt::format("max must exceed min on every axis; on axis {} min is {} and max is {}",
+                                                "xyz"[axis], box.lo[axis], box.hi[axis])};
+  return std::nullopt;
+}
+template <>
+struct SchemaOf<BoxShape> {
+  using T = BoxShape;
+  static constexpr Field fields[] = {point_field<&T::lo>("min").required_field(),
+                                     point_field<&T::hi>("max").required_field()};
+  static constexpr TypeSchema schema{.name = "box", .fields = fields, .check = check_box, .help = "an axis-aligned box"};
 };
 
 // Parallelogram corner + s*edge_u + t*edge_v, (s,t) in [0,1]^2; normal = normalize(cross(edge_u, edge_v)).
@@ -60,20 +93,56 @@ struct RectangleShape {
   Point3 corner{-1, -1, 0};
   Vec3 edge_u{2, 0, 0}, edge_v{0, 2, 0};
 };
+inline std::optional<SchemaViolation> check_rectangle(const void* object) {
+  const auto& r = *static_cast<const RectangleShape*>(object);
+  if (length(cross(r.edge_u, r.edge_v)) > 1e-6f * length(r.edge_u) * length(r.edge_v)) return std::nullopt;
+  return SchemaViolation{"edge_v", "edge_u and edge_v are parallel, so the rectangle has no area"};
+}
+template <>
+struct SchemaOf<RectangleShape> {
+  using T = RectangleShape;
+  static constexpr Field fields[] = {point_field<&T::corner>("corner").required_field(),
+                                     vector_field<&T::edge_u>("edge_u").required_field(),
+                                     vector_field<&T::edge_v>("edge_v").required_field()};
+  static constexpr TypeSchema schema{.name = "rectangle", .fields = fields, .check = check_rectangle,
+                                     .help = "a parallelogram"};
+};
 
+// A triangle mesh: its data is read from a file or given inline, beside the schema.
 struct MeshShape {
   TriangleMesh mesh;
+};
+template <>
+struct SchemaOf<MeshShape> {
+  static constexpr TypeSchema schema{.name = "mesh", .help = "a triangle mesh (OBJ, PLY, glTF, ... or inline)"};
 };
 
 // Disk of radius 1 around the origin in the z = 0 plane, normal +z (Mitsuba's "disk"); to_world
 // scales it. (u, v) = (r, phi / 2 pi), as Mitsuba parameterises it.
 struct DiskShape {};
+template <>
+struct SchemaOf<DiskShape> {
+  static constexpr TypeSchema schema{.name = "disk", .help = "the unit disk in the z = 0 plane"};
+};
 
 // Open tube (no caps) of `radius` around the segment p0-p1 (Mitsuba's "cylinder"), normals pointing
 // outwards; (u, v) = (phi / 2 pi, distance along the axis / its length).
 struct CylinderShape {
   Point3 p0{0.0f}, p1{0, 0, 1};
   float radius = 1;
+};
+inline std::optional<SchemaViolation> check_cylinder(const void* object) {
+  const auto& c = *static_cast<const CylinderShape*>(object);
+  if (length_squared(c.p1 - c.p0) > 0) return std::nullopt;
+  return SchemaViolation{"p1", "p1 must differ from p0 (the axis)"};
+}
+template <>
+struct SchemaOf<CylinderShape> {
+  using T = CylinderShape;
+  static constexpr Field fields[] = {point_field<&T::p0>("p0"), point_field<&T::p1>("p1"),
+                                     field<&T::radius>("radius", kPositive)};
+  static constexpr TypeSchema schema{.name = "cylinder", .fields = fields, .check = check_cylinder,
+                                     .help = "an open tube"};
 };
 
 // How an SDF grid's shading normal is found (Mitsuba's sdfgrid "normals").
@@ -82,6 +151,13 @@ enum class SdfNormals {
             // across voxel faces (Mitsuba's default)
   Analytic  // the gradient of the hit voxel's trilinear interpolant, as the geometric normal
 };
+constexpr std::string_view enum_name(SdfNormals v) {
+  switch (v) {
+    case SdfNormals::Smooth: return "smooth";
+    case SdfNormals::Analytic: return "analytic";
+  }
+  return {};
+}
 
 // A signed distance function sampled on a grid (Mitsuba's "sdfgrid"): the surface is the zero level
 // set of the trilinear interpolation of the samples, positive outside; normals point outwards. The
@@ -93,6 +169,12 @@ struct SdfGridShape {
   std::shared_ptr<const std::vector<float>> values;
   SdfNormals normals = SdfNormals::Smooth;
   std::string filename;  // the Mitsuba .vol file it was read from (empty: made in memory)
+};
+template <>
+struct SchemaOf<SdfGridShape> {
+  static constexpr Field fields[] = {enum_field<&SdfGridShape::normals>("normals", "how the shading normal is found")};
+  static constexpr TypeSchema schema{.name = "sdfgrid", .fields = fields,
+                                     .help = "a signed distance grid (a Mitsuba .vol file, or inline)"};
 };
 
 using ShapeGeometry =

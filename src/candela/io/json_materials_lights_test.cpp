@@ -57,7 +57,7 @@ TEST(JsonReader, ReadsTexturesWithDependenciesFirst) {
   const auto& wood = std::get<ImageTexture>(scene.textures[1]);
   EXPECT_EQ(wood.filename, (kTextureDir / "checker.ppm").string());  // relative to the scene's directory
   testing::expect_image_settings(wood,
-                                 {.wrap = TextureWrap::Mirror, .encoding = ColorEncoding::SRGB, .bilinear = false,
+                                 {.wrap = TextureWrap::Mirror, .encoding = ColorEncoding::SRGB, .filter = TextureFilter::Nearest,
                                   .scale = 2, .invert = true, .mapping = {.su = 3, .sv = 3, .du = 1, .dv = 2}},
                                  "wood");
   const auto& scale = std::get<ScaleTexture>(scene.textures[2]);
@@ -148,14 +148,16 @@ TEST(JsonReader, TextureErrorsNameTheirJsonPointer) {
                         "at /textures/t/wrapp: unknown key (did you mean \"wrap\"?); expected one of: type, filename, wrap, encoding, filter, "
                         "scale, invert, luminance, uv_matrix, uv_scale, uv_offset");
   expect_textured_error(with_texture(R"({"type": "image", "filename": "checker.ppm", "wrap": "tile"})"),
-                        "at /textures/t/wrap: unknown wrap mode \"tile\"; expected one of: repeat, clamp, black, "
+                        "at /textures/t/wrap: unknown wrap \"tile\"; expected one of: repeat, clamp, black, "
                         "mirror");
   expect_textured_error(with_texture(R"({"type": "image", "filename": "checker.ppm", "encoding": "gamma"})"),
-                        "at /textures/t/encoding: unknown colour encoding \"gamma\"; expected one of: auto, linear, "
+                        "at /textures/t/encoding: unknown encoding \"gamma\"; expected one of: auto, linear, "
                         "srgb");
   expect_textured_error(with_texture(R"({"type": "image", "filename": "checker.ppm", "filter": "trilinear"})"),
-                        "at /textures/t/filter: unknown texture filter \"trilinear\"; expected one of: bilinear, "
+                        "at /textures/t/filter: unknown filter \"trilinear\" (did you mean \"bilinear\"?); expected one of: bilinear, "
                         "nearest");
+  expect_textured_error(with_texture(R"({"type": "image", "filename": "checker.ppm", "filter": "nearst"})"),
+                        "at /textures/t/filter: unknown filter \"nearst\" (did you mean \"nearest\"?); expected one of");
   expect_textured_error(with_texture(R"({"type": "image", "filename": "checker.ppm", "scale": -1})"),
                         "at /textures/t/scale: expected a number >= 0, got -1");
   expect_textured_error(with_texture(R"({"type": "image", "filename": "checker.ppm", "uv_scale": [1, 0]})"),

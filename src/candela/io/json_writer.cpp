@@ -50,36 +50,6 @@ void write_mapping(const UVMapping& m, Json& j) {
   if (m.du != 0 || m.dv != 0) j["uv_offset"] = Json::array({m.du, m.dv});
 }
 
-Json texture_json(const TextureDesc& desc) {
-  return std::visit(
-      overloaded{
-          [](const ImageTexture& t) {
-            Json j{{"type", "image"}, {"filename", absolute(t.filename)}};
-            j["wrap"] = enum_name(t.wrap);
-            j["encoding"] = enum_name(t.encoding);
-            j["filter"] = t.bilinear ? "bilinear" : "nearest";
-            if (t.scale != 1) j["scale"] = t.scale;
-            if (t.invert) j["invert"] = true;
-            if (t.luminance) j["luminance"] = true;
-            write_mapping(t.mapping, j);
-            return j;
-          },
-          [](const CheckerboardTexture& t) {
-            Json j{{"type", "checkerboard"}, {"tex1", color(t.tex1)}, {"tex2", color(t.tex2)}};
-            write_mapping(t.mapping, j);
-            return j;
-          },
-          [](const ScaleTexture& t) { return Json{{"type", "scale"}, {"tex", color(t.tex)}, {"scale", number(t.scale)}}; },
-          [](const MixTexture& t) {
-            return Json{{"type", "mix"}, {"tex1", color(t.tex1)}, {"tex2", color(t.tex2)}, {"amount", number(t.amount)}};
-          },
-          [](const MeshAttributeTexture& t) {
-            return Json{{"type", "mesh_attribute"}, {"name", t.name}, {"per_face", t.per_face}};
-          },
-      },
-      desc);
-}
-
 void write_roughness(const Roughness& r, Json& j) {
   if (r.remap) j["remap_roughness"] = true;
   if (r.u.is_constant() && r.v.is_constant() && r.u.value == r.v.value) {
@@ -92,6 +62,27 @@ void write_roughness(const Roughness& r, Json& j) {
   }
   if (r.distribution != MicrofacetDistribution::GGX) j["distribution"] = enum_name(r.distribution);
 }
+
+// A grid from a file is written as its file name, one made in memory (pbrt's uniformgrid, an inline
+// grid) with its samples.
+Json volume_json(const VolumeDesc& v) {
+  Json j = Json::object();
+  if (!v.filename.empty()) {
+    j["filename"] = absolute(v.filename);
+    if (!v.grid_name.empty()) j["grid"] = v.grid_name;
+  } else {
+    j["resolution"] = v.resolution;
+    if (v.channels != 1) j["channels"] = v.channels;
+    j["values"] = v.values ? *v.values : std::vector<float>{};
+  }
+  // The scene's own placement; a VDB file brings its own.
+  const Transform placement = v.to_world * v.file_to_world.inverse();
+  if (!placement.is_identity()) j["transform"] = matrix(placement);
+  if (v.border != VolumeBorder::Clamp) j["border"] = enum_name(v.border);
+  return j;
+}
+
+Json scalar_or_grid(const VolumeDesc& v) { return v.is_constant() ? Json(v.constant.r) : volume_json(v); }
 
 // The fields of a type's schema (description/schema.h), as read_fields reads them: every field that
 // holds a value (not an unset optional, an absent texture, or one that another given field makes
@@ -121,10 +112,23 @@ void write_fields(const TypeSchema& schema, const void* object, Json& j) {
         break;
       case FieldKind::Rgb: j[f.key] = rgb(field_value<RGB>(f, object)); break;
       case FieldKind::Point:
+      case FieldKind::Vector:
       case FieldKind::Direction: j[f.key] = vec3(field_value<Vec3>(f, object)); break;
       case FieldKind::Transform: j[f.key] = matrix(field_value<Transform>(f, object)); break;
       case FieldKind::Enum: j[f.key] = f.names->name_of(f.member(const_cast<void*>(object))); break;
       case FieldKind::File: j[f.key] = absolute(field_value<std::string>(f, object)); break;
+      case FieldKind::Text: j[f.key] = field_value<std::string>(f, object); break;
+      case FieldKind::Integer: j[f.key] = field_value<int>(f, object); break;
+      case FieldKind::ScalarVolume: j[f.key] = scalar_or_grid(field_value<VolumeDesc>(f, object)); break;
+      case FieldKind::ColorVolume: {
+        const auto& v = field_value<VolumeDesc>(f, object);
+        j[f.key] = v.is_constant() ? rgb(v.constant) : volume_json(v);
+        break;
+      }
+      case FieldKind::OptionalScalarVolume:
+        if (const auto& v = field_value<std::optional<VolumeDesc>>(f, object)) j[f.key] = scalar_or_grid(*v);
+        break;
+      case FieldKind::UvMapping: write_mapping(field_value<UVMapping>(f, object), j); break;
     }
   }
 }
@@ -168,34 +172,19 @@ Json mesh_json(const TriangleMesh& mesh) {
   return j;
 }
 
+// The geometry's schema fields; a mesh's and an SDF grid's data beside them.
 Json geometry_json(const ShapeGeometry& geometry) {
-  return std::visit(
-      overloaded{
-          [](const SphereShape& s) { return Json{{"type", "sphere"}, {"center", vec3(s.center)}, {"radius", s.radius}}; },
-          [](const PlaneShape& p) { return Json{{"type", "plane"}, {"point", vec3(p.point)}, {"normal", vec3(p.normal)}}; },
-          [](const BoxShape& b) { return Json{{"type", "box"}, {"min", vec3(b.lo)}, {"max", vec3(b.hi)}}; },
-          [](const RectangleShape& r) {
-            return Json{{"type", "rectangle"}, {"corner", vec3(r.corner)}, {"edge_u", vec3(r.edge_u)},
-                        {"edge_v", vec3(r.edge_v)}};
-          },
-          [](const MeshShape& m) { return mesh_json(m.mesh); },
-          [](const DiskShape&) { return Json{{"type", "disk"}}; },
-          [](const CylinderShape& c) {
-            return Json{{"type", "cylinder"}, {"p0", vec3(c.p0)}, {"p1", vec3(c.p1)}, {"radius", c.radius}};
-          },
-          [](const SdfGridShape& g) {
-            Json j{{"type", "sdfgrid"}};
-            if (!g.filename.empty()) {
-              j["filename"] = absolute(g.filename);
-            } else {  // made in memory: the samples inline
-              j["resolution"] = g.resolution;
-              j["values"] = g.values ? *g.values : std::vector<float>{};
-            }
-            if (g.normals == SdfNormals::Analytic) j["normals"] = "analytic";
-            return j;
-          },
-      },
-      geometry);
+  Json j = schema_json(geometry);
+  if (const auto* m = std::get_if<MeshShape>(&geometry)) j.update(mesh_json(m->mesh));
+  if (const auto* g = std::get_if<SdfGridShape>(&geometry)) {
+    if (!g->filename.empty()) {
+      j["filename"] = absolute(g->filename);
+    } else {  // made in memory: the samples inline
+      j["resolution"] = g->resolution;
+      j["values"] = g->values ? *g->values : std::vector<float>{};
+    }
+  }
+  return j;
 }
 
 // The names media are written under: their own where they are unique (as every reader makes them),
@@ -212,44 +201,10 @@ std::vector<std::string> medium_names(const std::vector<MediumDesc>& media) {
   return names;
 }
 
-// A grid from a file is written as its file name, one made in memory (pbrt's uniformgrid, an inline
-// grid) with its samples.
-Json volume_json(const VolumeDesc& v) {
-  Json j = Json::object();
-  if (!v.filename.empty()) {
-    j["filename"] = absolute(v.filename);
-    if (!v.grid_name.empty()) j["grid"] = v.grid_name;
-  } else {
-    j["resolution"] = v.resolution;
-    if (v.channels != 1) j["channels"] = v.channels;
-    j["values"] = v.values ? *v.values : std::vector<float>{};
-  }
-  // The scene's own placement; a VDB file brings its own.
-  const Transform placement = v.to_world * v.file_to_world.inverse();
-  if (!placement.is_identity()) j["transform"] = matrix(placement);
-  if (v.border != VolumeBorder::Clamp) j["border"] = enum_name(v.border);
-  return j;
-}
-
 // sigma_t and albedo as the description holds them (sigma_a and sigma_s would not round-trip exactly).
 Json medium_json(const MediumDesc& m) {
-  const bool homogeneous = m.is_homogeneous() && m.density.constant == RGB(1.0f);
-  Json j{{"type", homogeneous ? "homogeneous" : "grid"}, {"sigma_t", rgb(m.sigma_t)}};
-  j["albedo"] = m.albedo.is_constant() ? rgb(m.albedo.constant) : volume_json(m.albedo);
-  if (!homogeneous) j["density"] = m.density.is_constant() ? Json(m.density.constant.r) : volume_json(m.density);
-  if (m.scale != 1) j["scale"] = m.scale;
-  if (m.g != 0) j["g"] = m.g;
-  if (!homogeneous && m.majorant_cell_samples != MediumDesc{}.majorant_cell_samples)
-    j["majorant_cell_samples"] = m.majorant_cell_samples;
-  if (!m.emission.is_black()) j["emission"] = rgb(m.emission);
-  auto scalar_or_grid = [](const VolumeDesc& v) { return v.is_constant() ? Json(v.constant.r) : volume_json(v); };
-  if (!(m.emission_scale.is_constant() && m.emission_scale.constant.r == 1))
-    j["emission_scale"] = scalar_or_grid(m.emission_scale);
-  if (m.temperature) j["temperature"] = scalar_or_grid(*m.temperature);
-  const MediumDesc defaults;
-  if (m.temperature_scale != defaults.temperature_scale) j["temperature_scale"] = m.temperature_scale;
-  if (m.temperature_offset != defaults.temperature_offset) j["temperature_offset"] = m.temperature_offset;
-  if (m.temperature_cutoff != defaults.temperature_cutoff) j["temperature_cutoff"] = m.temperature_cutoff;
+  Json j{{"type", m.is_homogeneous() ? "homogeneous" : "grid"}};
+  write_fields(SchemaOf<MediumDesc>::schema, &m, j);
   return j;
 }
 
@@ -342,7 +297,7 @@ std::string scene_to_json(const SceneDesc& scene) {
   root["camera"] = camera_json(scene, media);
   root["render"] = render_json(scene);
   Json textures = Json::object();
-  for (size_t i = 0; i < scene.textures.size(); ++i) textures[texture_name(int(i))] = texture_json(scene.textures[i]);
+  for (size_t i = 0; i < scene.textures.size(); ++i) textures[texture_name(int(i))] = schema_json(scene.textures[i]);
   root["textures"] = std::move(textures);
   Json materials = Json::object();
   for (size_t i = 0; i < scene.materials.size(); ++i)

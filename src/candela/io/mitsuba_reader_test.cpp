@@ -448,6 +448,13 @@ TEST(MitsubaReader, ErrorsNameFileAndLine) {
   EXPECT_NE(mitsuba_error_of("<shape type=\"sphere\"><float name=\"radiuss\" value=\"1\"/></shape>").find("unknown parameter"),
             std::string::npos);
   EXPECT_NE(mitsuba_error_of("<shape type=\"teapot\"/>").find("unknown shape type"), std::string::npos);
+  // A likely typo gets the nearest name the plugin reads, or the nearest type.
+  EXPECT_NE(mitsuba_error_of("<shape type=\"sphere\"><float name=\"radiuss\" value=\"1\"/></shape>")
+                .find("unknown parameter \"radiuss\" (did you mean \"radius\"?)"),
+            std::string::npos);
+  EXPECT_NE(mitsuba_error_of("<shape type=\"spehre\"/>").find("unknown shape type \"spehre\" (did you mean \"sphere\"?)"),
+            std::string::npos)
+      << mitsuba_error_of("<shape type=\"spehre\"/>");
   EXPECT_NE(mitsuba_error_of("<shape type=\"sphere\"><ref id=\"nothing\"/></shape>").find("undefined id \"nothing\""),
             std::string::npos);
   EXPECT_NE(mitsuba_error_of("<shape type=\"obj\"><string name=\"filename\" value=\"missing.obj\"/></shape>")

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "candela/base/nearest_name.h"
+
 namespace candela {
 
 void ParameterUsage::give(std::string name, SourceLocation where) {
@@ -31,6 +33,11 @@ std::string ParameterUsage::asked_list() const {
   std::string list;
   for (const std::string& name : asked_) list += (list.empty() ? "" : ", ") + name;
   return list;
+}
+
+std::string ParameterUsage::did_you_mean(std::string_view name) const {
+  std::vector<std::string_view> names(asked_.begin(), asked_.end());
+  return candela::did_you_mean(name, names);
 }
 
 const ParameterUsage::Parameter* ParameterUsage::first_unused() const {

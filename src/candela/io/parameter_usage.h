@@ -43,6 +43,8 @@ class ParameterUsage {
   const std::vector<Parameter>& given() const { return given_; }
   const std::vector<std::string>& asked() const { return asked_; }
   std::string asked_list() const;  // "a, b, c" in the order first asked
+  // " (did you mean \"x\"?)" for the asked-for name nearest to `name`, or "" (base/nearest_name.h).
+  std::string did_you_mean(std::string_view name) const;
 
   // The first parameter, in the order given, that nothing asked for.
   const Parameter* first_unused() const;

@@ -66,7 +66,7 @@ TEST(PbrtReader, StrayStringWhereADirectiveShouldBe) {
 
 TEST(PbrtReader, UnusedParameter) {
   expect_error({"WorldBegin", "Shape \"sphere\" \"float radius\" 1 \"float radiu\" 2"}, 2, "\"float radiu\"",
-               "unused parameter \"float radiu\" (parameters read here: radius, zmin, zmax, phimax, alpha)");
+               "unused parameter \"float radiu\" (did you mean \"radius\"?) (parameters read here: radius, zmin, zmax, phimax, alpha)");
 }
 
 TEST(PbrtReader, ParameterOfTheWrongType) {
@@ -182,7 +182,7 @@ TEST(PbrtReader, BadSampleCountsAndDepth) {
 
 TEST(PbrtReader, UnknownAndUnsupportedTypes) {
   expect_error({"WorldBegin", "Shape \"spere\""}, 2, "\"spere\"",
-               "unknown shape type \"spere\" (supported: \"sphere\", \"trianglemesh\", \"plymesh\", \"disk\", "
+               "unknown shape type \"spere\" (did you mean \"sphere\"?) (supported: \"sphere\", \"trianglemesh\", \"plymesh\", \"disk\", "
                "\"bilinearmesh\")");
   for (std::string type : {"cylinder", "curve", "loopsubdiv"})
     expect_error({"WorldBegin", "Shape \"" + type + "\""}, 2, "\"" + type + "\"",

@@ -154,6 +154,10 @@ TEST(PbrtReader, BadSamplers) {
   expect_error({"Sampler \"random\"", "WorldBegin"}, 1, "\"random\"",
                "unknown sampler type \"random\" (supported: \"independent\", \"stratified\", \"zsobol\", \"sobol\", "
                "\"halton\", \"paddedsobol\", \"pmj02bn\")");
+  // A likely typo gets the nearest name (of a type, of a parameter read there).
+  expect_error({"Sampler \"zsobl\"", "WorldBegin"}, 1, "\"zsobl\"", "unknown sampler type \"zsobl\" (did you mean \"zsobol\"?)");
+  expect_error({"Sampler \"zsobol\" \"integer pixelsample\" 4", "WorldBegin"}, 1, "\"integer pixelsample\"",
+               "unused parameter \"integer pixelsample\" (did you mean \"pixelsamples\"?)");
   expect_error({"Sampler \"pmj02bn\" \"string randomization\" \"owen\"", "WorldBegin"}, 1,
                "\"string randomization\"", "unused parameter");
   expect_error({"Sampler \"zsobol\" \"string randomization\" \"scrambled\"", "WorldBegin"}, 1,

@@ -434,7 +434,7 @@ TEST(PbrtReaderBitterli, VeachAjar) {
     EXPECT_EQ(fs::path(texture.filename).filename(), files[i]);
     // pbrt-v4 reads 8-bit .tga files as sRGB (the reference render agrees), so: sRGB for 8-bit files.
     EXPECT_EQ(texture.encoding, ColorEncoding::Auto);
-    EXPECT_TRUE(texture.bilinear);
+    EXPECT_EQ(texture.filter, TextureFilter::Bilinear);
   }
   // "Landscape" (the first MakeNamedMaterial) is the diffuse reflectance of texture 0.
   const auto& landscape = std::get<DiffuseMaterial>(scene.materials[0]);

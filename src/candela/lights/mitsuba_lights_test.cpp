@@ -257,7 +257,7 @@ TextureSet linear_texture(const std::string& file, bool bilinear, TextureWrap wr
   ImageTexture tex;
   tex.filename = file;
   tex.encoding = ColorEncoding::Linear;
-  tex.bilinear = bilinear;
+  tex.filter = bilinear ? TextureFilter::Bilinear : TextureFilter::Nearest;
   tex.wrap = wrap;
   return TextureSet(std::vector<TextureDesc>{tex});
 }

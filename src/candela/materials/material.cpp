@@ -38,9 +38,17 @@ bool has_constant_inputs(const MaterialDesc& desc) {
       case FieldKind::Rgb:
       case FieldKind::Point:
       case FieldKind::Direction:
+      case FieldKind::Vector:
       case FieldKind::Transform:
       case FieldKind::Enum:
-      case FieldKind::File: break;
+      case FieldKind::File:
+      // Not in materials' schemas.
+      case FieldKind::Text:
+      case FieldKind::UvMapping:
+      case FieldKind::Integer:
+      case FieldKind::ScalarVolume:
+      case FieldKind::ColorVolume:
+      case FieldKind::OptionalScalarVolume: break;
     }
   }
   return true;

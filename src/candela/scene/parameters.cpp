@@ -76,6 +76,10 @@ class Slots {
           break;
         case FieldKind::Roughness: roughness(prefix, field_value<Roughness>(f, object)); break;
         case FieldKind::Rgb: color(name, field_value<RGB>(f, object), f.range); break;
+        // A colour that may vary over a grid: editable where it is a constant.
+        case FieldKind::ColorVolume:
+          if (auto& v = field_value<VolumeDesc>(f, object); v.is_constant()) color(name, v.constant, f.range);
+          break;
         case FieldKind::Transform: transform(prefix + "to_world", field_value<Transform>(f, object)); break;
         // Not edited here: switches, names, positions and directions, and references to other
         // materials and textures.
@@ -85,8 +89,14 @@ class Slots {
         case FieldKind::Texture:
         case FieldKind::Point:
         case FieldKind::Direction:
+        case FieldKind::Vector:
         case FieldKind::Enum:
-        case FieldKind::File: break;
+        case FieldKind::File:
+        case FieldKind::Text:
+        case FieldKind::UvMapping:
+        case FieldKind::Integer:
+        case FieldKind::ScalarVolume:
+        case FieldKind::OptionalScalarVolume: break;
       }
     }
     schema_ = nullptr;
@@ -111,11 +121,13 @@ std::vector<std::string> labels(const std::vector<std::string>& names) {
   return out;
 }
 
-// A material's name as its scene file gives it: a JSON key (/materials/NAME), an OBJ newmtl.
-std::string material_name(const SceneDesc& scene, size_t i) {
-  if (i >= scene.places.materials.size()) return "";
-  const std::string& key = scene.places.materials[i].key_path;
-  if (key.starts_with("/materials/") && key.find('/', 11) == std::string::npos) return key.substr(11);
+// A material's or texture's name as its scene file gives it: a JSON key (/materials/NAME,
+// /textures/NAME), an OBJ newmtl.
+std::string entry_name(const std::vector<SourceLocation>& places, size_t i, std::string_view section) {
+  if (i >= places.size()) return "";
+  const std::string& key = places[i].key_path;
+  const std::string prefix = fmt::format("/{}/", section);
+  if (key.starts_with(prefix) && key.find('/', prefix.size()) == std::string::npos) return key.substr(prefix.size());
   if (key.starts_with("newmtl ")) return key.substr(7);
   return "";
 }
@@ -128,11 +140,17 @@ std::vector<Slot> slots(SceneDesc& scene) {
   s.number("camera.lens_radius", scene.camera.lens_radius);
   s.number("camera.focus_distance", scene.camera.focus_distance, kPositive);
   std::vector<std::string> names;
-  for (size_t i = 0; i < scene.materials.size(); ++i) names.push_back(material_name(scene, i));
+  for (size_t i = 0; i < scene.materials.size(); ++i) names.push_back(entry_name(scene.places.materials, i, "materials"));
   std::vector<std::string> material_labels = labels(names);
   for (size_t i = 0; i < scene.materials.size(); ++i)
     std::visit([&](auto& m) { s.fields("materials." + material_labels[i] + ".", SchemaOf<std::decay_t<decltype(m)>>::schema, &m); },
                scene.materials[i]);
+  names.clear();
+  for (size_t i = 0; i < scene.textures.size(); ++i) names.push_back(entry_name(scene.places.textures, i, "textures"));
+  std::vector<std::string> texture_labels = labels(names);
+  for (size_t i = 0; i < scene.textures.size(); ++i)
+    std::visit([&](auto& t) { s.fields("textures." + texture_labels[i] + ".", SchemaOf<std::decay_t<decltype(t)>>::schema, &t); },
+               scene.textures[i]);
   for (size_t i = 0; i < scene.lights.size(); ++i)
     std::visit([&](auto& l) { s.fields(fmt::format("lights.{}.", i), SchemaOf<std::decay_t<decltype(l)>>::schema, &l); },
                scene.lights[i]);
@@ -143,21 +161,16 @@ std::vector<Slot> slots(SceneDesc& scene) {
     ShapeDesc& shape = scene.shapes[i];
     s.transform("shapes." + shape_labels[i] + ".to_world", shape.to_world);
     if (shape.emission && shape.emission->texture < 0) s.color("shapes." + shape_labels[i] + ".emission", shape.emission->radiance);
+    std::visit([&](auto& g) { s.fields("shapes." + shape_labels[i] + ".", SchemaOf<std::decay_t<decltype(g)>>::schema, &g); },
+               shape.geometry);
   }
   for (size_t i = 0; i < scene.instances.size(); ++i)
     s.transform(fmt::format("instances.{}.to_world", i), scene.instances[i].to_world);
   names.clear();
   for (const MediumDesc& medium : scene.media) names.push_back(medium.name);
   std::vector<std::string> medium_labels = labels(names);
-  for (size_t i = 0; i < scene.media.size(); ++i) {
-    MediumDesc& m = scene.media[i];
-    const std::string p = "media." + medium_labels[i] + ".";
-    s.color(p + "sigma_t", m.sigma_t);
-    if (m.albedo.is_constant()) s.color(p + "albedo", m.albedo.constant, kAlbedo);
-    s.number(p + "scale", m.scale);
-    s.color(p + "emission", m.emission);
-    s.number(p + "g", m.g, ValueRange{.lo = -1, .hi = 1, .lo_open = true, .hi_open = true});
-  }
+  for (size_t i = 0; i < scene.media.size(); ++i)
+    s.fields("media." + medium_labels[i] + ".", SchemaOf<MediumDesc>::schema, &scene.media[i]);
   return out;
 }
 

@@ -411,7 +411,7 @@ TEST(SdfGridShape, JsonReadsAFileOrInlineSamplesAndRefusesWhatCannotBe) {
   const std::string file = R"("filename": ")" + vol.filename().string() + R"(")";
   EXPECT_NE(json_error(R"({"type": "sdfgrid", )" + file + R"(, "emission": {"radiance": 1}})").find("cannot emit light"),
             std::string::npos);
-  EXPECT_NE(json_error(R"({"type": "sdfgrid", )" + file + R"(, "normals": "flat"})").find("\"smooth\" or \"analytic\""),
+  EXPECT_NE(json_error(R"({"type": "sdfgrid", )" + file + R"(, "normals": "flat"})").find("unknown normals \"flat\"; expected one of: smooth, analytic"),
             std::string::npos);
   EXPECT_NE(json_error(R"({"type": "sdfgrid", )" + file + R"(, "values": [1]})").find("not both"), std::string::npos);
   EXPECT_NE(json_error(R"({"type": "sdfgrid"})").find("has neither"), std::string::npos);

@@ -20,7 +20,7 @@ inline void expect_mapping(const UVMapping& actual, const UVMapping& expected, c
 inline void expect_image_settings(const ImageTexture& actual, const ImageTexture& expected, const std::string& what) {
   EXPECT_EQ(actual.wrap, expected.wrap) << what;
   EXPECT_EQ(actual.encoding, expected.encoding) << what;
-  EXPECT_EQ(actual.bilinear, expected.bilinear) << what;
+  EXPECT_EQ(actual.filter, expected.filter) << what;
   EXPECT_FLOAT_EQ(actual.scale, expected.scale) << what;
   EXPECT_EQ(actual.invert, expected.invert) << what;
   EXPECT_EQ(actual.luminance, expected.luminance) << what;

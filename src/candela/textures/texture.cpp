@@ -172,7 +172,7 @@ TextureSet::TextureSet(const std::vector<TextureDesc>& descs, const EntryPlace& 
         // read_image's message already names the file.
         throw SceneError(fmt::format("{}: {}", name(i), e.what()));
       }
-      textures_.emplace_back(ImageLookup{image, desc->wrap, desc->bilinear, desc->scale, desc->invert, desc->luminance, desc->mapping});
+      textures_.emplace_back(ImageLookup{image, desc->wrap, desc->filter == TextureFilter::Bilinear, desc->scale, desc->invert, desc->luminance, desc->mapping});
     } else {
       std::visit(
           [&](const auto& d) {

@@ -63,7 +63,7 @@ ImageTexture image_desc(const fs::path& file, TextureWrap wrap = TextureWrap::Re
   ImageTexture desc;
   desc.filename = file.string();
   desc.wrap = wrap;
-  desc.bilinear = bilinear;
+  desc.filter = bilinear ? TextureFilter::Bilinear : TextureFilter::Nearest;
   desc.encoding = encoding;
   return desc;
 }

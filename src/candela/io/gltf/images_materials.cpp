@@ -206,7 +206,7 @@ int GltfReader::add_texture(int index, int tex_coord, const tg::ExtensionMap& ex
     if (s.wrapS != s.wrapT && warned_samplers_.insert(texture.sampler).second)
       warn(fmt::format("/samplers/{}", texture.sampler),
            "different wrap modes in s and t ({} and {}); candela uses wrapS ({}) for both", s.wrapS, s.wrapT, s.wrapS);
-    image.bilinear = s.magFilter != TINYGLTF_TEXTURE_FILTER_NEAREST;
+    image.filter = s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST ? TextureFilter::Nearest : TextureFilter::Bilinear;
   }
   if (auto tt = extensions.find("KHR_texture_transform"); tt != extensions.end()) {
     const tg::Value& v = tt->second;

@@ -14,18 +14,18 @@ void JsonSceneReader::read_lights(const Json& value, const std::string& pointer)
 void JsonSceneReader::read_light(const Json& value, const std::string& pointer) {
   CheckedObject light(report_, value, pointer);
   const std::string type = light.string("type");
+  // The shape's geometry, by its schema (description/shapes.h).
+  auto geometry = [&](auto shape) {
+    read_fields(light, SchemaOf<decltype(shape)>::schema, &shape);
+    check_fields(light, SchemaOf<decltype(shape)>::schema, &shape);
+    return shape;
+  };
   if (type == "sphere") {
-    scene_.shapes.push_back(read_shape_light(light, read_sphere(light)));
+    scene_.shapes.push_back(read_shape_light(light, geometry(SphereShape{})));
   } else if (type == "rectangle") {
-    scene_.shapes.push_back(read_shape_light(light, read_rectangle(light)));
+    scene_.shapes.push_back(read_shape_light(light, geometry(RectangleShape{})));
   } else {
-    std::optional<LightDesc> desc = default_of_type<LightDesc>(type);
-    if (!desc) {
-      std::vector<std::string_view> names = type_names_of<LightDesc>();
-      names.insert(names.end(), {"sphere", "rectangle"});
-      report_.fail(light.pointer_of("type"), "unknown light type \"{}\"{}; expected one of: {}", type,
-                   did_you_mean(type, names), fmt::join(names, ", "));
-    }
+    std::optional<LightDesc> desc = default_of_named_type<LightDesc>(light, "light", {"sphere", "rectangle"});
     std::visit(
         [&](auto& l) {
           using T = std::decay_t<decltype(l)>;

@@ -19,23 +19,11 @@ int JsonSceneReader::add_material(MaterialDesc material, SourceLocation where) {
 
 MaterialDesc JsonSceneReader::read_material(const Json& value, const std::string& pointer) {
   CheckedObject m(report_, value, pointer);
-  const std::string type = m.string("type");
-  std::optional<MaterialDesc> material = default_of_type<MaterialDesc>(type);
-  if (!material) {
-    std::vector<std::string_view> names = type_names_of<MaterialDesc>();
-    report_.fail(m.pointer_of("type"), "unknown material type \"{}\"{}; expected one of: {}", type,
-                 did_you_mean(type, names), fmt::join(names, ", "));
-  }
-  if (auto* conductor = std::get_if<ConductorMaterial>(&*material)) read_conductor_preset(m, *conductor);
-  std::visit(
-      [&](auto& desc) {
-        const TypeSchema& schema = SchemaOf<std::decay_t<decltype(desc)>>::schema;
-        read_fields(m, schema, &desc);
-        check_fields(m, schema, &desc);
-      },
-      *material);
+  MaterialDesc material = default_of_named_type<MaterialDesc>(m, "material");
+  if (auto* conductor = std::get_if<ConductorMaterial>(&material)) read_conductor_preset(m, *conductor);
+  read_schema_fields(m, material);
   m.finish();
-  return *material;
+  return material;
 }
 
 // GGX alpha (Roughness::remap = false): "roughness" for both axes, or "alpha_u" and "alpha_v".

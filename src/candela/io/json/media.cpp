@@ -25,14 +25,16 @@ void JsonSceneReader::read_media(const Json& value, const std::string& pointer) 
 }
 
 // "homogeneous": the same coefficients everywhere. "grid": a density (and optionally an albedo) that
-// varies over a grid's box; the medium has no density outside the density grid's box.
+// varies over a grid's box; the medium has no density outside the density grid's box. The fields
+// are the medium's schema (description/media.h); "sigma_a" and "sigma_s" are another way to give
+// sigma_t and the albedo.
 MediumDesc JsonSceneReader::read_medium(const Json& value, const std::string& pointer) {
   CheckedObject m(report_, value, pointer);
   static constexpr std::string_view kTypes[] = {"homogeneous", "grid"};
   const std::string type = m.string("type");
   if (type != kTypes[0] && type != kTypes[1])
-    report_.fail(m.pointer_of("type"), "unknown medium type \"{}\"; expected one of: {}", type,
-                 fmt::join(kTypes, ", "));
+    report_.fail(m.pointer_of("type"), "unknown medium type \"{}\"{}; expected one of: {}", type,
+                 did_you_mean(type, kTypes), fmt::join(kTypes, ", "));
   const bool grid = type == "grid";
 
   MediumDesc medium;
@@ -43,54 +45,17 @@ MediumDesc JsonSceneReader::read_medium(const Json& value, const std::string& po
   if (!absorption_scattering && !extinction_albedo)
     report_.fail(pointer, "a medium needs its coefficients: \"sigma_a\" and \"sigma_s\", or \"sigma_t\" and "
                  "\"albedo\"");
-  if (absorption_scattering) {
+  if (absorption_scattering)
     set_sigma_a_sigma_s(medium, m.rgb_or("sigma_a", ColorKind::NonNegative, RGB(0.0f)),
                         m.rgb_or("sigma_s", ColorKind::NonNegative, RGB(0.0f)));
-  } else {
-    medium.sigma_t = m.rgb_or("sigma_t", ColorKind::NonNegative, RGB(1.0f));
-    if (const Json* albedo = m.find("albedo")) {
-      if (!grid && albedo->is_object())
-        report_.fail(m.pointer_of("albedo"), "a homogeneous medium's albedo is an rgb; an albedo grid needs type "
-                     "\"grid\"");
-      if (albedo->is_object())
-        medium.albedo = read_volume(*albedo, m.pointer_of("albedo"), "albedo");
-      else
-        medium.albedo.constant = read_rgb(report_, *albedo, m.pointer_of("albedo"), ColorKind::Albedo);
-    }
-  }
-  medium.scale = m.number_or("scale", medium.scale, Bound::NonNegative);
-  medium.g = m.number_or("g", medium.g);
-  if (!(medium.g > -1 && medium.g < 1))
-    report_.fail(m.pointer_of("g"), "g (Henyey-Greenstein's mean cosine) must be in (-1, 1), got {}", medium.g);
-  medium.emission = m.rgb_or("emission", ColorKind::Emission, medium.emission);
-  // Emission that varies through the medium: a scale, and a temperature whose blackbody replaces
-  // "emission" (each a number or a grid).
-  auto scalar_or_grid = [&](const Json& v, std::string_view key) {
-    if (v.is_object()) return read_volume(v, m.pointer_of(key), key);
-    VolumeDesc constant;
-    const float x = read_float(report_, v, m.pointer_of(key));
-    constant.constant = RGB(key == "temperature" ? x : check_bound(report_, x, Bound::NonNegative, m.pointer_of(key)));
-    return constant;
-  };
-  if (const Json* scale = m.find("emission_scale")) medium.emission_scale = scalar_or_grid(*scale, "emission_scale");
-  if (const Json* temperature = m.find("temperature")) {
-    if (m.has("emission"))
-      report_.fail(m.pointer_of("temperature"), "a medium emits its \"temperature\"'s blackbody or \"emission\", not "
-                   "both");
-    medium.temperature = scalar_or_grid(*temperature, "temperature");
-  }
-  medium.temperature_scale = m.number_or("temperature_scale", medium.temperature_scale);
-  medium.temperature_offset = m.number_or("temperature_offset", medium.temperature_offset);
-  medium.temperature_cutoff = m.number_or("temperature_cutoff", medium.temperature_cutoff);
-  if (grid) {
-    const Json& density = m.require("density");
-    if (density.is_object())
-      medium.density = read_volume(density, m.pointer_of("density"), "density");
-    else
-      medium.density.constant = RGB(check_bound(report_, read_float(report_, density, m.pointer_of("density")),
-                                                Bound::NonNegative, m.pointer_of("density")));
-    medium.majorant_cell_samples = m.integer_or("majorant_cell_samples", medium.majorant_cell_samples, 0, 1 << 20);
-  }
+  if (!grid)
+    for (std::string_view key : {"albedo", "density"})
+      if (const Json* given = m.find(key); given && given->is_object())
+        report_.fail(m.pointer_of(key), "a homogeneous medium's {} is a constant; a grid of {} needs type \"grid\"", key, key);
+  if (grid) m.require("density");
+  const TypeSchema& schema = SchemaOf<MediumDesc>::schema;
+  read_fields(m, schema, &medium);
+  check_fields(m, schema, &medium);
   m.finish();
   // The keys were checked one by one above; this is the renderer's own account of what it can render,
   // so that the two cannot drift apart.

@@ -4,7 +4,10 @@
 // settings), textures.cpp, materials.cpp, shapes.cpp (shapes, objects and instances, meshes,
 // transforms), lights.cpp and media.cpp. Each reader of a kind of entry (texture, material, shape,
 // light) dispatches on a table of type names, from which its "unknown ... type" message lists the names.
+#include <fmt/ranges.h>
+
 #include <filesystem>
+#include <initializer_list>
 #include <map>
 #include <optional>
 #include <string>
@@ -27,38 +30,6 @@ constexpr int kMaxTextureDepth = 64;    // textures using textures
 
 // The "type" of an entry of "shapes" that places an object.
 constexpr std::string_view kInstanceType = "instance";
-
-// A table the readers dispatch on: a type name and the function reading that type.
-template <typename Reader>
-struct NamedReader {
-  std::string_view name;
-  Reader read;
-};
-
-// "a, b, c": the names of a table, for messages.
-template <typename Reader, size_t N>
-std::string type_names(const NamedReader<Reader> (&table)[N]) {
-  std::string names;
-  for (const NamedReader<Reader>& entry : table) {
-    if (!names.empty()) names += ", ";
-    names += entry.name;
-  }
-  return names;
-}
-
-// The table's reader for the object's "type"; an unknown type is an error at /type naming the
-// known ones (and `also_known`, a type told apart before the table is consulted).
-template <typename Reader, size_t N>
-const NamedReader<Reader>& reader_for(const NamedReader<Reader> (&table)[N], CheckedObject& object,
-                                      std::string_view kind, std::string_view also_known = {}) {
-  const std::string type = object.string("type");
-  for (const NamedReader<Reader>& entry : table)
-    if (entry.name == type) return entry;
-  std::vector<std::string_view> names;
-  for (const NamedReader<Reader>& entry : table) names.push_back(entry.name);
-  object.report().fail(object.pointer_of("type"), "unknown {} type \"{}\"{}; expected one of: {}{}{}", kind, type,
-                       did_you_mean(type, names), type_names(table), also_known.empty() ? "" : ", ", also_known);
-}
 
 class JsonSceneReader {
  public:
@@ -113,7 +84,6 @@ class JsonSceneReader {
   int named_texture(const std::string& name, const std::string& pointer);
   int add_texture(TextureDesc texture, SourceLocation where);
   TextureDesc read_texture(const Json& value, const std::string& pointer);
-  ImageTexture read_image_texture(CheckedObject& t) const;
   UVMapping read_uv_mapping(CheckedObject& t) const;
   std::string existing_file(CheckedObject& object, std::string_view key, std::string_view what) const;
 
@@ -133,6 +103,32 @@ class JsonSceneReader {
   // `object`, then, once the format's shorthands have filled in the rest, its cross-field check.
   void read_fields(CheckedObject& m, const TypeSchema& schema, void* object);
   void check_fields(CheckedObject& m, const TypeSchema& schema, const void* object) const;
+  // The alternative of Variant that the object's "type" names, default-constructed; an unknown type
+  // is an error at /type naming the known ones (and `also_known`: types told apart elsewhere).
+  template <typename Variant>
+  Variant default_of_named_type(CheckedObject& m, std::string_view kind,
+                                std::initializer_list<std::string_view> also_known = {}) const {
+    const std::string type = m.string("type");
+    std::optional<Variant> value = default_of_type<Variant>(type);
+    if (!value) {
+      std::vector<std::string_view> names = type_names_of<Variant>();
+      names.insert(names.end(), also_known.begin(), also_known.end());
+      report_.fail(m.pointer_of("type"), "unknown {} type \"{}\"{}; expected one of: {}", kind, type,
+                   did_you_mean(type, names), fmt::join(names, ", "));
+    }
+    return *value;
+  }
+  // Every field of the value's schema read from the object, and the schema's rule checked.
+  template <typename Variant>
+  void read_schema_fields(CheckedObject& m, Variant& value) {
+    std::visit(
+        [&](auto& desc) {
+          const TypeSchema& schema = SchemaOf<std::decay_t<decltype(desc)>>::schema;
+          read_fields(m, schema, &desc);
+          check_fields(m, schema, &desc);
+        },
+        value);
+  }
   Roughness read_roughness(CheckedObject& m);
   void read_conductor_preset(CheckedObject& m, ConductorMaterial& c) const;
   int material_by_name(const std::string& name, const std::string& pointer);
@@ -146,9 +142,6 @@ class JsonSceneReader {
   ShapeDesc read_shape(const Json& value, const std::string& pointer);
   ShapeGeometry read_geometry(CheckedObject& s);
   SdfGridShape read_sdf_grid(CheckedObject& s) const;
-  static SphereShape read_sphere(CheckedObject& s);
-  BoxShape read_box(CheckedObject& s) const;
-  RectangleShape read_rectangle(CheckedObject& s) const;
   int read_shape_material(CheckedObject& s);
   AreaEmission read_emission(const Json& value, const std::string& pointer);
 
@@ -192,6 +185,7 @@ class JsonSceneReader {
   // ---- participating media (media.cpp): read before the camera and the shapes that name them
   void read_media(const Json& value, const std::string& pointer);
   MediumDesc read_medium(const Json& value, const std::string& pointer);
+  VolumeDesc read_volume_or_constant(CheckedObject& m, const Field& f) const;
   VolumeDesc read_volume(const Json& value, const std::string& pointer, std::string_view what) const;
   int medium_by_name(const std::string& name, const std::string& pointer) const;
   int medium_reference(CheckedObject& object, std::string_view key) const;

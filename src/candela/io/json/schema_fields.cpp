@@ -62,6 +62,11 @@ void JsonSceneReader::read_fields(CheckedObject& m, const TypeSchema& schema, vo
         point = m.vec3_or(f.key, point);
         break;
       }
+      case FieldKind::Vector: {
+        auto& vector = field_value<Vec3>(f, object);
+        vector = m.direction_or(f.key, vector);  // not zero
+        break;
+      }
       case FieldKind::Direction: {
         auto& direction = field_value<Vec3>(f, object);
         direction = normalize(m.direction_or(f.key, direction));
@@ -73,15 +78,54 @@ void JsonSceneReader::read_fields(CheckedObject& m, const TypeSchema& schema, vo
       case FieldKind::Enum:
         if (const Json* given = m.find(f.key)) {
           std::string name = read_string(report_, *given, m.pointer_of(f.key));
-          if (!f.names->set_by_name(f.member(object), name))
-            report_.fail(m.pointer_of(f.key), "unknown {} \"{}\"; expected one of: {}", f.key, name, f.names->list());
+          if (!f.names->set_by_name(f.member(object), name)) {
+            const std::string list = f.names->list();
+            std::vector<std::string_view> names;
+            for (size_t at = 0; at < list.size();) {
+              const size_t end = std::min(list.find(", ", at), list.size());
+              names.push_back(std::string_view(list).substr(at, end - at));
+              at = end + 2;
+            }
+            report_.fail(m.pointer_of(f.key), "unknown {} \"{}\"{}; expected one of: {}", f.key, name,
+                         did_you_mean(name, names), list);
+          }
         }
         break;
       case FieldKind::File:
         if (f.required || m.has(f.key)) field_value<std::string>(f, object) = existing_file(m, f.key, f.help);
         break;
+      case FieldKind::Text:
+        if (f.required || m.has(f.key)) field_value<std::string>(f, object) = m.string(f.key);
+        break;
+      case FieldKind::UvMapping: field_value<UVMapping>(f, object) = read_uv_mapping(m); break;
+      case FieldKind::Integer: {
+        auto& number = field_value<int>(f, object);
+        number = m.integer_or(f.key, number, int64_t(std::max(f.range.lo, -2147483648.0)),
+                              int64_t(std::min(f.range.hi, 2147483647.0)));
+        break;
+      }
+      case FieldKind::ScalarVolume:
+      case FieldKind::ColorVolume:
+        if (m.has(f.key)) field_value<VolumeDesc>(f, object) = read_volume_or_constant(m, f);
+        break;
+      case FieldKind::OptionalScalarVolume:
+        if (m.has(f.key)) field_value<std::optional<VolumeDesc>>(f, object) = read_volume_or_constant(m, f);
+        break;
     }
   }
+}
+
+// A quantity over space: a grid (an object; read_volume) or a constant in the field's range.
+VolumeDesc JsonSceneReader::read_volume_or_constant(CheckedObject& m, const Field& f) const {
+  const Json& value = m.require(f.key);
+  const std::string pointer = m.pointer_of(f.key);
+  if (value.is_object()) return read_volume(value, pointer, f.key);
+  VolumeDesc constant;
+  if (f.kind == FieldKind::ColorVolume)
+    constant.constant = read_rgb(report_, value, pointer, f.range.bounded_above() ? ColorKind::Albedo : ColorKind::NonNegative);
+  else
+    constant.constant = RGB(check_bound(report_, read_float(report_, value, pointer), f.range, pointer));
+  return constant;
 }
 
 void JsonSceneReader::check_fields(CheckedObject& m, const TypeSchema& schema, const void* object) const {

@@ -36,36 +36,20 @@ ShapeDesc JsonSceneReader::read_shape(const Json& value, const std::string& poin
   return shape;
 }
 
+// The geometry's schema (description/shapes.h); a mesh's and an SDF grid's data beside it.
 ShapeGeometry JsonSceneReader::read_geometry(CheckedObject& s) {
-  using Reader = ShapeGeometry (*)(JsonSceneReader&, CheckedObject&);
-  using R = JsonSceneReader;
-  using S = CheckedObject;
-  static constexpr NamedReader<Reader> kShapes[] = {
-      {"sphere", [](R&, S& s) -> ShapeGeometry { return read_sphere(s); }},
-      {"plane", [](R&, S& s) -> ShapeGeometry { return PlaneShape{s.vec3("point"), normalize(s.direction("normal"))}; }},
-      {"box", [](R& r, S& s) -> ShapeGeometry { return r.read_box(s); }},
-      {"rectangle", [](R& r, S& s) -> ShapeGeometry { return r.read_rectangle(s); }},
-      {"mesh", [](R& r, S& s) -> ShapeGeometry { return r.read_mesh(s); }},
-      {"disk", [](R&, S&) -> ShapeGeometry { return DiskShape{}; }},
-      {"cylinder",
-       [](R& r, S& s) -> ShapeGeometry {
-         CylinderShape c{s.vec3_or("p0", {0, 0, 0}), s.vec3_or("p1", {0, 0, 1}),
-                         s.number_or("radius", 1, Bound::Positive)};
-         if (length_squared(c.p1 - c.p0) == 0) r.report_.fail(s.pointer_of("p1"), "p1 must differ from p0 (the axis)");
-         return c;
-       }},
-      {"sdfgrid", [](R& r, S& s) -> ShapeGeometry { return r.read_sdf_grid(s); }},
-  };
   // Instances are told apart before a shape is read (read_shapes).
-  return reader_for(kShapes, s, "shape", kInstanceType).read(*this, s);
+  ShapeGeometry geometry = default_of_named_type<ShapeGeometry>(s, "shape", {kInstanceType});
+  if (auto* mesh = std::get_if<MeshShape>(&geometry)) *mesh = read_mesh(s);
+  if (auto* grid = std::get_if<SdfGridShape>(&geometry)) *grid = read_sdf_grid(s);
+  read_schema_fields(s, geometry);
+  return geometry;
 }
 
 // A Mitsuba .vol file, or the samples inline (as `candela convert` writes a grid made in memory).
+// Its "normals" is a field of its schema, read after.
 SdfGridShape JsonSceneReader::read_sdf_grid(CheckedObject& s) const {
-  const std::string normals = s.string_or("normals", "smooth");
-  if (normals != "smooth" && normals != "analytic")
-    report_.fail(s.pointer_of("normals"), "expected \"smooth\" or \"analytic\", got \"{}\"", normals);
-  const SdfNormals mode = normals == "smooth" ? SdfNormals::Smooth : SdfNormals::Analytic;
+  const SdfNormals mode = SdfGridShape{}.normals;
   const bool from_file = s.has("filename"), inline_data = s.has("values") || s.has("resolution");
   if (from_file == inline_data)
     report_.fail(s.pointer(), "an sdfgrid takes either \"filename\" or inline \"resolution\" and \"values\", {}",
@@ -96,24 +80,6 @@ SdfGridShape JsonSceneReader::read_sdf_grid(CheckedObject& s) const {
   grid.values = std::make_shared<const std::vector<float>>(std::move(samples));
   if (std::string problem = sdf_grid_problem(grid); !problem.empty()) report_.fail(s.pointer(), "{}", problem);
   return grid;
-}
-
-SphereShape JsonSceneReader::read_sphere(CheckedObject& s) { return {s.vec3("center"), s.number("radius", Bound::Positive)}; }
-
-BoxShape JsonSceneReader::read_box(CheckedObject& s) const {
-  BoxShape box{s.vec3("min"), s.vec3("max")};
-  for (int axis = 0; axis < 3; ++axis)
-    if (!(box.lo[axis] < box.hi[axis]))
-      report_.fail(s.pointer_of("max"), "max must exceed min on every axis; on axis {} min is {} and max is {}",
-                   "xyz"[axis], box.lo[axis], box.hi[axis]);
-  return box;
-}
-
-RectangleShape JsonSceneReader::read_rectangle(CheckedObject& s) const {
-  RectangleShape r{s.vec3("corner"), s.direction("edge_u"), s.direction("edge_v")};
-  if (length(cross(r.edge_u, r.edge_v)) <= 1e-6f * length(r.edge_u) * length(r.edge_v))
-    report_.fail(s.pointer_of("edge_v"), "edge_u and edge_v are parallel, so the rectangle has no area");
-  return r;
 }
 
 int JsonSceneReader::read_shape_material(CheckedObject& s) {

@@ -72,61 +72,10 @@ TextureDesc JsonSceneReader::read_texture(const Json& value, const std::string& 
     ~DepthGuard() { --depth; }
   } guard(texture_depth_);
   CheckedObject t(report_, value, pointer);
-  // A texture may be used in any parameter, so the constants inside it are only checked to be >= 0.
-  static constexpr ColorKind kAny = ColorKind::NonNegative;
-  using Reader = TextureDesc (*)(JsonSceneReader&, CheckedObject&);
-  static constexpr NamedReader<Reader> kTextures[] = {
-      {"image", [](JsonSceneReader& r, CheckedObject& t) -> TextureDesc { return r.read_image_texture(t); }},
-      {"checkerboard",
-       [](JsonSceneReader& r, CheckedObject& t) -> TextureDesc {
-         CheckerboardTexture checkerboard;
-         checkerboard.tex1 = r.color_input_or(t, "tex1", kAny, checkerboard.tex1);
-         checkerboard.tex2 = r.color_input_or(t, "tex2", kAny, checkerboard.tex2);
-         checkerboard.mapping = r.read_uv_mapping(t);
-         return checkerboard;
-       }},
-      {"scale",
-       [](JsonSceneReader& r, CheckedObject& t) -> TextureDesc {
-         ScaleTexture scale;
-         scale.tex = r.color_input_or(t, "tex", kAny, scale.tex);
-         scale.scale = r.float_input_or(t, "scale", Bound::NonNegative, scale.scale);
-         return scale;
-       }},
-      {"mix",
-       [](JsonSceneReader& r, CheckedObject& t) -> TextureDesc {
-         MixTexture mix;
-         mix.tex1 = r.color_input_or(t, "tex1", kAny, mix.tex1);
-         mix.tex2 = r.color_input_or(t, "tex2", kAny, mix.tex2);
-         mix.amount = r.float_input_or(t, "amount", Bound::UnitInterval, mix.amount);
-         return mix;
-       }},
-      {"mesh_attribute",
-       [](JsonSceneReader&, CheckedObject& t) -> TextureDesc {
-         return MeshAttributeTexture{t.string("name"), t.boolean_or("per_face", false)};
-       }},
-  };
-  const NamedReader<Reader>& reader = reader_for(kTextures, t, "texture");
-  TextureDesc texture = reader.read(*this, t);
+  TextureDesc texture = default_of_named_type<TextureDesc>(t, "texture");
+  read_schema_fields(t, texture);
   t.finish();
   return texture;
-}
-
-ImageTexture JsonSceneReader::read_image_texture(CheckedObject& t) const {
-  ImageTexture image;
-  image.filename = existing_file(t, "filename", "image");
-  if (const Json* wrap = t.find("wrap"))
-    image.wrap = read_enum<TextureWrap>(report_, *wrap, t.pointer_of("wrap"), "wrap mode");
-  if (const Json* encoding = t.find("encoding"))
-    image.encoding = read_enum<ColorEncoding>(
-        report_, *encoding, t.pointer_of("encoding"), "colour encoding");
-  if (const Json* filter = t.find("filter"))
-    image.bilinear = read_name<bool>(report_, *filter, t.pointer_of("filter"), "texture filter",
-                                     {{"bilinear", true}, {"nearest", false}});
-  image.scale = t.number_or("scale", image.scale, Bound::NonNegative);
-  image.invert = t.boolean_or("invert", image.invert);
-  image.luminance = t.boolean_or("luminance", image.luminance);
-  image.mapping = read_uv_mapping(t);
-  return image;
 }
 
 // "uv_scale": [su, sv] (or one number for both) and "uv_offset": [du, dv].

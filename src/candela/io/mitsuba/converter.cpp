@@ -1,7 +1,11 @@
 // The Mitsuba converter: the scene's objects in turn, and the access to their properties.
 #include "candela/io/mitsuba/converter.h"
 
+#include <fmt/ranges.h>
+
 #include <limits>
+
+#include "candela/base/nearest_name.h"
 
 namespace candela::mitsuba {
 
@@ -125,6 +129,13 @@ void Converter::ignore(const Object& o, std::string_view name, const char* why) 
   if (p && why) warn(p->where, "{}: \"{}\" is ignored: {}", o.describe(), name, why);
 }
 
+void Converter::unknown_type(const Object& o, std::string_view what, std::string_view type,
+                             std::initializer_list<std::string_view> supported) {
+  std::vector<std::string_view> names(supported);
+  throw_scene_error(o.where.loc(), "unknown {} type \"{}\"{} (supported: {})", what, type, did_you_mean(type, names),
+                    fmt::join(names, ", "));
+}
+
 // Every property must have been read by the plugin.
 void Converter::check_all_used(const Object& o) {
   const ParameterUsage::Parameter* unused = o.usage.first_unused();
@@ -134,7 +145,7 @@ void Converter::check_all_used(const Object& o) {
     throw_scene_error(p.where.loc(), "{}: unexpected nested {}", o.describe(),
                       p.kind == Property::Kind::Ref ? fmt::format("reference to \"{}\"", p.text)
                                                     : "<" + p.object->tag + ">");
-  throw_scene_error(p.where.loc(), "{}: unknown parameter \"{}\"", o.describe(), p.name);
+  throw_scene_error(p.where.loc(), "{}: unknown parameter \"{}\"{}", o.describe(), p.name, o.usage.did_you_mean(p.name));
 }
 
 const Object& Converter::deref(const Property& p) {

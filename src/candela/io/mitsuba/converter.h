@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include <filesystem>
+#include <initializer_list>
 #include <map>
 #include <optional>
 #include <string>
@@ -49,6 +50,9 @@ class Converter {
   static const Property* find(const Object& o, std::string_view name);
 
   [[noreturn]] static void wrong_kind(const Object& o, const Property& p, const char* expected);
+  // "unknown WHAT type "x" (did you mean "y"?) (supported: ...)" at the object.
+  [[noreturn]] static void unknown_type(const Object& o, std::string_view what, std::string_view type,
+                                        std::initializer_list<std::string_view> supported);
 
   static float get_float(const Object& o, std::string_view name, float fallback);
   static int get_int(const Object& o, std::string_view name, int fallback);

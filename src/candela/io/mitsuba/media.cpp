@@ -50,7 +50,7 @@ VolumeDesc Converter::volume_parameter(const Object& m, std::string_view name, R
     ignore(vol, "accel", nullptr);
     v.values = std::make_shared<const std::vector<float>>(std::move(grid.values));
   } else {
-    throw_scene_error(vol.where.loc(), "unknown volume type \"{}\" (supported: constvolume, gridvolume)", vol.type);
+    unknown_type(vol, "volume", vol.type, {"constvolume", "gridvolume"});
   }
   check_all_used(vol);
   return v;
@@ -75,7 +75,7 @@ float Converter::phase_g(const Object& m) {
 int Converter::medium(const Object& m) {
   if (auto it = medium_memo_.find(&m); it != medium_memo_.end()) return it->second;
   if (m.type != "homogeneous" && m.type != "heterogeneous")
-    throw_scene_error(m.where.loc(), "unknown medium type \"{}\" (supported: homogeneous, heterogeneous)", m.type);
+    unknown_type(m, "medium", m.type, {"homogeneous", "heterogeneous"});
   MediumDesc out;
   out.name = m.id.empty() ? m.type : m.id;
   out.where = m.where.place();

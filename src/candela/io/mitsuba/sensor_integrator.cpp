@@ -78,8 +78,7 @@ void Converter::sensor(const Object& s) {
   } else if (s.type == "orthographic") {
     cam.projection = Projection::Orthographic;
   } else {
-    throw_scene_error(s.where.loc(), "unknown sensor type \"{}\" (supported: perspective, thinlens, orthographic)",
-                      s.type);
+    unknown_type(s, "sensor", s.type, {"perspective", "thinlens", "orthographic"});
   }
   for (auto& [prop, o] : nested(s, "film")) film(*o);
   for (auto& [prop, o] : nested(s, "sampler")) sampler(*o);
@@ -88,7 +87,7 @@ void Converter::sensor(const Object& s) {
 
 void Converter::film(const Object& f) {
   if (f.type != "hdrfilm" && f.type != "specfilm")
-    throw_scene_error(f.where.loc(), "unknown film type \"{}\" (supported: hdrfilm)", f.type);
+    unknown_type(f, "film", f.type, {"hdrfilm", "specfilm"});
   desc_.film.width = get_int(f, "width", 768);
   desc_.film.height = get_int(f, "height", 576);
   if (desc_.film.width <= 0 || desc_.film.height <= 0 || desc_.film.width > 65536 || desc_.film.height > 65536)
@@ -128,9 +127,7 @@ void Converter::rfilter(const Object& r) {
     f.mitchell_c = get_float(r, "C", r.type == "mitchell" ? 1.0f / 3 : 0.5f);
     f.radius = {2, 2};
   } else {
-    throw_scene_error(r.where.loc(), "unknown rfilter type \"{}\" (supported: box, gaussian, tent, mitchell, "
-                                     "catmullrom)",
-                      r.type);
+    unknown_type(r, "rfilter", r.type, {"box", "gaussian", "tent", "mitchell", "catmullrom"});
   }
   check_all_used(r);
 }
@@ -151,7 +148,7 @@ void Converter::sampler(const Object& s) {
     rs.sampler.type = SamplerType::ZSobol;
     warn(s.where, "sampler \"ldsampler\": using candela's zsobol sampler");
   } else {
-    throw_scene_error(s.where.loc(), "unknown sampler type \"{}\"", s.type);
+    unknown_type(s, "sampler", s.type, {"independent", "stratified", "multijitter", "orthogonal", "ldsampler"});
   }
   check_all_used(s);
 }
@@ -197,8 +194,7 @@ void Converter::integrator(const Object& i) {
       warn(i.where, "integrator \"direct\": emitter_samples/bsdf_samples are ignored (one of each, with MIS)");
     rs.hide_emitters = get_bool(i, "hide_emitters", false);
   } else {
-    throw_scene_error(i.where.loc(), "unknown integrator type \"{}\" (supported: path, volpath, volpathmis, direct, ptracer, moment)",
-                      i.type);
+    unknown_type(i, "integrator", i.type, {"path", "volpath", "volpathmis", "direct", "ptracer", "moment"});
   }
   check_all_used(i);
 }

@@ -116,9 +116,8 @@ void Converter::shape(const Object& s, ObjectDesc* group) {
   } else if (type == "shapegroup") {
     throw_scene_error(s.where.loc(), "a shapegroup cannot be nested in another shape");
   } else {
-    throw_scene_error(s.where.loc(), "unknown shape type \"{}\" (supported: obj, ply, serialized, sphere, rectangle, "
-                                     "cube, disk, cylinder, sdfgrid, shapegroup, instance)",
-                      type);
+    unknown_type(s, "shape", type, {"obj", "ply", "serialized", "sphere", "rectangle", "cube", "disk", "cylinder",
+                                    "sdfgrid", "shapegroup", "instance"});
   }
   out.reverse_orientation = get_bool(s, "flip_normals", false);
   shape_media(s, out);
@@ -258,9 +257,7 @@ Vec3 Converter::origin_of(const Transform& t) { return t.point({0, 0, 0}); }
   } else if (type == "area") {
     throw_scene_error(e.where.loc(), "an area emitter must be inside the shape it lights");
   } else {
-    throw_scene_error(e.where.loc(), "unknown emitter type \"{}\" (supported: area, point, spot, projector, "
-                                     "directional, constant, envmap)",
-                      type);
+    unknown_type(e, "emitter", type, {"area", "point", "spot", "projector", "directional", "constant", "envmap"});
   }
   check_all_used(e);
 }

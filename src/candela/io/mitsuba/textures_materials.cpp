@@ -147,7 +147,7 @@ int Converter::texture(const Object& t, TextureLookup lookup) {
     ImageTexture img;
     img.filename = resolve_file(t, "filename").string();
     std::string filter = get_string(t, "filter_type", "bilinear");
-    if (filter == "nearest") img.bilinear = false;
+    if (filter == "nearest") img.filter = TextureFilter::Nearest;
     else if (filter != "bilinear")
       throw_scene_error(t.where.loc(), "bitmap: filter_type \"{}\" (use bilinear or nearest)", filter);
     std::string wrap = get_string(t, "wrap_mode", "repeat");
@@ -202,9 +202,7 @@ int Converter::texture(const Object& t, TextureLookup lookup) {
   } else if (t.type == "blackbody") {
     index = constant_texture(blackbody(t), t.where);
   } else {
-    throw_scene_error(t.where.loc(), "unknown texture type \"{}\" (supported: bitmap, checkerboard, "
-                                     "mesh_attribute, rawconstant)",
-                      t.type);
+    unknown_type(t, "texture", t.type, {"bitmap", "checkerboard", "mesh_attribute", "rawconstant"});
   }
   check_all_used(t);
   texture_memo_[{&t, lookup}] = index;
@@ -416,7 +414,9 @@ int Converter::bsdf(const Object& b, bool two_sided) {
     // it is not wrapped in a OneSidedMaterial; the materials engineer implements its side rules.
     index = add_material(p, b.where);
   } else {
-    throw_scene_error(b.where.loc(), "unknown bsdf type \"{}\"", type);
+    unknown_type(b, "bsdf", type, {"diffuse", "dielectric", "roughdielectric", "thindielectric", "conductor",
+                                   "roughconductor", "plastic", "roughplastic", "twosided", "mask", "normalmap",
+                                   "bumpmap", "blendbsdf", "null", "principled", "principledthin"});
   }
   check_all_used(b);
   bsdf_memo_[key] = index;

@@ -55,6 +55,15 @@ MaterialDesc SceneParser::make_material(const std::string& type, const SourceLoc
     ignore_shading_params(params);
     return m;
   }
+  // A thin sheet: light goes straight through or reflects, with every internal reflection summed
+  // (R' = 2R / (1 + R), as pbrt-v4's ThinDielectricBxDF and Mitsuba's thindielectric).
+  if (type == "thindielectric") {
+    DielectricMaterial m;
+    m.ior = read_ior(params, "eta").value_or(1.5f);
+    m.thin = true;
+    ignore_shading_params(params);
+    return m;
+  }
   if (type == "coateddiffuse") {
     CoatedDiffuseMaterial m;
     m.reflectance = read_color(params, "reflectance", Role::Reflectance).value_or(ColorInput(RGB(0.5f)));
@@ -124,19 +133,18 @@ MaterialDesc SceneParser::make_material(const std::string& type, const SourceLoc
       pick = 0;
     else if (amount.is_constant() && amount.value >= 1)
       pick = 1;
-    if (pick < 0)
-      throw_scene_error(type_where,
-                        "material type \"mix\" is not supported: candela cannot blend two materials (only a constant "
-                        "\"amount\" of 0 or 1, which selects one of them, is read)");
-    if (chosen[pick] == -2) return InterfaceMaterial{};
-    return scene_.materials.at(chosen[pick]);
+    if (pick >= 0) return chosen[pick] == -2 ? MaterialDesc(InterfaceMaterial{}) : scene_.materials.at(chosen[pick]);
+    // pbrt-v4 picks one of the two at each hit, the second with probability amount (clamped to
+    // [0, 1]): in expectation the blend of the two with weight amount.
+    BlendMaterial blend;
+    blend.weight = amount;
+    blend.material0 = chosen[0] == -2 ? add_material(InterfaceMaterial{}, type_where) : chosen[0];
+    blend.material1 = chosen[1] == -2 ? add_material(InterfaceMaterial{}, type_where) : chosen[1];
+    return blend;
   }
-  if (type == "thindielectric")
-    throw_scene_error(type_where,
-                      "material type \"thindielectric\" is not supported: candela has no thin-sheet BSDF, and a "
-                      "\"dielectric\" in its place would bend the light that a thin sheet lets straight through");
   reject_type(type_where, "material", type,
-              {"diffuse", "conductor", "dielectric", "coateddiffuse", "diffusetransmission", "interface", "mix"},
+              {"diffuse", "conductor", "dielectric", "thindielectric", "coateddiffuse", "diffusetransmission", "interface",
+               "mix"},
               {"coatedconductor", "hair", "measured", "subsurface"}, "candela has no BSDF for it");
 }
 

@@ -4,6 +4,8 @@
 #include <optional>
 #include <sstream>
 
+#include "candela/base/nearest_name.h"
+
 namespace candela::pbrt {
 
 // ---------------------------------------------------------------- reading parameter lists
@@ -284,7 +286,8 @@ void ParamList::reject_unused() const {
   std::string known = usage_.asked_list();
   if (known.empty())
     throw_scene_error(unused->where, "{}: unused parameter {} (it takes no parameters)", owner_, declaration);
-  throw_scene_error(unused->where, "{}: unused parameter {} (parameters read here: {})", owner_, declaration, known);
+  throw_scene_error(unused->where, "{}: unused parameter {}{} (parameters read here: {})", owner_, declaration,
+                    usage_.did_you_mean(unused->name), known);
 }
 
 const Param* ParamList::find_in(const std::vector<Param>& params, std::string_view name) {
@@ -306,7 +309,9 @@ void reject_type(const SourceLocation& where, std::string_view what, std::string
   if (std::find(known_unsupported.begin(), known_unsupported.end(), type) != known_unsupported.end())
     throw_scene_error(where, "{} type \"{}\" is not supported{} (supported: {})", what, type,
                       why.empty() ? std::string(" yet") : fmt::format(": {}", why), list);
-  throw_scene_error(where, "unknown {} type \"{}\" (supported: {})", what, type, list);
+  std::vector<std::string_view> names(supported);
+  names.insert(names.end(), known_unsupported.begin(), known_unsupported.end());
+  throw_scene_error(where, "unknown {} type \"{}\"{} (supported: {})", what, type, did_you_mean(type, names), list);
 }
 
 }  // namespace candela::pbrt

@@ -195,7 +195,7 @@ ImageTexture SceneParser::make_image_texture(ParamList& params) {
 
   std::string filter = params.get_string("filter", "bilinear");
   if (filter == "point") {
-    texture.bilinear = false;
+    texture.filter = TextureFilter::Nearest;
   } else if (filter == "trilinear" || filter == "ewa") {
     warn(params.where("filter"),
          "{}: filter \"{}\" is read as \"bilinear\": candela does not mipmap textures (minified textures alias "
