@@ -7,7 +7,7 @@ per channel within 3% of the reference's, and at least 9 in 10 of the 8x8-pixel 
 Prints one line per scene (agrees / differs, with the numbers / refused, with candela's message) and a
 Markdown table for docs/pbrt-format.md with --markdown.
 
-    /usr/bin/python3 bench/pbrt_features.py build/candela [--spp 256] [--only mat_] [--markdown]
+    /usr/bin/python3 bench/pbrt_features.py [--spp 256] [--only mat_] [--markdown] build/candela
 
 Needs python3-openimageio (Debian) and NumPy; run with Debian's /usr/bin/python3.
 """

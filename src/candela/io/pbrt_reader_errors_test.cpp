@@ -319,6 +319,9 @@ TEST(PbrtReader, OtherPbrtIntegratorsAreRenderedWithOneThatConvergesToTheSameIma
     EXPECT_EQ(scene.settings.integrator, "path");
     EXPECT_EQ(scene.settings.max_depth, 9);
   }
+  // pbrt-v4's light tracer renders an image of its own: the warning says so.
+  expect_warning({"Integrator \"lightpath\"", "WorldBegin"}, 1, "\"lightpath\"",
+                 "pbrt-v4's light tracer renders a different image of this scene");
   Warned volpath = read_warned({"Integrator \"volpath\" \"integer maxdepth\" 7", "WorldBegin"});
   EXPECT_TRUE(volpath.warnings.empty()) << joined(volpath.warnings);
   EXPECT_EQ(volpath.scene.settings.integrator, "volpath");
