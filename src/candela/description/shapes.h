@@ -42,16 +42,30 @@ struct TriangleMesh {
 // grid's data (a file, or arrays inline) are read and written beside their schemas' fields
 // (io/json/shapes.cpp, io/json_writer.cpp).
 
+// How a sphere's surface is parameterised, with phi the azimuth from +x towards +y and theta the
+// angle from +z, both in its object space: u = phi / 2 pi, and v = theta / pi (Mitsuba's) or
+// 1 - theta / pi (pbrt-v4's). Textures are placed by it.
+enum class SphereUv { Mitsuba, Pbrt };
+constexpr std::string_view enum_name(SphereUv v) {
+  switch (v) {
+    case SphereUv::Mitsuba: return "mitsuba";
+    case SphereUv::Pbrt: return "pbrt";
+  }
+  return {};
+}
+
 // Sphere of `radius` around `center`, in object space (then to_world applies).
 struct SphereShape {
   Point3 center{0.0f};
   float radius = 1;
+  SphereUv uv = SphereUv::Mitsuba;
 };
 template <>
 struct SchemaOf<SphereShape> {
   using T = SphereShape;
   static constexpr Field fields[] = {point_field<&T::center>("center").required_field(),
-                                     field<&T::radius>("radius", kPositive).required_field()};
+                                     field<&T::radius>("radius", kPositive).required_field(),
+                                     enum_field<&T::uv>("uv", "the (u, v) parameterisation: v = theta / pi or 1 - theta / pi")};
   static constexpr TypeSchema schema{.name = "sphere", .fields = fields, .help = "a sphere"};
 };
 

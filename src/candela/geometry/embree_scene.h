@@ -13,6 +13,7 @@
 #include <optional>
 #include <vector>
 
+#include "candela/description/shapes.h"
 #include "candela/geometry/ray.h"
 #include "candela/geometry/ray_log.h"
 #include "candela/geometry/sdf_grid.h"
@@ -40,6 +41,7 @@ struct SphereGeometry {
   float radius;
   // A moving sphere: its transform at Embree time 1 (to_world is the one at time 0).
   std::optional<Transform> to_world_end;
+  SphereUv uv = SphereUv::Mitsuba;
 };
 // A disk or an open cylinder: the unit shape in its own space (disk: x^2 + y^2 <= 1 in the plane
 // z = 0; cylinder: x^2 + y^2 = 1, 0 <= z <= 1) placed by any invertible affine `to_world`

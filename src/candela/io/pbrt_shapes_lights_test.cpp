@@ -20,6 +20,7 @@
 #include "candela/io/pbrt_reader.h"
 #include "candela/io/scene_reader.h"
 #include "candela/description/scene_desc.h"
+#include "candela/scene/scene.h"
 #include "candela/spectral/cie.h"
 #include "candela/testing/pbrt_reader_helpers.h"
 
@@ -468,6 +469,29 @@ TEST(PbrtReaderBitterli, VeachBidir) {
   EXPECT_EQ(scene.shapes[3].emission->radiance, RGB(12048.179f, 8605.842f, 6196.206f));
   const auto& lamp = std::get<ConductorMaterial>(scene.materials[2]);
   EXPECT_EQ(lamp.eta.value, RGB(2.865601f, 2.119182f, 1.940077f));
+}
+
+// A sphere's (u, v) is pbrt-v4's: u = phi / 2 pi, v = 1 - theta / pi with theta from +z of its
+// object space (0 at the bottom, 1 at the top), so textures land where pbrt-v4 puts them.
+TEST(PbrtReader, SphereUvIsPbrts) {
+  SceneDesc desc = read_lines({"WorldBegin", "Translate 0 0 5", "Shape \"sphere\" \"float radius\" 2"});
+  EXPECT_EQ(std::get<SphereShape>(desc.shapes.at(0).geometry).uv, SphereUv::Pbrt);
+  Scene scene(desc);
+  auto hit_from = [&](Vec3 from, Vec3 towards) {
+    SurfaceHit hit;
+    EXPECT_TRUE(scene.intersect(Ray{from, normalize(towards - from), std::numeric_limits<float>::infinity(), 0}, hit));
+    EXPECT_NEAR(length(hit.p - Point3(0, 0, 5)), 2, 1e-4f);
+    EXPECT_GT(dot(hit.ng, hit.p - Point3(0, 0, 5)), 0) << "normals point outwards";
+    return hit;
+  };
+  EXPECT_NEAR(hit_from({0, 0, 20}, {0, 0, 5}).uv.y, 1, 1e-3f);  // the top, theta = 0
+  EXPECT_NEAR(hit_from({0, 0, -20}, {0, 0, 5}).uv.y, 0, 1e-3f);  // the bottom
+  // On the equator at phi = 90 degrees: u = 1/4, v = 1/2, and dp/dv points up (+z), as pbrt-v4's.
+  SurfaceHit side = hit_from({0, 20, 5}, {0, 0, 5});
+  EXPECT_NEAR(side.uv.x, 0.25f, 1e-3f);
+  EXPECT_NEAR(side.uv.y, 0.5f, 1e-3f);
+  EXPECT_GT(side.dpdv.z, 0);
+  EXPECT_LT(side.dpdu.x, 0);  // dp/du = 2 pi (-y, x, 0)
 }
 
 }  // namespace

@@ -325,7 +325,7 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int object, TriangleM
 void Scene::add_sphere(ShapeRecord rec, const SphereShape& s, const Transform& T, const Transform* T_end,
                        bool reverse, const std::optional<AreaEmission>& emission, int object) {
   rec.kind = ShapeRecord::Kind::Sphere;
-  rec.sphere = SphereGeometry{T, s.center, s.radius, T_end ? std::optional<Transform>(*T_end) : std::nullopt};
+  rec.sphere = SphereGeometry{T, s.center, s.radius, T_end ? std::optional<Transform>(*T_end) : std::nullopt, s.uv};
   for (const Transform* X : {&T, T_end})
     if (X) bounds_.extend(sphere_world_bounds(rec.sphere, *X));
   if (emission) {
@@ -344,7 +344,8 @@ void Scene::add_sphere(ShapeRecord rec, const SphereShape& s, const Transform& T
     light.emission_texture = {&textures_, rec.emission_texture};
     light.object_x = ex / lx;
     light.object_y = ey / ly;
-    light.object_z = ez / lz;
+    // pbrt-v4's v = 1 - theta / pi is Mitsuba's v of the point mirrored in z (u unchanged).
+    light.object_z = (s.uv == SphereUv::Pbrt ? -ez : ez) / lz;
     lights_.push_back(light);
   }
   embree_.add_sphere(uint32_t(shapes_.size()), rec.sphere, object);
@@ -617,11 +618,13 @@ void Scene::reconstruct_sphere_hit(const ShapeRecord& rec, const Ray& ray, float
   hit.ng = normalize(to_world->normal(po));
   if (rec.flip_normal) hit.ng = -hit.ng;
   hit.ns = hit.ng;
-  hit.uv = sphere_uv(po);
+  // pbrt-v4's v = 1 - theta / pi is Mitsuba's v of the point mirrored in z (u unchanged).
+  const float v_sign = s.uv == SphereUv::Pbrt ? -1.0f : 1.0f;
+  hit.uv = sphere_uv(Vec3(po.x, po.y, v_sign * po.z));
   hit.dpdu = to_world->vector(Vec3(-po.y, po.x, 0) * (2 * kPi));
-  // v = theta / pi: dp/dv = pi (z cos phi, z sin phi, -r sin theta).
+  // v = theta / pi: dp/dv = pi (z cos phi, z sin phi, -r sin theta); negated for 1 - theta / pi.
   float rho = std::sqrt(po.x * po.x + po.y * po.y);
-  hit.dpdv = rho > 0 ? to_world->vector(Vec3(po.z * po.x / rho, po.z * po.y / rho, -rho) * kPi) : Vec3(0.0f);
+  hit.dpdv = rho > 0 ? to_world->vector(Vec3(po.z * po.x / rho, po.z * po.y / rho, -rho) * (v_sign * kPi)) : Vec3(0.0f);
 }
 
 void Scene::reconstruct_quadric_hit(const ShapeRecord& rec, const Ray& ray, float t, SurfaceHit& hit) const {

@@ -29,7 +29,7 @@ BuiltGeometry SceneParser::make_sphere(ParamList& params) {
   if (std::max(z_min, z_max) < radius) params.fail("zmax", "cuts the sphere: partial spheres are not supported yet");
   if (phi_max < 360) params.fail("phimax", "cuts the sphere: partial spheres are not supported yet");
   BuiltGeometry built;
-  built.geometry = SphereShape{Point3(0.0f), radius};
+  built.geometry = SphereShape{Point3(0.0f), radius, SphereUv::Pbrt};
   built.object_area = 4 * kPi * radius * radius;
   return built;
 }
