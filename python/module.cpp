@@ -20,7 +20,7 @@
 #include "candela/film/image_io.h"
 #include "candela/io/json_writer.h"
 #include "candela/io/scene_reader.h"
-#include "candela/integrators/render_option_table.h"
+#include "candela/description/render_options.h"
 #include "candela/integrators/render_request.h"
 #include "candela/scene/parameters.h"
 #include "candela/scene/resource_limits.h"
@@ -46,7 +46,7 @@ struct PyScene {
 // __init__.py. Held without reference counting: they live as long as the interpreter.
 py::handle g_scene_error, g_usage_error;
 
-// render()'s keywords, from the option table (integrators/render_option_table.h): the kind of each,
+// render()'s keywords, from the option table (description/render_options.h): the kind of each,
 // for the package's type checks: int, uint, float, str or bool.
 py::dict request_kinds() {
   py::dict kinds;

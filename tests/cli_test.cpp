@@ -135,7 +135,7 @@ TEST_F(CommandLine, AdaptiveSamplingWritesTheSppMap) {
   EXPECT_GT(most, 8.0f);
   EXPECT_LE(most, 64.0f);
   expect_failure("render " + scene + " -o " + out() + " --adaptive-spp 8 --adaptive-batch 16", "at least the batch size");
-  expect_failure("render " + scene + " -o " + out() + " --adaptive-spp 64 --max-spp 32", "must be at least --adaptive-spp");
+  expect_failure("render " + scene + " -o " + out() + " --adaptive-spp 64 --max-spp 32", "--max-spp: must be at least the mean spp \\(64\\), got 32");
 }
 
 TEST_F(CommandLine, HelpDocumentsEveryOption) {

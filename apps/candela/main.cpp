@@ -34,7 +34,7 @@
 #include "candela/render/checkpoint.h"
 #include "candela/render/cluster.h"
 #include "candela/render/film_part.h"
-#include "candela/integrators/render_option_table.h"
+#include "candela/description/render_options.h"
 #include "candela/integrators/render_request.h"
 #include "candela/scene/resource_limits.h"
 #include "candela/scene/scene.h"
@@ -703,7 +703,7 @@ int main(int argc, char** argv) {
   render_cmd->add_option("-o,--output", cmd.output,
                          "Output image; the extension picks the format: .exr (linear HDR, with metadata), "
                          ".png (sRGB 8-bit), .pfm (linear). Default: the scene's film file name, else SCENE.exr");
-  // The render options, from their table (integrators/render_option_table.h); then the command's own.
+  // The render options, from their table (description/render_options.h); then the command's own.
   for (const RenderOption& option : render_options())
     std::visit(
         [&](auto member) {

@@ -1,4 +1,4 @@
-"""render()'s keywords come from the render option table (integrators/render_option_table.h), as the
+"""render()'s keywords come from the render option table (description/render_options.h), as the
 command line's flags do: an option added to the table is a keyword here with no other edit."""
 import subprocess
 

@@ -21,29 +21,39 @@ Camera::Camera(const CameraDesc& desc, int width, int height, Vec2 margin)
   camera_from_world_ = world_from_camera_.inverse();
   forward_ = normalize(world_from_camera_.vector(Vec3(0, 0, 1)));
   // The screen spans [-tan_half_x, tan_half_x] x [-tan_half_y, tan_half_y] at unit distance; the fov
-  // fixes one axis and the aspect ratio (square pixels) the other.
+  // fixes one axis and the aspect ratio (square pixels) the other. An orthographic film spans
+  // [-1, 1] x [-1 / aspect, 1 / aspect]. A screen window replaces either.
   float aspect = float(width) / float(height);
-  ortho_half_y_ = 1 / aspect;
   float t = std::tan(radians(desc.fov_degrees) / 2);
-  FovAxis axis = desc.fov_axis;
-  if (axis == FovAxis::Smaller) axis = width < height ? FovAxis::X : FovAxis::Y;
-  if (axis == FovAxis::Larger) axis = width < height ? FovAxis::Y : FovAxis::X;
-  switch (axis) {
-    case FovAxis::X: tan_half_x_ = t; tan_half_y_ = t / aspect; break;
-    case FovAxis::Y: tan_half_y_ = t; tan_half_x_ = t * aspect; break;
-    case FovAxis::Smaller:  // resolved to X or Y above
-    case FovAxis::Larger:
-    case FovAxis::Diagonal: {
-      float diag = std::sqrt(aspect * aspect + 1);
-      tan_half_x_ = t * aspect / diag;
-      tan_half_y_ = t / diag;
+  if (orthographic_) {
+    screen_half_ = {1, 1 / aspect};
+  } else {
+    FovAxis axis = desc.fov_axis;
+    if (axis == FovAxis::Smaller) axis = width < height ? FovAxis::X : FovAxis::Y;
+    if (axis == FovAxis::Larger) axis = width < height ? FovAxis::Y : FovAxis::X;
+    switch (axis) {
+      case FovAxis::X: screen_half_ = {t, t / aspect}; break;
+      case FovAxis::Y: screen_half_ = {t * aspect, t}; break;
+      case FovAxis::Smaller:  // resolved to X or Y above
+      case FovAxis::Larger:
+      case FovAxis::Diagonal: {
+        float diag = std::sqrt(aspect * aspect + 1);
+        screen_half_ = {t * aspect / diag, t / diag};
+      }
     }
+  }
+  if (desc.screen_window) {
+    const auto [x0, x1, y0, y1] = *desc.screen_window;
+    const float unit = orthographic_ ? 1.0f : t;  // screen space to camera space at unit distance
+    screen_center_ = {unit * 0.5f * (x0 + x1), unit * 0.5f * (y0 + y1)};
+    screen_half_ = {unit * 0.5f * (x1 - x0), unit * 0.5f * (y1 - y0)};
   }
   // A pinhole ray's world direction is linear in the film position: precompute it as
   // pinhole_dir0_ + film.x * pinhole_dx_ + film.y * pinhole_dy_ (no matrix product per camera ray).
-  pinhole_dir0_ = world_from_camera_.vector(Vec3(-tan_half_x_, tan_half_y_, 1));
-  pinhole_dx_ = world_from_camera_.vector(Vec3(2 * tan_half_x_ / float(width), 0, 0));
-  pinhole_dy_ = world_from_camera_.vector(Vec3(0, -2 * tan_half_y_ / float(height), 0));
+  pinhole_dir0_ = world_from_camera_.vector(
+      Vec3(screen_center_.x - screen_half_.x, screen_center_.y + screen_half_.y, 1));
+  pinhole_dx_ = world_from_camera_.vector(Vec3(2 * screen_half_.x / float(width), 0, 0));
+  pinhole_dy_ = world_from_camera_.vector(Vec3(0, -2 * screen_half_.y / float(height), 0));
 }
 
 float Camera::near_t(const Point3& o, const Vec3& d) const {
@@ -55,7 +65,8 @@ float Camera::near_t(const Point3& o, const Vec3& d) const {
 Ray Camera::generate_ray(Vec2 film, Vec2 lens, float time) const {
   const float inf = std::numeric_limits<float>::infinity();
   if (orthographic_) {
-    Point3 o(2 * film.x / float(width_) - 1, (1 - 2 * film.y / float(height_)) * ortho_half_y_, 0);
+    Point3 o((2 * film.x / float(width_) - 1) * screen_half_.x + screen_center_.x,
+             (1 - 2 * film.y / float(height_)) * screen_half_.y + screen_center_.y, 0);
     Vec3 d(0, 0, 1);
     Ray ray{world_from_camera_.point(o), normalize(world_from_camera_.vector(d)), inf, time};
     ray.t_min = near_t(o, d);
@@ -92,7 +103,8 @@ float Camera::importance(const Point3& lens_point, const Vec3& w, Vec2* raster) 
   if (!(wc.z > 0)) return 0;
   float depth = lens_radius_ > 0 ? focus_distance_ : 1.0f;
   Point3 focus = oc + wc * ((depth - oc.z) / wc.z);
-  float sx = focus.x / depth / tan_half_x_, sy = focus.y / depth / tan_half_y_;
+  float sx = (focus.x / depth - screen_center_.x) / screen_half_.x;
+  float sy = (focus.y / depth - screen_center_.y) / screen_half_.y;
   Vec2 r{(sx + 1) * 0.5f * float(width_), (1 - sy) * 0.5f * float(height_)};
   if (!(r.x >= -margin_.x && r.x < float(width_) + margin_.x && r.y >= -margin_.y && r.y < float(height_) + margin_.y))
     return 0;

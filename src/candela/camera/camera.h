@@ -76,7 +76,7 @@ class Camera {
  private:
   // The importance function's film on the plane at unit distance (margin included).
   float importance_film_area() const {
-    return 4 * tan_half_x_ * tan_half_y_ * importance_film_pixels() / (float(width_) * float(height_));
+    return 4 * screen_half_.x * screen_half_.y * importance_film_pixels() / (float(width_) * float(height_));
   }
 
   // Ray::t_min for a ray from the camera-space point o along the camera-space direction d (d.z > 0)
@@ -85,17 +85,19 @@ class Camera {
 
   // The pinhole ray through film position `film` in camera space, at depth z = 1.
   Vec3 camera_direction(Vec2 film) const {
-    return {(2 * film.x / float(width_) - 1) * tan_half_x_, (1 - 2 * film.y / float(height_)) * tan_half_y_, 1};
+    return {(2 * film.x / float(width_) - 1) * screen_half_.x + screen_center_.x,
+            (1 - 2 * film.y / float(height_)) * screen_half_.y + screen_center_.y, 1};
   }
 
   Transform world_from_camera_, camera_from_world_;
   bool orthographic_ = false;
   float near_clip_ = 0;
-  float ortho_half_y_ = 1;  // orthographic: the film spans [-1, 1] x [-ortho_half_y, ortho_half_y]
   Vec3 forward_{0, 0, 1};
   Point3 origin_;
   Vec3 pinhole_dir0_, pinhole_dx_, pinhole_dy_;  // see the constructor
-  float tan_half_x_ = 1, tan_half_y_ = 1;
+  // The film's centre and half extents on the plane z = 1 (perspective) or z = 0 (orthographic), in
+  // camera space.
+  Vec2 screen_center_{0, 0}, screen_half_{1, 1};
   float lens_radius_ = 0, focus_distance_ = 1;
   float shutter_open_ = 0, shutter_close_ = 1;
   int width_ = 1, height_ = 1;

@@ -122,3 +122,43 @@ TEST(NearClip, HidesASphereInFrontOfIt) {
 
 }  // namespace
 }  // namespace candela
+
+namespace candela {
+namespace {
+
+// A screen window (pbrt-v4's screenwindow) places the film on the screen: camera space for an
+// orthographic camera, camera space at unit distance over tan(fov / 2) for a perspective one. An
+// off-centre window shifts the view; the importance of a ray maps back to the pixel it came from.
+TEST(ScreenWindow, PlacesTheFilmOnTheScreenOfEitherProjection) {
+  const int w = 64, h = 32;
+  CameraDesc ortho;
+  ortho.projection = Projection::Orthographic;
+  ortho.screen_window = std::array<float, 4>{-0.5f, 1.5f, -2, 0};
+  Camera flat(ortho, w, h);
+  const Ray top_left = flat.generate_ray({0, 0}, {0.5f, 0.5f}, 0);
+  const Ray bottom_right = flat.generate_ray({float(w), float(h)}, {0.5f, 0.5f}, 0);
+  EXPECT_NEAR(top_left.origin.x, -0.5f, 1e-6f);
+  EXPECT_NEAR(top_left.origin.y, 0, 1e-6f);
+  EXPECT_NEAR(bottom_right.origin.x, 1.5f, 1e-6f);
+  EXPECT_NEAR(bottom_right.origin.y, -2, 1e-6f);
+
+  CameraDesc perspective;
+  perspective.fov_degrees = 90;  // tan(fov / 2) = 1: screen space is camera space at unit distance
+  perspective.screen_window = std::array<float, 4>{0, 2, -1, 1};
+  Camera shifted(perspective, w, h);
+  const Ray left = shifted.generate_ray({0, float(h) / 2}, {0.5f, 0.5f}, 0);
+  const Ray right = shifted.generate_ray({float(w), float(h) / 2}, {0.5f, 0.5f}, 0);
+  EXPECT_NEAR(left.direction.x, 0, 1e-6f);  // the left edge looks straight ahead
+  EXPECT_NEAR(right.direction.x / right.direction.z, 2, 1e-5f);
+  // A ray through a pixel's centre has its importance at that pixel (light tracing splats there).
+  for (Vec2 film : {Vec2{5.5f, 7.5f}, Vec2{60.5f, 30.5f}}) {
+    const Ray ray = shifted.generate_ray(film, {0.5f, 0.5f}, 0);
+    Vec2 raster;
+    ASSERT_GT(shifted.importance(ray.origin, ray.direction, &raster), 0);
+    EXPECT_NEAR(raster.x, film.x, 1e-3f);
+    EXPECT_NEAR(raster.y, film.y, 1e-3f);
+  }
+}
+
+}  // namespace
+}  // namespace candela

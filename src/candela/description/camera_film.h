@@ -55,6 +55,11 @@ struct CameraDesc {
   float near_clip = 0;
   float fov_degrees = 40;
   FovAxis fov_axis = FovAxis::Y;  // JSON gives a vertical fov; pbrt-v4 gives it on the smaller axis
+  // pbrt-v4's screen window: the rectangle [x0, x1] x [y0, y1] of screen space the film covers, where
+  // screen space is camera space for orthographic cameras, and camera space at unit distance over
+  // tan(fov / 2) for perspective ones. An off-centre window shifts the view without tilting the film.
+  // Unset: the film is centred and framed by the fov (perspective) or spans x in [-1, 1] (orthographic).
+  std::optional<std::array<float, 4>> screen_window;
   // Thin lens (depth of field): 0 = pinhole. Points at focus_distance along +z are sharp.
   float lens_radius = 0;
   float focus_distance = 1e6f;
@@ -77,6 +82,10 @@ inline CameraDesc camera_framing(const Point3& lo, const Point3& hi, float fov_d
   camera.fov_axis = FovAxis::Smaller;
   return camera;
 }
+
+// The largest film any front end accepts: each side, and pixels in all.
+inline constexpr int kMaxResolution = 65536;
+inline constexpr long long kMaxPixels = 1LL << 28;
 
 struct FilmDesc {
   int width = 512;

@@ -22,13 +22,32 @@
 
 namespace candela {
 
-// Texture coordinates from the surface's (u, v) by an affine map:
+// Where the (u, v) a texture's affine map starts from come from: the surface's own, or, as pbrt-v4's
+// other 2D mappings, the hit point p in the texture's own space:
+//   spherical:   (theta / pi, phi / 2 pi) of the direction from the origin to p (z is theta's axis);
+//   cylindrical: ((pi + atan2(p.y, p.x)) / 2 pi, p.z);
+//   planar:      (p . planar_s, p . planar_t).
+enum class TextureProjection { Surface, Spherical, Cylindrical, Planar };
+constexpr std::string_view enum_name(TextureProjection v) {
+  switch (v) {
+    case TextureProjection::Surface: return "uv";
+    case TextureProjection::Spherical: return "spherical";
+    case TextureProjection::Cylindrical: return "cylindrical";
+    case TextureProjection::Planar: return "planar";
+  }
+  return {};
+}
+
+// Texture coordinates from (u, v) (the surface's, or a projection's) by an affine map:
 //   s = su u + s_from_v v + du,   t = t_from_u u + sv v + dv.
 // The cross terms are zero unless the texture is rotated or sheared (glTF's KHR_texture_transform
 // rotation, Mitsuba's to_uv, JSON's uv_matrix).
 struct UVMapping {
   float su = 1, sv = 1, du = 0, dv = 0;
   float s_from_v = 0, t_from_u = 0;
+  TextureProjection projection = TextureProjection::Surface;
+  Transform to_world;                                 // the projection's space to the world
+  Vec3 planar_s{1, 0, 0}, planar_t{0, 1, 0};  // the planar projection's axes
   bool is_axis_aligned() const { return s_from_v == 0 && t_from_u == 0; }
 };
 
@@ -157,6 +176,131 @@ struct SchemaOf<MeshAttributeTexture> {
                                      .help = "a value stored on the mesh, per vertex or per face"};
 };
 
-using TextureDesc = std::variant<ImageTexture, CheckerboardTexture, ScaleTexture, MixTexture, MeshAttributeTexture>;
+// v00 at (s, t) = (0, 0), v10 at (1, 0), v01 at (0, 1), v11 at (1, 1), bilinearly in between (and
+// extrapolated beyond): pbrt-v4's "bilerp".
+struct BilerpTexture {
+  RGB v00{0.0f}, v01{1.0f}, v10{0.0f}, v11{1.0f};
+  UVMapping mapping;
+};
+template <>
+struct SchemaOf<BilerpTexture> {
+  using T = BilerpTexture;
+  static constexpr Field fields[] = {
+      field<&T::v00>("v00", kNonNegative, "at (s, t) = (0, 0)"), field<&T::v01>("v01", kNonNegative, "at (0, 1)"),
+      field<&T::v10>("v10", kNonNegative, "at (1, 0)"),          field<&T::v11>("v11", kNonNegative, "at (1, 1)"),
+      uv_mapping_field<&T::mapping>(),
+  };
+  static constexpr TypeSchema schema{.name = "bilerp", .fields = fields,
+                                     .help = "four colours at the corners of the unit square, bilinearly between"};
+};
+
+// Polka dots (pbrt-v4's "dots"): each unit cell of (s, t) around an integer point holds a dot where
+// Perlin noise at the cell is positive: a disc of radius 0.35, its centre moved by noise by up to
+// 0.15. `inside` on the dots, `outside` elsewhere.
+struct DotsTexture {
+  ColorInput inside{RGB(1.0f)}, outside{RGB(0.0f)};
+  UVMapping mapping;
+};
+template <>
+struct SchemaOf<DotsTexture> {
+  using T = DotsTexture;
+  static constexpr Field fields[] = {
+      field<&T::inside>("inside", kNonNegative, "on the dots"),
+      field<&T::outside>("outside", kNonNegative, "between them"),
+      uv_mapping_field<&T::mapping>(),
+  };
+  static constexpr TypeSchema schema{.name = "dots", .fields = fields, .help = "polka dots placed by noise"};
+};
+
+// The solid textures below are looked up at the hit point in their own space: `to_world` maps it to
+// the world (pbrt-v4: the transform current where the texture is declared).
+
+// A solid checkerboard (pbrt-v4's checkerboard of dimension 3): tex1 in the unit cubes where
+// floor(x) + floor(y) + floor(z) is even, tex2 in the others.
+struct SolidCheckerboardTexture {
+  ColorInput tex1{RGB(1.0f)}, tex2{RGB(0.0f)};
+  Transform to_world;
+};
+template <>
+struct SchemaOf<SolidCheckerboardTexture> {
+  using T = SolidCheckerboardTexture;
+  static constexpr Field fields[] = {
+      field<&T::tex1>("tex1", kNonNegative, "where floor(x) + floor(y) + floor(z) is even"),
+      field<&T::tex2>("tex2", kNonNegative, "where it is odd"),
+      field<&T::to_world>("transform", kAnyValue, "from the texture's space to the world"),
+  };
+  static constexpr TypeSchema schema{.name = "solid_checkerboard", .fields = fields,
+                                     .help = "a checkerboard of unit cubes in space"};
+};
+
+// Sums of Perlin noise over octaves (textures/noise.h), a grey value at the point in texture space:
+// fractional Brownian motion (pbrt-v4's "fbm": octave i is roughness^i noise(1.99^i p)), or its
+// turbulence (pbrt-v4's "wrinkled": the same sum of |noise|).
+enum class NoiseSum { Fbm, Turbulence };
+template <NoiseSum Sum>
+struct NoiseTexture {
+  int octaves = 8;
+  float roughness = 0.5f;  // each octave's amplitude relative to the one before
+  Transform to_world;
+};
+using FbmTexture = NoiseTexture<NoiseSum::Fbm>;
+using WrinkledTexture = NoiseTexture<NoiseSum::Turbulence>;
+template <NoiseSum Sum>
+inline constexpr Field kNoiseTextureFields[] = {
+    field<&NoiseTexture<Sum>::octaves>("octaves", ValueRange{.lo = 1, .hi = 32}),
+    field<&NoiseTexture<Sum>::roughness>("roughness", kNonNegative, "each octave's amplitude relative to the last"),
+    field<&NoiseTexture<Sum>::to_world>("transform", kAnyValue, "from the texture's space to the world"),
+};
+template <>
+struct SchemaOf<FbmTexture> {
+  static constexpr TypeSchema schema{.name = "fbm", .fields = kNoiseTextureFields<NoiseSum::Fbm>,
+                                     .help = "fractional Brownian motion: octaves of Perlin noise"};
+};
+template <>
+struct SchemaOf<WrinkledTexture> {
+  static constexpr TypeSchema schema{.name = "wrinkled", .fields = kNoiseTextureFields<NoiseSum::Turbulence>,
+                                     .help = "turbulence: octaves of the absolute value of Perlin noise"};
+};
+
+// Marble (pbrt-v4's "marble"): bands of sin(y + variation * fbm(p)) at p = scale * (the point in
+// texture space), coloured through pbrt-v4's spline of greys and a dark blue-grey.
+struct MarbleTexture {
+  int octaves = 8;
+  float roughness = 0.5f, scale = 1, variation = 0.2f;
+  Transform to_world;
+};
+template <>
+struct SchemaOf<MarbleTexture> {
+  using T = MarbleTexture;
+  static constexpr Field fields[] = {
+      field<&T::octaves>("octaves", ValueRange{.lo = 1, .hi = 32}),
+      field<&T::roughness>("roughness", kNonNegative, "each octave's amplitude relative to the last"),
+      field<&T::scale>("scale", kAnyValue, "the point's scale before the pattern"),
+      field<&T::variation>("variation", kAnyValue, "how far the noise bends the bands"),
+      field<&T::to_world>("transform", kAnyValue, "from the texture's space to the world"),
+  };
+  static constexpr TypeSchema schema{.name = "marble", .fields = fields, .help = "marble veins from noise"};
+};
+
+// a tex1 + (1 - a) tex2 with a = |n . direction| at the surface's normal n (pbrt-v4's "directionmix").
+struct DirectionMixTexture {
+  ColorInput tex1{RGB(0.0f)}, tex2{RGB(1.0f)};
+  Vec3 direction{0, 1, 0};  // unit length
+};
+template <>
+struct SchemaOf<DirectionMixTexture> {
+  using T = DirectionMixTexture;
+  static constexpr Field fields[] = {
+      field<&T::tex1>("tex1", kNonNegative, "where the normal is along the direction"),
+      field<&T::tex2>("tex2", kNonNegative, "where it is across it"),
+      direction_field<&T::direction>("direction"),
+  };
+  static constexpr TypeSchema schema{.name = "direction_mix", .fields = fields,
+                                     .help = "two textures mixed by the normal's alignment with a direction"};
+};
+
+using TextureDesc = std::variant<ImageTexture, CheckerboardTexture, ScaleTexture, MixTexture, MeshAttributeTexture,
+                                 BilerpTexture, DotsTexture, SolidCheckerboardTexture, FbmTexture, WrinkledTexture,
+                                 MarbleTexture, DirectionMixTexture>;
 
 }  // namespace candela

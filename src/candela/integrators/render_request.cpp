@@ -13,19 +13,11 @@
 #include <tuple>
 
 #include "candela/integrators/integrator.h"
-#include "candela/integrators/render_option_table.h"
 
 namespace candela {
 namespace {
 
-// `shown` is the size as the user gave it (WIDTHxHEIGHT), for the message.
-void check_resolution_range(long long width, long long height, const std::string& shown) {
-  if (width < 1 || height < 1 || width > kMaxResolution || height > kMaxResolution || width * height > kMaxPixels)
-    throw UsageError(fmt::format("resolution {} is out of range (each side 1..{}, at most {} pixels)", shown,
-                                 kMaxResolution, kMaxPixels));
-}
-
-// The option's value against its rule (render_option_table.h).
+// The option's value against its rule (description/render_options.h).
 void check_value(const RenderOption& option, const RenderRequest& request) {
   const std::string flag = option.flag();
   std::visit(
@@ -55,31 +47,13 @@ void check_value(const RenderOption& option, const RenderRequest& request) {
 
 }  // namespace
 
-// --resolution WIDTHxHEIGHT, in range. Sides of any number of digits are read (saturating), so that
-// 1000000000x1000000000 is out of range, not malformed.
-std::pair<int, int> parse_resolution(const std::string& text) {
-  std::smatch m;
-  static const std::regex pattern(R"((\d+)[xX](\d+))");
-  if (!std::regex_match(text, m, pattern))
-    throw UsageError(fmt::format("--resolution: expected WIDTHxHEIGHT such as 640x480, got '{}'", text));
-  const auto side = [](const std::string& digits) {
-    long long value = 0;
-    if (std::from_chars(digits.data(), digits.data() + digits.size(), value).ec != std::errc())
-      value = std::numeric_limits<long long>::max();
-    return value;
-  };
-  const long long width = side(m[1]), height = side(m[2]);
-  check_resolution_range(width, height, text);
-  return {int(width), int(height)};
-}
-
 void check_request_values(const RenderRequest& r) {
   for (const RenderOption& option : render_options()) check_value(option, r);
 }
 
 namespace {
 
-// The request given to the scene's settings, each option setting its own field (render_option_table.cpp),
+// The request given to the scene's settings, each option setting its own field (description/render_options.cpp),
 // then what depends on several.
 void apply_options(const RenderRequest& request, SceneDesc& scene) {
   for (const RenderOption& option : render_options())
@@ -102,14 +76,9 @@ void check_settings(const RenderRequest& request, const SceneDesc& scene) {
   const RenderSettings& rs = scene.settings;
   if (std::string problem = rs.mlt.problem(); !problem.empty())
     throw UsageError("--mlt-large-step, --mlt-lens, --mlt-caustic: " + problem);
-  if (rs.adaptive() && (rs.adaptive_batch & (rs.adaptive_batch - 1)) != 0)
-    throw UsageError(fmt::format("--adaptive-batch: must be a power of two, got {}", rs.adaptive_batch));
-  if (rs.adaptive_spp > 0 && rs.adaptive_spp < rs.adaptive_batch)
-    throw UsageError(fmt::format("--adaptive-spp ({}) must be at least the batch size ({})", rs.adaptive_spp,
-                                 rs.adaptive_batch));
-  if (rs.adaptive_spp > 0 && rs.adaptive_max_spp > 0 && rs.adaptive_max_spp < rs.adaptive_spp)
-    throw UsageError(fmt::format("--max-spp ({}) must be at least --adaptive-spp ({})", rs.adaptive_max_spp,
-                                 rs.adaptive_spp));
+  if (std::optional<SettingProblem> problem = adaptive_problem(rs))
+    for (const RenderOption& option : render_options())
+      if (option.scene_key == problem->scene_key) throw UsageError(option.flag() + ": " + problem->message);
   const auto& f = scene.film;
   check_resolution_range(f.width, f.height, fmt::format("{}x{}", f.width, f.height));
   if (request.target_error && rs.adaptive())
@@ -245,23 +214,17 @@ std::unique_ptr<IntegratorOutputs> RenderPlan::make_integrator_outputs(const Ren
   return integrator->make_strategy_images(settings, width, height, strategy_images, strategy_images_unweighted);
 }
 
-double parse_duration(const std::string& option, const std::string& text) {
-  static const std::regex plain(R"(\d{1,9}(\.\d{0,9})?)");
-  static const std::regex parts(R"((\d{1,9}(?:\.\d{0,9})?h)?(\d{1,9}(?:\.\d{0,9})?m)?(\d{1,9}(?:\.\d{0,9})?s)?)");
-  double seconds = 0;
-  std::smatch m;
-  if (std::regex_match(text, plain)) {
-    seconds = std::stod(text);
-  } else if (!text.empty() && std::regex_match(text, m, parts)) {
-    const double unit[] = {3600, 60, 1};
-    for (int i = 0; i < 3; ++i)
-      if (m[i + 1].matched) seconds += std::stod(m[i + 1].str()) * unit[i];
-  } else {
-    throw UsageError(fmt::format("{}: expected seconds or a duration such as 90s, 10m, 2h or 1h30m, got '{}'", option, text));
-  }
-  if (!(seconds > 0)) throw UsageError(fmt::format("{}: must be more than 0, got '{}'", option, text));
-  return seconds;
+RenderFingerprint render_fingerprint(const std::string& scene_bytes, const SceneDesc& desc,
+                                     const RenderRequest& request) {
+  RenderFingerprint fp;
+  fp.scene_hash = fnv1a64(scene_bytes.data(), scene_bytes.size());
+  for (const RenderOption& option : render_options())
+    if (option.fingerprint)
+      if (std::optional<std::string> value = option.fingerprint(desc, request))
+        fp.settings.emplace_back(option.fingerprint_key, std::move(*value));
+  return fp;
 }
+
 
 RenderOutcome render_requested(const Scene& scene, RenderSettings& settings, Film& film, const RenderPlan& plan,
                                RenderOptions options, const std::function<void(const std::string&)>& announce) {

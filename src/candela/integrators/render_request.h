@@ -14,41 +14,14 @@
 #include "candela/film/error_estimate.h"
 #include "candela/integrators/auto_integrator.h"
 #include "candela/integrators/integrator.h"
+#include "candela/description/render_options.h"  // RenderRequest, the option table
+#include "candela/render/checkpoint.h"          // RenderFingerprint
 #include "candela/render/render_loop.h"
 #include "candela/description/scene_desc.h"
 
 namespace candela {
 
-inline constexpr int kMaxResolution = 65536;       // pixels along either side
-inline constexpr long long kMaxPixels = 1LL << 28;  // pixels in all
 inline constexpr int kTargetErrorMaxSpp = 65536;    // the spp cap of --target-error without --spp
-
-// Every field is unset by default: the scene's own value holds. The names are the flags'; each field
-// before `quiet` is declared, checked and applied through its entry in integrators/render_option_table.h.
-struct RenderRequest {
-  std::optional<int> spp, threads, max_depth, rr_start_depth;
-  std::optional<uint64_t> seed;
-  std::string resolution;  // "WIDTHxHEIGHT"
-  std::string integrator;  // a registered name (integrators/integrator.h), "auto" included
-  std::string sampler, filter, direction_sampling, light_selection, bvh, transport;
-  std::optional<int> shadow_rays, max_spp, adaptive_batch, adaptive_spp;
-  std::optional<float> adaptive_threshold;
-  bool no_mis = false;
-  std::string time_limit;  // seconds ("90", "2.5") or a duration ("90s", "10m", "1h30m")
-  std::optional<double> target_error;
-  bool estimate_error = false;
-  std::optional<float> clamp;
-  std::string bdpt_strategies;  // a directory for bdpt's per-strategy images
-  bool bdpt_unweighted = false;
-  std::optional<int> mlt_bootstrap, mlt_chains;
-  std::optional<float> mlt_sigma, mlt_large_step, mlt_lens, mlt_caustic;
-  bool quiet = false;  // no progress bar, no notes (the command line's -q; Python renders quietly)
-  // What only the command line asks (flags of its own, no Python keywords), checked by plan_render
-  // with the rest because each asks something of the integrator.
-  std::string pixel;               // --pixel X,Y: that pixel alone
-  std::string part;                // --part K/N: every N-th tile, from the K-th
-  std::string checkpoint, resume;  // --checkpoint FILE, --resume FILE: the film is saved to be continued, or continued
-};
 
 // A request resolved against its scene, once, by plan_render: everything the render does, checked.
 // The settings it resolves stay in the scene's RenderSettings (the sampler's two independent halves
@@ -99,13 +72,10 @@ void check_request_values(const RenderRequest& request);
 // quiet) for a scene setting the chosen integrator ignores.
 RenderPlan plan_render(const RenderRequest& request, SceneDesc& scene);
 
-// WIDTHxHEIGHT (--resolution), each side 1..kMaxResolution and at most kMaxPixels in all; throws
-// UsageError.
-std::pair<int, int> parse_resolution(const std::string& text);
-
-// Seconds from "90", "2.5", "90s", "10m", "2h" or "1h30m" (each part a number with a unit, largest
-// first); `option` names the flag in the UsageError.
-double parse_duration(const std::string& option, const std::string& text);
+// What the image depends on besides the scene file's bytes: every option's fingerprint entry
+// (description/render_options.h), which a checkpoint or a part must match to be resumed or merged.
+RenderFingerprint render_fingerprint(const std::string& scene_bytes, const SceneDesc& desc,
+                                     const RenderRequest& request);
 
 struct RenderOutcome {
   RenderStats stats;              // its seconds include auto's pilots

@@ -130,14 +130,22 @@ TEST(JsonReader, BadResolutionIsAnError) {
 }
 
 TEST(JsonReader, BadRenderSettingsAreErrors) {
-  expect_error_containing(R"({"render": {"spp": 0}})", "at /render/spp: expected an integer >= 1, got 0");
-  expect_error_containing(R"({"render": {"max_depth": 0}})", "expected an integer >= 1");
+  expect_error_containing(R"({"render": {"spp": 0}})", "at /render/spp: expected an integer in [1, 16777216], got 0");
+  expect_error_containing(R"({"render": {"max_depth": 0}})", "expected an integer in [1, 100000]");
   expect_error_containing(R"({"render": {"rr_start_depth": -1}})", "expected an integer >= 0");
   expect_error_containing(R"({"render": {"seed": -1}})", "expected a non-negative integer, got -1");
-  expect_error_containing(R"({"render": {"spp": 3000000000}})", "expected an integer >= 1, got 3000000000");
+  expect_error_containing(R"({"render": {"spp": 3000000000}})", "expected an integer in [1, 16777216], got 3000000000");
   expect_error_containing(R"({"render": {"integrator": ""}})", "the integrator name is empty");
 }
 
+
+TEST(JsonReader, BadScreenWindowsAreErrors) {
+  expect_error_containing(R"({"camera": {"screen_window": [0, 1, 0]}})",
+                          "at /camera/screen_window: expected [x0, x1, y0, y1]");
+  expect_error_containing(R"({"camera": {"screen_window": [1, 0, 0, 1]}})",
+                          "at /camera/screen_window: the window must have x0 < x1 and y0 < y1, got [1, 0, 0, 1]");
+  expect_error_containing(R"({"camera": {"screen_window": [0, 1, "a", 1]}})", "at /camera/screen_window/2");
+}
 
 TEST(JsonReader, BadLensShutterAndMotionAreErrors) {
   expect_error_containing(R"({"camera": {"lens_radius": -1}})", "at /camera/lens_radius: expected a number >= 0");
@@ -168,7 +176,7 @@ TEST(JsonReader, BadLensShutterAndMotionAreErrors) {
 
 TEST(JsonReader, BadSamplerAndFilterAreErrors) {
   expect_error_containing(R"({"render": {"sampler": {"type": "halton"}}})",
-                          "at /render/sampler/type: unknown sampler type \"halton\"; expected one of: independent, "
+                          "at /render/sampler/type: unknown sampler \"halton\"; expected one of: random, independent, "
                           "stratified, poisson, zsobol");
   expect_error_containing(R"({"render": {"sampler": {}}})", "at /render/sampler: missing required key \"type\"");
   expect_error_containing(R"({"render": {"sampler": "zsobol"}})", "at /render/sampler: expected an object");
@@ -177,7 +185,7 @@ TEST(JsonReader, BadSamplerAndFilterAreErrors) {
   expect_error_containing(R"({"render": {"sampler": {"type": "stratified", "jitter": 0}}})",
                           "at /render/sampler/jitter: expected true or false");
   expect_error_containing(R"({"render": {"filter": {"type": "triangle"}}})",
-                          "at /render/filter/type: unknown filter type \"triangle\"; expected one of: box, tent, "
+                          "at /render/filter/type: unknown filter \"triangle\"; expected one of: box, tent, "
                           "gaussian, mitchell");
   expect_error_containing(R"({"render": {"filter": {"type": "box", "radius": 0}}})",
                           "at /render/filter/radius: a filter radius must be in (0, 64] pixels, got 0");
@@ -202,22 +210,22 @@ TEST(JsonReader, BadStrategiesAndAdaptiveSettingsAreErrors) {
                           "unknown light selection \"random\"; expected one of: power, paper, uniform, bvh");
   EXPECT_EQ(read(R"({"render": {"light_selection": "uniform"}})").settings.light_selection, LightSelection::Uniform);
   expect_error_containing(R"({"render": {"bvh": "small"}})",
-                          "at /render/bvh: unknown BVH layout \"small\"; expected one of: fast, compact");
+                          "at /render/bvh: unknown bvh \"small\"; expected one of: fast, compact");
   expect_error_containing(R"({"render": {"mis": "yes"}})", "at /render/mis: expected true or false");
-  expect_error_containing(R"({"render": {"shadow_rays": 0}})", "at /render/shadow_rays: expected an integer >= 1");
+  expect_error_containing(R"({"render": {"shadow_rays": 0}})", "at /render/shadow_rays: expected an integer in [1, 1024]");
   expect_error_containing(R"({"render": {"adaptive": {}}})",
                           "at /render/adaptive: expected \"threshold\", \"spp\" or both");
   expect_error_containing(R"({"render": {"adaptive": {"spp": 8}}})",
-                          "at /render/adaptive/spp: spp (8) must be at least the batch size (16)");
+                          "at /render/adaptive/spp: must be at least the batch size (16), got 8");
   expect_error_containing(R"({"render": {"adaptive": {"spp": 64, "max_spp": 32}}})",
-                          "at /render/adaptive/max_spp: max_spp (32) must be at least spp (64)");
+                          "at /render/adaptive/max_spp: must be at least the mean spp (64), got 32");
   expect_error_containing(R"({"render": {"adaptive": {"threshold": 0}}})",
                           "at /render/adaptive/threshold: expected a positive number");
   expect_error_containing(R"({"render": {"adaptive": {"threshold": 0.1, "batch": 12}}})",
-                          "at /render/adaptive/batch: expected a power of two, got 12");
-  expect_error_containing(R"({"render": {"adaptive": {"threshold": 0.1, "batch": 0}}})", "expected an integer >= 1");
+                          "at /render/adaptive/batch: must be a power of two, got 12");
+  expect_error_containing(R"({"render": {"adaptive": {"threshold": 0.1, "batch": 0}}})", "expected an integer in [1, 65536]");
   expect_error_containing(R"({"render": {"adaptive": {"threshold": 0.1, "batch": 32, "max_spp": 16}}})",
-                          "at /render/adaptive/max_spp: max_spp (16) must be at least the batch size (32)");
+                          "at /render/adaptive/max_spp: must be at least the batch size (32), got 16");
   expect_error_containing(R"({"render": {"adaptive": {"threshold": 0.1, "batches": 2}}})",
                           "at /render/adaptive/batches: unknown key");
 }

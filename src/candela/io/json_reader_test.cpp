@@ -136,7 +136,7 @@ TEST(JsonReader, ReadsMetropolisSettings) {
   EXPECT_EQ(defaults.settings.mlt.bootstrap, 100000);
   EXPECT_FLOAT_EQ(defaults.settings.mlt.large_step, 0.3f);
   expect_error_containing(R"({"render": {"mlt": {"chains": 0}}})", "/render/mlt/chains");
-  expect_error_containing(R"({"render": {"mlt": {"sigma": 2}}})", "sigma must be at most 1");
+  expect_error_containing(R"({"render": {"mlt": {"sigma": 2}}})", "at /render/mlt/sigma: expected a number in [1e-06, 1], got 2");
   expect_error_containing(R"({"render": {"mlt": {"large_step": 1.5}}})", "/render/mlt/large_step");
   expect_error_containing(R"({"render": {"mlt": {"mutations": 5}}})", "mutations");
   expect_error_containing(R"({"render": {"mlt": {"large_step": 0.5, "lens": 0.5, "caustic": 0.25}}})",

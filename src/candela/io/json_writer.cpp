@@ -15,6 +15,7 @@
 #include "candela/base/error.h"
 #include "candela/base/overloaded.h"
 #include "candela/description/integrator_traits.h"
+#include "candela/description/render_options.h"
 
 
 namespace candela {
@@ -42,6 +43,14 @@ Json number(const FloatInput& in) { return in.is_constant() ? Json(in.value) : J
 std::string absolute(const std::string& file) { return fs::absolute(file).lexically_normal().string(); }
 
 void write_mapping(const UVMapping& m, Json& j) {
+  if (m.projection != TextureProjection::Surface) {
+    j["projection"] = enum_name(m.projection);
+    if (!m.to_world.is_identity()) j["projection_transform"] = matrix(m.to_world);
+    if (m.projection == TextureProjection::Planar) {
+      j["planar_s"] = vec3(m.planar_s);
+      j["planar_t"] = vec3(m.planar_t);
+    }
+  }
   if (!m.is_axis_aligned()) {
     j["uv_matrix"] = Json::array({Json::array({m.su, m.s_from_v, m.du}), Json::array({m.t_from_u, m.sv, m.dv})});
     return;
@@ -230,6 +239,7 @@ Json camera_json(const SceneDesc& scene, const std::vector<std::string>& media) 
   Json j{{"transform", matrix(c.world_from_camera)}, {"fov", c.fov_degrees}, {"fov_axis", enum_name(c.fov_axis)}};
   if (c.projection == Projection::Orthographic) j["projection"] = "orthographic";
   if (c.near_clip != 0) j["near_clip"] = c.near_clip;
+  if (c.screen_window) j["screen_window"] = *c.screen_window;
   j["width"] = scene.film.width;
   j["height"] = scene.film.height;
   if (c.lens_radius != 0) {
@@ -241,45 +251,51 @@ Json camera_json(const SceneDesc& scene, const std::vector<std::string>& media) 
   return j;
 }
 
+// One option's value as the scene file holds it (description/render_options.h).
+Json render_option_json(const RenderOption& option, const RenderRequest& request) {
+  return std::visit(
+      [&](auto member) -> Json {
+        const auto& value = request.*member;
+        using T = std::remove_cvref_t<decltype(value)>;
+        if constexpr (std::is_same_v<T, bool>) return value != option.scene_negated;
+        else if constexpr (std::is_same_v<T, std::string>) {
+          if (!option.scene_true.empty()) return value == option.scene_true;
+          return value;
+        } else {
+          return *value;
+        }
+      },
+      option.field);
+}
+
+// The render options with a scene key, then the keys only a scene file gives.
 Json render_json(const SceneDesc& scene) {
   const RenderSettings& s = scene.settings;
-  Json j{{"spp", s.spp}, {"max_depth", s.max_depth}, {"seed", s.seed}, {"integrator", s.integrator}};
-  if (!scene.film.filename.empty()) j["output"] = scene.film.filename;
-  if (!scene.film.aovs.empty()) j["aovs"] = scene.film.aovs;
+  Json j = Json::object();
   // Only the selective settings the integrator reads: the reader rejects the others.
   const IntegratorTraits* integrator = find_integrator_traits(s.integrator);
-  auto reads = [&](std::string_view key) { return integrator && integrator->reads_setting(key); };
-  if (reads("rr_start_depth")) j["rr_start_depth"] = s.rr_start_depth;
-  j["transform_times"] = Json::array({scene.transform_start_time, scene.transform_end_time});
-  Json sampler{{"type", enum_name(s.sampler.type)}};
-  if (s.sampler.type == SamplerType::Stratified) sampler["jitter"] = s.sampler.jitter;
-  j["sampler"] = std::move(sampler);
-  Json filter{{"type", enum_name(s.filter.type)}, {"radius", Json::array({s.filter.radius.x, s.filter.radius.y})}};
-  if (s.filter.type == FilterType::Gaussian) filter["sigma"] = s.filter.gaussian_sigma;
-  if (s.filter.type == FilterType::Mitchell) {
-    filter["b"] = s.filter.mitchell_b;
-    filter["c"] = s.filter.mitchell_c;
+  for (const RenderOption& option : render_options()) {
+    if (option.scene_key.empty()) continue;
+    RenderRequest request;
+    option.extract(scene, request);
+    if (!option.given(request)) continue;
+    if (option.selective_in(request) && !(integrator && integrator->reads_setting(option.reads))) continue;
+    const size_t dot = option.scene_key.find('.');
+    Json& holder = dot == std::string_view::npos ? j : j[std::string(option.scene_key.substr(0, dot))];
+    holder[std::string(option.scene_key.substr(dot == std::string_view::npos ? 0 : dot + 1))] =
+        render_option_json(option, request);
   }
-  j["filter"] = std::move(filter);
-  if (reads("direction_sampling")) j["direction_sampling"] = enum_name(s.path.direction_sampling);
-  if (reads("mis")) j["mis"] = s.path.mis;
+  if (!scene.film.filename.empty()) j["output"] = scene.film.filename;
+  if (!scene.film.aovs.empty()) j["aovs"] = scene.film.aovs;
   if (s.hide_emitters) j["hide_emitters"] = true;
-  if (s.spectral) j["spectral"] = true;
-  if (s.light_selection != LightSelection::Paper || reads("light_selection=paper"))
-    j["light_selection"] = enum_name(s.light_selection);
-  if (reads("shadow_rays")) j["shadow_rays"] = s.path.shadow_rays;
-  j["bvh"] = enum_name(s.bvh);
-  if (s.adaptive() && reads("adaptive")) {
-    Json adaptive;
-    if (s.adaptive_threshold > 0) adaptive["threshold"] = s.adaptive_threshold;
-    if (s.adaptive_spp > 0) adaptive["spp"] = s.adaptive_spp;
-    adaptive["batch"] = s.adaptive_batch;
-    if (s.adaptive_max_spp > 0) adaptive["max_spp"] = s.adaptive_max_spp;
-    j["adaptive"] = std::move(adaptive);
+  j["transform_times"] = Json::array({scene.transform_start_time, scene.transform_end_time});
+  if (s.sampler.type == SamplerType::Stratified) j["sampler"]["jitter"] = s.sampler.jitter;
+  j["filter"]["radius"] = Json::array({s.filter.radius.x, s.filter.radius.y});
+  if (s.filter.type == FilterType::Gaussian) j["filter"]["sigma"] = s.filter.gaussian_sigma;
+  if (s.filter.type == FilterType::Mitchell) {
+    j["filter"]["b"] = s.filter.mitchell_b;
+    j["filter"]["c"] = s.filter.mitchell_c;
   }
-  if (reads("mlt"))
-    j["mlt"] = Json{{"bootstrap", s.mlt.bootstrap}, {"chains", s.mlt.chains},   {"sigma", s.mlt.sigma},
-                  {"large_step", s.mlt.large_step}, {"lens", s.mlt.lens}, {"caustic", s.mlt.caustic}};
   return j;
 }
 

@@ -220,6 +220,30 @@ TEST(ConvertJson, MediaRoundTrip) {
   EXPECT_EQ(empty.camera.medium, -1);
 }
 
+// A camera's screen window and the projections of textures survive `candela convert`.
+TEST(ConvertJson, ScreenWindowsAndTextureProjectionsRoundTrip) {
+  SceneDesc scene;
+  scene.camera.projection = Projection::Orthographic;
+  scene.camera.screen_window = std::array<float, 4>{-2, 2, -1.5f, 1.5f};
+  UVMapping planar{.du = 0.5f, .projection = TextureProjection::Planar};
+  planar.to_world = Transform::translate(Vec3(0, 1, 0));
+  planar.planar_s = Vec3(4, 0, 0);
+  scene.textures.push_back(CheckerboardTexture{ColorInput(RGB(1.0f)), ColorInput(RGB(0.0f)), planar});
+  scene.textures.push_back(ImageTexture{.filename = (fs::path(CANDELA_SOURCE_DIR) / "tests/data/textures/checker.ppm").string(),
+                                        .mapping = UVMapping{.projection = TextureProjection::Spherical}});
+  const SceneDesc back = read_json_scene(scene_to_json(scene), "converted.json", fs::temp_directory_path());
+  EXPECT_EQ(back.camera.screen_window, scene.camera.screen_window);
+  const UVMapping& read_planar = std::get<CheckerboardTexture>(back.textures.at(0)).mapping;
+  EXPECT_EQ(read_planar.projection, TextureProjection::Planar);
+  EXPECT_EQ(read_planar.planar_s, Vec3(4, 0, 0));
+  EXPECT_EQ(read_planar.planar_t, Vec3(0, 1, 0));
+  EXPECT_FLOAT_EQ(read_planar.du, 0.5f);
+  EXPECT_FLOAT_EQ(read_planar.to_world.point(Point3(0.0f)).y, 1);
+  EXPECT_EQ(std::get<ImageTexture>(back.textures.at(1)).mapping.projection, TextureProjection::Spherical);
+  EXPECT_FALSE(read_json_scene(scene_to_json(SceneDesc{}), "converted.json", fs::temp_directory_path())
+                   .camera.screen_window);
+}
+
 // pbrt's media convert too: a uniformgrid's samples are written inline.
 TEST(ConvertJson, PbrtMediaRoundTrip) {
   Warnings warnings;

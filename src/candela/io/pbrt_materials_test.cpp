@@ -169,10 +169,6 @@ TEST(PbrtReader, DiffuseTransmissionInterfaceAndDisplacement) {
   EXPECT_EQ(textured.reflectance.value, RGB(0.5f));
   EXPECT_TRUE(std::holds_alternative<InterfaceMaterial>(scene.materials[3]));
   EXPECT_TRUE(std::holds_alternative<InterfaceMaterial>(scene.materials[4]));
-  expect_warning({"WorldBegin", "Material \"diffuse\" \"float displacement\" 0.1"}, 2, "\"float displacement\"",
-                 "Material \"diffuse\": \"displacement\" is ignored: displacement mapping is not supported");
-  expect_warning({"WorldBegin", "Material \"conductor\" \"string normalmap\" \"n.png\""}, 2, "\"string normalmap\"",
-                 "\"normalmap\" is ignored: normal maps are not supported");
 }
 
 TEST(PbrtReader, MixMaterialSelectsOrBlends) {
@@ -269,8 +265,11 @@ TEST(PbrtReader, BadImageTextures) {
                "must be \"point\", \"bilinear\", \"trilinear\" or \"ewa\"");
   expect_error({"WorldBegin", wood + "\"string encoding\" \"gamma 1.8\""}, 2, "\"string encoding\"",
                "\"gamma 1.8\" is not supported");
-  expect_error({"WorldBegin", wood + "\"string mapping\" \"spherical\""}, 2, "\"string mapping\"",
-               "\"spherical\" is not supported (only \"uv\")");
+  expect_error({"WorldBegin", wood + "\"string mapping\" \"spheric\""}, 2, "\"string mapping\"",
+               "must be \"uv\", \"spherical\", \"cylindrical\" or \"planar\", got \"spheric\"");
+  // A spherical mapping takes no scale: pbrt-v4 leaves "uscale" unused, an error.
+  expect_error({"WorldBegin", wood + "\"string mapping\" \"spherical\" \"float uscale\" 2"}, 2, "\"float uscale\"",
+               "unused parameter");
   expect_error({"WorldBegin", wood, texture + "\"string filename\" \"wood.png\""}, 3, "\"a\"",
                "spectrum texture \"a\" is already defined at");
   expect_error({"WorldBegin", "Texture \"a\" \"color\" \"imagemap\""}, 2, "\"color\"",
@@ -316,10 +315,99 @@ TEST(PbrtReader, ProceduralTexturesComeAfterTheTexturesTheyUse) {
   const auto& constant = std::get<DiffuseMaterial>(scene.materials[1]).reflectance;
   EXPECT_TRUE(constant.is_constant());
   EXPECT_EQ(constant.value, RGB(0.1f, 0.2f, 0.3f));
-  expect_error({"WorldBegin", "Texture \"c\" \"spectrum\" \"checkerboard\" \"integer dimension\" 3"}, 2,
-               "\"integer dimension\"", "solid (3D) checkerboards are not supported");
+  expect_error({"WorldBegin", "Texture \"c\" \"spectrum\" \"checkerboard\" \"integer dimension\" 4"}, 2,
+               "\"integer dimension\"", "must be 2 or 3, got 4");
   expect_error({"WorldBegin", "Texture \"c\" \"spectrum\" \"scale\" \"texture tex\" \"later\""}, 2, "\"texture tex\"",
                "no spectrum texture named \"later\" is defined (Texture must come first)");
+}
+
+// pbrt-v4's procedural textures: solid ones read the transform current where they are declared.
+TEST(PbrtReader, NoiseSolidAndPatternTexturesAreRead) {
+  SceneDesc scene = read_lines(
+      {"WorldBegin",
+       "Texture \"b\" \"spectrum\" \"bilerp\" \"rgb v00\" [1 0 0] \"rgb v11\" [1 1 0] \"float uscale\" 2",
+       "Texture \"d\" \"spectrum\" \"dots\" \"rgb inside\" [0.9 0.2 0.1] \"float vscale\" 8",
+       "AttributeBegin", "Scale 2 2 2",
+       "Texture \"c\" \"spectrum\" \"checkerboard\" \"integer dimension\" 3 \"rgb tex2\" [0.1 0.1 0.1]",
+       "Texture \"f\" \"float\" \"fbm\" \"integer octaves\" 6 \"float roughness\" 0.4",
+       "AttributeEnd",
+       "Texture \"w\" \"float\" \"wrinkled\"",
+       "Texture \"m\" \"spectrum\" \"marble\" \"float scale\" 4 \"float variation\" 0.3",
+       "Texture \"x\" \"spectrum\" \"directionmix\" \"rgb tex1\" [1 0 0] \"vector3 dir\" [0 0 3]"});
+  ASSERT_EQ(scene.textures.size(), 7u);
+  const auto& bilerp = std::get<BilerpTexture>(scene.textures[0]);
+  EXPECT_EQ(bilerp.v00, RGB(1, 0, 0));
+  EXPECT_EQ(bilerp.v01, RGB(1.0f));  // pbrt-v4's defaults: 0, 1, 0, 1
+  EXPECT_EQ(bilerp.v10, RGB(0.0f));
+  EXPECT_FLOAT_EQ(bilerp.mapping.su, 2);
+  const auto& dots = std::get<DotsTexture>(scene.textures[1]);
+  // pbrt-v4's "inside" colours the surroundings of its dots (see io/pbrt/textures.cpp).
+  EXPECT_EQ(dots.outside.value, RGB(0.9f, 0.2f, 0.1f));
+  EXPECT_EQ(dots.inside.value, RGB(0.0f));
+  EXPECT_FLOAT_EQ(dots.mapping.sv, 8);
+  const auto& solid = std::get<SolidCheckerboardTexture>(scene.textures[2]);
+  EXPECT_EQ(solid.tex2.value, RGB(0.1f));
+  EXPECT_FLOAT_EQ(solid.to_world.point(Point3(1, 0, 0)).x, 2);
+  const auto& fbm = std::get<FbmTexture>(scene.textures[3]);
+  EXPECT_EQ(fbm.octaves, 6);
+  EXPECT_FLOAT_EQ(fbm.roughness, 0.4f);
+  EXPECT_FLOAT_EQ(fbm.to_world.point(Point3(0, 1, 0)).y, 2);
+  EXPECT_EQ(std::get<WrinkledTexture>(scene.textures[4]).octaves, 8);
+  const auto& marble = std::get<MarbleTexture>(scene.textures[5]);
+  EXPECT_FLOAT_EQ(marble.scale, 4);
+  EXPECT_FLOAT_EQ(marble.variation, 0.3f);
+  EXPECT_EQ(std::get<DirectionMixTexture>(scene.textures[6]).direction, Vec3(0, 0, 1));
+  expect_error({"WorldBegin", "Texture \"f\" \"spectrum\" \"fbm\""}, 2, "\"fbm\"", "is a float texture only");
+  expect_error({"WorldBegin", "Texture \"m\" \"float\" \"marble\""}, 2, "\"marble\"",
+               "is a spectrum texture only");
+  expect_error({"WorldBegin", "Texture \"x\" \"float\" \"directionmix\" \"vector3 dir\" [0 0 0]"}, 2,
+               "\"vector3 dir\"", "must be a non-zero direction");
+  expect_error({"WorldBegin", "Texture \"f\" \"float\" \"fbm\" \"integer octaves\" 0"}, 2,
+               "\"integer octaves\"", "must be in [1, 32], got 0");
+}
+
+// pbrt-v4's mappings other than "uv" project the point in the texture's space, which the CTM places.
+TEST(PbrtReader, TextureMappingsProjectThePointInTheTexturesSpace) {
+  SceneDesc scene = read_lines(
+      {"WorldBegin", "Translate 0 1 0",
+       "Texture \"p\" \"spectrum\" \"checkerboard\" \"string mapping\" \"planar\" \"vector3 v1\" [4 0 0] "
+       "\"vector3 v2\" [0 4 0] \"float udelta\" 0.5",
+       "Texture \"s\" \"float\" \"checkerboard\" \"string mapping\" \"spherical\"",
+       "Texture \"c\" \"spectrum\" \"dots\" \"string mapping\" \"cylindrical\""});
+  ASSERT_EQ(scene.textures.size(), 3u);
+  const UVMapping& planar = std::get<CheckerboardTexture>(scene.textures[0]).mapping;
+  EXPECT_EQ(planar.projection, TextureProjection::Planar);
+  EXPECT_EQ(planar.planar_s, Vec3(4, 0, 0));
+  EXPECT_EQ(planar.planar_t, Vec3(0, 4, 0));
+  EXPECT_FLOAT_EQ(planar.du, 0.5f);
+  EXPECT_FLOAT_EQ(planar.to_world.point(Point3(0.0f)).y, 1);
+  EXPECT_EQ(std::get<CheckerboardTexture>(scene.textures[1]).mapping.projection, TextureProjection::Spherical);
+  EXPECT_EQ(std::get<DotsTexture>(scene.textures[2]).mapping.projection, TextureProjection::Cylindrical);
+}
+
+// pbrt-v4's normal maps and displacement wrap the material; the normal map wins where both are given.
+TEST(PbrtReader, NormalMapsAndDisplacementWrapTheMaterial) {
+  ScratchFile png("bumps.png");
+  SceneDesc scene = read_lines(
+      {"WorldBegin", "Texture \"h\" \"float\" \"wrinkled\"",
+       "Material \"conductor\" \"string normalmap\" \"bumps.png\"",
+       "MakeNamedMaterial \"rough\" \"string type\" \"diffuse\" \"texture displacement\" \"h\"",
+       "Material \"diffuse\" \"string normalmap\" \"bumps.png\" \"texture displacement\" \"h\"",
+       "Material \"diffuse\" \"float displacement\" 0.5"});
+  ASSERT_EQ(scene.materials.size(), 7u);
+  const auto& mapped = std::get<NormalMapMaterial>(scene.materials[1]);
+  EXPECT_TRUE(std::holds_alternative<ConductorMaterial>(scene.materials.at(size_t(mapped.material))));
+  const auto& image = std::get<ImageTexture>(scene.textures.at(size_t(mapped.normal_map)));
+  EXPECT_EQ(image.encoding, ColorEncoding::Linear);
+  EXPECT_NE(image.filename.find("bumps.png"), std::string::npos);
+  const auto& bumped = std::get<BumpMapMaterial>(scene.materials[3]);
+  EXPECT_EQ(bumped.height, 0);
+  EXPECT_FLOAT_EQ(bumped.scale, 1);
+  EXPECT_TRUE(std::holds_alternative<DiffuseMaterial>(scene.materials.at(size_t(bumped.material))));
+  EXPECT_TRUE(std::holds_alternative<NormalMapMaterial>(scene.materials[5]));
+  EXPECT_TRUE(std::holds_alternative<DiffuseMaterial>(scene.materials[6]));  // a constant displacement
+  expect_error({"WorldBegin", "Material \"diffuse\" \"string normalmap\" \"missing.png\""}, 2,
+               "\"string normalmap\"", "cannot find \"missing.png\"");
 }
 
 // ---------------------------------------------------------------- named spectra

@@ -23,9 +23,10 @@ TEST(PbrtReader, UnknownDirective) {
 }
 
 TEST(PbrtReader, UnknownTextureTypeIsNamed) {
-  expect_error({"WorldBegin", "Texture \"t\" \"spectrum\" \"fbm\""}, 2, "\"fbm\"",
-               "texture type \"fbm\" is not supported: candela has no such texture (supported: \"imagemap\", "
-               "\"checkerboard\", \"scale\", \"mix\", \"constant\")");
+  expect_error({"WorldBegin", "Texture \"t\" \"spectrum\" \"windy\""}, 2, "\"windy\"",
+               "texture type \"windy\" is not supported: candela has no such texture (supported: \"imagemap\", "
+               "\"checkerboard\", \"scale\", \"mix\", \"constant\", \"bilerp\", \"directionmix\", \"dots\", "
+               "\"fbm\", \"marble\", \"wrinkled\")");
 }
 
 TEST(PbrtReader, WorldEndIsExplainedAsPbrtV3) {
@@ -200,7 +201,7 @@ TEST(PbrtReader, UnknownAndUnsupportedTypes) {
   expect_error({"Integrator \"whitted\"", "WorldBegin"}, 1, "\"whitted\"", "unknown integrator type \"whitted\"");
   expect_error({"Accelerator \"octree\"", "WorldBegin"}, 1, "\"octree\"", "unknown accelerator type");
   expect_error({"WorldBegin", "AreaLightSource \"glow\""}, 2, "\"glow\"", "unknown area light type");
-  expect_error({"Camera \"orthographic\"", "WorldBegin"}, 1, "\"orthographic\"", "not supported yet");
+  expect_error({"Camera \"realistic\"", "WorldBegin"}, 1, "\"realistic\"", "not supported yet");
   expect_error({"Film \"gbuffer\"", "WorldBegin"}, 1, "\"gbuffer\"", "not supported yet");
 }
 

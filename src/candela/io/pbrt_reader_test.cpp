@@ -248,6 +248,32 @@ TEST(PbrtReader, CameraLensAndShutter) {
   EXPECT_FLOAT_EQ(scene.camera.shutter_close, 0.75f);
 }
 
+// An orthographic camera's screen spans [-1, 1] on the film's shorter axis unless a screenwindow
+// says otherwise; a perspective camera keeps its window as given.
+TEST(PbrtReader, OrthographicCamerasAndScreenWindows) {
+  SceneDesc wide = read_lines({"Camera \"orthographic\"", "Film \"rgb\" \"integer xresolution\" 200 "
+                               "\"integer yresolution\" 100", "WorldBegin"});
+  EXPECT_EQ(wide.camera.projection, Projection::Orthographic);
+  EXPECT_EQ(wide.camera.screen_window, (std::array<float, 4>{-2, 2, -1, 1}));
+  SceneDesc tall = read_lines({"Film \"rgb\" \"integer xresolution\" 100 \"integer yresolution\" 200",
+                               "Camera \"orthographic\"", "WorldBegin"});
+  EXPECT_EQ(tall.camera.screen_window, (std::array<float, 4>{-1, 1, -2, 2}));
+  SceneDesc given = read_lines({"Camera \"orthographic\" \"float screenwindow\" [-2 2 -1.5 1.5]", "WorldBegin"});
+  EXPECT_EQ(given.camera.screen_window, (std::array<float, 4>{-2, 2, -1.5f, 1.5f}));
+  SceneDesc shifted =
+      read_lines({"Camera \"perspective\" \"float fov\" 38 \"float screenwindow\" [-0.5 1 -0.5 0.5]", "WorldBegin"});
+  EXPECT_EQ(shifted.camera.projection, Projection::Perspective);
+  EXPECT_EQ(shifted.camera.screen_window, (std::array<float, 4>{-0.5f, 1, -0.5f, 0.5f}));
+  EXPECT_FALSE(read_lines({"Camera \"perspective\"", "WorldBegin"}).camera.screen_window);
+  expect_error({"Camera \"orthographic\" \"float screenwindow\" [1 -1 0 1]", "WorldBegin"}, 1,
+               "\"float screenwindow\"", "must have x0 < x1 and y0 < y1");
+  expect_error({"Camera \"orthographic\" \"float screenwindow\" [-1 1 0]", "WorldBegin"}, 1,
+               "\"float screenwindow\"", "needs 4 values");
+  expect_error({"Camera \"orthographic\" \"float lensradius\" 0.1", "WorldBegin"}, 1, "\"float lensradius\"",
+               "depth of field with an orthographic camera is not supported");
+  expect_error({"Camera \"orthographic\" \"float fov\" 30", "WorldBegin"}, 1, "\"float fov\"", "unused");
+}
+
 TEST(PbrtReader, BadLensAndShutter) {
   expect_error({"Camera \"perspective\" \"float lensradius\" -0.1", "WorldBegin"}, 1, "\"float lensradius\"",
                "\"lensradius\" must not be negative");

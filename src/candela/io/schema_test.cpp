@@ -383,7 +383,9 @@ TEST(MaterialSchema, EveryTypeAndKeyIsDocumented) {
       if (f.kind != FieldKind::UvMapping) {  // written as uv_scale, uv_offset or uv_matrix
         EXPECT_TRUE(documented(f.key)) << schema_of(t).name << "." << f.key;
       }
-  for (std::string_view key : {"uv_scale", "uv_offset", "uv_matrix"}) EXPECT_TRUE(documented(key)) << key;
+  for (std::string_view key : {"uv_scale", "uv_offset", "uv_matrix", "projection", "projection_transform", "planar_s",
+                               "planar_t"})
+    EXPECT_TRUE(documented(key)) << key;
   for (const Field& f : SchemaOf<MediumDesc>::schema.fields) EXPECT_TRUE(documented(f.key)) << "medium." << f.key;
   for (std::string_view name : type_names_of<ShapeGeometry>()) EXPECT_TRUE(documented(name)) << "shape " << name;
   for (ShapeGeometry& g : every_type_of<ShapeGeometry>())

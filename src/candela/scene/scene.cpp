@@ -691,7 +691,7 @@ void Scene::reconstruct_sdf_hit(const ShapeRecord& rec, const Ray& ray, float t,
 }
 
 TextureEvalContext Scene::texture_context(const SurfaceHit& hit) const {
-  TextureEvalContext ctx{hit.p, hit.uv, {}};
+  TextureEvalContext ctx{hit.p, hit.uv, {}, hit.ng};
   const ShapeRecord& rec = shapes_[hit.shape];
   if (rec.attributes && rec.kind == ShapeRecord::Kind::Triangles && 3 * size_t(hit.primitive) + 2 < rec.indices.size()) {
     ctx.mesh.attributes = rec.attributes.get();

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <exception>
+#include <iterator>
 #include <filesystem>
 #include <string>
 #include <type_traits>
@@ -15,11 +16,31 @@
 #include "candela/film/image_io.h"
 #include "candela/base/error.h"
 #include "candela/base/overloaded.h"
+#include "candela/textures/noise.h"
 
 namespace candela {
 namespace {
 
-Vec2 apply_mapping(const UVMapping& m, Vec2 uv) {
+// The (u, v) the mapping's affine map starts from (description/textures.h's TextureProjection).
+Vec2 projected_uv(const UVMapping& m, const TextureEvalContext& ctx) {
+  if (m.projection == TextureProjection::Surface) return ctx.uv;
+  const Point3 p = m.to_world.inverse().point(ctx.p);
+  switch (m.projection) {
+    case TextureProjection::Surface: break;
+    case TextureProjection::Spherical: {
+      const Vec3 d = normalize(p);
+      float phi = std::atan2(d.y, d.x);
+      if (phi < 0) phi += 2 * kPi;
+      return {std::acos(std::clamp(d.z, -1.0f, 1.0f)) / kPi, phi / (2 * kPi)};
+    }
+    case TextureProjection::Cylindrical: return {(kPi + std::atan2(p.y, p.x)) / (2 * kPi), p.z};
+    case TextureProjection::Planar: return {dot(p, m.planar_s), dot(p, m.planar_t)};
+  }
+  return ctx.uv;
+}
+
+Vec2 apply_mapping(const UVMapping& m, const TextureEvalContext& ctx) {
+  const Vec2 uv = projected_uv(m, ctx);
   return {m.su * uv.x + m.s_from_v * uv.y + m.du, m.t_from_u * uv.x + m.sv * uv.y + m.dv};
 }
 
@@ -101,7 +122,20 @@ void for_each_reference(const TextureDesc& desc, F&& f) {
                           f(m.tex2.texture);
                           f(m.amount.texture);
                         },
-                        [](const ImageTexture&) {}, [](const MeshAttributeTexture&) {}},
+                        [&](const DotsTexture& d) {
+                          f(d.inside.texture);
+                          f(d.outside.texture);
+                        },
+                        [&](const SolidCheckerboardTexture& c) {
+                          f(c.tex1.texture);
+                          f(c.tex2.texture);
+                        },
+                        [&](const DirectionMixTexture& m) {
+                          f(m.tex1.texture);
+                          f(m.tex2.texture);
+                        },
+                        [](const ImageTexture&) {}, [](const MeshAttributeTexture&) {}, [](const BilerpTexture&) {},
+                        [](const FbmTexture&) {}, [](const WrinkledTexture&) {}, [](const MarbleTexture&) {}},
              desc);
 }
 
@@ -124,6 +158,37 @@ RGB eval_mesh_attribute(const MeshAttributeTexture& t, const MeshAttributeContex
   return RGB(0.0f);
 }
 
+// Whether (s, t) falls on one of pbrt-v4's polka dots: the cell around the nearest integer point has
+// a dot where the noise there is positive, its centre moved by noise.
+bool inside_polka_dot(Vec2 st) {
+  const float s_cell = std::floor(st.x + 0.5f), t_cell = std::floor(st.y + 0.5f);
+  if (!(perlin_noise({s_cell + 0.5f, t_cell + 0.5f, 0.5f}) > 0)) return false;
+  constexpr float kRadius = 0.35f, kMaxShift = 0.5f - kRadius;
+  const float s_centre = s_cell + kMaxShift * perlin_noise({s_cell + 1.5f, t_cell + 2.8f, 0.5f});
+  const float t_centre = t_cell + kMaxShift * perlin_noise({s_cell + 4.5f, t_cell + 9.8f, 0.5f});
+  const float ds = st.x - s_centre, dt = st.y - t_centre;
+  return ds * ds + dt * dt < kRadius * kRadius;
+}
+
+// pbrt-v4's marble colour at t in [0, 1]: a cubic Bezier spline through nine control colours (each
+// segment of four), times 1.5.
+RGB marble_colour(float t) {
+  static constexpr RGB kControl[] = {{.58f, .58f, .6f}, {.58f, .58f, .6f}, {.58f, .58f, .6f},
+                                     {.5f, .5f, .5f},   {.6f, .59f, .58f}, {.58f, .58f, .6f},
+                                     {.58f, .58f, .6f}, {.2f, .2f, .33f},  {.58f, .58f, .6f}};
+  constexpr int kSegments = int(std::size(kControl)) - 3;
+  const int first = std::clamp(int(std::floor(t * kSegments)), 0, kSegments - 1);
+  const float u = t * kSegments - float(first);
+  // De Casteljau's construction on the segment's four control points.
+  RGB p[4] = {kControl[first], kControl[first + 1], kControl[first + 2], kControl[first + 3]};
+  for (int level = 3; level > 0; --level)
+    for (int i = 0; i < level; ++i) p[i] = (1 - u) * p[i] + u * p[i + 1];
+  return 1.5f * p[0];
+}
+
+// The point in a solid texture's own space.
+Point3 texture_space(const Transform& to_world, Point3 p) { return to_world.inverse().point(p); }
+
 }  // namespace
 
 std::pair<int, int> TextureSet::resolution(int index) const {
@@ -133,10 +198,7 @@ std::pair<int, int> TextureSet::resolution(int index) const {
                                  return Resolution{std::max(1, t.image->width), std::max(1, t.image->height)};
                                },
                                // not images
-                               [](const CheckerboardTexture&) { return Resolution{1, 1}; },
-                               [](const ScaleTexture&) { return Resolution{1, 1}; },
-                               [](const MixTexture&) { return Resolution{1, 1}; },
-                               [](const MeshAttributeTexture&) { return Resolution{1, 1}; }},
+                               [](const auto&) { return Resolution{1, 1}; }},
                     textures_[size_t(index)]);
 }
 
@@ -187,18 +249,48 @@ RGB TextureSet::eval_texture(int index, const TextureEvalContext& ctx) const {
   return std::visit(
       overloaded{
           [&](const ImageLookup& t) {
-            RGB v = t.scale * lookup(*t.image, t.wrap, t.bilinear, apply_mapping(t.mapping, ctx.uv));
+            RGB v = t.scale * lookup(*t.image, t.wrap, t.bilinear, apply_mapping(t.mapping, ctx));
             if (t.luminance) v = RGB(v.luminance());
             return clamp_zero(t.invert ? RGB(1.0f) - v : v);  // pbrt-v4 clamps negative results too
           },
           [&](const CheckerboardTexture& t) {
-            Vec2 st = apply_mapping(t.mapping, ctx.uv);
+            Vec2 st = apply_mapping(t.mapping, ctx);
             // Sum in 64 bits: floor_index's range makes the sum fit, and & 1 is the parity for negatives too.
             bool even = ((int64_t(floor_index(st.x)) + floor_index(st.y)) & 1) == 0;
             return eval(even ? t.tex1 : t.tex2, ctx);
           },
           [&](const ScaleTexture& t) { return eval(t.tex, ctx) * eval(t.scale, ctx); },
           [&](const MeshAttributeTexture& t) { return eval_mesh_attribute(t, ctx.mesh); },
+          [&](const BilerpTexture& t) {
+            const Vec2 st = apply_mapping(t.mapping, ctx);
+            return (1 - st.x) * (1 - st.y) * t.v00 + st.x * (1 - st.y) * t.v10 + (1 - st.x) * st.y * t.v01 +
+                   st.x * st.y * t.v11;
+          },
+          [&](const DotsTexture& t) {
+            return eval(inside_polka_dot(apply_mapping(t.mapping, ctx)) ? t.inside : t.outside, ctx);
+          },
+          [&](const SolidCheckerboardTexture& t) {
+            const Point3 p = texture_space(t.to_world, ctx.p);
+            const int64_t sum = int64_t(floor_index(p.x)) + floor_index(p.y) + floor_index(p.z);
+            return eval((sum & 1) == 0 ? t.tex1 : t.tex2, ctx);
+          },
+          [&](const FbmTexture& t) { return RGB(fbm(texture_space(t.to_world, ctx.p), t.roughness, t.octaves)); },
+          [&](const WrinkledTexture& t) {
+            return RGB(turbulence(texture_space(t.to_world, ctx.p), t.roughness, t.octaves));
+          },
+          [&](const MarbleTexture& t) {
+            const Point3 p = t.scale * texture_space(t.to_world, ctx.p);
+            const float bands = p.y + t.variation * fbm(p, t.roughness, t.octaves);
+            return marble_colour(0.5f + 0.5f * std::sin(bands));
+          },
+          [&](const DirectionMixTexture& t) {
+            const float amount = std::abs(dot(Vec3(ctx.n), t.direction));
+            // As mix: a side with weight zero is not evaluated.
+            RGB result(0.0f);
+            if (amount != 0) result += amount * eval(t.tex1, ctx);
+            if (amount != 1) result += (1 - amount) * eval(t.tex2, ctx);
+            return result;
+          },
           [&](const MixTexture& t) {
             float amount = eval(t.amount, ctx);
             // A side with weight zero is not evaluated (as in pbrt-v4): cheaper, and an infinite value

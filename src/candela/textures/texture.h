@@ -31,11 +31,13 @@ struct MeshAttributeContext {
   float b1 = 0, b2 = 0;
 };
 
-// Where a texture is looked up: the hit point, the surface's (u, v) and, on meshes, the triangle.
+// Where a texture is looked up: the hit point, the surface's (u, v), on meshes the triangle, and the
+// surface's normal (zero where there is no surface: lights' emission profiles).
 struct TextureEvalContext {
   Point3 p;
   Vec2 uv;
   MeshAttributeContext mesh;
+  Normal3 n{0, 0, 0};
 };
 
 // Immutable after construction, so any number of threads may call eval at once. Copies share the
@@ -73,8 +75,15 @@ class TextureSet {
     bool luminance = false;
     UVMapping mapping;
   };
-  // The other kinds need nothing beyond their descriptions.
-  using Texture = std::variant<ImageLookup, CheckerboardTexture, ScaleTexture, MixTexture, MeshAttributeTexture>;
+  // TextureDesc's kinds with the image in memory in place of the image's description; the others
+  // need nothing beyond their descriptions.
+  template <typename Desc>
+  struct WithImageLoaded;
+  template <typename... Others>
+  struct WithImageLoaded<std::variant<ImageTexture, Others...>> {
+    using type = std::variant<ImageLookup, Others...>;
+  };
+  using Texture = WithImageLoaded<TextureDesc>::type;
 
   RGB eval_texture(int index, const TextureEvalContext& ctx) const;
 

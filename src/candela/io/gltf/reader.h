@@ -37,7 +37,6 @@ namespace fs = std::filesystem;
 namespace tg = tinygltf;
 
 inline constexpr int kMaxNodeDepth = 1024;
-inline constexpr int kMaxResolution = 65536;
 
 // ---------------------------------------------------------------- small helpers
 

@@ -6,6 +6,7 @@
 // light) dispatches on a table of type names, from which its "unknown ... type" message lists the names.
 #include <fmt/ranges.h>
 
+#include <array>
 #include <filesystem>
 #include <initializer_list>
 #include <map>
@@ -19,12 +20,15 @@
 #include "candela/io/named_spectra.h"
 #include "candela/description/scene_desc.h"
 
+namespace candela {
+struct RenderOption;
+struct RenderRequest;
+}  // namespace candela
+
 namespace candela::json {
 
 namespace fs = std::filesystem;
 
-constexpr int kMaxResolution = 65536;
-constexpr int64_t kMaxPixels = int64_t(1) << 28;
 constexpr float kMaxFilterRadius = 64;  // pixels; the filter is tabulated per unit of radius
 constexpr int kMaxTextureDepth = 64;    // textures using textures
 
@@ -50,16 +54,17 @@ class JsonSceneReader {
   // ---- camera and render settings (settings.cpp)
   void read_camera(const Json& value, const std::string& pointer);
   void read_lens_and_shutter(CheckedObject& camera);
+  std::array<float, 4> read_screen_window(const Json& value, const std::string& pointer) const;
   void check_view_direction(const CheckedObject& camera, Point3 position, Point3 look_at, Vec3 up) const;
   void read_render(const Json& value, const std::string& pointer);
+  void read_render_option(const RenderOption& option, const Json& value, const std::string& pointer,
+                          RenderRequest& request) const;
+  void read_film_outputs(CheckedObject& render);
   void check_integrator_reads(const Json& value, const CheckedObject& render, const RenderSettings& settings) const;
-  void read_mlt(const Json& value, const std::string& pointer, RenderSettings& settings) const;
   void read_transform_times(const Json& value, const std::string& pointer);
-  SamplerDesc read_sampler(const Json& value, const std::string& pointer) const;
-  FilterDesc read_filter(const Json& value, const std::string& pointer) const;
+  void read_filter_shape(CheckedObject& object, FilterDesc& filter) const;
   Vec2 read_filter_radius(const Json& value, const std::string& pointer) const;
-  void read_integrator_strategies(CheckedObject& render, RenderSettings& settings) const;
-  void read_adaptive(const Json& value, const std::string& pointer, RenderSettings& settings) const;
+  void check_adaptive(const CheckedObject& adaptive, const RenderSettings& settings) const;
 
   // ---- named textures and materials (textures.cpp)
   // They may refer to each other in any order. Each is read when first needed, so that
@@ -85,6 +90,7 @@ class JsonSceneReader {
   int add_texture(TextureDesc texture, SourceLocation where);
   TextureDesc read_texture(const Json& value, const std::string& pointer);
   UVMapping read_uv_mapping(CheckedObject& t) const;
+  void read_projection(CheckedObject& t, UVMapping& mapping) const;
   std::string existing_file(CheckedObject& object, std::string_view key, std::string_view what) const;
 
   // ---- material and texture parameters: a constant, a texture name, or an inline texture object

@@ -1,12 +1,15 @@
 // The "camera" and "render" sections: the camera, the film's size and the render settings.
 #include "candela/io/json/reader.h"
 
+#include <algorithm>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 #include "candela/base/error.h"
 #include "candela/film/aov_film.h"
 #include "candela/description/integrator_traits.h"
+#include "candela/description/render_options.h"
 
 namespace candela::json {
 
@@ -32,6 +35,8 @@ void JsonSceneReader::read_camera(const Json& value, const std::string& pointer)
     scene_.camera.projection =
         read_enum<Projection>(report_, *projection, camera.pointer_of("projection"), "projection");
   scene_.camera.near_clip = camera.number_or("near_clip", scene_.camera.near_clip, Bound::NonNegative);
+  if (const Json* window = camera.find("screen_window"))
+    scene_.camera.screen_window = read_screen_window(*window, camera.pointer_of("screen_window"));
   scene_.film.width = camera.integer_or("width", scene_.film.width, 1, kMaxResolution);
   scene_.film.height = camera.integer_or("height", scene_.film.height, 1, kMaxResolution);
   read_lens_and_shutter(camera);
@@ -47,6 +52,18 @@ void JsonSceneReader::read_camera(const Json& value, const std::string& pointer)
     scene_.camera.world_from_camera = Transform::look_at_right_handed(position, look_at, up);
   }
   scene_.camera.fov_degrees = fov;
+}
+
+// [x0, x1, y0, y1] with x0 < x1 and y0 < y1 (CameraDesc::screen_window).
+std::array<float, 4> JsonSceneReader::read_screen_window(const Json& value, const std::string& pointer) const {
+  if (!value.is_array() || value.size() != 4)
+    report_.fail(pointer, "expected [x0, x1, y0, y1], got {}", describe(value));
+  std::array<float, 4> window;
+  for (size_t i = 0; i < 4; ++i) window[i] = read_float(report_, value[i], fmt::format("{}/{}", pointer, i));
+  if (!(window[0] < window[1] && window[2] < window[3]))
+    report_.fail(pointer, "the window must have x0 < x1 and y0 < y1, got [{}, {}, {}, {}]", window[0], window[1],
+                 window[2], window[3]);
+  return window;
 }
 
 void JsonSceneReader::read_lens_and_shutter(CheckedObject& camera) {
@@ -71,16 +88,111 @@ void JsonSceneReader::check_view_direction(const CheckedObject& camera, Point3 p
     report_.fail(camera.pointer_of("up"), "up is parallel to the view direction, so the image has no defined up");
 }
 
+// The "render" object: first the render options' keys (description/render_options.h), read with
+// the rules the command line checks them by and applied to the scene as the command line applies
+// them; then the keys only a scene file gives (the output, the AOVs, hidden emitters, the transform
+// times, the sampler's jitter, the filter's size and shape) and what depends on several.
 void JsonSceneReader::read_render(const Json& value, const std::string& pointer) {
   CheckedObject render(report_, value, pointer);
-  constexpr int64_t kIntMax = std::numeric_limits<int>::max();
   RenderSettings& settings = scene_.settings;
-  settings.spp = render.integer_or("spp", settings.spp, 1, kIntMax);
-  settings.max_depth = render.integer_or("max_depth", settings.max_depth, 1, kIntMax);
-  if (const Json* seed = render.find("seed")) settings.seed = read_uint64(report_, *seed, render.pointer_of("seed"));
-  // A scene with media renders with the volumetric path tracer unless it names another integrator.
-  settings.integrator = render.string_or("integrator", scene_.media.empty() ? settings.integrator : "volpath");
-  if (settings.integrator.empty()) report_.fail(render.pointer_of("integrator"), "the integrator name is empty");
+  // The format's own defaults: a scene with media renders with the volumetric path tracer, and the
+  // sampler is the most efficient measured (docs/performance.md).
+  if (!scene_.media.empty()) settings.integrator = "volpath";
+  settings.sampler.type = SamplerType::ZSobol;
+  RenderRequest request;
+  std::map<std::string, CheckedObject, std::less<>> groups;  // "adaptive": {"spp": 64} holds adaptive.spp
+  for (const RenderOption& option : render_options()) {
+    if (option.scene_key.empty()) continue;
+    const size_t dot = option.scene_key.find('.');
+    CheckedObject* object = &render;
+    if (dot != std::string_view::npos) {
+      const std::string group(option.scene_key.substr(0, dot));
+      auto it = groups.find(group);
+      if (it == groups.end()) {
+        const Json* given = render.find(group);
+        if (!given) continue;
+        it = groups.try_emplace(group, report_, *given, render.pointer_of(group)).first;
+      }
+      object = &it->second;
+    }
+    const std::string_view key = option.scene_key.substr(dot == std::string_view::npos ? 0 : dot + 1);
+    if (const Json* given = object->find(key)) read_render_option(option, *given, object->pointer_of(key), request);
+  }
+  for (const RenderOption& option : render_options())
+    if (!option.scene_key.empty() && option.given(request)) option.apply(request, scene_);
+  read_film_outputs(render);
+  settings.hide_emitters = render.boolean_or("hide_emitters", settings.hide_emitters);
+  if (const Json* times = render.find("transform_times"))
+    read_transform_times(*times, render.pointer_of("transform_times"));
+  if (auto sampler = groups.find("sampler"); sampler != groups.end()) {
+    sampler->second.require("type");
+    if (settings.sampler.type == SamplerType::Stratified)
+      settings.sampler.jitter = sampler->second.boolean_or("jitter", settings.sampler.jitter);
+  }
+  if (auto filter = groups.find("filter"); filter != groups.end()) {
+    filter->second.require("type");
+    read_filter_shape(filter->second, settings.filter);
+  }
+  if (auto adaptive = groups.find("adaptive"); adaptive != groups.end()) check_adaptive(adaptive->second, settings);
+  if (auto mlt = groups.find("mlt"); mlt != groups.end())
+    if (std::string problem = settings.mlt.problem(); !problem.empty()) report_.fail(mlt->second.pointer(), "{}", problem);
+  for (const auto& [group, object] : groups) object.finish();
+  render.finish();
+  check_integrator_reads(value, render, settings);
+}
+
+// One option's value from the file into `request`, checked against the option's rule.
+void JsonSceneReader::read_render_option(const RenderOption& option, const Json& value, const std::string& pointer,
+                                         RenderRequest& request) const {
+  std::string what = option.name;
+  std::replace(what.begin(), what.end(), '_', ' ');
+  std::visit(
+      [&](auto member) {
+        auto& field = request.*member;
+        using T = std::remove_cvref_t<decltype(field)>;
+        if constexpr (std::is_same_v<T, bool>) {
+          field = read_bool(report_, value, pointer) != option.scene_negated;
+        } else if constexpr (std::is_same_v<T, std::string>) {
+          const auto* choice = std::get_if<ChoiceValue>(&option.rule);
+          if (!option.scene_true.empty()) {
+            // A flag in the file: true is `scene_true`, false the other of the two choices.
+            const bool flag = read_bool(report_, value, pointer);
+            for (const std::string& name : choice->names)
+              if ((name == option.scene_true) == flag) field = name;
+            return;
+          }
+          field = read_string(report_, value, pointer);
+          if (field.empty()) report_.fail(pointer, "the {} name is empty", what);
+          if (choice && std::find(choice->names.begin(), choice->names.end(), field) == choice->names.end()) {
+            std::vector<std::string_view> names(choice->names.begin(), choice->names.end());
+            report_.fail(pointer, "unknown {} \"{}\"{}; expected one of: {}", what, field, did_you_mean(field, names),
+                         fmt::join(choice->names, ", "));
+          }
+        } else {
+          using V = typename T::value_type;
+          const auto* range = std::get_if<ValueRange>(&option.rule);
+          if constexpr (std::is_same_v<V, uint64_t>) {
+            field = read_uint64(report_, value, pointer);
+          } else if constexpr (std::is_integral_v<V>) {
+            const int64_t n = read_int64(report_, value, pointer);
+            if (range && !range->contains(double(n))) {
+              if (range->hi >= std::numeric_limits<int>::max())
+                report_.fail(pointer, "expected an integer >= {}, got {}", range->lo, n);
+              report_.fail(pointer, "expected an integer in [{}, {}], got {}", range->lo, range->hi, n);
+            }
+            field = V(n);
+          } else {
+            const ValueRange bound = range ? *range : std::holds_alternative<PositiveValue>(option.rule) ? kPositive
+                                                                                                          : kAnyValue;
+            field = V(check_bound(report_, read_float(report_, value, pointer), bound, pointer));
+          }
+        }
+      },
+      option.field);
+}
+
+// What the image is written to: the file and the extra layers.
+void JsonSceneReader::read_film_outputs(CheckedObject& render) {
   scene_.film.filename = render.string_or("output", "");
   scene_.film.aovs = render.string_or("aovs", "");
   if (!scene_.film.aovs.empty()) {
@@ -90,20 +202,6 @@ void JsonSceneReader::read_render(const Json& value, const std::string& pointer)
       report_.fail(render.pointer_of("aovs"), "{}", e.what());
     }
   }
-  settings.rr_start_depth = render.integer_or("rr_start_depth", settings.rr_start_depth, 0, kIntMax);
-  if (const Json* times = render.find("transform_times"))
-    read_transform_times(*times, render.pointer_of("transform_times"));
-  if (const Json* sampler = render.find("sampler"))
-    settings.sampler = read_sampler(*sampler, render.pointer_of("sampler"));
-  else
-    settings.sampler.type = SamplerType::ZSobol;  // the most efficient measured (docs/performance.md)
-  if (const Json* filter = render.find("filter")) settings.filter = read_filter(*filter, render.pointer_of("filter"));
-  read_integrator_strategies(render, settings);
-  if (const Json* adaptive = render.find("adaptive"))
-    read_adaptive(*adaptive, render.pointer_of("adaptive"), settings);
-  if (const Json* mlt = render.find("mlt")) read_mlt(*mlt, render.pointer_of("mlt"), settings);
-  render.finish();
-  check_integrator_reads(value, render, settings);
 }
 
 // The scene's integrator must exist and read every selective setting the scene gives
@@ -125,21 +223,6 @@ void JsonSceneReader::check_integrator_reads(const Json& value, const CheckedObj
   }
 }
 
-// Metropolis light transport's parameters (integrator "mlt").
-void JsonSceneReader::read_mlt(const Json& value, const std::string& pointer, RenderSettings& settings) const {
-  CheckedObject object(report_, value, pointer);
-  constexpr int64_t kIntMax = std::numeric_limits<int>::max();
-  settings.mlt.bootstrap = object.integer_or("bootstrap", settings.mlt.bootstrap, 1, kIntMax);
-  settings.mlt.chains = object.integer_or("chains", settings.mlt.chains, 1, kIntMax);
-  settings.mlt.sigma = object.number_or("sigma", settings.mlt.sigma, Bound::Positive);
-  if (settings.mlt.sigma > 1) report_.fail(object.pointer_of("sigma"), "sigma must be at most 1, got {}", settings.mlt.sigma);
-  settings.mlt.large_step = object.number_or("large_step", settings.mlt.large_step, Bound::UnitInterval);
-  settings.mlt.lens = object.number_or("lens", settings.mlt.lens, Bound::UnitInterval);
-  settings.mlt.caustic = object.number_or("caustic", settings.mlt.caustic, Bound::UnitInterval);
-  if (std::string problem = settings.mlt.problem(); !problem.empty()) report_.fail(pointer, "{}", problem);
-  object.finish();
-}
-
 void JsonSceneReader::read_transform_times(const Json& value, const std::string& pointer) {
   Vec2 times = read_vec2(report_, value, pointer);
   // Shapes are interpolated between the two times, so they must span an interval.
@@ -149,30 +232,17 @@ void JsonSceneReader::read_transform_times(const Json& value, const std::string&
   scene_.transform_end_time = times.y;
 }
 
-SamplerDesc JsonSceneReader::read_sampler(const Json& value, const std::string& pointer) const {
-  CheckedObject object(report_, value, pointer);
-  SamplerDesc sampler;
-  sampler.type = read_enum<SamplerType>(report_, object.require("type"), object.pointer_of("type"), "sampler type");
-  if (sampler.type == SamplerType::Stratified) sampler.jitter = object.boolean_or("jitter", sampler.jitter);
-  object.finish();
-  return sampler;
-}
-
-// Each type starts from pbrt-v4's defaults; only the keys of that type's parameters are allowed.
-FilterDesc JsonSceneReader::read_filter(const Json& value, const std::string& pointer) const {
-  CheckedObject object(report_, value, pointer);
-  FilterType type = read_enum<FilterType>(report_, object.require("type"), object.pointer_of("type"), "filter type");
-  FilterDesc filter = default_filter(type);
+// The filter's size and shape, each type from pbrt-v4's defaults (its type set them): only the keys
+// of that type's parameters are allowed.
+void JsonSceneReader::read_filter_shape(CheckedObject& object, FilterDesc& filter) const {
   if (const Json* radius = object.find("radius"))
     filter.radius = read_filter_radius(*radius, object.pointer_of("radius"));
-  if (type == FilterType::Gaussian)
+  if (filter.type == FilterType::Gaussian)
     filter.gaussian_sigma = object.number_or("sigma", filter.gaussian_sigma, Bound::Positive);
-  if (type == FilterType::Mitchell) {
+  if (filter.type == FilterType::Mitchell) {
     filter.mitchell_b = object.number_or("b", filter.mitchell_b);
     filter.mitchell_c = object.number_or("c", filter.mitchell_c);
   }
-  object.finish();
-  return filter;
 }
 
 // One number for both axes, or [x, y].
@@ -185,44 +255,13 @@ Vec2 JsonSceneReader::read_filter_radius(const Json& value, const std::string& p
   return radius;
 }
 
-void JsonSceneReader::read_integrator_strategies(CheckedObject& render, RenderSettings& settings) const {
-  if (const Json* value = render.find("direction_sampling"))
-    settings.path.direction_sampling = read_enum<DirectionSampling>(
-        report_, *value, render.pointer_of("direction_sampling"), "direction sampling");
-  settings.path.mis = render.boolean_or("mis", settings.path.mis);
-  settings.hide_emitters = render.boolean_or("hide_emitters", settings.hide_emitters);
-  settings.spectral = render.boolean_or("spectral", settings.spectral);
-  if (const Json* value = render.find("light_selection"))
-    settings.light_selection =
-        read_enum<LightSelection>(report_, *value, render.pointer_of("light_selection"), "light selection");
-  settings.path.shadow_rays = render.integer_or("shadow_rays", settings.path.shadow_rays, 1, std::numeric_limits<int>::max());
-  if (const Json* value = render.find("bvh"))
-    settings.bvh = read_enum<BvhLayout>(report_, *value, render.pointer_of("bvh"), "BVH layout");
-}
-
 // Present = on (RenderSettings): a threshold on the pixels' relative error, a budget of samples
-// per pixel on average, or both.
-void JsonSceneReader::read_adaptive(const Json& value, const std::string& pointer, RenderSettings& settings) const {
-  CheckedObject adaptive(report_, value, pointer);
-  constexpr int64_t kIntMax = std::numeric_limits<int>::max();
-  settings.adaptive_threshold = adaptive.number_or("threshold", 0, Bound::Positive);
-  settings.adaptive_spp = adaptive.integer_or("spp", 0, 1, kIntMax);
-  if (!settings.adaptive()) report_.fail(pointer, "expected \"threshold\", \"spp\" or both");
-  settings.adaptive_batch = adaptive.integer_or("batch", settings.adaptive_batch, 1, kIntMax);
-  // Batches of a power of two keep every sampler's stratification within a batch.
-  if ((settings.adaptive_batch & (settings.adaptive_batch - 1)) != 0)
-    report_.fail(adaptive.pointer_of("batch"), "expected a power of two, got {}", settings.adaptive_batch);
-  if (settings.adaptive_spp > 0 && settings.adaptive_spp < settings.adaptive_batch)
-    report_.fail(adaptive.pointer_of("spp"), "spp ({}) must be at least the batch size ({})", settings.adaptive_spp,
-                 settings.adaptive_batch);
-  settings.adaptive_max_spp = adaptive.integer_or("max_spp", 0, 1, kIntMax);
-  if (settings.adaptive_max_spp > 0 && settings.adaptive_max_spp < settings.adaptive_batch)
-    report_.fail(adaptive.pointer_of("max_spp"), "max_spp ({}) must be at least the batch size ({})",
-                 settings.adaptive_max_spp, settings.adaptive_batch);
-  if (settings.adaptive_max_spp > 0 && settings.adaptive_max_spp < settings.adaptive_spp)
-    report_.fail(adaptive.pointer_of("max_spp"), "max_spp ({}) must be at least spp ({})", settings.adaptive_max_spp,
-                 settings.adaptive_spp);
-  adaptive.finish();
+// per pixel on average, or both; the batch and the budgets agree (adaptive_problem).
+void JsonSceneReader::check_adaptive(const CheckedObject& adaptive, const RenderSettings& settings) const {
+  if (!settings.adaptive()) report_.fail(adaptive.pointer(), "expected \"threshold\", \"spp\" or both");
+  if (std::optional<SettingProblem> problem = adaptive_problem(settings))
+    report_.fail(adaptive.pointer_of(problem->scene_key.substr(problem->scene_key.find('.') + 1)), "{}",
+                 problem->message);
 }
 
 }  // namespace candela::json

@@ -96,6 +96,7 @@ UVMapping JsonSceneReader::read_uv_mapping(CheckedObject& t) const {
     if (m[0][0] * m[1][1] - m[0][1] * m[1][0] == 0)
       report_.fail(pointer, "the uv matrix is singular (it maps the surface onto a line)");
     mapping = {m[0][0], m[1][1], m[0][2], m[1][2], m[0][1], m[1][0]};
+    read_projection(t, mapping);
     return mapping;
   }
   if (const Json* scale = t.find("uv_scale")) {
@@ -111,7 +112,22 @@ UVMapping JsonSceneReader::read_uv_mapping(CheckedObject& t) const {
     mapping.du = d.x;
     mapping.dv = d.y;
   }
+  read_projection(t, mapping);
   return mapping;
+}
+
+// "projection" (TextureProjection) and, for the projections from the hit point, the space they
+// work in ("projection_transform") and the planar one's axes.
+void JsonSceneReader::read_projection(CheckedObject& t, UVMapping& mapping) const {
+  if (const Json* projection = t.find("projection"))
+    mapping.projection = read_enum<TextureProjection>(report_, *projection, t.pointer_of("projection"),
+                                                      "texture projection");
+  if (mapping.projection == TextureProjection::Surface) return;
+  if (const Json* transform = t.find("projection_transform"))
+    mapping.to_world = read_transform(*transform, t.pointer_of("projection_transform"));
+  if (mapping.projection != TextureProjection::Planar) return;
+  mapping.planar_s = t.vec3_or("planar_s", mapping.planar_s);
+  mapping.planar_t = t.vec3_or("planar_t", mapping.planar_t);
 }
 
 // A file named relative to the scene file's directory (as mesh files are). It must exist when the

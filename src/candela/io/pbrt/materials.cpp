@@ -30,7 +30,7 @@ MaterialDesc SceneParser::make_material(const std::string& type, const SourceLoc
   if (type == "diffuse") {
     DiffuseMaterial m;
     m.reflectance = read_color(params, "reflectance", Role::Reflectance).value_or(ColorInput(RGB(0.5f)));
-    ignore_shading_params(params);
+    read_shading_normals(params);
     return m;
   }
   if (type == "conductor") {
@@ -45,14 +45,14 @@ MaterialDesc SceneParser::make_material(const std::string& type, const SourceLoc
     if (k) m.k = *k;
     m.reflectance = reflectance;
     m.roughness = read_roughness(params);
-    ignore_shading_params(params);
+    read_shading_normals(params);
     return m;
   }
   if (type == "dielectric") {
     DielectricMaterial m;
     m.ior = read_ior(params, "eta").value_or(1.5f);
     m.roughness = read_roughness(params);
-    ignore_shading_params(params);
+    read_shading_normals(params);
     return m;
   }
   // A thin sheet: light goes straight through or reflects, with every internal reflection summed
@@ -61,7 +61,7 @@ MaterialDesc SceneParser::make_material(const std::string& type, const SourceLoc
     DielectricMaterial m;
     m.ior = read_ior(params, "eta").value_or(1.5f);
     m.thin = true;
-    ignore_shading_params(params);
+    read_shading_normals(params);
     return m;
   }
   if (type == "coateddiffuse") {
@@ -88,7 +88,7 @@ MaterialDesc SceneParser::make_material(const std::string& type, const SourceLoc
     int samples = params.get_int("nsamples", 1);      // sums the whole series in closed form
     if (max_depth < 1) params.fail("maxdepth", "must be positive, got {}", max_depth);
     if (samples < 1) params.fail("nsamples", "must be positive, got {}", samples);
-    ignore_shading_params(params);
+    read_shading_normals(params);
     return m;
   }
   if (type == "diffusetransmission") {
@@ -105,7 +105,7 @@ MaterialDesc SceneParser::make_material(const std::string& type, const SourceLoc
     };
     m.reflectance = clamp01(scaled(reflectance, scale, params.directive()));
     m.transmittance = clamp01(scaled(transmittance, scale, params.directive()));
-    ignore_shading_params(params);
+    read_shading_normals(params);
     return m;
   }
   if (type == "interface" || type == "none" || type.empty()) return InterfaceMaterial{};
@@ -148,13 +148,39 @@ MaterialDesc SceneParser::make_material(const std::string& type, const SourceLoc
               {"coatedconductor", "hair", "measured", "subsurface"}, "candela has no BSDF for it");
 }
 
+// pbrt-v4's "string normalmap" (an image of tangent-space normals, 2 rgb - 1, read without colour
+// decoding and repeated) and "texture displacement" (a float texture that moves the surface along its
+// normal: bump mapping). Where both are given pbrt-v4 uses the normal map; so does candela.
+void SceneParser::read_shading_normals(ParamList& params) {
+  if (params.has("normalmap")) {
+    const std::string name = params.get_string("normalmap", "");
+    ImageTexture image;
+    image.filename =
+        resolve_path(name, params.where("normalmap"), fmt::format("{}: \"normalmap\"", params.owner())).string();
+    image.encoding = ColorEncoding::Linear;
+    shading_normals_.normal_map = add_texture(image, params.where("normalmap"));
+  }
+  shading_normals_.displacement = read_float_texture(params, "displacement");
+}
+
+int SceneParser::wrap_shading_normals(int material, const SourceLocation& where) {
+  const ShadingNormals normals = std::exchange(shading_normals_, {});
+  if (normals.normal_map >= 0)
+    return add_material(NormalMapMaterial{.normal_map = normals.normal_map, .material = material}, where);
+  // A constant displacement moves the surface without tilting it: nothing to do.
+  if (normals.displacement && !normals.displacement->is_constant())
+    return add_material(BumpMapMaterial{.height = normals.displacement->texture, .material = material}, where);
+  return material;
+}
+
 void SceneParser::material(const Token& d) {
   require_world(d);
   Token type = expect_string(d, "the material type");
   ParamList params = read_params(d, fmt::format("Material \"{}\"", type.text), kMaterialAttributes);
+  shading_normals_ = {};
   MaterialDesc desc = make_material(type.text, at(type), params);
   params.reject_unused();
-  state_.material = add_material(std::move(desc), at(d));
+  state_.material = wrap_shading_normals(add_material(std::move(desc), at(d)), at(d));
 }
 
 void SceneParser::make_named_material(const Token& d) {
@@ -167,9 +193,10 @@ void SceneParser::make_named_material(const Token& d) {
   if (!params.has("type"))
     throw_scene_error(at(d), "MakeNamedMaterial \"{}\": missing the \"string type\" parameter", name.text);
   std::string type = params.get_string("type", "");
+  shading_normals_ = {};
   MaterialDesc desc = make_material(type, params.where("type"), params);
   params.reject_unused();
-  named_materials_[name.text] = {add_material(std::move(desc), at(d)), at(name)};
+  named_materials_[name.text] = {wrap_shading_normals(add_material(std::move(desc), at(d)), at(d)), at(name)};
 }
 
 void SceneParser::named_material(const Token& d) {

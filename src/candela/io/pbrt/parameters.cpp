@@ -228,6 +228,11 @@ Point3 ParamList::get_point3(std::string_view name, Point3 fallback) {
   return p ? to_vec3(p->numbers, 0) : fallback;
 }
 
+Vec3 ParamList::get_vector3(std::string_view name, Vec3 fallback) {
+  const Param* p = take_single(name, "vector3", 3);
+  return p ? to_vec3(p->numbers, 0) : fallback;
+}
+
 std::vector<double> ParamList::get_floats(std::string_view name) {
   const Param* p = take(name, {"float"});
   return p ? p->numbers : std::vector<double>{};

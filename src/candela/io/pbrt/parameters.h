@@ -79,6 +79,7 @@ class ParamList {
   std::string get_string(std::string_view name, std::string fallback);
   std::vector<std::string> get_strings(std::string_view name);
   Point3 get_point3(std::string_view name, Point3 fallback);
+  Vec3 get_vector3(std::string_view name, Vec3 fallback);
   std::vector<double> get_floats(std::string_view name);
 
   // Colours are never negative; reflectances (albedos) are at most 1, as pbrt-v4 requires.

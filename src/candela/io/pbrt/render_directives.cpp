@@ -19,13 +19,24 @@ constexpr float kMaxFilterRadius = 64;  // pixels; the filter is tabulated per u
 void SceneParser::camera(const Token& d) {
   require_options(d);
   Token type = expect_string(d, "the camera type");
-  if (type.text != "perspective")
-    reject_type(at(type), "camera", type.text, {"perspective"}, {"orthographic", "realistic", "spherical"});
-  ParamList params = read_params(d, "Camera \"perspective\"");
-  float fov = params.get_float("fov", 90);
+  if (type.text != "perspective" && type.text != "orthographic")
+    reject_type(at(type), "camera", type.text, {"perspective", "orthographic"}, {"realistic", "spherical"});
+  const bool orthographic = type.text == "orthographic";
+  ParamList params = read_params(d, fmt::format("Camera \"{}\"", type.text));
+  float fov = orthographic ? 90 : params.get_float("fov", 90);
   if (!(fov > 0 && fov < 180)) params.fail("fov", "must be between 0 and 180 degrees, got {}", fov);
   float lens_radius = params.get_float("lensradius", 0);
   if (lens_radius < 0) params.fail("lensradius", "must not be negative, got {}", lens_radius);
+  if (orthographic && lens_radius > 0)
+    params.fail("lensradius", "{}: depth of field with an orthographic camera is not supported", lens_radius);
+  std::optional<std::array<float, 4>> window;
+  if (params.has("screenwindow")) {
+    const std::vector<double> w = params.get_floats("screenwindow");
+    if (w.size() != 4) params.fail("screenwindow", "needs 4 values (x0 x1 y0 y1), got {}", w.size());
+    if (!(w[0] < w[1] && w[2] < w[3]))
+      params.fail("screenwindow", "must have x0 < x1 and y0 < y1, got [{} {} {} {}]", w[0], w[1], w[2], w[3]);
+    window = std::array<float, 4>{float(w[0]), float(w[1]), float(w[2]), float(w[3])};
+  }
   float focus_distance = params.get_float("focaldistance", 1e6f);
   if (!(focus_distance > 0)) params.fail("focaldistance", "must be positive, got {}", focus_distance);
   float shutter_open = params.get_float("shutteropen", 0);
@@ -42,6 +53,8 @@ void SceneParser::camera(const Token& d) {
   // The CTM maps world space to camera space here; pbrt names the inverse "camera".
   CameraDesc& camera = scene_.camera;
   camera.world_from_camera = state_.ctm.start.inverse();
+  camera.projection = orthographic ? Projection::Orthographic : Projection::Perspective;
+  camera.screen_window = window;
   camera.fov_degrees = fov;
   camera.fov_axis = FovAxis::Smaller;
   camera.lens_radius = lens_radius;

@@ -434,6 +434,14 @@ void SceneParser::reverse_orientation(const Token& d) {
 void SceneParser::world_begin(const Token& d) {
   require_options(d);
   section_ = Section::World;
+  // pbrt-v4 frames an orthographic camera's screen by the film's aspect ratio (now known): the
+  // smaller axis spans [-1, 1].
+  CameraDesc& camera = scene_.camera;
+  if (camera.projection == Projection::Orthographic && !camera.screen_window) {
+    const float aspect = float(scene_.film.width) / float(scene_.film.height);
+    camera.screen_window = aspect > 1 ? std::array<float, 4>{-aspect, aspect, -1, 1}
+                                      : std::array<float, 4>{-1, 1, -1 / aspect, 1 / aspect};
+  }
   world_begin_ = at(d);
   state_.ctm = {};
   state_.active_transforms = kAllTransforms;

@@ -200,12 +200,23 @@ class SceneParser {
   std::optional<RGB> read_spectrum(ParamList& params, std::string_view name, pbrt_spectra::Role role);
   std::optional<float> read_ior(ParamList& params, std::string_view name);
   Roughness read_roughness(ParamList& params);
-  void ignore_shading_params(ParamList& params);
+  // A material's shading-normal parameters (every pbrt-v4 material but "mix" and "interface"):
+  // read_shading_normals reads them into shading_normals_, wrap_shading_normals wraps the material
+  // added after it.
+  struct ShadingNormals {
+    int normal_map = -1;                    // an image texture of tangent-space normals
+    std::optional<FloatInput> displacement;  // a height texture (bump mapping)
+  };
+  void read_shading_normals(ParamList& params);
+  int wrap_shading_normals(int material, const SourceLocation& where);
+  ShadingNormals shading_normals_;
   int add_texture(TextureDesc texture, const SourceLocation& where);
 
   // textures
   UVMapping read_uv_mapping(ParamList& params);
   ImageTexture make_image_texture(ParamList& params);
+  RGB read_constant_input(ParamList& params, std::string_view name, bool is_float, RGB fallback);
+  static int read_octaves(ParamList& params);
   ColorInput read_texture_input(ParamList& params, std::string_view name, bool is_float, RGB fallback);
 
   // scene objects from parameter lists

@@ -159,11 +159,6 @@ Roughness SceneParser::read_roughness(ParamList& params) {
   return roughness;
 }
 
-void SceneParser::ignore_shading_params(ParamList& params) {
-  ignore_param(params, "displacement", "displacement mapping is not supported");
-  ignore_param(params, "normalmap", "normal maps are not supported");
-}
-
 int SceneParser::add_texture(TextureDesc texture, const SourceLocation& where) {
   scene_.textures.push_back(std::move(texture));
   scene_.places.textures.push_back(where);
@@ -172,17 +167,29 @@ int SceneParser::add_texture(TextureDesc texture, const SourceLocation& where) {
 
 // ---------------------------------------------------------------- textures
 
+// pbrt-v4's 2D texture mappings: "uv" scales and offsets the surface's (u, v); the others project the
+// point in the texture's space (the CTM where the texture is declared maps it to the world) and take
+// no scale ("planar" takes offsets).
 UVMapping SceneParser::read_uv_mapping(ParamList& params) {
   std::string mapping = params.get_string("mapping", "uv");
-  if (mapping == "spherical" || mapping == "cylindrical" || mapping == "planar")
-    params.fail("mapping", "\"{}\" is not supported (only \"uv\")", mapping);
-  if (mapping != "uv")
-    params.fail("mapping", "must be \"uv\", \"spherical\", \"cylindrical\" or \"planar\", got \"{}\"", mapping);
   UVMapping uv;
-  uv.su = params.get_float("uscale", 1);
-  uv.sv = params.get_float("vscale", 1);
-  uv.du = params.get_float("udelta", 0);
-  uv.dv = params.get_float("vdelta", 0);
+  if (mapping == "uv") {
+    uv.su = params.get_float("uscale", 1);
+    uv.sv = params.get_float("vscale", 1);
+  } else if (mapping == "spherical" || mapping == "cylindrical" || mapping == "planar") {
+    uv.projection = *enum_from_name<TextureProjection>(mapping);
+    uv.to_world = state_.ctm.start;
+  } else {
+    params.fail("mapping", "must be \"uv\", \"spherical\", \"cylindrical\" or \"planar\", got \"{}\"", mapping);
+  }
+  if (mapping == "planar") {
+    uv.planar_s = params.get_vector3("v1", Vec3(1, 0, 0));
+    uv.planar_t = params.get_vector3("v2", Vec3(0, 1, 0));
+  }
+  if (mapping == "uv" || mapping == "planar") {
+    uv.du = params.get_float("udelta", 0);
+    uv.dv = params.get_float("vdelta", 0);
+  }
   return uv;
 }
 
@@ -268,6 +275,23 @@ ColorInput SceneParser::read_texture_input(ParamList& params, std::string_view n
   return color;
 }
 
+// A texture's constant colour (bilerp's corners): a spectrum texture's "rgb"/"spectrum", a float
+// texture's "float" (as grey). Not a texture: pbrt-v4 reads these as plain values.
+RGB SceneParser::read_constant_input(ParamList& params, std::string_view name, bool is_float, RGB fallback) {
+  if (is_float) return RGB(params.get_float(name, fallback.average()));
+  std::optional<ColorInput> color = read_color(params, name, Role::Unbounded);
+  if (!color) return fallback;
+  if (!color->is_constant()) params.fail(name, "must be a value, not a texture");
+  return color->value;
+}
+
+// The octaves of a noise texture: pbrt-v4 sums this many (fewer where a pixel covers the finest).
+int SceneParser::read_octaves(ParamList& params) {
+  const int octaves = params.get_int("octaves", 8);
+  if (octaves < 1 || octaves > 32) params.fail("octaves", "must be in [1, 32], got {}", octaves);
+  return octaves;
+}
+
 void SceneParser::texture(const Token& d) {
   require_world(d);
   Token name = expect_string(d, "the texture name");
@@ -290,13 +314,55 @@ void SceneParser::texture(const Token& d) {
     named.index = add_texture(make_image_texture(params), at(d));
   } else if (type.text == "checkerboard") {
     int dimension = params.get_int("dimension", 2);
-    if (dimension == 3) params.fail("dimension", "3: solid (3D) checkerboards are not supported");
-    if (dimension != 2) params.fail("dimension", "must be 2 or 3, got {}", dimension);
-    CheckerboardTexture checkerboard;
-    checkerboard.mapping = read_uv_mapping(params);
-    checkerboard.tex1 = read_texture_input(params, "tex1", is_float, RGB(1.0f));
-    checkerboard.tex2 = read_texture_input(params, "tex2", is_float, RGB(0.0f));
-    named.index = add_texture(checkerboard, at(d));
+    if (dimension != 2 && dimension != 3) params.fail("dimension", "must be 2 or 3, got {}", dimension);
+    ColorInput tex1 = read_texture_input(params, "tex1", is_float, RGB(1.0f));
+    ColorInput tex2 = read_texture_input(params, "tex2", is_float, RGB(0.0f));
+    if (dimension == 3)
+      named.index = add_texture(SolidCheckerboardTexture{tex1, tex2, state_.ctm.start}, at(d));
+    else
+      named.index = add_texture(CheckerboardTexture{tex1, tex2, read_uv_mapping(params)}, at(d));
+  } else if (type.text == "bilerp") {
+    BilerpTexture bilerp;
+    for (auto [key, corner] : {std::pair{"v00", &BilerpTexture::v00}, std::pair{"v01", &BilerpTexture::v01},
+                               std::pair{"v10", &BilerpTexture::v10}, std::pair{"v11", &BilerpTexture::v11}})
+      bilerp.*corner = read_constant_input(params, key, is_float, bilerp.*corner);
+    bilerp.mapping = read_uv_mapping(params);
+    named.index = add_texture(bilerp, at(d));
+  } else if (type.text == "dots") {
+    // pbrt-v4 hands "inside" to the dots' surroundings and "outside" to the dots (its constructor takes
+    // them in the other order than its Create passes them); its renders show that, and so does candela.
+    DotsTexture dots;
+    dots.outside = read_texture_input(params, "inside", is_float, RGB(1.0f));
+    dots.inside = read_texture_input(params, "outside", is_float, RGB(0.0f));
+    dots.mapping = read_uv_mapping(params);
+    named.index = add_texture(dots, at(d));
+  } else if (type.text == "fbm" || type.text == "wrinkled") {
+    if (!is_float) throw_scene_error(at(type), "Texture \"{}\": \"{}\" is a float texture only", name.text, type.text);
+    const int octaves = read_octaves(params);
+    const float roughness = params.get_float("roughness", 0.5f);
+    if (type.text == "fbm")
+      named.index = add_texture(FbmTexture{octaves, roughness, state_.ctm.start}, at(d));
+    else
+      named.index = add_texture(WrinkledTexture{octaves, roughness, state_.ctm.start}, at(d));
+  } else if (type.text == "marble") {
+    if (is_float) throw_scene_error(at(type), "Texture \"{}\": \"marble\" is a spectrum texture only", name.text);
+    MarbleTexture marble;
+    marble.octaves = read_octaves(params);
+    marble.roughness = params.get_float("roughness", 0.5f);
+    marble.scale = params.get_float("scale", 1);
+    marble.variation = params.get_float("variation", 0.2f);
+    marble.to_world = state_.ctm.start;
+    named.index = add_texture(marble, at(d));
+  } else if (type.text == "directionmix") {
+    DirectionMixTexture mix;
+    mix.tex1 = read_texture_input(params, "tex1", is_float, RGB(0.0f));
+    mix.tex2 = read_texture_input(params, "tex2", is_float, RGB(1.0f));
+    // Given in the texture's space, as pbrt-v4 reads it.
+    const Vec3 direction = state_.ctm.start.vector(params.get_vector3("dir", Vec3(0, 1, 0)));
+    if (!(length_squared(direction) > 0) || !is_finite(normalize(direction)))
+      params.fail("dir", "must be a non-zero direction");
+    mix.direction = normalize(direction);
+    named.index = add_texture(mix, at(d));
   } else if (type.text == "scale") {
     ScaleTexture scale;
     scale.tex = read_texture_input(params, "tex", is_float, RGB(1.0f));
@@ -318,9 +384,10 @@ void SceneParser::texture(const Token& d) {
       named.value = FloatInput(named.color.value.average());
     }
   } else {
-    reject_type(at(type), "texture", type.text, {"imagemap", "checkerboard", "scale", "mix", "constant"},
-                {"bilerp", "directionmix", "dots", "fbm", "marble", "ptex", "windy", "wrinkled"},
-                "candela has no such texture");
+    reject_type(at(type), "texture", type.text,
+                {"imagemap", "checkerboard", "scale", "mix", "constant", "bilerp", "directionmix", "dots", "fbm",
+                 "marble", "wrinkled"},
+                {"ptex", "windy"}, "candela has no such texture");
   }
   params.reject_unused();
   if (named.index >= 0) {

@@ -1,16 +1,19 @@
-// The option table (render_option_table.h) walked through every front end it generates: an option
+// The option table (description/render_options.h) walked through every front end it generates: an option
 // added to the table must appear in the command line's --help, be checked, applied, refused where the
 // integrator does not read it, and enter the fingerprint, with no other edit. (The Python module's
 // keywords are checked against the table in python/tests/test_options.py.)
-#include "candela/integrators/render_option_table.h"
+#include "candela/description/render_options.h"
 
 #include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <limits>
 #include <set>
 
 #include "candela/integrators/integrator.h"
+#include "candela/integrators/render_request.h"
 #include "candela/io/json_writer.h"
 #include "candela/io/scene_reader.h"
 #include "candela/testing/command_line.h"
@@ -207,6 +210,45 @@ TEST(RenderOptionTable, SelectiveOptionsAreRefusedByIntegratorsThatDoNotReadThem
       }
       EXPECT_TRUE(named) << option.flag() << " with " << entry.name << ": no refusal named both";
     }
+  }
+}
+
+// The scene file's "render" keys are generated from the table too: each option with a scene key is
+// written by the JSON writer and read back by the JSON reader to the same value, under its key.
+TEST(RenderOptionTable, EveryOptionWithASceneKeyRoundTripsThroughTheSceneFile) {
+  const SceneDesc scene = builtin_scene();
+  for (const RenderOption& option : render_options()) {
+    EXPECT_EQ(option.scene_key.empty(), option.extract == nullptr) << option.name;
+    if (option.scene_key.empty()) continue;
+    EXPECT_NE(option.apply, nullptr) << option.name;
+    std::vector<std::string> shown;
+    const std::vector<RenderRequest> requests = with_valid_values(option, shown);
+    int written = 0;
+    for (size_t i = 0; i < requests.size(); ++i) {
+      SceneDesc given = scene;
+      try {
+        plan_render(combined(option, enabling(option), requests[i]), given);
+      } catch (const UsageError&) {
+        continue;  // a rule across options
+      }
+      const std::string text = scene_to_json(given);
+      const SceneDesc read = read_json_scene(text, "<written>", ".");
+      RenderRequest before, after;
+      option.extract(given, before);
+      option.extract(read, after);
+      std::visit([&](auto member) { EXPECT_EQ(before.*member, after.*member) << option.scene_key << " " << shown[i]; },
+                 option.field);
+      // Written under its key where the scene gives it (an unset flag is the file's default).
+      nlohmann::json value = nlohmann::json::parse(text)["render"];
+      const std::string key(option.scene_key);
+      const size_t dot = key.find('.');
+      if (dot != std::string::npos) value = value.value(key.substr(0, dot), nlohmann::json::object());
+      if (option.given(before)) {
+        EXPECT_TRUE(value.contains(key.substr(dot + 1))) << key << " " << shown[i] << " is not written";
+        ++written;
+      }
+    }
+    EXPECT_GT(written, 0) << option.scene_key << ": no value was written";
   }
 }
 
