@@ -78,7 +78,7 @@ struct RenderOption {
   RequestField field;
   ValueRule rule;
   std::string help;  // one paragraph, for --help and docs/cli.md
-  // The selective setting (integrators/integrator.h) an integrator must read to accept the option,
+  // The selective setting (description/integrator_traits.h) an integrator must read to accept the option,
   // or empty: every integrator reads it. With `reads_when`, only that value is selective.
   std::string_view reads, reads_when;
   // Its key in the scene file's "render" object ("spp"; "adaptive.spp": the key "spp" of the object
