@@ -18,7 +18,7 @@ runs="${1:-10000000}"
 shift || true
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(checkpoint_reader json_reader pbrt_reader obj_reader mitsuba_reader vol_reader
-  ply_reader gzip serialized_reader http_request gltf_reader nanovdb_reader part_reader)
+  ply_reader gzip serialized_reader http_request gltf_reader nanovdb_reader part_reader spectrum_file)
 export LSAN_OPTIONS="suppressions=$root/fuzz/lsan_suppressions.txt${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 mkdir -p "$campaign"
 touch "$campaign/summary.tsv"

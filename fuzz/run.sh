@@ -4,7 +4,7 @@
 # Exits non-zero on the first crash, sanitizer report, timeout (>10 s for one input) or OOM.
 # Usage: fuzz/run.sh [SECONDS] [TARGET...]   TARGET is json_reader, pbrt_reader, obj_reader, ply_reader,
 # serialized_reader, mitsuba_reader, gltf_reader, vol_reader, nanovdb_reader, part_reader, checkpoint_reader,
-# http_request, gzip
+# http_request, gzip, spectrum_file
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${FUZZ_BUILD_DIR:-$root/build-fuzz}"
@@ -12,7 +12,7 @@ seconds="${1:-30}"
 shift || true
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(json_reader pbrt_reader obj_reader ply_reader serialized_reader mitsuba_reader gltf_reader
-  vol_reader nanovdb_reader part_reader checkpoint_reader http_request gzip)
+  vol_reader nanovdb_reader part_reader checkpoint_reader http_request gzip spectrum_file)
 # Leaks inside libraries candela cannot fix are suppressed by name (fuzz/lsan_suppressions.txt).
 export LSAN_OPTIONS="suppressions=$root/fuzz/lsan_suppressions.txt${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 work="$(mktemp -d)"

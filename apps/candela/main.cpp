@@ -512,6 +512,12 @@ void write_images(const RenderCommand& cmd, const CommandPlan& plan, const Scene
     film = std::move(part.film);
   } else {
     Image image = film.mean_image();
+    if (const auto& crop = plan.desc.film.crop) {
+      image.x = crop->x;
+      image.y = crop->y;
+      image.full_width = crop->full_width;
+      image.full_height = crop->full_height;
+    }
     const FloatChannels aov_channels = aov_film ? exr_channels(aov_film->images(film)) : FloatChannels{};
     for (const auto& f : plan.outputs) {
       if (aov_channels.names.empty() || !is_exr(f))

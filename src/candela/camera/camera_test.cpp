@@ -4,6 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <filesystem>
+
+#include "candela/film/image_io.h"
+#include "candela/io/pbrt_reader.h"
 #include "candela/testing/render_helpers.h"
 
 namespace candela {
@@ -23,6 +31,45 @@ TEST(Camera, PinholeRaysCoverTheFieldOfView) {
   EXPECT_NEAR(PerspectiveCamera(d, 200, 100).generate_ray({0, 0}, {}, 0).direction.y /
                   PerspectiveCamera(d, 200, 100).generate_ray({0, 0}, {}, 0).direction.z,
               1.0f, 1e-5f);
+}
+
+// A cropped film (pbrt-v4's cropwindow) sees through each pixel what the full image's pixel there
+// sees, for perspective and orthographic cameras; its EXR records where it lies.
+TEST(Camera, CroppedFilmPixelsSeeWhatTheFullImageSeesThere) {
+  for (const char* camera : {"\"perspective\" \"float fov\" 38", "\"orthographic\""}) {
+    auto read = [&](const char* crop) {
+      return read_pbrt_string(fmt::format("LookAt 0 1 5  0 0.5 0  0 1 0\nCamera {}\nFilm \"rgb\" \"integer "
+                                          "xresolution\" 128 \"integer yresolution\" 96 {}\nWorldBegin\n",
+                                          camera, crop),
+                              "crop.pbrt", ".");
+    };
+    SceneDesc full = read(""), cropped = read("\"float cropwindow\" [0.25 0.75 0.2 0.8]");
+    ASSERT_TRUE(cropped.film.crop);
+    PerspectiveCamera full_camera(full.camera, full.film.width, full.film.height);
+    PerspectiveCamera crop_camera(cropped.camera, cropped.film.width, cropped.film.height);
+    for (Vec2 p : {Vec2{0, 0}, Vec2{0.5f, 0.5f}, Vec2{63.9f, 56.9f}, Vec2{17.3f, 40.1f}}) {
+      Ray a = crop_camera.generate_ray(p, {0.5f, 0.5f}, 0);
+      Ray b = full_camera.generate_ray({p.x + 32, p.y + 20}, {0.5f, 0.5f}, 0);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(a.origin[c], b.origin[c], 1e-4f) << camera;
+        EXPECT_NEAR(a.direction[c], b.direction[c], 1e-5f) << camera;
+      }
+    }
+  }
+  Image image(4, 3);
+  image.x = 5, image.y = 6, image.full_width = 20, image.full_height = 10;
+  const auto file = std::filesystem::temp_directory_path() / fmt::format("candela_crop_{}.exr", getpid());
+  write_image(file, image, {});
+  auto in = OIIO::ImageInput::open(file.string());
+  ASSERT_TRUE(in);
+  const OIIO::ImageSpec& spec = in->spec();
+  EXPECT_EQ(spec.width, 4);
+  EXPECT_EQ(spec.x, 5);
+  EXPECT_EQ(spec.y, 6);
+  EXPECT_EQ(spec.full_width, 20);
+  EXPECT_EQ(spec.full_height, 10);
+  in->close();
+  std::filesystem::remove(file);
 }
 
 TEST(Camera, ThinLensRaysMeetOnThePlaneOfFocus) {

@@ -94,6 +94,13 @@ struct FilmDesc {
   // The AOV layers written beside the colour in an EXR output, as --aov takes them ("albedo,normal";
   // film/aov_film.h); empty = none. The command line's --aov replaces it.
   std::string aovs;
+  // Where the image lies in a larger one (pbrt-v4's cropwindow and pixelbounds): its top-left pixel is
+  // (x, y) of a full_width x full_height image, whose view the camera's screen window was narrowed
+  // from. EXR outputs record it as their data window inside that display window; --resolution drops it.
+  struct Crop {
+    int x = 0, y = 0, full_width = 0, full_height = 0;
+  };
+  std::optional<Crop> crop;
 };
 
 }  // namespace candela

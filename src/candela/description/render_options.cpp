@@ -58,7 +58,11 @@ std::vector<RenderOption> make_table() {
       {.name = "resolution", .field = &R::resolution,
        .rule = FormattedValue{[](const std::string&, const std::string& text) { parse_resolution(text); }},
        .help = "Image size WIDTHxHEIGHT (overrides the scene's camera width and height)",
-       .apply = [](Q r, SceneDesc& d) { std::tie(d.film.width, d.film.height) = parse_resolution(r.resolution); },
+       .apply =
+           [](Q r, SceneDesc& d) {
+             std::tie(d.film.width, d.film.height) = parse_resolution(r.resolution);
+             d.film.crop.reset();  // the crop's view at another size no longer lies in the full image
+           },
        .fingerprint_key = "resolution",
        .fingerprint = [](S d, Q) -> std::optional<std::string> {
          return fmt::format("{}x{}", d.film.width, d.film.height);

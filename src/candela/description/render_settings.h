@@ -50,28 +50,36 @@ struct SamplerDesc {
 
 // Pixel reconstruction filters; every sample contributes to its own pixel only, with the weight
 // f(offset) / pdf(offset) of filter importance sampling (pbrt-v4).
-enum class FilterType { Box, Tent, Gaussian, Mitchell };
+enum class FilterType { Box, Tent, Gaussian, Mitchell, LanczosSinc };
 constexpr std::string_view enum_name(FilterType v) {
   switch (v) {
     case FilterType::Box: return "box";
     case FilterType::Tent: return "tent";
     case FilterType::Gaussian: return "gaussian";
     case FilterType::Mitchell: return "mitchell";
+    case FilterType::LanczosSinc: return "sinc";
   }
   return {};
 }
 struct FilterDesc {
   FilterType type = FilterType::Box;
-  Vec2 radius{0.5f, 0.5f};    // in pixels; pbrt's defaults: box 0.5, triangle 2, gaussian 1.5, mitchell 2
+  Vec2 radius{0.5f, 0.5f};    // in pixels; pbrt's defaults: box 0.5, triangle 2, gaussian 1.5, mitchell 2, sinc 4
   float gaussian_sigma = 0.5f;
   float mitchell_b = 1.0f / 3, mitchell_c = 1.0f / 3;
+  float sinc_tau = 3;  // the Lanczos window's width: sinc(x) sinc(x / tau) (Mitsuba's lanczos: tau = lobes)
 };
+
+// The largest filter radius the readers accept, in pixels (the filter is tabulated per unit of radius).
+constexpr float kMaxFilterRadius = 64;
 
 // A filter of the given type with pbrt-v4's default parameters.
 inline FilterDesc default_filter(FilterType type) {
   FilterDesc f;
   f.type = type;
-  float r = type == FilterType::Box ? 0.5f : type == FilterType::Gaussian ? 1.5f : 2.0f;
+  float r = type == FilterType::Box        ? 0.5f
+            : type == FilterType::Gaussian   ? 1.5f
+            : type == FilterType::LanczosSinc ? 4.0f
+                                              : 2.0f;
   f.radius = {r, r};
   return f;
 }

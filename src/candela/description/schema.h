@@ -82,6 +82,7 @@ enum class FieldKind {
   NumberIfGiven,  // float, with a bool member (`flag`) that says whether it was given
   Flag,           // bool
   Roughness,      // Roughness: "roughness" or "alpha_u" + "alpha_v", "remap_roughness", "distribution"
+                  // (each after the prefix of a key "<prefix>roughness": roughness_field_at)
   Material,       // int: the index of a material this one wraps (given by name or inline)
   MaterialPair,   // two ints (the member and `second`): the materials a blend mixes, as a list of two
   Texture,        // int: the index of a texture (given by name or inline); -1 = none where not required
@@ -269,6 +270,19 @@ template <auto Member>
 constexpr Field roughness_field(std::string_view help = {}) {
   return Field{.key = "roughness", .kind = FieldKind::Roughness, .member = &schema_detail::member_at<Member>,
                .range = kNonNegative, .help = help};
+}
+// A second roughness of one type (a coated conductor's conductor): `key` is "<prefix>roughness", and
+// its other keys are the prefix followed by "alpha_u", "alpha_v", "remap_roughness", "distribution".
+template <auto Member>
+constexpr Field roughness_field_at(std::string_view key, std::string_view help = {}) {
+  Field f = roughness_field<Member>(help);
+  f.key = key;
+  return f;
+}
+// The prefix of a Roughness field's keys: "" for "roughness", "conductor_" for "conductor_roughness".
+constexpr std::string_view roughness_prefix(const Field& f) {
+  constexpr std::string_view stem = "roughness";
+  return f.key.ends_with(stem) ? f.key.substr(0, f.key.size() - stem.size()) : std::string_view{};
 }
 template <auto Member>
 constexpr Field material_ref(std::string_view key, std::string_view help = {}) {

@@ -54,19 +54,46 @@ constexpr std::string_view enum_name(SphereUv v) {
   return {};
 }
 
-// Sphere of `radius` around `center`, in object space (then to_world applies).
+// Sphere of `radius` around `center`, in object space (then to_world applies). It may be cut to a
+// partial sphere (pbrt-v4's zmin, zmax, phimax): only the points at heights z_min <= z <= z_max above
+// the centre along its z axis (each clamped to [-radius, radius]; absent: the whole height) and with
+// azimuth phi <= phi_max degrees are kept. Through the cut its inside shows. With uv = pbrt, (u, v) are
+// pbrt-v4's of the part kept: u = phi / phi_max, v = (theta - theta(z_min)) / (theta(z_max) - theta(z_min))
+// with theta(z) = acos(z / radius), which is 1 - theta / pi for the whole sphere; with uv = mitsuba
+// they stay (phi / 2 pi, theta / pi).
 struct SphereShape {
   Point3 center{0.0f};
   float radius = 1;
   SphereUv uv = SphereUv::Mitsuba;
+  float z_min = 0, z_max = 0;
+  bool z_min_given = false, z_max_given = false;
+  float phi_max = 360;  // degrees, in (0, 360]
+
+  // The heights kept, clamped to the sphere (as pbrt-v4 clamps them).
+  float z_lo() const { return z_min_given ? std::clamp(z_min, -radius, radius) : -radius; }
+  float z_hi() const { return z_max_given ? std::clamp(z_max, -radius, radius) : radius; }
+  bool partial() const { return z_lo() > -radius || z_hi() < radius || phi_max < 360; }
 };
+inline std::optional<SchemaViolation> check_sphere(const void* object) {
+  const auto& s = *static_cast<const SphereShape*>(object);
+  if (s.z_min_given && s.z_max_given && !(s.z_min < s.z_max))
+    return SchemaViolation{"z_max", fmt::format("z_max must exceed z_min; z_min is {} and z_max is {}", s.z_min, s.z_max)};
+  return std::nullopt;
+}
 template <>
 struct SchemaOf<SphereShape> {
   using T = SphereShape;
-  static constexpr Field fields[] = {point_field<&T::center>("center").required_field(),
-                                     field<&T::radius>("radius", kPositive).required_field(),
-                                     enum_field<&T::uv>("uv", "the (u, v) parameterisation: v = theta / pi or 1 - theta / pi")};
-  static constexpr TypeSchema schema{.name = "sphere", .fields = fields, .help = "a sphere"};
+  static constexpr Field fields[] = {
+      point_field<&T::center>("center").required_field(),
+      field<&T::radius>("radius", kPositive).required_field(),
+      enum_field<&T::uv>("uv", "the (u, v) parameterisation: v = theta / pi or 1 - theta / pi"),
+      number_if_given<&T::z_min, &T::z_min_given>("z_min", kAnyValue,
+                                                  "cuts off what lies below this height above the centre"),
+      number_if_given<&T::z_max, &T::z_max_given>("z_max", kAnyValue,
+                                                  "cuts off what lies above this height above the centre"),
+      field<&T::phi_max>("phi_max", ValueRange{.lo = 0, .hi = 360, .lo_open = true},
+                         "keeps the azimuths up to this many degrees")};
+  static constexpr TypeSchema schema{.name = "sphere", .fields = fields, .check = check_sphere, .help = "a sphere"};
 };
 
 // Infinite plane through `point` with normal `normal` (object space).
@@ -140,10 +167,14 @@ struct SchemaOf<DiskShape> {
 };
 
 // Open tube (no caps) of `radius` around the segment p0-p1 (Mitsuba's "cylinder"), normals pointing
-// outwards; (u, v) = (phi / 2 pi, distance along the axis / its length).
+// outwards; (u, v) = (phi / phi_max, distance along the axis / its length), with phi the azimuth
+// about the axis from the first vector of its frame (Frame(normalize(p1 - p0)).s: +x for an axis
+// along +z, as pbrt-v4's). phi_max < 360 keeps only the azimuths up to it (pbrt-v4's phimax): through
+// the cut its inside shows.
 struct CylinderShape {
   Point3 p0{0.0f}, p1{0, 0, 1};
   float radius = 1;
+  float phi_max = 360;  // degrees, in (0, 360]
 };
 inline std::optional<SchemaViolation> check_cylinder(const void* object) {
   const auto& c = *static_cast<const CylinderShape*>(object);
@@ -154,7 +185,9 @@ template <>
 struct SchemaOf<CylinderShape> {
   using T = CylinderShape;
   static constexpr Field fields[] = {point_field<&T::p0>("p0"), point_field<&T::p1>("p1"),
-                                     field<&T::radius>("radius", kPositive)};
+                                     field<&T::radius>("radius", kPositive),
+                                     field<&T::phi_max>("phi_max", ValueRange{.lo = 0, .hi = 360, .lo_open = true},
+                                                        "keeps the azimuths up to this many degrees")};
   static constexpr TypeSchema schema{.name = "cylinder", .fields = fields, .check = check_cylinder,
                                      .help = "an open tube"};
 };

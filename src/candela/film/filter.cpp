@@ -26,6 +26,7 @@ bool is_known(FilterType type) {
     case FilterType::Tent:
     case FilterType::Gaussian:
     case FilterType::Mitchell:
+    case FilterType::LanczosSinc:
       return true;
   }
   return false;
@@ -43,6 +44,8 @@ void validate(const FilterDesc& desc) {
   if (desc.type == FilterType::Mitchell && !(std::isfinite(desc.mitchell_b) && std::isfinite(desc.mitchell_c)))
     throw InternalError(
         fmt::format("mitchell filter B and C must be finite, got {} and {}", desc.mitchell_b, desc.mitchell_c));
+  if (desc.type == FilterType::LanczosSinc && !is_positive_finite(desc.sinc_tau))
+    throw InternalError(fmt::format("sinc filter tau must be positive and finite, got {}", desc.sinc_tau));
 }
 
 // The normal density with deviation sigma; in double so that g(x) - g(r) keeps its digits when sigma
@@ -71,6 +74,30 @@ float mitchell_1d(float x, float b, float c) {
   return 0;
 }
 
+// sin(pi x) / (pi x), 1 at 0.
+double sinc(double x) {
+  double px = std::numbers::pi * x;
+  return std::abs(px) < 1e-5 ? 1 - px * px / 6 : std::sin(px) / px;
+}
+
+// pbrt-v4's windowed sinc: the sinc cut off at the radius and tapered by a Lanczos window of width tau.
+float lanczos_sinc(float x, float radius, float tau) {
+  return std::abs(x) <= radius ? float(sinc(x) * sinc(x / tau)) : 0.0f;
+}
+
+// Its integral over [-radius, radius], by Simpson's rule on 256 intervals per pixel (the kernel is
+// smooth: the error is far below float precision).
+float lanczos_sinc_integral(float radius, float tau) {
+  int n = 2 * std::max(1, int(std::ceil(128 * radius)));
+  double h = 2.0 * radius / n, sum = 0;
+  for (int i = 0; i <= n; ++i) {
+    double x = -radius + i * h;
+    double weight = i == 0 || i == n ? 1 : i % 2 ? 4 : 2;
+    sum += weight * sinc(x) * sinc(x / tau);
+  }
+  return float(sum * h / 3);
+}
+
 // Inverts the CDF of the tent density (r - |x|) / r^2 on [-r, r]; the lower half of u gives x <= 0.
 float sample_tent(float u, float r) {
   if (u < 0.5f) return -r + r * std::sqrt(2 * u);
@@ -84,10 +111,11 @@ Filter::Filter(const FilterDesc& desc)
       radius_(desc.radius),
       sigma_(desc.gaussian_sigma),
       mitchell_b_(desc.mitchell_b),
-      mitchell_c_(desc.mitchell_c) {
+      mitchell_c_(desc.mitchell_c),
+      sinc_tau_(desc.sinc_tau) {
   validate(desc);
   integral_ = integral_axis(radius_.x) * integral_axis(radius_.y);
-  if (type_ == FilterType::Gaussian || type_ == FilterType::Mitchell) {
+  if (type_ != FilterType::Box && type_ != FilterType::Tent) {
     table_x_ = tabulate_axis(radius_.x);
     table_y_ = tabulate_axis(radius_.y);
   }
@@ -103,6 +131,8 @@ float Filter::evaluate_axis(float x, float radius) const {
       return std::abs(x) <= radius ? truncated_gaussian(x, radius, sigma_) : 0.0f;
     case FilterType::Mitchell:
       return mitchell_1d(2 * x / radius, mitchell_b_, mitchell_c_);
+    case FilterType::LanczosSinc:
+      return lanczos_sinc(x, radius, sinc_tau_);
   }
   return 0;  // unreachable: the constructor rejects unknown types
 }
@@ -117,6 +147,8 @@ float Filter::integral_axis(float radius) const {
       return truncated_gaussian_integral(radius, sigma_);
     case FilterType::Mitchell:
       return radius / 2;  // the unit-integral kernel on [-2, 2] stretched to [-radius, radius]
+    case FilterType::LanczosSinc:
+      return lanczos_sinc_integral(radius, sinc_tau_);
   }
   return 0;  // unreachable: the constructor rejects unknown types
 }
@@ -154,6 +186,7 @@ Filter::AxisSample Filter::sample_axis(float u, float radius, const TabulatedAxi
       return {sample_tent(u, radius), radius * radius};
     case FilterType::Gaussian:
     case FilterType::Mitchell:
+    case FilterType::LanczosSinc:
       return sample_tabulated_axis(u, radius, table);
   }
   return {0, 0};  // unreachable: the constructor rejects unknown types

@@ -14,6 +14,7 @@
 //   tent      max(0, r_x - |x|) max(0, r_y - |y|)                          (pbrt's triangle)
 //   gaussian  max(0, g(x) - g(r_x)) max(0, g(y) - g(r_y)), g the normal density of deviation sigma
 //   mitchell  M(2x / r_x) M(2y / r_y), M the Mitchell-Netravali cubic with parameters B, C on [-2, 2]
+//   sinc      s(x) s(y), s(x) = sinc(x) sinc(x / tau) for |x| <= r (pbrt's Lanczos windowed sinc)
 #include "candela/math/vec.h"
 #include "candela/sampling/distribution1d.h"
 #include "candela/description/scene_desc.h"
@@ -38,7 +39,7 @@ class Filter {
   // The integral of evaluate() over its support.
   float integral() const { return integral_; }
   // Draws an offset with density proportional to |f| (exactly for box and tent, piecewise-constant
-  // in 16 cells per pixel for gaussian and mitchell); u uniform in [0,1)^2.
+  // in 16 cells per pixel for gaussian, mitchell and sinc); u uniform in [0,1)^2.
   Sample sample(Vec2 u) const;
 
  private:
@@ -64,6 +65,7 @@ class Filter {
   Vec2 radius_;
   float sigma_;
   float mitchell_b_, mitchell_c_;
+  float sinc_tau_;
   float integral_ = 0;
   TabulatedAxis table_x_, table_y_;  // empty for the exactly sampled box and tent
 };

@@ -80,6 +80,7 @@ std::vector<FilterCase> filter_cases() {
       {"Gaussian", gaussian_desc({1.5f, 1.0f}, 0.5f)},
       {"Mitchell", mitchell_desc({2.0f, 1.5f}, 1.0f / 3, 1.0f / 3)},
       {"CatmullRom", mitchell_desc({2.0f, 2.0f}, 0.0f, 0.5f)},  // Mitchell's deepest common negative lobes
+      {"Sinc", make_desc(FilterType::LanczosSinc, {4.0f, 2.0f})},  // tau 3: several sign changes
   };
 }
 
@@ -218,6 +219,20 @@ TEST(FilterEvaluate, MitchellIsTheStretchedNetravaliCubic) {
   EXPECT_FLOAT_EQ(mitchell.integral(), 2.0f * 1.5f / 4);
 }
 
+// pbrt-v4's Lanczos windowed sinc: sinc(x) sinc(x / tau), zero at the integers and cut at the radius.
+TEST(FilterEvaluate, SincIsTheLanczosWindowedSinc) {
+  FilterDesc desc = make_desc(FilterType::LanczosSinc, {4.0f, 4.0f});
+  desc.sinc_tau = 3;
+  Filter sinc(desc);
+  auto s = [](double x) { return x == 0 ? 1.0 : std::sin(std::numbers::pi * x) / (std::numbers::pi * x); };
+  EXPECT_NEAR(sinc.evaluate({0, 0}), 1.0f, 1e-6);
+  EXPECT_NEAR(sinc.evaluate({1.0f, 0}), 0.0f, 1e-6);
+  EXPECT_NEAR(sinc.evaluate({0.5f, 0}), s(0.5) * s(0.5 / 3), 1e-6);
+  EXPECT_NEAR(sinc.evaluate({1.5f, -0.25f}), s(1.5) * s(0.5) * s(-0.25) * s(-0.25 / 3), 1e-6);
+  EXPECT_LT(sinc.evaluate({1.5f, 0}), 0.0f);  // the first negative lobe
+  EXPECT_EQ(sinc.evaluate({4.5f, 0}), 0.0f);
+}
+
 TEST(FilterSample, BoxAndTentAreSampledExactlyWithWeightTheIntegral) {
   for (FilterType type : {FilterType::Box, FilterType::Tent}) {
     Filter filter(make_desc(type, {1.5f, 0.75f}));
@@ -250,8 +265,14 @@ TEST(FilterSample, ExtremeUniformNumbersStayWithinTheRadius) {
 TEST(FilterConstruction, RejectsBadParameters) {
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   for (Vec2 radius : {Vec2{0, 1}, Vec2{1, -1}, Vec2{nan, 1}, Vec2{1, inf}})
-    for (FilterType type : {FilterType::Box, FilterType::Tent, FilterType::Gaussian, FilterType::Mitchell})
+    for (FilterType type :
+         {FilterType::Box, FilterType::Tent, FilterType::Gaussian, FilterType::Mitchell, FilterType::LanczosSinc})
       EXPECT_THROW(Filter(make_desc(type, radius)), InternalError);
+  for (float tau : {0.0f, -1.0f, nan, inf}) {
+    FilterDesc desc = make_desc(FilterType::LanczosSinc, {4, 4});
+    desc.sinc_tau = tau;
+    EXPECT_THROW(Filter{desc}, InternalError);
+  }
   for (float sigma : {0.0f, -0.5f, nan, inf}) EXPECT_THROW(Filter(gaussian_desc({1, 1}, sigma)), InternalError);
   EXPECT_THROW(Filter(mitchell_desc({2, 2}, nan, 0.5f)), InternalError);
   EXPECT_THROW(Filter(mitchell_desc({2, 2}, 0.5f, inf)), InternalError);

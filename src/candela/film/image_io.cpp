@@ -100,6 +100,12 @@ std::string write_with_oiio(const std::filesystem::path& tmp, const std::string&
     ok = write_png(*out, tmp.string(), image);
   } else {
     OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::FLOAT);
+    if (ext == ".exr" && image.full_width > 0) {  // a crop: its data window in the display window
+      spec.x = image.x;
+      spec.y = image.y;
+      spec.full_width = image.full_width;
+      spec.full_height = image.full_height;
+    }
     spec.attribute("oiio:ColorSpace", "Linear");
     spec.attribute("compression", "zip");
     for (const auto& [key, value] : metadata) spec.attribute(key, value);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -24,8 +25,21 @@ struct UserRay {
   float time;
 };
 
+// Whether the point `offset` from a partial sphere's centre (object space, on the sphere up to
+// rounding) is in the part kept: its height, moved onto the sphere, within [z_min, z_max] (tested
+// only where the cut is inside the sphere, as pbrt-v4 does) and its azimuth at most phi_max.
+bool partial_sphere_keeps(const SphereGeometry& s, const Vec3d& offset) {
+  double len = std::sqrt(dot(offset, offset));
+  double z = len > 0 ? offset.z * (double(s.radius) / len) : 0;
+  if ((s.z_min > -s.radius && z < s.z_min) || (s.z_max < s.radius && z > s.z_max)) return false;
+  double phi = std::atan2(offset.y, offset.x);
+  if (phi < 0) phi += 2 * std::numbers::pi;
+  return phi <= double(s.phi_max);
+}
+
 // Nearest root of the ray-sphere quadratic in (t_near, t_far), solved in object space (reached with
 // `inv`, the world-to-object matrix) in double precision with the cancellation-free quadratic formula.
+// A partial sphere takes the far root where the near one is cut away.
 bool intersect_sphere_in_object_space(const SphereGeometry& s, const Matrix4& inv, const UserRay& ray, double& t_hit) {
   const double t_near = ray.t_near, t_far = ray.t_far;
   Vec3d o = apply(inv, ray.o, 1);
@@ -45,6 +59,14 @@ bool intersect_sphere_in_object_space(const SphereGeometry& s, const Matrix4& in
   double q = -(b_half + std::copysign(std::sqrt(a * disc), b_half));
   double t0 = q / a, t1 = q != 0 ? c / q : t0;
   if (t0 > t1) std::swap(t0, t1);
+  if (s.partial) {
+    for (double t : {t0, t1})
+      if (t > t_near && t < t_far && partial_sphere_keeps(s, {f.x + t * d.x, f.y + t * d.y, f.z + t * d.z})) {
+        t_hit = t;
+        return true;
+      }
+    return false;
+  }
   if (t0 > t_near && t0 < t_far) { t_hit = t0; return true; }
   if (t1 > t_near && t1 < t_far) { t_hit = t1; return true; }
   return false;
@@ -61,10 +83,10 @@ bool intersect_moving_sphere(const SphereGeometry& s, const UserRay& ray, double
   return to_world && intersect_sphere_in_object_space(s, to_world->inverse_matrix(), ray, t_hit);
 }
 
-// The unit disk (z = 0, x^2 + y^2 <= 1) or open unit cylinder (x^2 + y^2 = 1, 0 <= z <= 1), in
-// object space, in double precision.
+// The unit disk (z = 0, x^2 + y^2 <= 1) or open unit cylinder (x^2 + y^2 = 1, 0 <= z <= 1, the
+// azimuths up to phi_max), in object space, in double precision.
 bool intersect_unit_quadric_d(QuadricGeometry::Kind kind, const Vec3d& o, const Vec3d& d, double t_near, double t_far,
-                              double& t_hit) {
+                              double& t_hit, float phi_max) {
   if (kind == QuadricGeometry::Kind::Disk) {
     if (d.z == 0) return false;
     double t = -o.z / d.z;
@@ -75,7 +97,8 @@ bool intersect_unit_quadric_d(QuadricGeometry::Kind kind, const Vec3d& o, const 
     return true;
   }
   // The tube: the 2D ray (o.xy + t d.xy) against the unit circle, roots in increasing order, the
-  // first in (t_near, t_far) whose height is within [0, 1]. The discriminant comes from the
+  // first in (t_near, t_far) whose height is within [0, 1] (and azimuth within [0, phi_max], so that
+  // through a cut the far side is hit). The discriminant comes from the
   // perpendicular distance to the axis, which stays accurate for distant rays (as for spheres).
   double a = d.x * d.x + d.y * d.y;
   if (!(a > 0)) return false;
@@ -91,13 +114,18 @@ bool intersect_unit_quadric_d(QuadricGeometry::Kind kind, const Vec3d& o, const 
   double q = -(b_half + std::copysign(std::sqrt(a * disc), b_half));
   double t0 = q / a, t1 = q != 0 ? c / q : t0;
   if (t0 > t1) std::swap(t0, t1);
+  const bool cut = phi_max < 2 * kPi;
   for (double t : {t0, t1}) {
     if (!(t > t_near && t < t_far)) continue;
     double z = o.z + t * d.z;
-    if (z >= 0 && z <= 1) {
-      t_hit = t;
-      return true;
+    if (!(z >= 0 && z <= 1)) continue;
+    if (cut) {
+      double phi = std::atan2(o.y + t * d.y, o.x + t * d.x);
+      if (phi < 0) phi += 2 * std::numbers::pi;
+      if (phi > double(phi_max)) continue;
     }
+    t_hit = t;
+    return true;
   }
   return false;
 }
@@ -113,7 +141,7 @@ bool intersect_quadric(const QuadricGeometry& q, const UserRay& ray, double& t_h
   }
   Vec3d o = apply(*inv, ray.o, 1);
   Vec3d d = apply(*inv, ray.d, 0);
-  return intersect_unit_quadric_d(q.kind, o, d, ray.t_near, ray.t_far, t_hit);
+  return intersect_unit_quadric_d(q.kind, o, d, ray.t_near, ray.t_far, t_hit, q.phi_max);
 }
 
 bool intersect_plane(const PlaneGeometry& pl, float extent, const UserRay& ray, double& t_hit) {
@@ -254,8 +282,8 @@ std::optional<Transform> SdfGridGeometry::index_to_world(float time) const {
 }
 
 bool intersect_unit_quadric(QuadricGeometry::Kind kind, const Point3& o, const Vec3& d, double t_near, double t_far,
-                            double& t_hit) {
-  return intersect_unit_quadric_d(kind, {o.x, o.y, o.z}, {d.x, d.y, d.z}, t_near, t_far, t_hit);
+                            double& t_hit, float phi_max) {
+  return intersect_unit_quadric_d(kind, {o.x, o.y, o.z}, {d.x, d.y, d.z}, t_near, t_far, t_hit, phi_max);
 }
 
 std::optional<Transform> interpolate_transform(const Transform& start, const Transform& end, float t) {

@@ -42,6 +42,13 @@ struct SphereGeometry {
   // A moving sphere: its transform at Embree time 1 (to_world is the one at time 0).
   std::optional<Transform> to_world_end;
   SphereUv uv = SphereUv::Mitsuba;
+  // A partial sphere (SphereShape::partial): only the points with z_min <= z <= z_max (heights above
+  // the centre, within [-radius, radius]) and azimuth phi <= phi_max (radians) are hit; rays pass
+  // through the rest to the far side. theta_z_min and theta_z_max (acos(z / radius) of the two)
+  // place pbrt-v4's v.
+  bool partial = false;
+  float z_min = 0, z_max = 0, phi_max = 2 * kPi;
+  float theta_z_min = kPi, theta_z_max = 0;
 };
 // A disk or an open cylinder: the unit shape in its own space (disk: x^2 + y^2 <= 1 in the plane
 // z = 0; cylinder: x^2 + y^2 = 1, 0 <= z <= 1) placed by any invertible affine `to_world`
@@ -51,6 +58,9 @@ struct QuadricGeometry {
   Kind kind = Kind::Disk;
   Transform to_world;
   std::optional<Transform> to_world_end;  // moving: the transform at Embree time 1
+  // Cylinders: only the azimuths atan2(y, x) in [0, phi_max] of the unit tube are hit (a partial
+  // cylinder when below 2 pi).
+  float phi_max = 2 * kPi;
 };
 // An SDF grid (sdf_grid.h) placed by `to_world` (any invertible affine map); each voxel the surface
 // passes through is one Embree primitive, intersected in double precision.
@@ -75,9 +85,9 @@ Bounds3 quadric_world_bounds(const QuadricGeometry& q, const Transform& to_world
 // Bounds of voxel `voxel` of an SDF grid under `to_world` (the grid's object-to-world transform).
 Bounds3 sdf_voxel_world_bounds(const SdfGrid& grid, uint32_t voxel, const Transform& to_world);
 // The nearest intersection of (o + t d) with the unit disk or cylinder in its own space, t in
-// (t_near, t_far); exposed for tests.
+// (t_near, t_far), the cylinder cut to the azimuths up to phi_max; exposed for tests.
 bool intersect_unit_quadric(QuadricGeometry::Kind kind, const Point3& o, const Vec3& d, double t_near, double t_far,
-                            double& t_hit);
+                            double& t_hit, float phi_max = 2 * kPi);
 
 class EmbreeScene {
  public:

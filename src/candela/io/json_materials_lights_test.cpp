@@ -302,6 +302,61 @@ TEST(JsonReader, ReadsCoatedDiffuseWithPlasticAlias) {
   EXPECT_FALSE(plain.tabulated_coat);
 }
 
+// pbrt-v4's layered materials: the coat's keys as coated_diffuse's, the slab's, and (for the coated
+// conductor) the conductor's as a conductor's, its roughness under "conductor_".
+TEST(JsonReader, ReadsLayeredMaterials) {
+  SceneDesc scene = read(with_material(R"({"type": "layered_diffuse", "reflectance": [0.2, 0.4, 0.7], "ior": 1.4,
+      "roughness": 0.1, "remap_roughness": true, "thickness": 0.05, "albedo": [0.5, 0.5, 0.1], "g": -0.3,
+      "max_depth": 20, "samples": 4},
+      "lacquered gold": {"type": "coated_conductor", "metal": "Au", "roughness": 0.05, "conductor_alpha_u": 0.3,
+      "conductor_alpha_v": 0.1, "conductor_distribution": "beckmann"},
+      "painted": {"type": "layered_conductor", "reflectance": [0.9, 0.5, 0.2], "conductor_roughness": 0.2,
+      "conductor_remap_roughness": true},
+      "default": {"type": "layered_conductor"})"));
+  const auto& diffuse = std::get<LayeredDiffuseMaterial>(scene.materials[0]);
+  EXPECT_EQ(diffuse.reflectance.value, RGB(0.2f, 0.4f, 0.7f));
+  EXPECT_FLOAT_EQ(diffuse.ior, 1.4f);
+  EXPECT_FLOAT_EQ(diffuse.roughness.u.value, 0.1f);
+  EXPECT_TRUE(diffuse.roughness.remap);
+  EXPECT_FLOAT_EQ(diffuse.layer.thickness.value, 0.05f);
+  EXPECT_EQ(diffuse.layer.albedo.value, RGB(0.5f, 0.5f, 0.1f));
+  EXPECT_FLOAT_EQ(diffuse.layer.g.value, -0.3f);
+  EXPECT_EQ(diffuse.layer.max_depth, 20);
+  EXPECT_EQ(diffuse.layer.samples, 4);
+  const auto& gold = std::get<LayeredConductorMaterial>(scene.materials[1]);
+  const SceneDesc bare = read(with_material(R"({"type": "conductor", "metal": "Au"})"));
+  const auto& au = std::get<ConductorMaterial>(bare.materials[0]);
+  EXPECT_EQ(gold.eta.value, au.eta.value);
+  EXPECT_EQ(gold.k.value, au.k.value);
+  EXPECT_FLOAT_EQ(gold.roughness.u.value, 0.05f);
+  EXPECT_FLOAT_EQ(gold.conductor_roughness.u.value, 0.3f);
+  EXPECT_FLOAT_EQ(gold.conductor_roughness.v.value, 0.1f);
+  EXPECT_EQ(gold.conductor_roughness.distribution, MicrofacetDistribution::Beckmann);
+  EXPECT_EQ(gold.roughness.distribution, MicrofacetDistribution::GGX);
+  const auto& painted = std::get<LayeredConductorMaterial>(scene.materials[2]);
+  ASSERT_TRUE(painted.reflectance);
+  EXPECT_EQ(painted.reflectance->value, RGB(0.9f, 0.5f, 0.2f));
+  EXPECT_TRUE(painted.conductor_roughness.remap);
+  EXPECT_FALSE(painted.roughness.remap);
+  const auto& defaults = std::get<LayeredConductorMaterial>(scene.materials[3]);
+  EXPECT_FLOAT_EQ(defaults.ior, 1.5f);
+  EXPECT_FLOAT_EQ(defaults.layer.thickness.value, 0.01f);
+  EXPECT_EQ(defaults.layer.albedo.value, RGB(0.0f));
+  EXPECT_EQ(defaults.layer.max_depth, 10);
+  EXPECT_EQ(defaults.layer.samples, 1);
+  EXPECT_EQ(defaults.eta.value, ConductorMaterial{}.eta.value);  // copper, as pbrt-v4's
+
+  expect_error_containing(with_material(R"({"type": "layered_diffuse", "samples": 0})"),
+                          "at /materials/m/samples: expected an integer in [1, 65535], got 0");
+  expect_error_containing(with_material(R"({"type": "layered_diffuse", "g": 1.5})"), "at /materials/m/g");
+  expect_error_containing(with_material(R"({"type": "coated_conductor", "conductor_alpha_u": 0.2})"),
+                          "missing required key \"conductor_alpha_v\"");
+  expect_error_containing(with_material(R"({"type": "coated_conductor", "metal": "Au", "reflectance": 0.5})"),
+                          "a conductor takes only one of");
+  expect_error_containing(with_material(R"({"type": "coated_conductor", "conductor_roughnes": 0.2})"),
+                          "conductor_roughness");
+}
+
 TEST(JsonReader, TabulatedCoatNeedsAConstantRoughness) {
   SceneDesc scene = read(with_material(R"({"type": "plastic", "roughness": 0.1, "tabulated_coat": true})"));
   EXPECT_TRUE(std::get<CoatedDiffuseMaterial>(scene.materials[0]).tabulated_coat);

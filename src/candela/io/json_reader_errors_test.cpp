@@ -39,7 +39,8 @@ TEST(JsonReader, UnknownKeyNamesItsJsonPointer) {
       "  {\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"radiuss\": 2}]}");
   EXPECT_EQ(message,
             "test.json:3:56: at /shapes/1/radiuss: unknown key (did you mean \"radius\"?); expected one of: type, center, radius, uv, "
-            "material, emission, transform, transform_end, name, reverse_orientation, interior, exterior");
+            "z_min, z_max, phi_max, material, emission, transform, transform_end, name, reverse_orientation, interior, "
+            "exterior");
   expect_error_containing(R"({"camera": {"fov": 40, "zoom": 2}})", "at /camera/zoom: unknown key");
   expect_error_containing(R"({"scene": {}})", "at /scene: unknown key");
   expect_error_containing(R"({"render": {"samples": 4}})", "at /render/samples: unknown key");

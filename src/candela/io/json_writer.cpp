@@ -59,17 +59,18 @@ void write_mapping(const UVMapping& m, Json& j) {
   if (m.du != 0 || m.dv != 0) j["uv_offset"] = Json::array({m.du, m.dv});
 }
 
-void write_roughness(const Roughness& r, Json& j) {
-  if (r.remap) j["remap_roughness"] = true;
+void write_roughness(const Roughness& r, Json& j, std::string_view prefix) {
+  const std::string p(prefix);
+  if (r.remap) j[p + "remap_roughness"] = true;
   if (r.u.is_constant() && r.v.is_constant() && r.u.value == r.v.value) {
-    if (r.u.value != 0) j["roughness"] = r.u.value;
+    if (r.u.value != 0) j[p + "roughness"] = r.u.value;
   } else if (r.u.texture == r.v.texture && !r.u.is_constant()) {
-    j["roughness"] = number(r.u);
+    j[p + "roughness"] = number(r.u);
   } else {
-    j["alpha_u"] = number(r.u);
-    j["alpha_v"] = number(r.v);
+    j[p + "alpha_u"] = number(r.u);
+    j[p + "alpha_v"] = number(r.v);
   }
-  if (r.distribution != MicrofacetDistribution::GGX) j["distribution"] = enum_name(r.distribution);
+  if (r.distribution != MicrofacetDistribution::GGX) j[p + "distribution"] = enum_name(r.distribution);
 }
 
 // A grid from a file is written as its file name, one made in memory (pbrt's uniformgrid, an inline
@@ -111,7 +112,7 @@ void write_fields(const TypeSchema& schema, const void* object, Json& j) {
         if (field_second<bool>(f, object)) j[f.key] = field_value<float>(f, object);
         break;
       case FieldKind::Flag: j[f.key] = field_value<bool>(f, object); break;
-      case FieldKind::Roughness: write_roughness(field_value<Roughness>(f, object), j); break;
+      case FieldKind::Roughness: write_roughness(field_value<Roughness>(f, object), j, roughness_prefix(f)); break;
       case FieldKind::Material: j[f.key] = material_name(field_value<int>(f, object)); break;
       case FieldKind::MaterialPair:
         j[f.key] = Json::array({material_name(field_value<int>(f, object)), material_name(field_second<int>(f, object))});
@@ -242,6 +243,8 @@ Json camera_json(const SceneDesc& scene, const std::vector<std::string>& media) 
   if (c.screen_window) j["screen_window"] = *c.screen_window;
   j["width"] = scene.film.width;
   j["height"] = scene.film.height;
+  if (const auto& crop = scene.film.crop)
+    j["crop"] = Json::array({crop->x, crop->y, crop->full_width, crop->full_height});
   if (c.lens_radius != 0) {
     j["lens_radius"] = c.lens_radius;
     j["focus_distance"] = c.focus_distance;
@@ -292,6 +295,7 @@ Json render_json(const SceneDesc& scene) {
   if (s.sampler.type == SamplerType::Stratified) j["sampler"]["jitter"] = s.sampler.jitter;
   j["filter"]["radius"] = Json::array({s.filter.radius.x, s.filter.radius.y});
   if (s.filter.type == FilterType::Gaussian) j["filter"]["sigma"] = s.filter.gaussian_sigma;
+  if (s.filter.type == FilterType::LanczosSinc) j["filter"]["tau"] = s.filter.sinc_tau;
   if (s.filter.type == FilterType::Mitchell) {
     j["filter"]["b"] = s.filter.mitchell_b;
     j["filter"]["c"] = s.filter.mitchell_c;

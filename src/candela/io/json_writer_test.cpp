@@ -58,6 +58,8 @@ TEST_P(ConvertRoundTrip, JsonRendersTheSameImage) {
 
 INSTANTIATE_TEST_SUITE_P(Scenes, ConvertRoundTrip,
                          ::testing::Values("scenes/cornell-box/cornell-box.pbrt", "scenes/bitterli/veach-mis/scene-v4.pbrt",
+                                           "scenes/pbrt-v4-features/shape_partial_sphere.pbrt",
+                                           "scenes/pbrt-v4-features/shape_cylinder.pbrt",
                                            "scenes/bitterli/veach-ajar/scene-v4.pbrt",
                                            "scenes/mitsuba-tests/tests/scenes/instancing/test_instancing_path.xml",
                                            "scenes/mitsuba-tests/tests/scenes/bsdf_spheres/test_constant_path.xml",
@@ -65,7 +67,10 @@ INSTANTIATE_TEST_SUITE_P(Scenes, ConvertRoundTrip,
                                            "scenes/mitsuba-tests/tests/scenes/spot_light/test_spot_direct.xml",
                                            "scenes/mitsuba-tests/tests/scenes/various_shapes/test_various_shapes_path.xml",
                                            "meshes/gltf-sample-assets/BoxTextured/glTF/BoxTextured.gltf",
-                                           "meshes/cornell-box/CornellBox-Glossy.obj"),
+                                           "meshes/cornell-box/CornellBox-Glossy.obj",
+                                           // pbrt-v4's layered materials (materials/layered.h)
+                                           "scenes/pbrt-v4-features/mat_coateddiffuse.pbrt",
+                                           "scenes/pbrt-v4-features/mat_coatedconductor.pbrt"),
                          [](const ::testing::TestParamInfo<const char*>& info) {
                            fs::path file(info.param);
                            std::string name = file.parent_path().filename().string() + "_" + file.stem().string();
@@ -221,7 +226,7 @@ TEST(ConvertJson, MediaRoundTrip) {
 }
 
 // A camera's screen window and the projections of textures survive `candela convert`.
-TEST(ConvertJson, ScreenWindowsAndTextureProjectionsRoundTrip) {
+TEST(ConvertJson, ScreenWindowsCropsSincFiltersAndTextureProjectionsRoundTrip) {
   SceneDesc scene;
   scene.camera.projection = Projection::Orthographic;
   scene.camera.screen_window = std::array<float, 4>{-2, 2, -1.5f, 1.5f};
@@ -233,6 +238,23 @@ TEST(ConvertJson, ScreenWindowsAndTextureProjectionsRoundTrip) {
                                         .mapping = UVMapping{.projection = TextureProjection::Spherical}});
   const SceneDesc back = read_json_scene(scene_to_json(scene), "converted.json", fs::temp_directory_path());
   EXPECT_EQ(back.camera.screen_window, scene.camera.screen_window);
+  EXPECT_FALSE(back.film.crop);
+  scene.film.width = 30;
+  scene.film.height = 20;
+  scene.film.crop = FilmDesc::Crop{5, 7, 64, 48};
+  scene.settings.filter = default_filter(FilterType::LanczosSinc);
+  scene.settings.filter.sinc_tau = 2;
+  const SceneDesc cropped = read_json_scene(scene_to_json(scene), "converted.json", fs::temp_directory_path());
+  ASSERT_TRUE(cropped.film.crop);
+  EXPECT_EQ(cropped.film.crop->x, 5);
+  EXPECT_EQ(cropped.film.crop->y, 7);
+  EXPECT_EQ(cropped.film.crop->full_width, 64);
+  EXPECT_EQ(cropped.film.crop->full_height, 48);
+  EXPECT_EQ(cropped.settings.filter.type, FilterType::LanczosSinc);
+  EXPECT_FLOAT_EQ(cropped.settings.filter.sinc_tau, 2);
+  EXPECT_FLOAT_EQ(cropped.settings.filter.radius.x, 4);
+  scene.film.crop = FilmDesc::Crop{40, 7, 64, 48};  // 40 + 30 > 64
+  EXPECT_THROW(read_json_scene(scene_to_json(scene), "converted.json", fs::temp_directory_path()), SceneError);
   const UVMapping& read_planar = std::get<CheckerboardTexture>(back.textures.at(0)).mapping;
   EXPECT_EQ(read_planar.projection, TextureProjection::Planar);
   EXPECT_EQ(read_planar.planar_s, Vec3(4, 0, 0));

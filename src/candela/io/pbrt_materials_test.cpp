@@ -117,28 +117,89 @@ TEST(PbrtReader, DielectricMaterials) {
   EXPECT_FLOAT_EQ(sheet.ior, 1.33f);
 }
 
-TEST(PbrtReader, CoatedDiffuseIsTheClosedFormPlastic) {
+// pbrt-v4's "coateddiffuse" and "coatedconductor" are its layered BSDFs, every parameter read with
+// pbrt-v4's defaults (materials/layered.h).
+TEST(PbrtReader, CoatedDiffuseIsPbrtsLayeredBsdf) {
   Warned read = read_warned({"WorldBegin",
+                             "Texture \"t\" \"float\" \"scale\" \"float tex\" 0.5 \"float scale\" 0.2",
                              "Material \"coateddiffuse\" \"rgb reflectance\" [ 0.2 0.4 0.6 ] \"float roughness\" 0.1 "
                              "\"float eta\" 1.6 \"integer maxdepth\" 20 \"integer nsamples\" 4 "
-                             "\"rgb albedo\" [ 0 0 0 ] "
+                             "\"rgb albedo\" [ 0.3 0.2 0.1 ] \"texture thickness\" \"t\" "
                              "\"float g\" 0.3",
-                             "Material \"coateddiffuse\""});
+                             "Material \"coateddiffuse\"",
+                             "Material \"coateddiffuse\" \"float g\" -4"});
   EXPECT_TRUE(read.warnings.empty()) << joined(read.warnings);
-  const auto& coated = std::get<CoatedDiffuseMaterial>(read.scene.materials.at(0));
+  const auto& coated = std::get<LayeredDiffuseMaterial>(read.scene.materials.at(0));
   EXPECT_EQ(coated.reflectance.value, RGB(0.2f, 0.4f, 0.6f));
   EXPECT_FLOAT_EQ(coated.ior, 1.6f);
   EXPECT_FLOAT_EQ(coated.roughness.u.value, 0.1f);
   EXPECT_TRUE(coated.roughness.remap);
-  EXPECT_EQ(coated.specular.value, RGB(1.0f));
-  const auto& defaults = std::get<CoatedDiffuseMaterial>(read.scene.materials.at(1));
+  EXPECT_EQ(coated.layer.albedo.value, RGB(0.3f, 0.2f, 0.1f));
+  EXPECT_FALSE(coated.layer.thickness.is_constant());
+  EXPECT_FLOAT_EQ(coated.layer.g.value, 0.3f);
+  EXPECT_EQ(coated.layer.max_depth, 20);
+  EXPECT_EQ(coated.layer.samples, 4);
+  const auto& defaults = std::get<LayeredDiffuseMaterial>(read.scene.materials.at(1));
   EXPECT_EQ(defaults.reflectance.value, RGB(0.5f));
   EXPECT_FLOAT_EQ(defaults.ior, 1.5f);
   EXPECT_FLOAT_EQ(defaults.roughness.u.value, 0);
-  expect_warning({"WorldBegin", "Material \"coateddiffuse\" \"rgb albedo\" [ 0.5 0.5 0.5 ]"}, 2, "\"rgb albedo\"",
-                 "\"albedo\" is ignored: candela's coated diffuse has no scattering medium");
-  expect_warning({"WorldBegin", "Material \"coateddiffuse\" \"float thickness\" 0.1"}, 2, "\"float thickness\"",
-                 "\"thickness\" is ignored");
+  EXPECT_FLOAT_EQ(defaults.layer.thickness.value, 0.01f);
+  EXPECT_EQ(defaults.layer.albedo.value, RGB(0.0f));
+  EXPECT_FLOAT_EQ(defaults.layer.g.value, 0);
+  EXPECT_EQ(defaults.layer.max_depth, 10);
+  EXPECT_EQ(defaults.layer.samples, 1);
+  EXPECT_FLOAT_EQ(std::get<LayeredDiffuseMaterial>(read.scene.materials.at(2)).layer.g.value, -1);  // clamped
+  expect_error({"WorldBegin", "Material \"coateddiffuse\" \"integer maxdepth\" 0"}, 2, "\"integer maxdepth\"",
+               "must be in [1, 65535], got 0");
+  expect_error({"WorldBegin", "Material \"coateddiffuse\" \"float thickness\" -1"}, 2, "\"float thickness\"",
+               "must not be negative");
+}
+
+TEST(PbrtReader, CoatedConductorIsPbrtsLayeredBsdf) {
+  Warned read = read_warned(
+      {"WorldBegin",
+       "Material \"coatedconductor\" \"spectrum conductor.eta\" \"metal-Au-eta\" \"spectrum conductor.k\" \"metal-Au-k\" "
+       "\"float interface.roughness\" 0.05 \"float conductor.uroughness\" 0.2 \"float conductor.vroughness\" 0.1 "
+       "\"float interface.eta\" 1.4 \"float thickness\" 0.1 \"rgb albedo\" [ 0.5 0.5 0.5 ] \"float g\" 0.2 "
+       "\"integer maxdepth\" 5 \"integer nsamples\" 2 \"bool remaproughness\" false",
+       "Material \"coatedconductor\"",
+       "Material \"coatedconductor\" \"rgb reflectance\" [ 0.9 0.6 0.3 ]"});
+  EXPECT_TRUE(read.warnings.empty()) << joined(read.warnings);
+  const auto& gold = std::get<LayeredConductorMaterial>(read.scene.materials.at(0));
+  const SceneDesc bare = read_lines(
+      {"WorldBegin", "Material \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\""});
+  const auto& bare_gold = std::get<ConductorMaterial>(bare.materials.at(0));
+  EXPECT_EQ(gold.eta.value, bare_gold.eta.value);
+  EXPECT_EQ(gold.k.value, bare_gold.k.value);
+  EXPECT_FALSE(gold.reflectance);
+  EXPECT_FLOAT_EQ(gold.ior, 1.4f);
+  EXPECT_FLOAT_EQ(gold.roughness.u.value, 0.05f);
+  EXPECT_FLOAT_EQ(gold.roughness.v.value, 0.05f);
+  EXPECT_FALSE(gold.roughness.remap);
+  EXPECT_FLOAT_EQ(gold.conductor_roughness.u.value, 0.2f);
+  EXPECT_FLOAT_EQ(gold.conductor_roughness.v.value, 0.1f);
+  EXPECT_FALSE(gold.conductor_roughness.remap);
+  EXPECT_FLOAT_EQ(gold.layer.thickness.value, 0.1f);
+  EXPECT_EQ(gold.layer.albedo.value, RGB(0.5f));
+  EXPECT_FLOAT_EQ(gold.layer.g.value, 0.2f);
+  EXPECT_EQ(gold.layer.max_depth, 5);
+  EXPECT_EQ(gold.layer.samples, 2);
+  const auto& copper = std::get<LayeredConductorMaterial>(read.scene.materials.at(1));
+  EXPECT_EQ(copper.eta.value, ConductorMaterial{}.eta.value);
+  EXPECT_EQ(copper.k.value, ConductorMaterial{}.k.value);
+  EXPECT_FLOAT_EQ(copper.ior, 1.5f);
+  EXPECT_FLOAT_EQ(copper.roughness.u.value, 0);
+  EXPECT_FLOAT_EQ(copper.conductor_roughness.u.value, 0);
+  EXPECT_TRUE(copper.roughness.remap);
+  EXPECT_TRUE(copper.conductor_roughness.remap);
+  EXPECT_FLOAT_EQ(copper.layer.thickness.value, 0.01f);
+  const auto& artist = std::get<LayeredConductorMaterial>(read.scene.materials.at(2));
+  ASSERT_TRUE(artist.reflectance);
+  EXPECT_EQ(artist.reflectance->value, RGB(0.9f, 0.6f, 0.3f));
+  expect_error({"WorldBegin", "Material \"coatedconductor\" \"rgb reflectance\" [ 0.5 0.5 0.5 ] \"rgb conductor.k\" [ 1 1 1 ]"},
+               2, "\"rgb reflectance\"", "cannot be given together with \"conductor.k\"");
+  expect_error({"WorldBegin", "Material \"coatedconductor\" \"float roughness\" 0.1"}, 2, "\"float roughness\"",
+               "unused parameter");
 }
 
 TEST(PbrtReader, DiffuseTransmissionInterfaceAndDisplacement) {

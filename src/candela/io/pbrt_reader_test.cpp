@@ -200,13 +200,18 @@ TEST(PbrtReader, ReadsTheFourPixelFiltersWithPbrtDefaults) {
   EXPECT_FLOAT_EQ(catmull_rom.mitchell_b, 0);
   EXPECT_FLOAT_EQ(catmull_rom.mitchell_c, 0.5f);
   expect_radius(filter_of("PixelFilter \"box\" \"float xradius\" 1"), 1, 0.5f);
+  FilterDesc sinc = filter_of("PixelFilter \"sinc\" \"float tau\" 2");
+  EXPECT_EQ(sinc.type, FilterType::LanczosSinc);
+  expect_radius(sinc, 4, 4);  // pbrt-v4's default
+  EXPECT_FLOAT_EQ(sinc.sinc_tau, 2);
+  EXPECT_FLOAT_EQ(filter_of("PixelFilter \"sinc\"").sinc_tau, 3);
 }
 
 TEST(PbrtReader, BadPixelFilters) {
-  expect_error({"PixelFilter \"sinc\"", "WorldBegin"}, 1, "\"sinc\"",
-               "pixel filter type \"sinc\" is not supported yet (supported: \"box\", \"triangle\", \"gaussian\", "
-               "\"mitchell\")");
-  expect_error({"PixelFilter \"tent\"", "WorldBegin"}, 1, "\"tent\"", "unknown pixel filter type \"tent\"");
+  expect_error({"PixelFilter \"tent\"", "WorldBegin"}, 1, "\"tent\"",
+               "unknown pixel filter type \"tent\" (supported: \"box\", \"triangle\", \"gaussian\", \"mitchell\", "
+               "\"sinc\")");
+  expect_error({"PixelFilter \"sinc\" \"float tau\" 0", "WorldBegin"}, 1, "\"float tau\"", "\"tau\" must be positive");
   expect_error({"PixelFilter \"box\" \"float xradius\" 0", "WorldBegin"}, 1, "\"float xradius\"",
                "\"xradius\" must be in (0, 64] pixels, got 0");
   expect_error({"PixelFilter \"triangle\" \"float yradius\" 1000", "WorldBegin"}, 1, "\"float yradius\"",
@@ -272,6 +277,44 @@ TEST(PbrtReader, OrthographicCamerasAndScreenWindows) {
   expect_error({"Camera \"orthographic\" \"float lensradius\" 0.1", "WorldBegin"}, 1, "\"float lensradius\"",
                "depth of field with an orthographic camera is not supported");
   expect_error({"Camera \"orthographic\" \"float fov\" 30", "WorldBegin"}, 1, "\"float fov\"", "unused");
+}
+
+// pbrt-v4's cropwindow and pixelbounds: the film is that part of the image, the screen window narrowed
+// to it, so that its pixels see what the full image's pixels there see.
+TEST(PbrtReader, CropWindowsAndPixelBoundsNarrowTheFilm) {
+  SceneDesc crop = read_lines({"Camera \"perspective\" \"float fov\" 38",
+                               "Film \"rgb\" \"integer xresolution\" 128 \"integer yresolution\" 96 "
+                               "\"float cropwindow\" [0.25 0.75 0.2 0.8]", "WorldBegin"});
+  EXPECT_EQ(crop.film.width, 64);  // x: ceil(32) to ceil(96)
+  EXPECT_EQ(crop.film.height, 57);  // y: ceil(19.2) = 20 to ceil(76.8) = 77
+  ASSERT_TRUE(crop.film.crop);
+  EXPECT_EQ(crop.film.crop->x, 32);
+  EXPECT_EQ(crop.film.crop->y, 20);
+  EXPECT_EQ(crop.film.crop->full_width, 128);
+  EXPECT_EQ(crop.film.crop->full_height, 96);
+  // The full window is [-4/3, 4/3] x [-1, 1]; rows go down while screen y goes up.
+  ASSERT_TRUE(crop.camera.screen_window);
+  const auto [x0, x1, y0, y1] = *crop.camera.screen_window;
+  EXPECT_FLOAT_EQ(x0, -4.0f / 3 + 8.0f / 3 * 32 / 128);
+  EXPECT_FLOAT_EQ(x1, -4.0f / 3 + 8.0f / 3 * 96 / 128);
+  EXPECT_FLOAT_EQ(y0, 1 - 2.0f * 77 / 96);
+  EXPECT_FLOAT_EQ(y1, 1 - 2.0f * 20 / 96);
+  SceneDesc bounds = read_lines({"Film \"rgb\" \"integer xresolution\" 128 \"integer yresolution\" 96 "
+                                 "\"integer pixelbounds\" [10 90 20 70]", "WorldBegin"});
+  EXPECT_EQ(bounds.film.width, 80);
+  EXPECT_EQ(bounds.film.height, 50);
+  EXPECT_EQ(bounds.film.crop->x, 10);
+  EXPECT_EQ(bounds.film.crop->y, 20);
+  SceneDesc whole = read_lines({"Film \"rgb\" \"integer xresolution\" 64 \"integer yresolution\" 32 "
+                                "\"float cropwindow\" [0 1 0 1]", "WorldBegin"});
+  EXPECT_FALSE(whole.film.crop);
+  EXPECT_FALSE(whole.camera.screen_window);
+  expect_error({"Film \"rgb\" \"integer xresolution\" 64 \"integer yresolution\" 32 \"integer pixelbounds\" "
+                "[10 90 0 10]", "WorldBegin"}, 1, "\"integer pixelbounds\"", "is not a non-empty part of the 64 x 32 image");
+  expect_error({"Film \"rgb\" \"float cropwindow\" [0.5 0.5 0 1]", "WorldBegin"}, 1, "\"float cropwindow\"",
+               "holds no pixel");
+  expect_error({"Film \"rgb\" \"float cropwindow\" [0 1 0]", "WorldBegin"}, 1, "\"float cropwindow\"",
+               "takes 4 values");
 }
 
 TEST(PbrtReader, BadLensAndShutter) {

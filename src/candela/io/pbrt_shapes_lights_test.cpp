@@ -278,6 +278,57 @@ TEST(PbrtReader, BilinearPatchPowerIsPerPatch) {
   EXPECT_NEAR(scene.shapes[1].emission->radiance.r, 1 / (pi * 3), 1e-5f);
 }
 
+// pbrt-v4's Loop subdivision surfaces (geometry/loop_subdivision.h): 3 levels unless "levels" says
+// otherwise, points on the limit surface with its normals, which face away from the winding as
+// pbrt-v4's do.
+TEST(PbrtReader, LoopSubdivisionSurfaces) {
+  const std::string octahedron =
+      "\"point3 P\" [ 0 1 0  1 0 0  0 0 1  -1 0 0  0 0 -1  0 -1 0 ] "
+      "\"integer indices\" [ 0 2 1  0 3 2  0 4 3  0 1 4  5 1 2  5 2 3  5 3 4  5 4 1 ]";
+  SceneDesc scene =
+      read_lines({"WorldBegin", "Shape \"loopsubdiv\" " + octahedron,
+                  "Shape \"loopsubdiv\" \"integer levels\" 0 \"string scheme\" \"loop\" " + octahedron});
+  ASSERT_EQ(scene.shapes.size(), 2u);
+  const TriangleMesh& smooth = mesh_of(scene.shapes[0]);
+  EXPECT_EQ(smooth.triangle_count(), 8u * 64);
+  ASSERT_EQ(smooth.normals.size(), smooth.positions.size());
+  EXPECT_TRUE(smooth.uvs.empty());
+  float top = 0;
+  for (size_t i = 0; i < smooth.positions.size(); ++i) {
+    top = std::max(top, smooth.positions[i].y);
+    EXPECT_LT(dot(smooth.normals[i], smooth.positions[i]), 0) << i;  // inwards: against the winding
+  }
+  // pbrt-v4's limit point of a valence-4 vertex: half of it and an eighth of each of its neighbours.
+  EXPECT_NEAR(top, 0.5f, 1e-6f);
+  const TriangleMesh& coarse = mesh_of(scene.shapes[1]);
+  EXPECT_EQ(coarse.triangle_count(), 8u);
+  for (const Point3& p : coarse.positions) EXPECT_NEAR(std::abs(p.x) + std::abs(p.y) + std::abs(p.z), 0.5f, 1e-6f);
+
+  // One triangle with `parameters` added.
+  auto triangle = [](const std::string& parameters) {
+    return std::vector<std::string>{"WorldBegin",
+                                    "Shape \"loopsubdiv\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0 ] " + parameters};
+  };
+  expect_error(triangle(""), 2, "Shape",
+               "\"indices\" is required: give the control mesh's triangles as \"integer indices\"");
+  expect_error({"WorldBegin", "Shape \"loopsubdiv\" \"integer indices\" [ 0 1 2 ]"}, 2, "Shape",
+               "\"P\" is required");
+  expect_error(triangle("\"integer indices\" [ 0 1 2 0 ]"), 2, "\"integer indices\"",
+               "has 4 values, which is not a multiple of 3");
+  expect_error(triangle("\"integer indices\" [ 0 1 3 ]"), 2, "\"integer indices\"",
+               "value 3 (number 3) is out of range: \"P\" has 3 points");
+  expect_error(triangle("\"integer indices\" [ 0 1 1 ]"), 2, "\"integer indices\"",
+               "do not make a mesh that can be subdivided: triangle 1 (0 1 1) names a point twice");
+  expect_error(triangle("\"integer indices\" [ 0 1 2 ] \"integer levels\" -1"), 2, "\"integer levels\"",
+               "must be at least 0, got -1");
+  expect_error(triangle("\"integer indices\" [ 0 1 2 ] \"integer levels\" 20"), 2, "\"integer levels\"",
+               "20 would make 1099511627776 triangles of the 1 given, more than the 4194304");
+  expect_error(triangle("\"integer indices\" [ 0 1 2 ] \"normal N\" [ 0 0 1 ]"), 2, "\"normal N\"",
+               "unused parameter");
+  expect_warning(triangle("\"integer indices\" [ 0 1 2 ] \"string scheme\" \"catmull-clark\""), 2,
+                 "\"string scheme\"", "\"scheme\" \"catmull-clark\" is ignored: pbrt-v4 subdivides with Loop's");
+}
+
 TEST(PbrtReader, AlphaAndOtherShapeParameters) {
   SceneDesc scene = read_lines({"WorldBegin", "Shape \"sphere\" \"float alpha\" 1"});
   EXPECT_EQ(scene.shapes.size(), 1u);
@@ -492,6 +543,93 @@ TEST(PbrtReader, SphereUvIsPbrts) {
   EXPECT_NEAR(side.uv.y, 0.5f, 1e-3f);
   EXPECT_GT(side.dpdv.z, 0);
   EXPECT_LT(side.dpdu.x, 0);  // dp/du = 2 pi (-y, x, 0)
+}
+
+// A partial sphere and a cylinder (zmin, zmax, phimax) are analytic shapes with pbrt-v4's (u, v) of
+// the part kept: u = phi / phimax; the sphere's v = (theta - theta(zmin)) / (theta(zmax) - theta(zmin)),
+// the cylinder's v = (z - zmin) / (zmax - zmin). Through the cuts their insides show.
+TEST(PbrtReader, PartialSpheresAndCylinders) {
+  SceneDesc desc = read_lines({"WorldBegin", "Translate 0 0 5",
+                               "Shape \"sphere\" \"float radius\" 2 \"float zmin\" -1 \"float zmax\" 1.5 \"float phimax\" 270",
+                               "Translate 10 0 0",
+                               "Shape \"cylinder\" \"float radius\" 0.5 \"float zmin\" -1 \"float zmax\" 2 \"float phimax\" 180",
+                               "Shape \"sphere\" \"float zmin\" -3 \"float zmax\" 1 \"float phimax\" 360",
+                               "Shape \"cylinder\""});
+  ASSERT_EQ(desc.shapes.size(), 4u);
+  const auto& sphere = std::get<SphereShape>(desc.shapes[0].geometry);
+  EXPECT_EQ(sphere.uv, SphereUv::Pbrt);
+  EXPECT_EQ(sphere.radius, 2);
+  EXPECT_TRUE(sphere.z_min_given && sphere.z_max_given);
+  EXPECT_EQ(sphere.z_min, -1);
+  EXPECT_EQ(sphere.z_max, 1.5f);
+  EXPECT_EQ(sphere.phi_max, 270);
+  const auto& cylinder = std::get<CylinderShape>(desc.shapes[1].geometry);
+  EXPECT_EQ(cylinder.p0, Point3(0, 0, -1));
+  EXPECT_EQ(cylinder.p1, Point3(0, 0, 2));
+  EXPECT_EQ(cylinder.radius, 0.5f);
+  EXPECT_EQ(cylinder.phi_max, 180);
+  // Values that cut nothing off leave the whole sphere; the cylinder's defaults are pbrt-v4's.
+  const auto& whole = std::get<SphereShape>(desc.shapes[2].geometry);
+  EXPECT_FALSE(whole.partial());
+  EXPECT_FALSE(whole.z_min_given || whole.z_max_given);
+  const auto& unit = std::get<CylinderShape>(desc.shapes[3].geometry);
+  EXPECT_EQ(unit.p0, Point3(0, 0, -1));
+  EXPECT_EQ(unit.p1, Point3(0, 0, 1));
+  EXPECT_EQ(unit.radius, 1);
+  EXPECT_EQ(unit.phi_max, 360);
+
+  desc.shapes.resize(2);
+  Scene scene(desc);
+  auto hit_from = [&](Vec3 from, Vec3 towards) {
+    SurfaceHit hit;
+    EXPECT_TRUE(scene.intersect(Ray{from, normalize(towards - from), std::numeric_limits<float>::infinity(), 0}, hit))
+        << from.x << " " << from.y << " " << from.z;
+    return hit;
+  };
+  // The sphere at phi = 90 degrees on its equator: u = 90 / 270, v = (pi/2 - acos(-1/2)) / (acos(3/4) - acos(-1/2)).
+  const float v_equator = (kPi / 2 - std::acos(-0.5f)) / (std::acos(0.75f) - std::acos(-0.5f));
+  SurfaceHit side = hit_from({0, 20, 5}, {0, 0, 5});
+  EXPECT_NEAR(side.uv.x, 1.0f / 3, 1e-4f);
+  EXPECT_NEAR(side.uv.y, v_equator, 1e-4f);
+  EXPECT_GT(side.ng.y, 0.999f);
+  EXPECT_LT(side.dpdu.x, 0);  // dp/du = phimax (-y, x, 0)
+  EXPECT_GT(side.dpdv.z, 0);  // v grows with z
+  // From phi = 315 degrees (cut away) through the centre: the inside of phi = 135 degrees.
+  SurfaceHit inside = hit_from({20, -20, 5}, {0, 0, 5});
+  EXPECT_NEAR(inside.p.x, -std::sqrt(2.0f), 1e-4f);
+  EXPECT_NEAR(inside.uv.x, 0.5f, 1e-4f);
+  EXPECT_NEAR(inside.uv.y, v_equator, 1e-4f);
+  EXPECT_GT(dot(inside.ng, normalize(Vec3(-1, 1, 0))), 0.999f) << "the normal points outwards, away from the ray";
+  // Down its axis, through the caps cut off above 1.5 and below -1: nothing.
+  SurfaceHit hit;
+  EXPECT_FALSE(scene.intersect(Ray{{0, 0, 20}, {0, 0, -1}, std::numeric_limits<float>::infinity(), 0}, hit));
+  // The half cylinder (phi <= 180: y >= 0) at x = 10, z = 5 + 0.5: from +y, u = 1/2, v = 1/2; from
+  // -y through the cut, the inside of the same point.
+  for (float from_y : {20.0f, -20.0f}) {
+    SurfaceHit c = hit_from({10, from_y, 5.5f}, {10, 0, 5.5f});
+    EXPECT_NEAR(c.p.y, 0.5f, 1e-4f) << from_y;
+    EXPECT_NEAR(c.uv.x, 0.5f, 1e-4f) << from_y;
+    EXPECT_NEAR(c.uv.y, 0.5f, 1e-4f) << from_y;
+    EXPECT_GT(c.ng.y, 0.999f) << from_y;
+    EXPECT_NEAR(c.dpdu.x, -kPi * 0.5f, 1e-4f) << from_y;  // dp/du = phimax (-y, x, 0)
+    EXPECT_NEAR(c.dpdv.z, 3, 1e-4f) << from_y;             // dp/dv = (0, 0, zmax - zmin)
+  }
+}
+
+// pbrt-v4's "power" spreads over a partial sphere's and a cylinder's area, phimax r (zmax - zmin).
+TEST(PbrtReader, PartialShapeAreaLightPower) {
+  const float pi = std::numbers::pi_v<float>;
+  SceneDesc scene = read_lines(
+      {"WorldBegin", "AreaLightSource \"diffuse\" \"float power\" 10",
+       "Shape \"sphere\" \"float radius\" 2 \"float zmin\" -1 \"float zmax\" 1.5 \"float phimax\" 270",
+       "Shape \"cylinder\" \"float radius\" 0.5 \"float zmin\" -1 \"float zmax\" 2 \"float phimax\" 180"});
+  ASSERT_EQ(scene.shapes.size(), 2u);
+  EXPECT_NEAR(scene.shapes[0].emission->radiance.r, 10 / (pi * (1.5f * pi * 2 * 2.5f)), 1e-5f);
+  EXPECT_NEAR(scene.shapes[1].emission->radiance.r, 10 / (pi * (pi * 0.5f * 3)), 1e-5f);
+  Scene built(scene);
+  ASSERT_EQ(built.lights().size(), 2u);
+  EXPECT_NEAR(light_power(built.lights()[0]), 10, 1e-3f);  // the luminance of a grey radiance is its value
+  EXPECT_NEAR(light_power(built.lights()[1]), 10, 1e-3f);
 }
 
 }  // namespace

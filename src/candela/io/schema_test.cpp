@@ -32,7 +32,8 @@ void set_probe(const Field& f, void* object) {
     case FieldKind::Float: field_value<FloatInput>(f, object) = number; break;
     case FieldKind::Number: field_value<float>(f, object) = number; break;
     case FieldKind::NumberIfGiven:
-      field_value<float>(f, object) = number;
+      // Above z_min where a rule wants a range (a partial sphere's z_min < z_max).
+      field_value<float>(f, object) = f.key == "z_max" ? 2 * number : number;
       field_second<bool>(f, object) = true;
       break;
     case FieldKind::Flag: field_value<bool>(f, object) = !field_value<bool>(f, object); break;
@@ -289,7 +290,8 @@ TEST(ShapeSchema, NumbersAreEditableParameters) {
   const size_t first = scene.shapes.size() - every_geometry_probe().size();
   for (size_t i = first; i < scene.shapes.size(); ++i)
     for (const Field& f : schema_of(scene.shapes[i].geometry).fields)
-      EXPECT_EQ(names.count(fmt::format("shapes.{}.{}", i, f.key)), f.kind == FieldKind::Number ? 1u : 0u)
+      EXPECT_EQ(names.count(fmt::format("shapes.{}.{}", i, f.key)),
+                f.kind == FieldKind::Number || f.kind == FieldKind::NumberIfGiven ? 1u : 0u)  // given in the probe
           << schema_of(scene.shapes[i].geometry).name << "." << f.key;
   const size_t sphere = first + size_t(ShapeGeometry(SphereShape{}).index());
   set_scene_parameter(scene, fmt::format("shapes.{}.radius", sphere), 2.5f);

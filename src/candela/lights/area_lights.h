@@ -1,6 +1,6 @@
 #pragma once
 // Diffuse area lights on shapes: one TriangleLight per emissive triangle (meshes and boxes become
-// triangles), RectangleLight, SphereLight, DiskLight and CylinderLight for those shapes. Radiance is constant over the
+// triangles), RectangleLight, SphereLight, PartialSphereLight, DiskLight and CylinderLight for those shapes. Radiance is constant over the
 // surface (or a texture at the point's (u, v) times it) and emitted on the side of `n` (both sides if two_sided).
 #include "candela/geometry/quadric_uv.h"
 #include "candela/lights/light_sample.h"
@@ -228,6 +228,86 @@ struct SphereLight {
   }
 };
 
+// A partial sphere (description/shapes.h: SphereShape::partial): the points center + radius (sin theta
+// (cos phi axis_x + sin phi axis_y) + cos theta axis_z) with z = radius cos theta in [z_min, z_max] and
+// phi in [0, phi_max], axis_x, axis_y, axis_z orthonormal (emissive spheres are only moved, turned,
+// mirrored and scaled uniformly). Sampled uniformly by area: z uniform in [z_min, z_max] (Archimedes:
+// a sphere's zones of equal height have equal area) and phi uniform in [0, phi_max]; area =
+// phi_max radius (z_max - z_min). Whole spheres are SphereLights, which sample the cone they subtend.
+struct PartialSphereLight {
+  static constexpr LightFlags flags = LightFlags::Area;
+  Point3 center;
+  Vec3 axis_x, axis_y, axis_z;  // unit: the world directions of the sphere's own axes
+  float radius;
+  float z_min, z_max;  // heights above the centre along axis_z, within [-radius, radius]
+  float phi_max;       // radians
+  float area;
+  RGB radiance;
+  bool two_sided;
+  bool emits_inward;  // reverse orientation: the emitting side faces the centre
+  // Textured emitters: the texture, and the (u, v) the hits have (pbrt-v4's of the part kept, or
+  // Mitsuba's (phi / 2 pi, theta / pi)).
+  EmissionTexture emission_texture;
+  bool pbrt_uv = false;
+  float theta_z_min = kPi, theta_z_max = 0;
+
+  Normal3 emitting_normal(const Point3& p) const {
+    Normal3 out = normalize(p - center);
+    return emits_inward ? -out : out;
+  }
+  // A uniform point, its emitting normal and the radiance it emits.
+  Point3 point(Vec2 u, Normal3& n, RGB& emitted) const {
+    float z = std::lerp(z_min, z_max, u.x);
+    float rho = safe_sqrt(radius * radius - z * z);
+    float phi = phi_max * u.y, c = std::cos(phi), s = std::sin(phi);
+    Vec3 offset = axis_x * (rho * c) + axis_y * (rho * s) + axis_z * z;
+    Point3 p = center + offset;
+    n = normalize(offset);
+    if (emits_inward) n = -n;
+    if (emission_texture.texture < 0) {
+      emitted = radiance;
+    } else {
+      Vec3 local(rho * c, rho * s, z);
+      Vec2 uv = pbrt_uv ? partial_sphere_uv(local, phi_max, theta_z_min, theta_z_max) : sphere_uv(local);
+      emitted = emission_texture(radiance, uv, p);
+    }
+    return p;
+  }
+  LightSample sample_li(const LightSampleContext& ctx, Vec2 u) const {
+    Normal3 n;
+    RGB emitted;
+    Point3 p = point(u, n, emitted);
+    return flat_light_sample(p, n, area, emitted, two_sided, ctx);
+  }
+  LightEmission sample_le(Vec2 u_pos, Vec2 u_dir, const SceneSphere&) const {
+    Normal3 n;
+    RGB emitted;
+    Point3 p = point(u_pos, n, emitted);
+    float pdf_dir;
+    Vec3 w = sample_cosine_emission(n, two_sided, u_dir, pdf_dir);
+    return {emitted, p, w, n, 1 / area, pdf_dir};
+  }
+  EmissionPdf pdf_le(const Point3& p, const Normal3&, const Vec3& w, const SceneSphere&) const {
+    return {1 / area, cosine_emission_pdf(emitting_normal(p), two_sided, w)};
+  }
+  float pdf_li(const LightSampleContext& ctx, const Vec3&, const Point3& p, const Normal3&) const {
+    return area_to_solid_angle_pdf(1 / area, ctx.p, p, emitting_normal(p));
+  }
+  float power() const { return uniform_emitter_power(radiance, area, two_sided); }
+  // Estimated irradiance at ctx: the whole sphere's estimate (SphereLight::importance) times the
+  // fraction of its area kept.
+  float importance(const LightSampleContext& ctx) const {
+    float fraction = area / (4 * kPi * radius * radius);
+    Vec3 d = center - ctx.p;
+    float d2 = length_squared(d);
+    if (d2 <= radius * radius * 1.0001f) return radiance.luminance() * kPi * fraction;
+    Vec3 w = d / std::sqrt(d2);
+    float sin2 = radius * radius / d2;
+    float cos_p = ctx.n == Normal3(0.0f) ? 1.0f : std::max(0.0f, dot(ctx.n, w));
+    return radiance.luminance() * kPi * sin2 * cos_p * fraction;
+  }
+};
+
 // A disk (an ellipse under a non-uniform to_world): center + axis_u x + axis_v y over the unit disk,
 // sampled uniformly by area (the concentric map is area-preserving up to the constant Jacobian).
 struct DiskLight {
@@ -268,9 +348,9 @@ struct DiskLight {
 };
 
 // An open circular tube: base + radius (cos(phi) axis_u + sin(phi) axis_v) + z axis, phi in
-// [0, 2 pi), z in [0, 1], with axis_u, axis_v orthonormal and axis perpendicular to both (a
-// cylinder, not an elliptic or oblique tube: only then is (phi, z) proportional to area).
-// Sampled uniformly by area as Mitsuba does (z from u.x, phi from u.y).
+// [0, phi_max) (2 pi unless cut: pbrt-v4's partial cylinders), z in [0, 1], with axis_u, axis_v
+// orthonormal and axis perpendicular to both (a cylinder, not an elliptic or oblique tube: only then
+// is (phi, z) proportional to area). Sampled uniformly by area as Mitsuba does (z from u.x, phi from u.y).
 struct CylinderLight {
   static constexpr LightFlags flags = LightFlags::Area;
   Point3 base;
@@ -282,6 +362,7 @@ struct CylinderLight {
   bool two_sided;
   bool emits_inward;  // flipped normals: the emitting side faces the axis
   EmissionTexture emission_texture;  // textured emitters
+  float phi_max = 2 * kPi;  // area = phi_max radius |axis|
 
   Normal3 emitting_normal(const Point3& p) const {
     Vec3 d = p - base;
@@ -292,11 +373,11 @@ struct CylinderLight {
   }
   // A uniform point, its emitting normal and the radiance it emits.
   Point3 point(Vec2 u, Normal3& n, RGB& emitted) const {
-    float phi = 2 * kPi * u.y, c = std::cos(phi), s = std::sin(phi);
+    float phi = phi_max * u.y, c = std::cos(phi), s = std::sin(phi);
     Vec3 radial = axis_u * c + axis_v * s;
     n = emits_inward ? -radial : radial;
     Point3 p = base + radial * radius + axis * u.x;
-    emitted = emission_texture.texture < 0 ? radiance : emission_texture(radiance, cylinder_uv(c, s, u.x), p);
+    emitted = emission_texture.texture < 0 ? radiance : emission_texture(radiance, cylinder_uv(c, s, u.x, phi_max), p);
     return p;
   }
   LightSample sample_li(const LightSampleContext& ctx, Vec2 u) const {

@@ -28,7 +28,7 @@ namespace candela {
 
 using Light = std::variant<PointLightSource, TriangleLight, RectangleLight, SphereLight, SkyLightSource,
                            SpotLightSource, DistantLightSource, EnvironmentLight, DiskLight, CylinderLight,
-                           ProjectorLightSource>;
+                           ProjectorLightSource, PartialSphereLight>;
 
 inline LightSample light_sample_li(const Light& l, const LightSampleContext& ctx, Vec2 u) {
   return std::visit([&](const auto& x) { return x.sample_li(ctx, u); }, l);

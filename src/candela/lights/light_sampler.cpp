@@ -99,6 +99,12 @@ std::optional<LightBounds> light_bounds(const Light& light) {
             b.extend(l.center + Vec3(l.radius));
             return omnidirectional(b, l.radiance.luminance() * kPi * l.radius * l.radius);
           },
+          [](const PartialSphereLight& l) -> std::optional<LightBounds> {
+            // Seen from anywhere, at most the whole sphere's disk, and at most its own area.
+            Bounds3 b = point_bounds(l.center - Vec3(l.radius));
+            b.extend(l.center + Vec3(l.radius));
+            return omnidirectional(b, l.radiance.luminance() * std::min(kPi * l.radius * l.radius, l.area));
+          },
           [](const CylinderLight& l) -> std::optional<LightBounds> {
             Bounds3 b = point_bounds(l.base - Vec3(l.radius));
             b.extend(l.base + Vec3(l.radius));

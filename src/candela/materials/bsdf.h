@@ -12,6 +12,9 @@
 //                                BSDF picks its non-delta lobes exactly when u_lobe < non_delta_probability(wo),
 //                                which lets the integrator swap in another direction-sampling strategy for them
 //   static constexpr flags       what the type can do, whatever its parameters (bsdf_flags.h)
+// A Stochastic BSDF (layered.h) estimates eval() and pdf() by random walks: each call is a fixed
+// function of its arguments and the BSDF's seed, eval() unbiased for f; its sample weights match
+// eval() |cos| / density in expectation only.
 // Radiance-carrying (camera) paths are assumed: refraction scales radiance by 1 / eta^2, and
 // BsdfSample::eta reports the relative IOR crossed.
 // The closed list of BSDFs is the variant `Bsdf`; dispatch happens once, here.
@@ -23,6 +26,7 @@
 #include "candela/materials/dielectric.h"
 #include "candela/materials/diffuse.h"
 #include "candela/materials/diffuse_transmission.h"
+#include "candela/materials/layered.h"
 #include "candela/materials/phong.h"
 #include "candela/materials/principled.h"
 #include "candela/materials/specular.h"
@@ -30,7 +34,8 @@
 namespace candela {
 
 using Bsdf = std::variant<DiffuseBsdf, PhongBsdf, MirrorBsdf, DielectricBsdf, BlackBsdf, ConductorBsdf,
-                          CoatedDiffuseBsdf, DiffuseTransmissionBsdf, PrincipledBsdf, PrincipledThinBsdf>;
+                          CoatedDiffuseBsdf, DiffuseTransmissionBsdf, PrincipledBsdf, PrincipledThinBsdf,
+                          LayeredDiffuseBsdf, LayeredConductorBsdf>;
 
 inline RGB bsdf_eval(const Bsdf& b, const Vec3& wo, const Vec3& wi) {
   return std::visit([&](const auto& x) { return x.eval(wo, wi); }, b);

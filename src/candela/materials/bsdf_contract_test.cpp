@@ -4,6 +4,10 @@
 // and each type behaves as its flags (bsdf_flags.h) say. The list is built per alternative of the
 // variant (cases_of<B>), so a BSDF added to `Bsdf` without cases here does not compile.
 // (Chi-square tests of sample() against pdf() and the analytic checks stay beside each BSDF.)
+// Stochastic BSDFs (BsdfFlags::Stochastic: the layered BSDFs, whose eval() and pdf() are random-walk
+// estimates) cannot match weight and eval sample by sample: for them the first check is
+// statistical (testing/stochastic_bsdf.h), each sample's pdf is pdf() exactly, and the others
+// hold as they are (layered_test.cpp checks the rest).
 #include <gtest/gtest.h>
 
 #include <cctype>
@@ -19,6 +23,7 @@
 #include "candela/sampling/warp.h"
 #include "candela/testing/bsdf_helpers.h"
 #include "candela/testing/principled_cases.h"
+#include "candela/testing/stochastic_bsdf.h"
 
 namespace candela {
 namespace {
@@ -222,6 +227,59 @@ std::vector<ContractCase> cases_of<PrincipledThinBsdf>() {
           thin_case("principled thin rough anisotropic", rough)};
 }
 
+// pbrt-v4's layered BSDFs: a dielectric coat over a diffuse base or a conductor, with a slab
+// between (layered.h). Smooth and rough coats and bases, an absorbing and a scattering slab.
+LayeredDiffuseBsdf layered_diffuse(const Microfacet& coat, float thickness, RGB albedo = RGB(0.0f), float g = 0) {
+  LayeredDiffuseBsdf b;
+  b.top = CoatInterface{1.5f, coat};
+  b.bottom = DiffuseBsdf{RGB(0.7f, 0.5f, 0.3f)};
+  b.thickness = thickness;
+  b.albedo = albedo;
+  b.g = g;
+  b.seed = 3;
+  return b;
+}
+LayeredConductorBsdf layered_gold(const Microfacet& coat, const Microfacet& metal, RGB albedo = RGB(0.0f)) {
+  LayeredConductorBsdf b;
+  b.top = CoatInterface{1.5f, coat};
+  b.bottom = ConductorBsdf{RGB(0.143119f, 0.374957f, 1.442479f) / 1.5f, RGB(3.983160f, 2.385721f, 1.603215f) / 1.5f,
+                           RGB(1.0f), metal};
+  b.thickness = 0.1f;
+  b.albedo = albedo;
+  b.g = -0.3f;
+  b.seed = 5;
+  return b;
+}
+
+template <>
+std::vector<ContractCase> cases_of<LayeredDiffuseBsdf>() {
+  auto wos = each({direction(0), direction(60), below(direction(40))}, 30000);
+  return {{"layered diffuse smooth", [] { return Bsdf(layered_diffuse(TrowbridgeReitz(0, 0), 0.05f)); }, wos, 100000},
+          {"layered diffuse rough", [] { return Bsdf(layered_diffuse(TrowbridgeReitz(0.3f, 0.3f), 0.05f)); }, wos, 100000},
+          {"layered diffuse scattering slab",
+           [] { return Bsdf(layered_diffuse(TrowbridgeReitz(0.4f, 0.2f), 0.5f, RGB(0.9f, 0.6f, 0.3f), 0.4f)); }, wos,
+           100000},
+          {"layered diffuse beckmann", [] { return Bsdf(layered_diffuse(Beckmann(0.3f, 0.3f), 0.0f)); },
+           each({direction(30), direction(80)}, 30000), 100000}};
+}
+
+template <>
+std::vector<ContractCase> cases_of<LayeredConductorBsdf>() {
+  auto wos = each({direction(0), direction(60), below(direction(40))}, 30000);
+  return {{"layered conductor smooth coat", [] { return Bsdf(layered_gold(TrowbridgeReitz(0, 0), TrowbridgeReitz(0.3f, 0.3f))); },
+           wos, 100000},
+          {"layered conductor rough", [] { return Bsdf(layered_gold(TrowbridgeReitz(0.3f, 0.3f), TrowbridgeReitz(0.4f, 0.4f))); },
+           wos, 100000},
+          {"layered conductor smooth metal",
+           [] { return Bsdf(layered_gold(TrowbridgeReitz(0.3f, 0.3f), TrowbridgeReitz(0, 0))); }, wos, 100000},
+          {"layered conductor scattering slab",
+           [] { return Bsdf(layered_gold(TrowbridgeReitz(0.3f, 0.3f), TrowbridgeReitz(0.2f, 0.2f), RGB(0.5f, 0.8f, 0.9f))); },
+           wos, 100000},
+          {"layered conductor all smooth",
+           [] { return Bsdf(layered_gold(TrowbridgeReitz(0, 0), TrowbridgeReitz(0, 0))); },
+           each({direction(30), below(direction(70))}, 0), 2000}};
+}
+
 // Every alternative's cases, in the variant's order.
 template <typename... Bs>
 std::vector<ContractCase> cases_of_every(const std::variant<Bs...>*) {
@@ -247,6 +305,29 @@ class BsdfContract : public ::testing::TestWithParam<ContractCase> {};
 TEST_P(BsdfContract, SampleWeightIsEvalCosOverPdf) {
   const ContractCase& c = GetParam();
   const Bsdf b = c.make();
+  if (has(bsdf_flags(b), BsdfFlags::Stochastic)) {
+    // Statistically: per cell of wo's hemisphere, the mean sample weight against the mean of eval()
+    // (over seeds) integrated over the cell; and each non-delta sample's pdf is pdf() itself.
+    for (const Outgoing& o : c.wos) {
+      Rng rng(11, 12);
+      int checked = 0, pdf_mismatches = 0;
+      for (int i = 0; i < 2000; ++i) {
+        auto s = bsdf_sample(b, o.wo, rng.next_float(), {rng.next_float(), rng.next_float()});
+        if (!s || s->is_delta) continue;
+        ++checked;
+        if (!(s->pdf > 0) || s->pdf != bsdf_pdf(b, o.wo, s->wi) || !s->weight.is_finite()) ++pdf_mismatches;
+      }
+      EXPECT_EQ(pdf_mismatches, 0) << "wo.z " << o.wo.z;
+      if (o.min_checked == 0) continue;
+      EXPECT_GE(checked, o.min_checked * 2000 / c.samples) << "wo.z " << o.wo.z;
+      testing::StochasticWeightTest t = testing::stochastic_weight_test(b, o.wo, c.samples, 2000, c.seed);
+      EXPECT_GT(t.p_value, testing::kChiSquareAlpha)
+          << "wo.z " << o.wo.z << ": " << t.cells << " cells, worst z " << t.worst_z << "; albedo from samples "
+          << t.sample_total << ", from eval " << t.eval_total << " +- " << t.total_standard_error;
+      EXPECT_NEAR(t.sample_total, t.eval_total, 4 * t.total_standard_error) << "wo.z " << o.wo.z;
+    }
+    return;
+  }
   int failures = 0;
   for (const Outgoing& o : c.wos) {
     Rng rng(11, 12);

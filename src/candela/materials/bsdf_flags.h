@@ -18,6 +18,11 @@ enum class BsdfFlags : uint8_t {
   // n_inside / n_outside): radiance is scaled by 1 / eta'^2 there and importance is not, so the
   // adjoint differs from eval (bsdf_adjoint_scale).
   Refraction = 1 << 4,
+  // eval() and pdf() are Monte Carlo estimates (layered BSDFs: random walks through the layers),
+  // each a fixed function of its arguments and the BSDF's seed: unbiased for f, and for pdf an
+  // approximation that multiple importance sampling can use; sample()'s weight is unbiased for
+  // f |cos| / density but is not eval() |cos| / pdf() of any one call.
+  Stochastic = 1 << 5,
 };
 
 constexpr BsdfFlags operator|(BsdfFlags a, BsdfFlags b) { return BsdfFlags(uint8_t(a) | uint8_t(b)); }

@@ -1,7 +1,10 @@
 #include "candela/materials/material.h"
 
+#include <bit>
+
 #include "candela/base/error.h"
 #include "candela/base/overloaded.h"
+#include "candela/sampling/rng.h"
 
 namespace candela {
 namespace {
@@ -96,6 +99,8 @@ MaterialTable::MaterialTable(const std::vector<MaterialDesc>& descs, const Textu
     bool interface = std::holds_alternative<InterfaceMaterial>(d);
     bool passes = interface || std::holds_alternative<MaskMaterial>(d) || (dielectric && dielectric->thin);
     entries_.push_back({d, std::nullopt, interface, passes, {}});
+    entries_.back().stochastic =
+        std::holds_alternative<LayeredDiffuseMaterial>(d) || std::holds_alternative<LayeredConductorMaterial>(d);
   }
   entries_.push_back({DiffuseMaterial{RGB(0.5f)}, std::nullopt, false, false, {}});
   // Wrappers refer to materials before them, so one pass in order sees every nested material done.
@@ -117,6 +122,7 @@ MaterialTable::MaterialTable(const std::vector<MaterialDesc>& descs, const Textu
       if (n < 0 || size_t(n) >= i)
         throw SceneError(fmt::format("{}: wraps material {}, which is not a material before it", name(i), n));
       e.may_pass_through = e.may_pass_through || entries_[size_t(n)].may_pass_through;
+      e.stochastic = e.stochastic || entries_[size_t(n)].stochastic;
       if (std::holds_alternative<TwoSidedMaterial>(entries_[size_t(n)].desc))
         throw SceneError(fmt::format("{}: wraps material {}, which has two sides; a two-sided material must be "
                                      "the outermost (it is chosen per hit by the side seen)", name(i), n));
@@ -191,6 +197,18 @@ Shading MaterialTable::shading(uint32_t material, const TextureEvalContext& ctx,
     material = uint32_t(dot(wo, hit.ng) >= 0 ? sides->front : sides->back);
   Shading s{one_side_bsdf(material, ctx), Frame::from_normal_tangent(hit.ns, hit.dpdu)};
   const Entry& e = entries_[material];
+  // Layered BSDFs draw their random walks from a seed per shading point: the hit point's bits,
+  // which are the same in every run whatever the thread count (materials/layered.h).
+  if (e.stochastic) {
+    const uint32_t seed = uint32_t(hash_values(std::bit_cast<uint32_t>(hit.p.x), std::bit_cast<uint32_t>(hit.p.y),
+                                               std::bit_cast<uint32_t>(hit.p.z), hit.shape, hit.primitive));
+    for (int k = 0; k < s.bsdf.count; ++k)
+      std::visit(
+          [&](auto& b) {
+            if constexpr (has(std::decay_t<decltype(b)>::flags, BsdfFlags::Stochastic)) b.seed = seed;
+          },
+          s.bsdf.components[size_t(k)].bsdf);
+  }
   if (e.perturbations.empty()) return s;
   const Normal3 original = s.frame.n;
   bool shadowing = false;
@@ -266,6 +284,15 @@ Bsdf MaterialTable::build(const Entry& entry, const TextureEvalContext& ctx) con
     return RGB(std::clamp(v.r, 0.0f, 1.0f), std::clamp(v.g, 0.0f, 1.0f), std::clamp(v.b, 0.0f, 1.0f));
   };
   auto distribution = [&](const Roughness& r) { return microfacet(r, tex, ctx); };
+  // The slab of a layered material at the hit (pbrt-v4 clamps g to [-1, 1]; here a little inside,
+  // where Henyey-Greenstein stays finite).
+  auto set_layer = [&](auto& b, const LayerSlab& layer) {
+    b.thickness = std::max(0.0f, tex.eval(layer.thickness, ctx));
+    b.albedo = albedo(layer.albedo);
+    b.g = std::clamp(tex.eval(layer.g, ctx), -0.999f, 0.999f);
+    b.max_depth = uint16_t(std::clamp(layer.max_depth, 1, 65535));
+    b.samples = uint16_t(std::clamp(layer.samples, 1, 65535));
+  };
   return std::visit(
       [&](const auto& m) -> Bsdf {
         using T = std::decay_t<decltype(m)>;
@@ -288,6 +315,24 @@ Bsdf MaterialTable::build(const Entry& entry, const TextureEvalContext& ctx) con
         } else if constexpr (std::is_same_v<T, CoatedDiffuseMaterial>) {
           return CoatedDiffuseBsdf{albedo(m.reflectance), albedo(m.specular), m.ior, distribution(m.roughness),
                                    m.nonlinear, entry.coat_table.get()};
+        } else if constexpr (std::is_same_v<T, LayeredDiffuseMaterial>) {
+          LayeredDiffuseBsdf b;
+          b.top = CoatInterface{m.ior, distribution(m.roughness)};
+          b.bottom = DiffuseBsdf{albedo(m.reflectance)};
+          set_layer(b, m.layer);
+          return b;
+        } else if constexpr (std::is_same_v<T, LayeredConductorMaterial>) {
+          LayeredConductorBsdf b;
+          b.top = CoatInterface{m.ior, distribution(m.roughness)};
+          RGB eta = color(m.eta), k = color(m.k);
+          if (m.reflectance) {
+            eta = RGB(1.0f);
+            k = conductor_k_from_reflectance(albedo(*m.reflectance));
+          }
+          // The conductor lies under the coat: its index relative to the coat's (as pbrt-v4).
+          b.bottom = ConductorBsdf{eta / m.ior, k / m.ior, RGB(1.0f), distribution(m.conductor_roughness)};
+          set_layer(b, m.layer);
+          return b;
         } else if constexpr (std::is_same_v<T, DiffuseTransmissionMaterial>) {
           return DiffuseTransmissionBsdf{albedo(m.reflectance), albedo(m.transmittance)};
         } else if constexpr (std::is_same_v<T, PrincipledMaterial>) {

@@ -67,6 +67,7 @@ class MaterialTable {
     bool may_pass_through = false;
     std::vector<int> perturbations;  // the normal / bump map materials that apply, outermost first
     std::shared_ptr<const RoughCoatTable> coat_table;  // for a tabulated coated diffuse
+    bool stochastic = false;  // it or a material it wraps builds a layered BSDF (seeded per hit)
   };
   // The BSDF of a material that is not two-sided: cached when constant.
   SurfaceBsdf one_side_bsdf(uint32_t material, const TextureEvalContext& ctx) const {

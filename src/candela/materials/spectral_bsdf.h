@@ -10,6 +10,12 @@ namespace candela {
 
 inline void bsdf_at_wavelengths(Bsdf& bsdf, const Wavelengths& wl) {
   auto reflectance = [&](RGB& c) { c = reflectance_at(c, wl); };
+  // A conductor's optical constants as unbounded spectra (also the base of a coated conductor).
+  auto conductor = [&](ConductorBsdf& b) {
+    b.eta = unbounded_at(b.eta, wl);
+    b.k = unbounded_at(b.k, wl);
+    reflectance(b.tint);
+  };
   std::visit(
       [&](auto& b) {
         using T = std::decay_t<decltype(b)>;
@@ -23,9 +29,13 @@ inline void bsdf_at_wavelengths(Bsdf& bsdf, const Wavelengths& wl) {
           reflectance(b.reflectance);
           reflectance(b.transmittance);
         } else if constexpr (std::is_same_v<T, ConductorBsdf>) {
-          b.eta = unbounded_at(b.eta, wl);
-          b.k = unbounded_at(b.k, wl);
-          reflectance(b.tint);
+          conductor(b);
+        } else if constexpr (std::is_same_v<T, LayeredDiffuseBsdf>) {
+          reflectance(b.bottom.reflectance);
+          reflectance(b.albedo);
+        } else if constexpr (std::is_same_v<T, LayeredConductorBsdf>) {
+          conductor(b.bottom);  // eta and k relative to the coat: a scale, which unbounded spectra keep
+          reflectance(b.albedo);
         } else if constexpr (std::is_same_v<T, CoatedDiffuseBsdf>) {
           reflectance(b.reflectance);
           reflectance(b.specular);

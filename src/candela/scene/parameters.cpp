@@ -74,7 +74,7 @@ class Slots {
         case FieldKind::NumberIfGiven:
           if (field_second<bool>(f, object)) number(name, field_value<float>(f, object), f.range);
           break;
-        case FieldKind::Roughness: roughness(prefix, field_value<Roughness>(f, object)); break;
+        case FieldKind::Roughness: roughness(prefix + std::string(roughness_prefix(f)), field_value<Roughness>(f, object)); break;
         case FieldKind::Rgb: color(name, field_value<RGB>(f, object), f.range); break;
         // A colour that may vary over a grid: editable where it is a constant.
         case FieldKind::ColorVolume:

@@ -1,5 +1,6 @@
 #include "candela/scene/scene.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "candela/film/image_io.h"
@@ -40,6 +41,13 @@ const Transform* moving_end_transform(const ShapeDesc& desc) {
 }
 
 Vec3 lerp(float t, const Vec3& a, const Vec3& b) { return a * (1 - t) + b * t; }
+
+// A partial sphere's or cylinder's phi_max (degrees, in (0, 360]) in radians: exactly 2 pi for a full turn.
+float phi_max_radians(float degrees, const std::string& shape) {
+  if (!(degrees > 0 && degrees <= 360))
+    throw SceneError(fmt::format("{}: phi_max must be in (0, 360] degrees, got {}", shape, degrees));
+  return degrees == 360 ? 2 * kPi : radians(degrees);
+}
 
 // Object-space shading normals to world space, in place (flipped by reverse orientation).
 void place_normals(std::vector<Normal3>& normals, const Transform& T, bool reverse) {
@@ -292,6 +300,7 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int object, TriangleM
             if (!(len > 0) || !(c.radius > 0) || !std::isfinite(len) || !std::isfinite(c.radius))
               throw SceneError(fmt::format("{}: a cylinder needs a positive radius and two distinct end points",
                                            rec.name));
+            const float phi_max = phi_max_radians(c.phi_max, rec.name);
             Frame f(d / len);
             Matrix4 m = Matrix4::identity();
             for (int r = 0; r < 3; ++r) {
@@ -305,7 +314,7 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int object, TriangleM
             std::optional<Transform> unit_end;
             if (T_end) unit_end = *T_end * place;
             add_quadric(std::move(rec), QuadricGeometry::Kind::Cylinder, unit, unit_end ? &*unit_end : nullptr,
-                        desc.emission, object);
+                        desc.emission, object, phi_max);
           },
           [&](const SdfGridShape& g) {
             if (desc.emission)
@@ -326,6 +335,25 @@ void Scene::add_sphere(ShapeRecord rec, const SphereShape& s, const Transform& T
                        bool reverse, const std::optional<AreaEmission>& emission, int object) {
   rec.kind = ShapeRecord::Kind::Sphere;
   rec.sphere = SphereGeometry{T, s.center, s.radius, T_end ? std::optional<Transform>(*T_end) : std::nullopt, s.uv};
+  const float phi_max = phi_max_radians(s.phi_max, rec.name);
+  if ((s.z_min_given && !std::isfinite(s.z_min)) || (s.z_max_given && !std::isfinite(s.z_max)))
+    throw SceneError(fmt::format("{}: the sphere's z_min and z_max must be finite numbers", rec.name));
+  if (s.z_min_given && s.z_max_given && !(s.z_min < s.z_max))
+    throw SceneError(fmt::format("{}: the sphere's z_max ({}) must exceed its z_min ({})", rec.name, s.z_max, s.z_min));
+  if (s.partial()) {
+    // pbrt-v4's partial sphere: the heights clamped to the sphere, the polar angles of the two cuts.
+    SphereGeometry& g = rec.sphere;
+    g.partial = true;
+    g.z_min = s.z_lo();
+    g.z_max = s.z_hi();
+    if (!(g.z_min < g.z_max))
+      throw SceneError(fmt::format("{}: the sphere's heights z_min {} to z_max {} leave nothing of it (radius {})",
+                                   rec.name, s.z_min_given ? s.z_min : -s.radius, s.z_max_given ? s.z_max : s.radius,
+                                   s.radius));
+    g.phi_max = phi_max;
+    g.theta_z_min = std::acos(std::clamp(g.z_min / s.radius, -1.0f, 1.0f));
+    g.theta_z_max = std::acos(std::clamp(g.z_max / s.radius, -1.0f, 1.0f));
+  }
   for (const Transform* X : {&T, T_end})
     if (X) bounds_.extend(sphere_world_bounds(rec.sphere, *X));
   if (emission) {
@@ -340,25 +368,38 @@ void Scene::add_sphere(ShapeRecord rec, const SphereShape& s, const Transform& T
     rec.radiance = emission->radiance;
     rec.two_sided_emission = emission->two_sided;
     rec.emission_texture = emission->texture;
-    SphereLight light{T.point(s.center), s.radius * lx, rec.radiance, rec.two_sided_emission, reverse};
-    light.emission_texture = {&textures_, rec.emission_texture};
-    light.object_x = ex / lx;
-    light.object_y = ey / ly;
-    // pbrt-v4's v = 1 - theta / pi is Mitsuba's v of the point mirrored in z (u unchanged).
-    light.object_z = (s.uv == SphereUv::Pbrt ? -ez : ez) / lz;
-    lights_.push_back(light);
+    if (rec.sphere.partial) {
+      // Sampled uniformly by area over the part kept (uniform in height and azimuth).
+      const SphereGeometry& g = rec.sphere;
+      const float radius = s.radius * lx, z_min = g.z_min * lx, z_max = g.z_max * lx;
+      PartialSphereLight light{T.point(s.center), ex / lx, ey / ly, ez / lz, radius, z_min, z_max, g.phi_max,
+                               g.phi_max * radius * (z_max - z_min), rec.radiance, rec.two_sided_emission, reverse};
+      light.emission_texture = {&textures_, rec.emission_texture};
+      light.pbrt_uv = s.uv == SphereUv::Pbrt;
+      light.theta_z_min = g.theta_z_min;
+      light.theta_z_max = g.theta_z_max;
+      lights_.push_back(light);
+    } else {
+      SphereLight light{T.point(s.center), s.radius * lx, rec.radiance, rec.two_sided_emission, reverse};
+      light.emission_texture = {&textures_, rec.emission_texture};
+      light.object_x = ex / lx;
+      light.object_y = ey / ly;
+      // pbrt-v4's v = 1 - theta / pi is Mitsuba's v of the point mirrored in z (u unchanged).
+      light.object_z = (s.uv == SphereUv::Pbrt ? -ez : ez) / lz;
+      lights_.push_back(light);
+    }
   }
   embree_.add_sphere(uint32_t(shapes_.size()), rec.sphere, object);
   shapes_.push_back(std::move(rec));
 }
 
 void Scene::add_quadric(ShapeRecord rec, QuadricGeometry::Kind kind, const Transform& M, const Transform* M_end,
-                        const std::optional<AreaEmission>& emission, int object) {
+                        const std::optional<AreaEmission>& emission, int object, float phi_max) {
   const bool disk = kind == QuadricGeometry::Kind::Disk;
   rec.kind = disk ? ShapeRecord::Kind::Disk : ShapeRecord::Kind::Cylinder;
   if (!Transform::from_matrix(M.matrix()) || (M_end && !Transform::from_matrix(M_end->matrix())))
     throw SceneError(fmt::format("{}: the transform is singular", rec.name));
-  rec.quadric = QuadricGeometry{kind, M, M_end ? std::optional<Transform>(*M_end) : std::nullopt};
+  rec.quadric = QuadricGeometry{kind, M, M_end ? std::optional<Transform>(*M_end) : std::nullopt, phi_max};
   for (const Transform* X : {&M, M_end})
     if (X) bounds_.extend(quadric_world_bounds(rec.quadric, *X));
   if (emission) {
@@ -381,8 +422,8 @@ void Scene::add_quadric(ShapeRecord rec, QuadricGeometry::Kind kind, const Trans
         throw SceneError(fmt::format(
             "{}: an emissive cylinder must stay circular (no non-uniform scale across its axis, no shear)",
             rec.name));
-      lights_.push_back(CylinderLight{M.point(Point3(0.0f)), eu / lu, ev / lv, ez, lu, 2 * kPi * lu * lz,
-                                      rec.radiance, rec.two_sided_emission, rec.flip_normal, texture});
+      lights_.push_back(CylinderLight{M.point(Point3(0.0f)), eu / lu, ev / lv, ez, lu, phi_max * lu * lz,
+                                      rec.radiance, rec.two_sided_emission, rec.flip_normal, texture, phi_max});
     }
   }
   embree_.add_quadric(uint32_t(shapes_.size()), rec.quadric, object);
@@ -618,12 +659,21 @@ void Scene::reconstruct_sphere_hit(const ShapeRecord& rec, const Ray& ray, float
   hit.ng = normalize(to_world->normal(po));
   if (rec.flip_normal) hit.ng = -hit.ng;
   hit.ns = hit.ng;
+  float rho = std::sqrt(po.x * po.x + po.y * po.y);
+  if (s.partial && s.uv == SphereUv::Pbrt) {
+    // pbrt-v4's (u, v) of the part kept: u = phi / phi_max, v from theta(z_min) to theta(z_max);
+    // dp/du = phi_max (-y, x, 0), dp/dv = (theta(z_max) - theta(z_min)) (z cos phi, z sin phi, -r sin theta).
+    const float dtheta = s.theta_z_max - s.theta_z_min;
+    hit.uv = partial_sphere_uv(Vec3(po.x, po.y, po.z), s.phi_max, s.theta_z_min, s.theta_z_max);
+    hit.dpdu = to_world->vector(Vec3(-po.y, po.x, 0) * s.phi_max);
+    hit.dpdv = rho > 0 ? to_world->vector(Vec3(po.z * po.x / rho, po.z * po.y / rho, -rho) * dtheta) : Vec3(0.0f);
+    return;
+  }
   // pbrt-v4's v = 1 - theta / pi is Mitsuba's v of the point mirrored in z (u unchanged).
   const float v_sign = s.uv == SphereUv::Pbrt ? -1.0f : 1.0f;
   hit.uv = sphere_uv(Vec3(po.x, po.y, v_sign * po.z));
   hit.dpdu = to_world->vector(Vec3(-po.y, po.x, 0) * (2 * kPi));
   // v = theta / pi: dp/dv = pi (z cos phi, z sin phi, -r sin theta); negated for 1 - theta / pi.
-  float rho = std::sqrt(po.x * po.x + po.y * po.y);
   hit.dpdv = rho > 0 ? to_world->vector(Vec3(po.z * po.x / rho, po.z * po.y / rho, -rho) * (v_sign * kPi)) : Vec3(0.0f);
 }
 
@@ -644,12 +694,13 @@ void Scene::reconstruct_quadric_hit(const ShapeRecord& rec, const Ray& ray, floa
     hit.ng = normalize(M->normal({0, 0, 1}));
   } else {
     // Mitsuba's cylinder: (u, v) = (phi / 2 pi, height along the axis / its length),
-    // dp/du = 2 pi (-y, x, 0) in the tube's space; the normal points away from the axis.
+    // dp/du = 2 pi (-y, x, 0) in the tube's space; the normal points away from the axis. Cut to
+    // phi_max (pbrt-v4's): u = phi / phi_max, dp/du = phi_max (-y, x, 0).
     float rho = std::sqrt(local.x * local.x + local.y * local.y);
     float x = rho > 0 ? local.x / rho : 1.0f, y = rho > 0 ? local.y / rho : 0.0f;
     local = {x, y, std::clamp(local.z, 0.0f, 1.0f)};
-    hit.uv = cylinder_uv(x, y, local.z);
-    hit.dpdu = M->vector(Vec3(-y, x, 0) * (2 * kPi));
+    hit.uv = cylinder_uv(x, y, local.z, q.phi_max);
+    hit.dpdu = M->vector(Vec3(-y, x, 0) * q.phi_max);
     hit.dpdv = M->vector(Vec3(0, 0, 1));
     hit.ng = normalize(M->normal({x, y, 0}));
   }

@@ -150,8 +150,10 @@ class Scene {
   void add_sphere(ShapeRecord rec, const SphereShape& sphere, const Transform& to_world,
                   const Transform* to_world_end, bool reverse, const std::optional<AreaEmission>& emission,
                   int object);
+  // A disk, or a cylinder (cut to the azimuths up to phi_max radians when below 2 pi).
   void add_quadric(ShapeRecord rec, QuadricGeometry::Kind kind, const Transform& unit_to_world,
-                   const Transform* unit_to_world_end, const std::optional<AreaEmission>& emission, int object);
+                   const Transform* unit_to_world_end, const std::optional<AreaEmission>& emission, int object,
+                   float phi_max = 2 * kPi);
   void add_sdf_grid(ShapeRecord rec, const SdfGridShape& grid, const Transform& to_world,
                     const Transform* to_world_end, int object);
   // A shape or instance at a ray's time: to_world, or where it moves (to_world_end) and the

@@ -20,42 +20,46 @@ int JsonSceneReader::add_material(MaterialDesc material, SourceLocation where) {
 MaterialDesc JsonSceneReader::read_material(const Json& value, const std::string& pointer) {
   CheckedObject m(report_, value, pointer);
   MaterialDesc material = default_of_named_type<MaterialDesc>(m, "material");
-  if (auto* conductor = std::get_if<ConductorMaterial>(&material)) read_conductor_preset(m, *conductor);
+  if (auto* conductor = std::get_if<ConductorMaterial>(&material)) read_conductor_preset(m, conductor->eta, conductor->k);
+  if (auto* coated = std::get_if<LayeredConductorMaterial>(&material)) read_conductor_preset(m, coated->eta, coated->k);
   read_schema_fields(m, material);
   m.finish();
   return material;
 }
 
-// GGX alpha (Roughness::remap = false): "roughness" for both axes, or "alpha_u" and "alpha_v".
-Roughness JsonSceneReader::read_roughness(CheckedObject& m) {
+// GGX alpha (Roughness::remap = false): "roughness" for both axes, or "alpha_u" and "alpha_v" (each
+// key after `prefix`: a coated conductor's "conductor_roughness").
+Roughness JsonSceneReader::read_roughness(CheckedObject& m, std::string_view prefix) {
+  const std::string p(prefix);
+  const std::string k_roughness = p + "roughness", k_alpha_u = p + "alpha_u", k_alpha_v = p + "alpha_v";
   Roughness roughness;
   roughness.remap = false;
-  const Json* isotropic = m.find("roughness");
-  const Json* alpha_u = m.find("alpha_u");
-  const Json* alpha_v = m.find("alpha_v");
+  const Json* isotropic = m.find(k_roughness);
+  const Json* alpha_u = m.find(k_alpha_u);
+  const Json* alpha_v = m.find(k_alpha_v);
   if (isotropic && (alpha_u || alpha_v))
-    report_.fail(m.pointer_of(alpha_u ? "alpha_u" : "alpha_v"),
-                 "give either \"roughness\" or \"alpha_u\" and \"alpha_v\", not both");
+    report_.fail(m.pointer_of(alpha_u ? k_alpha_u : k_alpha_v), "give either \"{}\" or \"{}\" and \"{}\", not both",
+                 k_roughness, k_alpha_u, k_alpha_v);
   if (bool(alpha_u) != bool(alpha_v))
-    report_.fail(m.pointer(), "missing required key \"{}\" (an anisotropic roughness needs alpha_u and alpha_v)",
-                 alpha_u ? "alpha_v" : "alpha_u");
+    report_.fail(m.pointer(), "missing required key \"{}\" (an anisotropic roughness needs {} and {})",
+                 alpha_u ? k_alpha_v : k_alpha_u, k_alpha_u, k_alpha_v);
   if (isotropic) {
-    roughness.u = roughness.v = read_float_input(*isotropic, m.pointer_of("roughness"), kNonNegative);
+    roughness.u = roughness.v = read_float_input(*isotropic, m.pointer_of(k_roughness), kNonNegative);
   } else if (alpha_u) {
-    roughness.u = read_float_input(*alpha_u, m.pointer_of("alpha_u"), kNonNegative);
-    roughness.v = read_float_input(*alpha_v, m.pointer_of("alpha_v"), kNonNegative);
+    roughness.u = read_float_input(*alpha_u, m.pointer_of(k_alpha_u), kNonNegative);
+    roughness.v = read_float_input(*alpha_v, m.pointer_of(k_alpha_v), kNonNegative);
   }
   // pbrt-v4's remaproughness: the values are pbrt's "roughness", alpha = sqrt(roughness).
-  roughness.remap = m.boolean_or("remap_roughness", false);
-  if (const Json* distribution = m.find("distribution"))
+  roughness.remap = m.boolean_or(p + "remap_roughness", false);
+  if (const Json* distribution = m.find(p + "distribution"))
     roughness.distribution = read_enum<MicrofacetDistribution>(
-        report_, *distribution, m.pointer_of("distribution"), "microfacet distribution");
+        report_, *distribution, m.pointer_of(p + "distribution"), "microfacet distribution");
   return roughness;
 }
 
-// JSON's shorthand for a conductor: "metal": a named metal's eta and k. Only one of "eta"/"k",
-// "reflectance" and "metal" may be given.
-void JsonSceneReader::read_conductor_preset(CheckedObject& m, ConductorMaterial& c) const {
+// JSON's shorthand for a conductor (and a coated conductor's): "metal": a named metal's eta and k.
+// Only one of "eta"/"k", "reflectance" and "metal" may be given.
+void JsonSceneReader::read_conductor_preset(CheckedObject& m, ColorInput& eta, ColorInput& k) const {
   bool has_ior = m.has("eta") || m.has("k");
   if (int(has_ior) + int(m.has("reflectance")) + int(m.has("metal")) > 1)
     report_.fail(m.pointer(), "a conductor takes only one of: \"eta\"/\"k\", \"reflectance\", \"metal\"");
@@ -66,8 +70,8 @@ void JsonSceneReader::read_conductor_preset(CheckedObject& m, ConductorMaterial&
   if (!preset)
     report_.fail(m.pointer_of("metal"), "unknown metal \"{}\"; expected one of: {}", name,
                  fmt::join(named_metal_names(), ", "));
-  c.eta = preset->eta;
-  c.k = preset->k;
+  eta = preset->eta;
+  k = preset->k;
 }
 
 int JsonSceneReader::material_by_name(const std::string& name, const std::string& pointer) {

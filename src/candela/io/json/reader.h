@@ -29,7 +29,6 @@ namespace candela::json {
 
 namespace fs = std::filesystem;
 
-constexpr float kMaxFilterRadius = 64;  // pixels; the filter is tabulated per unit of radius
 constexpr int kMaxTextureDepth = 64;    // textures using textures
 
 // The "type" of an entry of "shapes" that places an object.
@@ -55,6 +54,7 @@ class JsonSceneReader {
   void read_camera(const Json& value, const std::string& pointer);
   void read_lens_and_shutter(CheckedObject& camera);
   std::array<float, 4> read_screen_window(const Json& value, const std::string& pointer) const;
+  void read_crop(const Json& value, const std::string& pointer);
   void check_view_direction(const CheckedObject& camera, Point3 position, Point3 look_at, Vec3 up) const;
   void read_render(const Json& value, const std::string& pointer);
   void read_render_option(const RenderOption& option, const Json& value, const std::string& pointer,
@@ -135,8 +135,8 @@ class JsonSceneReader {
         },
         value);
   }
-  Roughness read_roughness(CheckedObject& m);
-  void read_conductor_preset(CheckedObject& m, ConductorMaterial& c) const;
+  Roughness read_roughness(CheckedObject& m, std::string_view prefix = {});
+  void read_conductor_preset(CheckedObject& m, ColorInput& eta, ColorInput& k) const;
   int material_by_name(const std::string& name, const std::string& pointer);
   int wrapped_material(CheckedObject& m, std::string_view key);
   std::array<int, 2> material_pair(CheckedObject& m, std::string_view key);

@@ -41,7 +41,7 @@ void JsonSceneReader::read_fields(CheckedObject& m, const TypeSchema& schema, vo
         flag = m.boolean_or(f.key, flag);
         break;
       }
-      case FieldKind::Roughness: field_value<Roughness>(f, object) = read_roughness(m); break;
+      case FieldKind::Roughness: field_value<Roughness>(f, object) = read_roughness(m, roughness_prefix(f)); break;
       case FieldKind::Material: field_value<int>(f, object) = wrapped_material(m, f.key); break;
       case FieldKind::MaterialPair: {
         std::array<int, 2> pair = material_pair(m, f.key);

@@ -39,6 +39,7 @@ void JsonSceneReader::read_camera(const Json& value, const std::string& pointer)
     scene_.camera.screen_window = read_screen_window(*window, camera.pointer_of("screen_window"));
   scene_.film.width = camera.integer_or("width", scene_.film.width, 1, kMaxResolution);
   scene_.film.height = camera.integer_or("height", scene_.film.height, 1, kMaxResolution);
+  if (const Json* crop = camera.find("crop")) read_crop(*crop, camera.pointer_of("crop"));
   read_lens_and_shutter(camera);
   scene_.camera.medium = medium_reference(camera, "medium");
   camera.finish();
@@ -64,6 +65,25 @@ std::array<float, 4> JsonSceneReader::read_screen_window(const Json& value, cons
     report_.fail(pointer, "the window must have x0 < x1 and y0 < y1, got [{}, {}, {}, {}]", window[0], window[1],
                  window[2], window[3]);
   return window;
+}
+
+// [x, y, full_width, full_height]: the image (width x height) at (x, y) of a larger one (FilmDesc::crop).
+void JsonSceneReader::read_crop(const Json& value, const std::string& pointer) {
+  if (!value.is_array() || value.size() != 4)
+    report_.fail(pointer, "expected [x, y, full_width, full_height], got {}", describe(value));
+  std::array<int, 4> c;
+  for (size_t i = 0; i < 4; ++i) {
+    const Json& v = value[i];
+    if (!v.is_number_integer() || v.get<int64_t>() < 0 || v.get<int64_t>() > kMaxResolution)
+      report_.fail(fmt::format("{}/{}", pointer, i), "expected an integer in [0, {}], got {}", kMaxResolution,
+                   describe(v));
+    c[i] = v.get<int>();
+  }
+  const FilmDesc& film = scene_.film;
+  if (int64_t(c[0]) + film.width > c[2] || int64_t(c[1]) + film.height > c[3])
+    report_.fail(pointer, "the {} x {} image at ({}, {}) does not fit in {} x {}", film.width, film.height, c[0], c[1],
+                 c[2], c[3]);
+  scene_.film.crop = FilmDesc::Crop{c[0], c[1], c[2], c[3]};
 }
 
 void JsonSceneReader::read_lens_and_shutter(CheckedObject& camera) {
@@ -243,6 +263,8 @@ void JsonSceneReader::read_filter_shape(CheckedObject& object, FilterDesc& filte
     filter.mitchell_b = object.number_or("b", filter.mitchell_b);
     filter.mitchell_c = object.number_or("c", filter.mitchell_c);
   }
+  if (filter.type == FilterType::LanczosSinc)
+    filter.sinc_tau = object.number_or("tau", filter.sinc_tau, Bound::Positive);
 }
 
 // One number for both axes, or [x, y].

@@ -126,8 +126,17 @@ void Converter::rfilter(const Object& r) {
     f.mitchell_b = get_float(r, "B", r.type == "mitchell" ? 1.0f / 3 : 0.0f);
     f.mitchell_c = get_float(r, "C", r.type == "mitchell" ? 1.0f / 3 : 0.5f);
     f.radius = {2, 2};
+  } else if (r.type == "lanczos") {
+    // Mitsuba's lanczos: sinc(x) sinc(x / lobes) out to `lobes` pixels.
+    f = default_filter(FilterType::LanczosSinc);
+    int lobes = get_int(r, "lobes", 3);
+    if (lobes < 1 || lobes > int(kMaxFilterRadius))
+      throw_scene_error(r.where.loc(), "{}: lobes must be in [1, {}], got {}", r.describe(), int(kMaxFilterRadius),
+                        lobes);
+    f.sinc_tau = float(lobes);
+    f.radius = {float(lobes), float(lobes)};
   } else {
-    unknown_type(r, "rfilter", r.type, {"box", "gaussian", "tent", "mitchell", "catmullrom"});
+    unknown_type(r, "rfilter", r.type, {"box", "gaussian", "tent", "mitchell", "catmullrom", "lanczos"});
   }
   check_all_used(r);
 }

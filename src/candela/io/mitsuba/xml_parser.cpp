@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "candela/io/mitsuba/object_tree.h"
+#include "candela/io/spectrum_file.h"
 
 namespace candela::mitsuba {
 namespace {
@@ -442,8 +443,8 @@ class XmlParser {
     throw_scene_error(where.loc(), "unknown element <{}>", tag);
   }
 
-  // Mitsuba's spectrum files: one "wavelength value" pair per line (nm), increasing; '#' starts a
-  // comment. The pairs then mean exactly what inline wavelength:value pairs mean.
+  // Mitsuba's spectrum files (io/spectrum_file.h): "wavelength value" pairs (nm), increasing. The
+  // pairs then mean exactly what inline wavelength:value pairs mean.
   void read_spectrum_file(const Document& doc, const std::string& name, const Where& where, Property& p) {
     fs::path file = doc.dir / name;
     if (!fs::exists(file)) {
@@ -451,27 +452,10 @@ class XmlParser {
       if (!found) throw_scene_error(where.loc(), "<spectrum>: file \"{}\" not found (searched {})", name, search_path_text());
       file = *found;
     }
-    std::ifstream in(file);
-    if (!in) throw_scene_error(where.loc(), "<spectrum>: cannot open \"{}\"", file.string());
-    std::string line;
-    for (int line_number = 1; std::getline(in, line); ++line_number) {
-      if (size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
-      std::vector<std::string> words = tokenize(line, " \t\r,");
-      if (words.empty()) continue;
-      double w = 0, v = 0;
-      auto parse = [&](const std::string& word, double& out) {
-        const char* end = word.data() + word.size();
-        auto [stop, error] = std::from_chars(word.data(), end, out);
-        return error == std::errc() && stop == end && std::isfinite(out);
-      };
-      if (words.size() != 2 || !parse(words[0], w) || !parse(words[1], v))
-        throw_scene_error(SourceLocation{file.string(), line_number, 1, {}},
-                          "expected \"wavelength value\" (two numbers), got \"{}\"", line);
-      if (!p.wavelengths.empty() && w <= p.wavelengths.back())
-        throw_scene_error(SourceLocation{file.string(), line_number, 1, {}}, "wavelengths must increase ({} after {})",
-                          w, p.wavelengths.back());
-      p.wavelengths.push_back(w);
-      p.values.push_back(v);
+    std::vector<double> pairs = candela::read_spectrum_file(file);
+    for (size_t i = 0; i < pairs.size(); i += 2) {
+      p.wavelengths.push_back(pairs[i]);
+      p.values.push_back(pairs[i + 1]);
     }
     if (p.wavelengths.size() < 2)
       throw_scene_error(where.loc(), "<spectrum>: \"{}\" holds fewer than two wavelength-value pairs", file.string());

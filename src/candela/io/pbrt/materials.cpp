@@ -64,30 +64,32 @@ MaterialDesc SceneParser::make_material(const std::string& type, const SourceLoc
     read_shading_normals(params);
     return m;
   }
+  // pbrt-v4's layered materials: a coat over a base with a slab between, random-walked
+  // (materials/layered.h), with every parameter as pbrt-v4 reads it.
   if (type == "coateddiffuse") {
-    CoatedDiffuseMaterial m;
+    LayeredDiffuseMaterial m;
     m.reflectance = read_color(params, "reflectance", Role::Reflectance).value_or(ColorInput(RGB(0.5f)));
     m.roughness = read_roughness(params);
     m.ior = read_ior(params, "eta").value_or(1.5f);
-    // candela's coat is the closed form of Mitsuba's plastic: an interface over a Lambertian base
-    // with every internal bounce summed, no layer in between. pbrt-v4 simulates the layer.
-    bool own_thickness = params.has_own("thickness");
-    if (std::optional<FloatInput> thickness = read_float_texture(params, "thickness"); thickness && own_thickness)
-      warn(params.where("thickness"),
-           "{}: \"thickness\" is ignored: candela's coated diffuse has no layer between coat and base (the "
-           "closed-form Mitsuba plastic model)",
-           params.owner());
-    std::optional<ColorInput> albedo = read_color(params, "albedo", Role::Reflectance);
-    if (albedo && !(albedo->is_constant() && albedo->value.is_black()))
-      warn(params.where("albedo"),
-           "{}: \"albedo\" is ignored: candela's coated diffuse has no scattering medium between coat and base "
-           "(the closed-form Mitsuba plastic model); the layer is rendered as if empty",
-           params.owner());
-    read_float_texture(params, "g");                  // only matters with an albedo
-    int max_depth = params.get_int("maxdepth", 10);   // pbrt's random walk through the layer: candela
-    int samples = params.get_int("nsamples", 1);      // sums the whole series in closed form
-    if (max_depth < 1) params.fail("maxdepth", "must be positive, got {}", max_depth);
-    if (samples < 1) params.fail("nsamples", "must be positive, got {}", samples);
+    m.layer = read_layer_slab(params);
+    read_shading_normals(params);
+    return m;
+  }
+  if (type == "coatedconductor") {
+    LayeredConductorMaterial m;  // the conductor is copper by default, as in pbrt-v4
+    m.roughness = read_roughness(params, "interface.");
+    m.ior = read_ior(params, "interface.eta").value_or(1.5f);
+    std::optional<ColorInput> eta = read_color(params, "conductor.eta", Role::Unbounded);
+    std::optional<ColorInput> k = read_color(params, "conductor.k", Role::Unbounded);
+    std::optional<ColorInput> reflectance = read_color(params, "reflectance", Role::Reflectance);
+    if (reflectance && (eta || k))
+      params.fail("reflectance", "cannot be given together with \"{}\" (as in pbrt-v4: the normal-incidence "
+                  "reflectance replaces the conductor's optical constants)", eta ? "conductor.eta" : "conductor.k");
+    if (eta) m.eta = *eta;
+    if (k) m.k = *k;
+    m.reflectance = reflectance;
+    m.conductor_roughness = read_roughness(params, "conductor.");
+    m.layer = read_layer_slab(params);
     read_shading_normals(params);
     return m;
   }
@@ -143,9 +145,25 @@ MaterialDesc SceneParser::make_material(const std::string& type, const SourceLoc
     return blend;
   }
   reject_type(type_where, "material", type,
-              {"diffuse", "conductor", "dielectric", "thindielectric", "coateddiffuse", "diffusetransmission", "interface",
-               "mix"},
-              {"coatedconductor", "hair", "measured", "subsurface"}, "candela has no BSDF for it");
+              {"diffuse", "conductor", "dielectric", "thindielectric", "coateddiffuse", "coatedconductor",
+               "diffusetransmission", "interface", "mix"},
+              {"hair", "measured", "subsurface"}, "candela has no BSDF for it");
+}
+
+LayerSlab SceneParser::read_layer_slab(ParamList& params) {
+  LayerSlab slab;
+  slab.thickness = read_float_texture(params, "thickness").value_or(FloatInput(0.01f));
+  if (slab.thickness.is_constant() && slab.thickness.value < 0)
+    params.fail("thickness", "must not be negative, got {}", slab.thickness.value);
+  slab.albedo = read_color(params, "albedo", Role::Reflectance).value_or(ColorInput(RGB(0.0f)));
+  slab.g = read_float_texture(params, "g").value_or(FloatInput(0.0f));
+  if (slab.g.is_constant()) slab.g.value = std::clamp(slab.g.value, -1.0f, 1.0f);  // as pbrt-v4 (textures: per hit)
+  slab.max_depth = params.get_int("maxdepth", 10);
+  slab.samples = params.get_int("nsamples", 1);
+  if (slab.max_depth < 1 || slab.max_depth > 65535)
+    params.fail("maxdepth", "must be in [1, 65535], got {}", slab.max_depth);
+  if (slab.samples < 1 || slab.samples > 65535) params.fail("nsamples", "must be in [1, 65535], got {}", slab.samples);
+  return slab;
 }
 
 // pbrt-v4's "string normalmap" (an image of tangent-space normals, 2 rgb - 1, read without colour

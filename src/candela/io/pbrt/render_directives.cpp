@@ -1,6 +1,8 @@
 // The rendering-option directives (before WorldBegin): Camera, Film, Sampler, Integrator,
 // PixelFilter, Accelerator, Option and ColorSpace.
+#include <algorithm>
 #include <climits>
+#include <cmath>
 #include <cstdint>
 
 #include "candela/io/pbrt/scene_parser.h"
@@ -12,7 +14,6 @@ namespace {
 // pbrt's limits on what a scene may ask for, beyond which the request is surely a mistake.
 constexpr int kMaxResolutionPerSide = 65536;
 constexpr int64_t kMaxPixels = int64_t{1} << 28;
-constexpr float kMaxFilterRadius = 64;  // pixels; the filter is tabulated per unit of radius
 
 }  // namespace
 
@@ -81,6 +82,37 @@ void SceneParser::film(const Token& d) {
                       "Film \"rgb\": {} x {} is too many pixels (at most 2^28 = {})", width, height, kMaxPixels);
   std::string filename = params.get_string("filename", "");
   params.get_bool("savefp16", true);  // the precision of the output file only
+  // The film's diagonal in mm only sizes pbrt-v4's realistic camera's sensor.
+  if (float diagonal = params.get_float("diagonal", 35); !(diagonal > 0))
+    params.fail("diagonal", "must be positive, got {}", diagonal);
+  pixel_bounds_.reset();
+  // pbrt-v4's image is the part of the full image inside pixelbounds [x0 x1 y0 y1] (in pixels, x1 and
+  // y1 excluded) or else cropwindow [x0 x1 y0 y1] (fractions, rounded up to pixels); world_begin
+  // narrows the camera's screen window to it.
+  if (params.has("pixelbounds")) {
+    std::vector<int> b = params.get_int_array("pixelbounds");
+    if (b.size() != 4) params.fail("pixelbounds", "takes 4 values [x0 x1 y0 y1], got {}", b.size());
+    if (!(0 <= b[0] && b[0] < b[1] && b[1] <= width && 0 <= b[2] && b[2] < b[3] && b[3] <= height))
+      params.fail("pixelbounds", "[{} {} {} {}] is not a non-empty part of the {} x {} image", b[0], b[1], b[2], b[3],
+                  width, height);
+    if (params.has("cropwindow"))
+      warn(params.where("cropwindow"), "Film \"rgb\": both \"pixelbounds\" and \"cropwindow\" are given; "
+           "\"pixelbounds\" is used, as in pbrt-v4");
+    params.take_any("cropwindow");
+    pixel_bounds_ = {b[0], b[1], b[2], b[3]};
+  } else if (params.has("cropwindow")) {
+    std::vector<double> c = params.get_floats("cropwindow");
+    if (c.size() != 4) params.fail("cropwindow", "takes 4 values [x0 x1 y0 y1], got {}", c.size());
+    auto to_pixel = [](double fraction, int size) {
+      return static_cast<int>(std::ceil(std::clamp(fraction, 0.0, 1.0) * size));
+    };
+    std::array<int, 4> b = {to_pixel(std::min(c[0], c[1]), width), to_pixel(std::max(c[0], c[1]), width),
+                            to_pixel(std::min(c[2], c[3]), height), to_pixel(std::max(c[2], c[3]), height)};
+    if (!(b[0] < b[1] && b[2] < b[3]))
+      params.fail("cropwindow", "[{} {} {} {}] holds no pixel of the {} x {} image", c[0], c[1], c[2], c[3], width,
+                  height);
+    pixel_bounds_ = b;
+  }
   ignore_param(params, "maxcomponentvalue", "candela does not clamp sample values (pbrt would, trading energy "
                "for fewer fireflies)");
   params.reject_unused();
@@ -241,8 +273,10 @@ void SceneParser::pixel_filter(const Token& d) {
     filter = default_filter(FilterType::Gaussian);
   else if (type.text == "mitchell")
     filter = default_filter(FilterType::Mitchell);
+  else if (type.text == "sinc")
+    filter = default_filter(FilterType::LanczosSinc);
   else
-    reject_type(at(type), "pixel filter", type.text, {"box", "triangle", "gaussian", "mitchell"}, {"sinc"});
+    reject_type(at(type), "pixel filter", type.text, {"box", "triangle", "gaussian", "mitchell", "sinc"}, {});
   ParamList params = read_params(d, fmt::format("PixelFilter \"{}\"", type.text));
   filter.radius = {params.get_float("xradius", filter.radius.x), params.get_float("yradius", filter.radius.y)};
   for (auto [name, radius] : {std::pair{"xradius", filter.radius.x}, std::pair{"yradius", filter.radius.y}})
@@ -255,6 +289,10 @@ void SceneParser::pixel_filter(const Token& d) {
   if (filter.type == FilterType::Mitchell) {
     filter.mitchell_b = params.get_float("B", filter.mitchell_b);
     filter.mitchell_c = params.get_float("C", filter.mitchell_c);
+  }
+  if (filter.type == FilterType::LanczosSinc) {
+    filter.sinc_tau = params.get_float("tau", filter.sinc_tau);
+    if (!(filter.sinc_tau > 0)) params.fail("tau", "must be positive, got {}", filter.sinc_tau);
   }
   params.reject_unused();
   options_.filter = filter;

@@ -431,6 +431,24 @@ void SceneParser::reverse_orientation(const Token& d) {
   state_.reverse_orientation = !state_.reverse_orientation;
 }
 
+void SceneParser::crop_film(const std::array<int, 4>& bounds) {
+  const auto [x0, x1, y0, y1] = bounds;
+  const int width = scene_.film.width, height = scene_.film.height;
+  if (x0 == 0 && y0 == 0 && x1 == width && y1 == height) return;  // the whole image
+  // The full image's screen window (pbrt-v4's default frames the smaller axis by [-1, 1]), of which the
+  // part over the crop's pixels becomes the camera's; screen y points up, pixel rows down.
+  CameraDesc& camera = scene_.camera;
+  const float aspect = float(width) / float(height);
+  const std::array<float, 4> full = camera.screen_window.value_or(
+      aspect > 1 ? std::array<float, 4>{-aspect, aspect, -1, 1} : std::array<float, 4>{-1, 1, -1 / aspect, 1 / aspect});
+  auto screen_x = [&](int px) { return full[0] + (full[1] - full[0]) * float(px) / float(width); };
+  auto screen_y = [&](int py) { return full[3] - (full[3] - full[2]) * float(py) / float(height); };
+  camera.screen_window = std::array<float, 4>{screen_x(x0), screen_x(x1), screen_y(y1), screen_y(y0)};
+  scene_.film.crop = FilmDesc::Crop{x0, y0, width, height};
+  scene_.film.width = x1 - x0;
+  scene_.film.height = y1 - y0;
+}
+
 void SceneParser::world_begin(const Token& d) {
   require_options(d);
   section_ = Section::World;
@@ -442,6 +460,7 @@ void SceneParser::world_begin(const Token& d) {
     camera.screen_window = aspect > 1 ? std::array<float, 4>{-aspect, aspect, -1, 1}
                                       : std::array<float, 4>{-1, 1, -1 / aspect, 1 / aspect};
   }
+  if (pixel_bounds_) crop_film(*pixel_bounds_);
   world_begin_ = at(d);
   state_.ctm = {};
   state_.active_transforms = kAllTransforms;

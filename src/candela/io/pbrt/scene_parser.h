@@ -14,6 +14,7 @@
 // file:line:column; what would change the image materially is an error.
 #include <fmt/format.h>
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -51,7 +52,7 @@ struct BuiltGeometry {
   ShapeGeometry geometry;
   // Meshes: the pbrt primitive each triangle belongs to (empty: each triangle is its own).
   std::vector<uint32_t> primitive_of_triangle;
-  // Spheres and disks: pbrt's object-space area (pbrt ignores the CTM's scale here).
+  // Spheres, cylinders and disks: pbrt's object-space area (pbrt ignores the CTM's scale here).
   float object_area = 0;
 };
 
@@ -192,6 +193,10 @@ class SceneParser {
 
   // the rendering options, once read
   void write_render_settings(RenderSettings& settings) const;
+  // The Film's pixelbounds or cropwindow as pixels [x0, x1) x [y0, y1) of the full image, if given.
+  std::optional<std::array<int, 4>> pixel_bounds_;
+  // Makes the film that part of the full image: the camera's screen window narrowed to it.
+  void crop_film(const std::array<int, 4>& bounds);
 
   // spectra and textured parameters
   std::optional<ColorInput> read_color(ParamList& params, std::string_view name, pbrt_spectra::Role role);
@@ -199,7 +204,14 @@ class SceneParser {
   std::optional<RGB> read_emission(ParamList& params, std::string_view name);
   std::optional<RGB> read_spectrum(ParamList& params, std::string_view name, pbrt_spectra::Role role);
   std::optional<float> read_ior(ParamList& params, std::string_view name);
-  Roughness read_roughness(ParamList& params);
+  // A "spectrum" parameter's value as RGB: a named spectrum, a spectrum file or (wavelength, value) pairs.
+  RGB spectrum_rgb(const Param& p, const ParamList& params, pbrt_spectra::Role role);
+  // The pairs of the spectrum file a "spectrum" parameter's string names, read once per file.
+  const std::vector<double>& spectrum_file_pairs(const Param& p, const ParamList& params);
+  std::map<fs::path, std::vector<double>> spectrum_files_;
+  Roughness read_roughness(ParamList& params, std::string_view prefix = {});
+  // The slab of pbrt-v4's layered materials: thickness, albedo, g, maxdepth, nsamples.
+  LayerSlab read_layer_slab(ParamList& params);
   // A material's shading-normal parameters (every pbrt-v4 material but "mix" and "interface"):
   // read_shading_normals reads them into shading_normals_, wrap_shading_normals wraps the material
   // added after it.
@@ -225,10 +237,12 @@ class SceneParser {
   int add_material(MaterialDesc material, const SourceLocation& where);
   void add_light(LightDesc light, const SourceLocation& where);
   BuiltGeometry make_sphere(ParamList& params);
+  BuiltGeometry make_cylinder(ParamList& params);
   BuiltGeometry make_triangle_mesh(ParamList& params);
   BuiltGeometry make_ply_mesh(ParamList& params);
   BuiltGeometry make_disk(ParamList& params);
   BuiltGeometry make_bilinear_mesh(ParamList& params);
+  BuiltGeometry make_loop_subdivision(ParamList& params);
   RGB read_light_scale(ParamList& params, RGB emitted);
   void require_static_light(const Token& directive, const Token& type) const;
   void add_emissive_shape(ShapeDesc shape, const BuiltGeometry& built, const Token& directive);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 
+#include "candela/geometry/loop_subdivision.h"
 #include "candela/io/mesh_io.h"
 #include "candela/io/pbrt/scene_parser.h"
 
@@ -17,20 +18,64 @@ constexpr int kBilinearPatchTessellation = 16;  // a non-planar bilinear patch b
 
 }  // namespace
 
-// pbrt clamps zmin/zmax to the radius and phimax to 360; anything less than the whole sphere is
-// a partial sphere, which candela cannot represent.
+namespace {
+
+// pbrt-v4's phimax of a sphere or cylinder, in degrees: in (0, 360] (pbrt-v4 clamps it to [0, 360];
+// 0 would leave nothing, and a value past a full turn is taken for a mistake).
+float read_phi_max(ParamList& params) {
+  float phi_max = params.get_float("phimax", 360);
+  if (!(phi_max > 0 && phi_max <= 360)) params.fail("phimax", "must be in (0, 360] degrees, got {}", phi_max);
+  return phi_max;
+}
+
+// pbrt-v4's zmin and zmax of a sphere or cylinder: zmin below zmax (pbrt-v4 would swap them).
+void check_z_range(ParamList& params, float z_min, float z_max) {
+  if (!(z_min < z_max)) params.fail("zmax", "must exceed \"zmin\" ({}), got {}", z_min, z_max);
+}
+
+}  // namespace
+
+// pbrt-v4's sphere: radius, and the partial sphere of zmin <= z <= zmax (clamped to the radius, as
+// pbrt-v4 does) and phi <= phimax, with pbrt-v4's (u, v) of the part kept. A value that cuts nothing
+// off leaves the whole sphere (written without the cut).
 BuiltGeometry SceneParser::make_sphere(ParamList& params) {
   float radius = params.get_float("radius", 1);
   if (!(radius > 0)) params.fail("radius", "must be positive, got {}", radius);
   float z_min = params.get_float("zmin", -radius);
   float z_max = params.get_float("zmax", radius);
-  float phi_max = params.get_float("phimax", 360);
-  if (std::min(z_min, z_max) > -radius) params.fail("zmin", "cuts the sphere: partial spheres are not supported yet");
-  if (std::max(z_min, z_max) < radius) params.fail("zmax", "cuts the sphere: partial spheres are not supported yet");
-  if (phi_max < 360) params.fail("phimax", "cuts the sphere: partial spheres are not supported yet");
+  float phi_max = read_phi_max(params);
+  if (!(z_min < radius)) params.fail("zmin", "must be below the radius ({}) or nothing is left, got {}", radius, z_min);
+  if (!(z_max > -radius))
+    params.fail("zmax", "must be above minus the radius ({}) or nothing is left, got {}", -radius, z_max);
+  check_z_range(params, z_min, z_max);
+  SphereShape sphere{Point3(0.0f), radius, SphereUv::Pbrt};
+  sphere.z_min_given = z_min > -radius;
+  sphere.z_max_given = z_max < radius;
+  if (sphere.z_min_given) sphere.z_min = z_min;
+  if (sphere.z_max_given) sphere.z_max = z_max;
+  sphere.phi_max = phi_max;
   BuiltGeometry built;
-  built.geometry = SphereShape{Point3(0.0f), radius, SphereUv::Pbrt};
-  built.object_area = 4 * kPi * radius * radius;
+  built.geometry = sphere;
+  // pbrt-v4's Area(): phimax r (zmax - zmin), the heights clamped (4 pi r^2 for the whole sphere).
+  built.object_area = sphere.partial()
+                          ? static_cast<float>(radians(phi_max) * double(radius) * (double(sphere.z_hi()) - sphere.z_lo()))
+                          : 4 * kPi * radius * radius;
+  return built;
+}
+
+// pbrt-v4's cylinder: the open tube x^2 + y^2 = radius^2 for zmin <= z <= zmax and phi <= phimax, a
+// CylinderShape from (0, 0, zmin) to (0, 0, zmax) (its phi from +x, (u, v) = (phi / phimax,
+// (z - zmin) / (zmax - zmin)), as pbrt-v4's).
+BuiltGeometry SceneParser::make_cylinder(ParamList& params) {
+  float radius = params.get_float("radius", 1);
+  if (!(radius > 0)) params.fail("radius", "must be positive, got {}", radius);
+  float z_min = params.get_float("zmin", -1);
+  float z_max = params.get_float("zmax", 1);
+  float phi_max = read_phi_max(params);
+  check_z_range(params, z_min, z_max);
+  BuiltGeometry built;
+  built.geometry = CylinderShape{{0, 0, z_min}, {0, 0, z_max}, radius, phi_max};
+  built.object_area = static_cast<float>(radians(phi_max) * double(radius) * (double(z_max) - z_min));
   return built;
 }
 
@@ -200,6 +245,39 @@ BuiltGeometry SceneParser::make_bilinear_mesh(ParamList& params) {
   return built;
 }
 
+// pbrt-v4's Loop subdivision surface: "levels" (3) levels of Loop subdivision of the triangles
+// "indices" over the points "P", every vertex then on the limit surface with the limit surface's
+// normal (geometry/loop_subdivision.h, with pbrt-v4's rules; the normals face away from the
+// triangles' winding, as pbrt-v4's do). "scheme" is read and not used, as in pbrt-v4.
+BuiltGeometry SceneParser::make_loop_subdivision(ParamList& params) {
+  int levels = params.get_int("levels", 3);
+  std::vector<Vec3> p = params.get_vec3_array("P", "point3");
+  std::vector<int> indices = params.get_int_array("indices");
+  std::string scheme = params.get_string("scheme", "loop");
+  size_t n = p.size();
+  if (n == 0) params.fail("P", "is required: give the control mesh's points as \"point3 P\"");
+  if (indices.empty())
+    params.fail("indices", "is required: give the control mesh's triangles as \"integer indices\", three each");
+  if (indices.size() % 3 != 0)
+    params.fail("indices", "has {} values, which is not a multiple of 3 (three per triangle)", indices.size());
+  for (size_t i = 0; i < indices.size(); ++i)
+    if (indices[i] < 0 || static_cast<size_t>(indices[i]) >= n)
+      params.fail("indices", "value {} (number {}) is out of range: \"P\" has {} points", indices[i], i + 1, n);
+  if (levels < 0) params.fail("levels", "must be at least 0, got {}", levels);
+  if (uint64_t triangles = loop_subdivision_triangle_count(indices.size() / 3, levels);
+      triangles > kMaxLoopSubdivisionTriangles)
+    params.fail("levels", "{} would make {} triangles of the {} given, more than the {} candela makes of one shape; "
+                "give fewer levels", levels,
+                triangles == UINT64_MAX ? std::string("too many") : std::to_string(triangles), indices.size() / 3,
+                kMaxLoopSubdivisionTriangles);
+  if (std::string problem = loop_subdivision_problem(n, indices, levels); !problem.empty())
+    params.fail("indices", "do not make a mesh that can be subdivided: {}", problem);
+  if (scheme != "loop")
+    warn(params.where("scheme"), "{}: \"scheme\" \"{}\" is ignored: pbrt-v4 subdivides with Loop's scheme whatever "
+         "it names, and so does candela", params.owner(), scheme);
+  return BuiltGeometry{MeshShape{loop_subdivide(p, indices, levels, LoopRules::PbrtV4)}, {}, 0};
+}
+
 namespace {
 
 // The triangles `triangles` of `mesh` as a mesh of their own.
@@ -302,6 +380,8 @@ void SceneParser::shape(const Token& d) {
   BuiltGeometry built;
   if (type.text == "sphere")
     built = make_sphere(params);
+  else if (type.text == "cylinder")
+    built = make_cylinder(params);
   else if (type.text == "trianglemesh")
     built = make_triangle_mesh(params);
   else if (type.text == "plymesh")
@@ -310,9 +390,12 @@ void SceneParser::shape(const Token& d) {
     built = make_disk(params);
   else if (type.text == "bilinearmesh")
     built = make_bilinear_mesh(params);
+  else if (type.text == "loopsubdiv")
+    built = make_loop_subdivision(params);
   else
-    reject_type(at(type), "shape", type.text, {"sphere", "trianglemesh", "plymesh", "disk", "bilinearmesh"},
-                {"curve", "cylinder", "loopsubdiv"}, "candela has no primitive or tessellation for it");
+    reject_type(at(type), "shape", type.text,
+                {"sphere", "cylinder", "trianglemesh", "plymesh", "disk", "bilinearmesh", "loopsubdiv"}, {"curve"},
+                "candela has no primitive or tessellation for it");
   if (const Param* alpha = params.take("alpha", {"float", "texture"})) {
     params.expect_count(*alpha, 1);
     if (alpha->type == "texture")

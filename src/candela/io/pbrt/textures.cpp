@@ -1,8 +1,10 @@
 // Colours, spectra and textured parameters, and the Texture directive.
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 #include "candela/io/pbrt/scene_parser.h"
+#include "candela/io/spectrum_file.h"
 
 namespace candela::pbrt {
 
@@ -10,21 +12,42 @@ using pbrt_spectra::Role;
 
 namespace {
 
-// A "spectrum" parameter's value as RGB: a named spectrum or (wavelength, value) pairs.
-RGB spectrum_rgb(const Param& p, const ParamList& params, Role role) {
+// Checks (wavelength, value) pairs written inline in the scene (a file's were checked as it was read)
+// and turns them into RGB for `role`.
+RGB sampled_pairs_rgb(std::span<const double> pairs, const Param& p, const ParamList& params, Role role) {
+  for (size_t i = 0; i < pairs.size(); i += 2)
+    if (pairs[i + 1] < 0)
+      throw_scene_error(p.where, "{}: {}: the value at {} nm is negative ({})", params.owner(), p.declaration(),
+                        pairs[i], pairs[i + 1]);
+  RGB rgb = pbrt_spectra::sampled_spectrum_rgb(pairs, role);
+  rgb = rgb.map([](float v) { return std::max(v, 0.0f); });
+  if (role == Role::Reflectance) rgb = rgb.map([](float v) { return std::min(v, 1.0f); });
+  return rgb;
+}
+
+}  // namespace
+
+// As pbrt-v4 does: a string that is not a named spectrum is a file name, looked up as other files are.
+const std::vector<double>& SceneParser::spectrum_file_pairs(const Param& p, const ParamList& params) {
+  const std::string& name = p.strings[0];
+  std::string names;
+  for (std::string_view n : pbrt_spectra::named_spectrum_names())
+    names += fmt::format("{}\"{}\"", names.empty() ? "" : ", ", n);
+  fs::path file = resolve_path(
+      name, p.where,
+      fmt::format("{}: {}: \"{}\" is neither a named spectrum ({}) nor a spectrum file", params.owner(),
+                  p.declaration(), name, names));
+  auto cached = spectrum_files_.find(file);
+  if (cached == spectrum_files_.end()) cached = spectrum_files_.emplace(file, read_spectrum_file(file)).first;
+  return cached->second;
+}
+
+RGB SceneParser::spectrum_rgb(const Param& p, const ParamList& params, Role role) {
   if (!p.strings.empty()) {
     params.expect_count(p, 1);
     const std::string& name = p.strings[0];
     std::optional<pbrt_spectra::NamedSpectrum> named = pbrt_spectra::find_named(name);
-    if (!named) {
-      std::string names;
-      for (std::string_view n : pbrt_spectra::named_spectrum_names())
-        names += fmt::format("{}\"{}\"", names.empty() ? "" : ", ", n);
-      throw_scene_error(p.where,
-                        "{}: {}: unknown named spectrum \"{}\" (spectrum files are not supported; the named spectra "
-                        "are {})",
-                        params.owner(), p.declaration(), name, names);
-    }
+    if (!named) return sampled_pairs_rgb(spectrum_file_pairs(p, params), p, params, role);
     bool fits = role == Role::Illuminant ? named->kind == pbrt_spectra::NamedKind::Illuminant
                                          : named->kind != pbrt_spectra::NamedKind::Illuminant;
     if (!fits || role == Role::Reflectance)
@@ -35,21 +58,12 @@ RGB spectrum_rgb(const Param& p, const ParamList& params, Role role) {
     return named->rgb;
   }
   params.expect_multiple(p, 2);
-  for (size_t i = 0; i < p.numbers.size(); i += 2) {
-    if (i > 0 && !(p.numbers[i] > p.numbers[i - 2]))
+  for (size_t i = 2; i < p.numbers.size(); i += 2)
+    if (!(p.numbers[i] > p.numbers[i - 2]))
       throw_scene_error(p.where, "{}: {}: the wavelengths must increase ({} follows {})", params.owner(),
                         p.declaration(), p.numbers[i], p.numbers[i - 2]);
-    if (p.numbers[i + 1] < 0)
-      throw_scene_error(p.where, "{}: {}: the value at {} nm is negative ({})", params.owner(), p.declaration(),
-                        p.numbers[i], p.numbers[i + 1]);
-  }
-  RGB rgb = pbrt_spectra::sampled_spectrum_rgb(p.numbers, role);
-  rgb = rgb.map([](float v) { return std::max(v, 0.0f); });
-  if (role == Role::Reflectance) rgb = rgb.map([](float v) { return std::min(v, 1.0f); });
-  return rgb;
+  return sampled_pairs_rgb(p.numbers, p, params, role);
 }
-
-}  // namespace
 
 // A colour parameter of a material or texture: "rgb", "spectrum" or "texture" (a spectrum texture).
 // `is_albedo` limits constant colours to [0, 1], as pbrt-v4 does for reflectances.
@@ -132,6 +146,8 @@ std::optional<float> SceneParser::read_ior(ParamList& params, std::string_view n
     std::optional<pbrt_spectra::NamedSpectrum> named = pbrt_spectra::find_named(p->strings[0]);
     if (named && named->kind == pbrt_spectra::NamedKind::Glass)
       ior = named->ior_550nm;
+    else if (!named)
+      ior = pbrt_spectra::sampled_spectrum_at(spectrum_file_pairs(*p, params), 550);
     else
       throw_scene_error(p->where,
                         "{}: {}: \"{}\" is not one of pbrt-v4's glasses (\"glass-BK7\", \"glass-BAF10\", "
@@ -146,16 +162,18 @@ std::optional<float> SceneParser::read_ior(ParamList& params, std::string_view n
 }
 
 // pbrt-v4's microfacet roughness: "roughness" for both axes unless "uroughness"/"vroughness" are
-// given; "remaproughness" (true) reads them as roughness and uses alpha = sqrt(roughness).
-Roughness SceneParser::read_roughness(ParamList& params) {
+// given; "remaproughness" (true) reads them as roughness and uses alpha = sqrt(roughness). `prefix`
+// names one layer of a coated conductor ("interface.", "conductor."); "remaproughness" has none.
+Roughness SceneParser::read_roughness(ParamList& params, std::string_view prefix) {
+  const std::string p(prefix), both_name = p + "roughness", u_name = p + "uroughness", v_name = p + "vroughness";
   Roughness roughness;
-  FloatInput both = read_float_texture(params, "roughness").value_or(FloatInput(0.0f));
-  roughness.u = read_float_texture(params, "uroughness").value_or(both);
-  roughness.v = read_float_texture(params, "vroughness").value_or(both);
+  FloatInput both = read_float_texture(params, both_name).value_or(FloatInput(0.0f));
+  roughness.u = read_float_texture(params, u_name).value_or(both);
+  roughness.v = read_float_texture(params, v_name).value_or(both);
   roughness.remap = params.get_bool("remaproughness", true);
-  for (auto [name, value] : {std::pair{"roughness", both}, std::pair{"uroughness", roughness.u},
-                             std::pair{"vroughness", roughness.v}})
-    if (value.is_constant() && value.value < 0) params.fail(name, "must not be negative, got {}", value.value);
+  for (auto [name, value] : {std::pair{&both_name, both}, std::pair{&u_name, roughness.u},
+                             std::pair{&v_name, roughness.v}})
+    if (value.is_constant() && value.value < 0) params.fail(*name, "must not be negative, got {}", value.value);
   return roughness;
 }
 
