@@ -18,7 +18,7 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-SceneDesc single_shape(ShapeGeometry g, const Transform& to_world, bool reverse = false) {
+SceneDesc single_partial_shape(ShapeGeometry g, const Transform& to_world, bool reverse = false) {
   SceneDesc d;
   ShapeDesc s;
   s.geometry = std::move(g);
@@ -28,7 +28,7 @@ SceneDesc single_shape(ShapeGeometry g, const Transform& to_world, bool reverse 
   return d;
 }
 
-void expect_vec_near(const Vec3& a, const Vec3& b, float tol, const std::string& what) {
+void expect_partial_vec_near(const Vec3& a, const Vec3& b, float tol, const std::string& what) {
   EXPECT_NEAR(a.x, b.x, tol) << what;
   EXPECT_NEAR(a.y, b.y, tol) << what;
   EXPECT_NEAR(a.z, b.z, tol) << what;
@@ -67,7 +67,7 @@ struct PartialSphereCase {
 TEST(PartialSphere, KeptPointsHaveThePbrtParameterisation) {
   const PartialSphereCase c;
   for (bool reverse : {false, true}) {
-    Scene scene(single_shape(c.sphere, c.T, reverse));
+    Scene scene(single_partial_shape(c.sphere, c.T, reverse));
     Rng rng(3, 4);
     for (int i = 0; i < 2000; ++i) {
       float u = 0.002f + 0.996f * rng.next_float(), v = 0.002f + 0.996f * rng.next_float();
@@ -78,17 +78,17 @@ TEST(PartialSphere, KeptPointsHaveThePbrtParameterisation) {
       std::string what = "sphere sample " + std::to_string(i) + (reverse ? " (reversed)" : "");
       ASSERT_TRUE(scene.intersect(Ray{target + outward * 3.0f, -outward, kInf, 0}, hit)) << what;
       EXPECT_NEAR(hit.t, 3, 2e-4f) << what;
-      expect_vec_near(hit.p, target, 2e-4f, what + " p");
+      expect_partial_vec_near(hit.p, target, 2e-4f, what + " p");
       EXPECT_NEAR(hit.uv.x, u, 2e-4f) << what;
       EXPECT_NEAR(hit.uv.y, v, 2e-4f) << what;
-      expect_vec_near(hit.ng, reverse ? -outward : outward, 1e-4f, what + " ng");
+      expect_partial_vec_near(hit.ng, reverse ? -outward : outward, 1e-4f, what + " ng");
       // dp/du and dp/dv: central differences of the parameterisation (where both sides are on it).
       const float h = 1e-3f;
       if (u > h && u < 1 - h && v > h && v < 1 - h) {
         Vec3 dpdu = (c.world(c.offset(u + h, v)) - c.world(c.offset(u - h, v))) / (2 * h);
         Vec3 dpdv = (c.world(c.offset(u, v + h)) - c.world(c.offset(u, v - h))) / (2 * h);
-        expect_vec_near(hit.dpdu, dpdu, 2e-3f * length(dpdu), what + " dpdu");
-        expect_vec_near(hit.dpdv, dpdv, 2e-3f * length(dpdv) + 1e-4f, what + " dpdv");
+        expect_partial_vec_near(hit.dpdu, dpdu, 2e-3f * length(dpdu), what + " dpdu");
+        expect_partial_vec_near(hit.dpdv, dpdv, 2e-3f * length(dpdv) + 1e-4f, what + " dpdv");
       }
     }
   }
@@ -96,7 +96,7 @@ TEST(PartialSphere, KeptPointsHaveThePbrtParameterisation) {
 
 TEST(PartialSphere, ARayThroughTheCutSeesTheInsideOfTheFarSide) {
   const PartialSphereCase c;
-  Scene scene(single_shape(c.sphere, c.T));
+  Scene scene(single_partial_shape(c.sphere, c.T));
   Rng rng(5, 6);
   for (int i = 0; i < 1000; ++i) {
     // Aimed along the normal at a point of the cut-away azimuths (270 to 360 degrees), height within
@@ -112,9 +112,9 @@ TEST(PartialSphere, ARayThroughTheCutSeesTheInsideOfTheFarSide) {
     std::string what = "through the cut " + std::to_string(i);
     ASSERT_TRUE(scene.intersect(Ray{start, -outward, kInf, 0}, hit)) << what;
     EXPECT_NEAR(hit.t, length(far - start), 3e-4f) << what;
-    expect_vec_near(hit.p, far, 3e-4f, what + " p");
+    expect_partial_vec_near(hit.p, far, 3e-4f, what + " p");
     // The normal still points outwards, away from the ray: its inside is what the ray sees.
-    expect_vec_near(hit.ng, normalize(c.T.normal(-local)), 1e-4f, what + " ng");
+    expect_partial_vec_near(hit.ng, normalize(c.T.normal(-local)), 1e-4f, what + " ng");
     EXPECT_GT(dot(hit.ng, -outward), 0.99f) << what;
     Vec3 far_local = -local;
     float theta = std::acos(far_local.z / c.sphere.radius);
@@ -125,7 +125,7 @@ TEST(PartialSphere, ARayThroughTheCutSeesTheInsideOfTheFarSide) {
 
 TEST(PartialSphere, RaysThatMeetOnlyTheCutAwayPartMiss) {
   const PartialSphereCase c;
-  Scene scene(single_shape(c.sphere, c.T));
+  Scene scene(single_partial_shape(c.sphere, c.T));
   SurfaceHit hit;
   // Down the sphere's own z axis: through the cap above z_max and the cap below z_min.
   Point3 above = c.world({0, 0, 3}), below = c.world({0, 0, -3});
@@ -143,7 +143,7 @@ TEST(PartialSphere, RaysThatMeetOnlyTheCutAwayPartMiss) {
     // The same chord turned by 180 degrees lies in the kept azimuths.
     Point3 a2 = at(100), b2 = at(170);
     EXPECT_TRUE(scene.intersect(Ray{a2 + (a2 - b2), normalize(b2 - a2), kInf, 0}, hit)) << "kept chord at z " << z;
-    expect_vec_near(hit.p, a2, 3e-4f, "kept chord");
+    expect_partial_vec_near(hit.p, a2, 3e-4f, "kept chord");
   }
 }
 
@@ -192,27 +192,27 @@ TEST(PartialSphere, EmptyOrInvalidCutsAreSceneErrors) {
   SphereShape s{{0, 0, 0}, 1, SphereUv::Pbrt};
   s.z_min = 1.5f;  // above the sphere: nothing left
   s.z_min_given = true;
-  EXPECT_THROW(Scene{single_shape(s, Transform())}, SceneError);
+  EXPECT_THROW(Scene{single_partial_shape(s, Transform())}, SceneError);
   s.z_min = 0.5f;
   s.z_max = 0.25f;
   s.z_max_given = true;
-  EXPECT_THROW(Scene{single_shape(s, Transform())}, SceneError);
+  EXPECT_THROW(Scene{single_partial_shape(s, Transform())}, SceneError);
   s.z_max = 0.75f;
-  EXPECT_NO_THROW(Scene{single_shape(s, Transform())});
+  EXPECT_NO_THROW(Scene{single_partial_shape(s, Transform())});
   for (float phi_max : {0.0f, -10.0f, 361.0f, std::nanf("")}) {
     SphereShape p{{0, 0, 0}, 1, SphereUv::Pbrt};
     p.phi_max = phi_max;
-    EXPECT_THROW(Scene{single_shape(p, Transform())}, SceneError) << phi_max;
+    EXPECT_THROW(Scene{single_partial_shape(p, Transform())}, SceneError) << phi_max;
     CylinderShape cyl;
     cyl.phi_max = phi_max;
-    EXPECT_THROW(Scene{single_shape(cyl, Transform())}, SceneError) << phi_max;
+    EXPECT_THROW(Scene{single_partial_shape(cyl, Transform())}, SceneError) << phi_max;
   }
 }
 
 // ---------------------------------------------------------------- partial cylinders
 
 // A shear, a non-uniform scale and a turn, as the whole cylinders' tests use.
-Transform skewed_transform() {
+Transform partial_skewed_transform() {
   Matrix4 shear = Matrix4::identity();
   shear.m[0][1] = 0.3;
   shear.m[2][0] = -0.2;
@@ -221,12 +221,12 @@ Transform skewed_transform() {
 }
 
 TEST(PartialCylinder, KeptPointsHaveThePbrtParameterisation) {
-  const Transform T = skewed_transform();
+  const Transform T = partial_skewed_transform();
   const CylinderShape c{{0.2f, -0.1f, 0.3f}, {-0.4f, 0.5f, 1.8f}, 0.7f, 270};
   const float phi_max = 1.5f * kPi;
   const Vec3 axis = c.p1 - c.p0;
   const Frame f(normalize(axis));  // phi = 0 along f.s
-  Scene scene(single_shape(c, T));
+  Scene scene(single_partial_shape(c, T));
   Rng rng(7, 8);
   for (int i = 0; i < 2000; ++i) {
     float h = 0.001f + 0.998f * rng.next_float(), u = 0.001f + 0.998f * rng.next_float(), phi = u * phi_max;
@@ -237,21 +237,21 @@ TEST(PartialCylinder, KeptPointsHaveThePbrtParameterisation) {
     SurfaceHit hit;
     ASSERT_TRUE(scene.intersect(Ray{target + outward * 3.0f, -outward, kInf, 0}, hit)) << what;
     EXPECT_NEAR(hit.t, 3, 2e-4f) << what;
-    expect_vec_near(hit.p, target, 2e-4f, what + " p");
+    expect_partial_vec_near(hit.p, target, 2e-4f, what + " p");
     EXPECT_NEAR(hit.uv.x, u, 1e-4f) << what;  // pbrt-v4: u = phi / phimax, v = (z - zmin) / (zmax - zmin)
     EXPECT_NEAR(hit.uv.y, h, 1e-4f) << what;
-    expect_vec_near(hit.ng, outward, 1e-4f, what + " ng");
-    expect_vec_near(hit.dpdu, T.vector((f.t * std::cos(phi) - f.s * std::sin(phi)) * (phi_max * c.radius)), 3e-4f,
+    expect_partial_vec_near(hit.ng, outward, 1e-4f, what + " ng");
+    expect_partial_vec_near(hit.dpdu, T.vector((f.t * std::cos(phi) - f.s * std::sin(phi)) * (phi_max * c.radius)), 3e-4f,
                     what + " dpdu");
   }
 }
 
 TEST(PartialCylinder, ARayThroughTheCutSeesTheInsideAndOneOutsidePhiMaxMisses) {
-  const Transform T = skewed_transform();
+  const Transform T = partial_skewed_transform();
   const CylinderShape c{{0.2f, -0.1f, 0.3f}, {-0.4f, 0.5f, 1.8f}, 0.7f, 270};
   const Vec3 axis = c.p1 - c.p0;
   const Frame f(normalize(axis));
-  Scene scene(single_shape(c, T));
+  Scene scene(single_partial_shape(c, T));
   auto point = [&](float degrees, float r, float h) {
     float phi = radians(degrees);
     return T.point(c.p0 + (f.s * std::cos(phi) + f.t * std::sin(phi)) * (r * c.radius) + axis * h);
@@ -266,7 +266,7 @@ TEST(PartialCylinder, ARayThroughTheCutSeesTheInsideAndOneOutsidePhiMaxMisses) {
     std::string what = "through the cut " + std::to_string(i);
     ASSERT_TRUE(scene.intersect(Ray{start, normalize(far - start), kInf, 0}, hit)) << what;
     EXPECT_NEAR(hit.t, length(far - start), 3e-4f) << what;
-    expect_vec_near(hit.p, far, 3e-4f, what + " p");
+    expect_partial_vec_near(hit.p, far, 3e-4f, what + " p");
     EXPECT_GT(dot(hit.ng, normalize(far - start)), 0) << what << ": the inside faces the ray";
     EXPECT_NEAR(hit.uv.x, (degrees - 180) / 270, 1e-4f) << what;
     EXPECT_NEAR(hit.uv.y, h, 1e-4f) << what;
