@@ -17,7 +17,7 @@ namespace {
 struct Numbers {
   float camera[3], light[5];
 };
-Numbers read(MltSampler& sampler) {
+Numbers read_numbers(MltSampler& sampler) {
   Numbers n{};
   sampler.start_stream(MltSampler::kCameraStream);
   for (float& x : n.camera) x = sampler.get_1d();
@@ -30,11 +30,11 @@ const MltPerturbedNumbers kPerturbed{1, 3, {64, 32}};
 
 TEST(MltSampler, EachPerturbationMovesOnlyItsPair) {
   MltSampler sampler(7, 3, 0.01f, {0.1f, 0.3f, 0.3f}, kPerturbed);
-  Numbers current = read(sampler);  // the start: a large step
+  Numbers current = read_numbers(sampler);  // the start: a large step
   int lens = 0, caustic = 0;
   for (int i = 0; i < 2000; ++i) {
     sampler.start_iteration();
-    Numbers next = read(sampler);
+    Numbers next = read_numbers(sampler);
     auto mutation = sampler.mutation();
     for (int k = 0; k < 3; ++k) {
       bool moves = mutation == MltSampler::Mutation::Large || mutation == MltSampler::Mutation::Small ||
@@ -110,14 +110,14 @@ TEST(MltSampler, ChainWithEveryMutationSamplesItsTarget) {
                                                      : MltMutationProbabilities{0.2f, 0.3f, 0.3f},
                        kPerturbed);
     Rng accept_rng(1, 2);
-    Numbers current = read(sampler);
+    Numbers current = read_numbers(sampler);
     float f_current = target(current);
     const int batches = 50, per_batch = 40000;
     std::vector<std::array<double, 5>> batch_means(batches, {0, 0, 0, 0, 0});
     for (int b = 0; b < batches; ++b)
       for (int i = 0; i < per_batch; ++i) {
         sampler.start_iteration(lens_moves(current), caustic_moves(current));
-        Numbers next = read(sampler);
+        Numbers next = read_numbers(sampler);
         float ratio = target(next) / f_current;
         if (sampler.mutation() == MltSampler::Mutation::Small)
           ratio *= sampler.small_step_probability(lens_moves(next), caustic_moves(next)) /
