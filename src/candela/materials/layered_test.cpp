@@ -284,11 +284,12 @@ TEST(LayeredBsdf, MaterialTableBuildsAndSeedsPerHit) {
   EXPECT_EQ(built.thickness, 0.05f);
   EXPECT_EQ(built.samples, 2);
   EXPECT_EQ(built.max_depth, 10);
-  const auto& from_reflectance =
-      std::get<LayeredConductorBsdf>(table.shading(1, TextureEvalContext{}, hit, wo).bsdf.components[0].bsdf);
+  const Shading from_reflectance_shading = table.shading(1, TextureEvalContext{}, hit, wo);
+  const auto& from_reflectance = std::get<LayeredConductorBsdf>(from_reflectance_shading.bsdf.components[0].bsdf);
   EXPECT_EQ(from_reflectance.bottom.eta, RGB(1.0f) / 1.5f);
   EXPECT_EQ(from_reflectance.bottom.k, conductor_k_from_reflectance(RGB(0.9f, 0.6f, 0.3f)) / 1.5f);
-  const auto& diffuse = std::get<LayeredDiffuseBsdf>(table.shading(2, TextureEvalContext{}, hit, wo).bsdf.components[0].bsdf);
+  const Shading diffuse_shading = table.shading(2, TextureEvalContext{}, hit, wo);
+  const auto& diffuse = std::get<LayeredDiffuseBsdf>(diffuse_shading.bsdf.components[0].bsdf);
   EXPECT_EQ(diffuse.albedo, RGB(0.3f));
   EXPECT_LT(diffuse.g, 1.0f);  // kept where Henyey-Greenstein is finite
   EXPECT_GT(diffuse.g, 0.99f);
