@@ -204,7 +204,7 @@ TEST_F(CommandLine, BidirectionalAndMetropolisIntegrators) {
 
 TEST_F(CommandLine, IntegratorOptionsAreChecked) {
   std::string scene = write("good.json", kGoodJson);
-  expect_failure("render " + scene + " -o " + out() + " --integrator whitted", "unknown integrator 'whitted' \\(known: path, bdpt, mlt, volpath, auto\\)");
+  expect_failure("render " + scene + " -o " + out() + " --integrator whitted", "unknown integrator 'whitted' \\(known: path, bdpt, mlt, volpath, ambient_occlusion, light_path, auto\\)");
   expect_failure("render " + scene + " -o " + out() + " --bdpt-strategies " + dir_.string(),
                  "--bdpt-strategies: the path integrator writes no strategy images \\(bdpt does\\)");
   expect_failure("render " + scene + " -o " + out() + " --integrator bdpt --bdpt-strategies " + (dir_ / "nope").string(),
@@ -278,9 +278,9 @@ TEST_F(CommandLine, AFlagTheIntegratorDoesNotReadIsAnError) {
       {"--no-mis", "mis", "mlt", "path"},
       {"--shadow-rays 4", "shadow_rays", "bdpt", "path"},
       {"--light-selection paper", "light_selection=paper", "bdpt", "path"},
-      {"--adaptive-spp 32", "adaptive", "mlt", "path, bdpt, volpath"},
-      {"--adaptive-batch 8", "adaptive", "mlt", "path, bdpt, volpath"},
-      {"--max-spp 64", "adaptive", "mlt", "path, bdpt, volpath"},
+      {"--adaptive-spp 32", "adaptive", "mlt", "path, bdpt, volpath, ambient_occlusion"},
+      {"--adaptive-batch 8", "adaptive", "mlt", "path, bdpt, volpath, ambient_occlusion"},
+      {"--max-spp 64", "adaptive", "mlt", "path, bdpt, volpath, ambient_occlusion"},
       {"--mlt-bootstrap 100", "mlt", "path", "mlt"},
       {"--mlt-chains 10", "mlt", "bdpt", "mlt"},
       {"--mlt-sigma 0.1", "mlt", "path", "mlt"},

@@ -34,6 +34,7 @@
 #include "candela/render/checkpoint.h"
 #include "candela/render/cluster.h"
 #include "candela/render/film_part.h"
+#include "candela/render/first_hit_aovs.h"
 #include "candela/description/render_options.h"
 #include "candela/integrators/render_request.h"
 #include "candela/scene/resource_limits.h"
@@ -217,12 +218,12 @@ struct CommandPlan {
   // checkpoint, a part (a plain render does not read the file twice).
   std::string scene_bytes;
   std::vector<fs::path> outputs;  // the images to write
-  std::vector<Aov> aov_layers;    // --aov, else the scene's (none with --resume or --part)
+  AovSelection aovs;              // --aov, else the scene's (none with --resume or --part)
 };
 
-std::vector<Aov> parse_aov_list(const std::string& list, const char* where) {
+AovSelection parse_aov_list(const std::string& list, const char* where) {
   try {
-    return parse_aovs(list);
+    return parse_aov_selection(list);
   } catch (const UsageError& e) {
     throw UsageError(fmt::format("{}: {}", where, e.what()));
   }
@@ -254,12 +255,12 @@ void check_command_flags(const RenderCommand& cmd) {
 }
 
 // The AOV layers: --aov, else the scene's; checkpoints and parts do not keep them.
-std::vector<Aov> plan_aovs(const RenderCommand& cmd, const CommandPlan& plan, Cluster& cluster) {
+AovSelection plan_aovs(const RenderCommand& cmd, const CommandPlan& plan, Cluster& cluster) {
   const bool keeps_none = !cmd.resume.empty() || !cmd.part.empty();
   const char* which = cmd.resume.empty() ? "--part" : "--resume";
   if (!cmd.aov.empty() && keeps_none)
     throw UsageError(fmt::format("--aov cannot be combined with {} (checkpoints and parts do not keep the AOVs)", which));
-  std::vector<Aov> layers;
+  AovSelection layers;
   if (!cmd.aov.empty()) {
     layers = parse_aov_list(cmd.aov, "--aov");
   } else if (!plan.desc.film.aovs.empty()) {
@@ -268,7 +269,7 @@ std::vector<Aov> plan_aovs(const RenderCommand& cmd, const CommandPlan& plan, Cl
       if (!cmd.quiet && cluster.is_root())
         std::fprintf(stderr, "note: the scene's AOVs are not written with %s (checkpoints and parts do not keep them)\n",
                      which);
-      layers.clear();
+      layers = AovSelection{};
     }
   }
   if (!layers.empty() && !plan.render.one_pixel() && !cmd.quiet && cluster.is_root())
@@ -307,7 +308,7 @@ CommandPlan plan_command(const RenderCommand& cmd, Cluster& cluster) {
   if (plan.render.one_pixel() && cluster.distributed())
     throw UsageError("--pixel renders one pixel in one process: run it without mpirun");
   plan.outputs = output_files(cmd, plan.desc);
-  plan.aov_layers = plan_aovs(cmd, plan, cluster);
+  plan.aovs = plan_aovs(cmd, plan, cluster);
   check_command_outputs(cmd, plan, cluster);
   // Refuse what cannot fit in memory before allocating the scene and the film.
   check_resources(plan.desc);
@@ -595,7 +596,8 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   Film film(desc.film.width, desc.film.height);
   const uint64_t earlier_non_finite = resumed ? restore(*resumed, film, cluster) : 0;
   std::optional<AovFilm> aov_film;
-  if (!plan.aov_layers.empty() && !plan.render.one_pixel()) aov_film.emplace(film.width(), film.height(), plan.aov_layers);
+  if (!plan.aovs.empty() && !plan.render.one_pixel())
+    aov_film.emplace(film.width(), film.height(), plan.aovs, aov_camera_frame(scene.camera()));
   const std::unique_ptr<IntegratorOutputs> integrator_outputs =
       plan.render.make_integrator_outputs(desc.settings, film.width(), film.height());
   RenderOptions options =
@@ -732,7 +734,9 @@ int main(int argc, char** argv) {
                          "127.0.0.1:14158); reconnects if tev is not there yet or restarts");
   render_cmd->add_option("--aov", cmd.aov,
                          "Also write AOV layers into the .exr output, comma-separated: albedo, normal, depth, "
-                         "position, spp, variance, or all (docs/cli.md)");
+                         "position, spp, variance, geometric_normal, uv, depth_derivatives, relative_variance, "
+                         "or all; camera_space for camera-space positions and normals; gbuffer for pbrt-v4's "
+                         "gbuffer film's layers and names (docs/cli.md)");
   render_cmd->add_flag("-q,--quiet", cmd.quiet, "No progress bar");
   render_cmd->add_option("--checkpoint", cmd.checkpoint,
                          "Write the render state to FILE (atomically) every --checkpoint-every seconds "

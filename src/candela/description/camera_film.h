@@ -101,6 +101,20 @@ struct FilmDesc {
     int x = 0, y = 0, full_width = 0, full_height = 0;
   };
   std::optional<Crop> crop;
+  // The sensor every sample passes on its way to the film (pbrt-v4's PixelSensor with its CIE 1931
+  // sensor; film/sensor.h applies it). The default changes nothing.
+  struct Sensor {
+    // pbrt-v4's imaging ratio: the exposure time (the shutter interval) x ISO / 100; scales every sample.
+    float exposure = 1;
+    // Kelvin, 0 = none: light is white-balanced from the CIE daylight illuminant of this correlated
+    // colour temperature to the output's white (D65), by von Kries adaptation in Bradford's cone space.
+    float white_balance = 0;
+    // > 0: a sample whose largest sensor component (CIE XYZ x exposure) is above it is scaled down
+    // to it (pbrt-v4's maxcomponentvalue: less energy, fewer fireflies); 0 = no limit.
+    float max_component = 0;
+    bool changes_nothing() const { return exposure == 1 && white_balance == 0 && max_component == 0; }
+  };
+  Sensor sensor;
 };
 
 }  // namespace candela

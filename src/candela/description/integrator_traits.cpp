@@ -31,6 +31,24 @@ const std::vector<IntegratorTraits>& integrator_traits() {
        .resumable = true,
        .single_pixel = true,
        .participating_media = true},
+      // Media are ignored, as pbrt-v4's does: the occlusion of the surfaces by surfaces is what it shows.
+      {.name = "ambient_occlusion",
+       .description = "ambient occlusion (pbrt-v4's ambientocclusion): the cosine-weighted unoccluded fraction of the "
+                      "hemisphere at the first surface seen, white where nothing occludes; no light transport",
+       .reads = {"ambient_occlusion", "adaptive"},
+       .resumable = true,
+       .single_pixel = true,
+       .participating_media = true,
+       .geometric = true},
+      // Light subpaths as bdpt traces them (Russian roulette included), each vertex joined to the lens
+      // (t = 1 alone, unweighted) and splatted. Media: the light subpaths scatter in them as bdpt's do.
+      {.name = "light_path",
+       .description = "light tracing (pbrt-v4's lightpath): light subpaths joined to the lens and splatted; "
+                      "black where the camera sees a delta surface, an emitter or the sky",
+       .reads = {"rr_start_depth"},
+       .resumable = true,
+       .participating_media = true,
+       .partial_transport = true},
       {.name = "auto",
        .description = "short pilots of each measure which reaches the lowest error in the budget: --time-limit, "
                       "--target-error, or the path tracer's time for --spp; the pilots aim at 10%",

@@ -41,6 +41,8 @@ inline constexpr SelectiveSetting kSelectiveSettings[] = {
     {"adaptive", "adaptive sampling", [](const RenderSettings& s) { return s.adaptive(); }},
     {"mlt", "Metropolis light transport's parameters",
      [](const RenderSettings& s) { return s.mlt != MltSettings{}; }},
+    {"ambient_occlusion", "ambient occlusion's parameters",
+     [](const RenderSettings& s) { return s.ambient_occlusion != AmbientOcclusionSettings{}; }},
 };
 
 struct IntegratorTraits {
@@ -52,6 +54,14 @@ struct IntegratorTraits {
   bool strategy_images = false;         // writes per-strategy images (--bdpt-strategies)
   bool samples_are_mutations = false;   // RenderSettings::spp counts Markov chain mutations per pixel
   bool participating_media = false;     // renders scenes with participating media
+  // Renders a geometric quantity of the surfaces seen (ambient occlusion), not the light the scene
+  // carries: a different image, so the one that chooses never chooses it and the light-transport
+  // tests (furnace_test.cpp) leave it out.
+  bool geometric = false;
+  // Renders only part of the light transport (the light tracer: nothing the camera sees through a
+  // delta surface, no emitter seen directly): a different image wherever the camera sees those, so
+  // the one that chooses never chooses it and the furnace tests leave it out.
+  bool partial_transport = false;
   // Renders nothing itself but chooses one of the others for the scene and the budget ("auto": short
   // pilots, integrators/auto_integrator.h): a name a request may give, not a scene file. Reads what
   // the one it chooses reads (the candidates are those that read every setting given).
@@ -66,8 +76,8 @@ const std::vector<IntegratorTraits>& integrator_traits();
 // The integrator named `name`, or null.
 const IntegratorTraits* find_integrator_traits(std::string_view name);
 
-// "path, bdpt, mlt, volpath": the integrators that render (the names a scene file may give), for
-// messages; with `and_choosers`, every name a request may give ("path, bdpt, mlt, volpath, auto").
+// "path, bdpt, mlt, volpath, ambient_occlusion": the integrators that render (the names a scene file
+// may give), for messages; with `and_choosers`, every name a request may give (then also "auto").
 std::string integrator_names(bool and_choosers = false);
 
 // "bdpt" or "path, bdpt, volpath": the integrators that render and have `capability`, for messages.

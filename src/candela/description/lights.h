@@ -86,15 +86,48 @@ struct SchemaOf<SpotLight> {
                                      .help = "a point light in a cone"};
 };
 
-// A point light that projects an image (Mitsuba's "projector"): at the origin of to_world looking
-// along its +z with the field of view `fov_degrees` on the image's wider axis; `irradiance` is the
-// image (index into SceneDesc::textures), scaled by `scale`, as Mitsuba defines it (irradiance on a
-// surface one unit away facing the projector).
+// What a projector's image means.
+enum class ProjectorRadiometry {
+  // Mitsuba's projector: the image is the irradiance delivered to a surface one unit away facing the
+  // projector, so the intensity is I = pi scale image(uv) / cos^3(theta), theta from the axis.
+  Irradiance,
+  // pbrt-v4's "projection" light: the image is the intensity itself, I = scale image(uv).
+  Intensity,
+};
+constexpr std::string_view enum_name(ProjectorRadiometry v) {
+  switch (v) {
+    case ProjectorRadiometry::Irradiance: return "irradiance";
+    case ProjectorRadiometry::Intensity: return "intensity";
+  }
+  return {};
+}
+
+// Which of the image's axes a projector's field of view spans (the other follows from the aspect ratio).
+enum class ProjectorFovAxis {
+  Larger,   // the image's longer side (Mitsuba's fov_axis is converted to it by the reader)
+  Smaller,  // the image's shorter side (pbrt-v4's "projection" light; the camera's FovAxis::Smaller)
+};
+constexpr std::string_view enum_name(ProjectorFovAxis v) {
+  switch (v) {
+    case ProjectorFovAxis::Larger: return "larger";
+    case ProjectorFovAxis::Smaller: return "smaller";
+  }
+  return {};
+}
+
+// A point light that projects an image (Mitsuba's "projector", pbrt-v4's "projection"): at the origin
+// of to_world looking along its +z with the field of view `fov_degrees` on the image's `fov_axis`;
+// `irradiance` is the image (index into SceneDesc::textures), scaled by `scale`, meaning what
+// `radiometry` says. power > 0 (pbrt-v4's "power"): the emission is multiplied by power / (the power
+// the projector would emit with scale 1, reckoned as pbrt-v4 does: cos^3 at each texel's centre).
 struct ProjectorLight {
   Transform to_world;
   float fov_degrees = 90;
   int irradiance = -1;
   RGB scale{1.0f};
+  ProjectorRadiometry radiometry = ProjectorRadiometry::Irradiance;
+  ProjectorFovAxis fov_axis = ProjectorFovAxis::Larger;
+  float power = 0;
 };
 template <>
 struct SchemaOf<ProjectorLight> {
@@ -102,11 +135,42 @@ struct SchemaOf<ProjectorLight> {
   static constexpr Field fields[] = {
       field<&L::to_world>("transform", kAnyValue, "from the projector's frame (looking along +z) to the world"),
       field<&L::fov_degrees>("fov", ValueRange{.lo = 0, .hi = 180, .lo_open = true, .hi_open = true},
-                             "degrees, on the image's wider axis"),
+                             "degrees, on the image's fov_axis"),
       texture_ref<&L::irradiance>("irradiance").required_field(),
       field<&L::scale>("scale", kNonNegative),
+      enum_field<&L::radiometry>("radiometry", "what the image means"),
+      enum_field<&L::fov_axis>("fov_axis", "the image axis fov spans"),
+      field<&L::power>("power", kNonNegative, "W with scale 1; 0 = not normalised"),
   };
   static constexpr TypeSchema schema{.name = "projector", .fields = fields, .help = "projects an image"};
+};
+
+// A point light whose intensity over directions is an image (pbrt-v4's "goniometric" light): at the
+// origin of to_world, the intensity along the local unit direction d is
+//   I(d) = intensity x image(equal_area_sphere_to_square(d.x, d.z, d.y)),
+// Clarberg's equal-area square (sampling/warp.h) with the light's +y at the square's centre (pbrt-v4
+// swaps y and z), read at the nearest texel (texel (x, y) covers [x, x+1) / width x [y, y+1) / height,
+// row 0 the top); the image must be square, and each texel counts as the mean of its R, G and B
+// (pbrt-v4 makes it one channel so), negative values as zero. power > 0 (pbrt-v4's "power"): the
+// intensity is multiplied by power / (4 pi x the image's mean), so that an intensity of luminance 1
+// emits `power`.
+struct GoniometricLight {
+  Transform to_world;
+  std::string filename;  // resolved by the reader
+  RGB intensity{1.0f};
+  float power = 0;
+};
+template <>
+struct SchemaOf<GoniometricLight> {
+  using L = GoniometricLight;
+  static constexpr Field fields[] = {
+      field<&L::to_world>("transform", kAnyValue, "from the light's frame (+y at the image's centre) to the world"),
+      field<&L::filename>("filename", kAnyValue, "square equal-area image of the directions").required_field(),
+      field<&L::intensity>("intensity", kNonNegative, "W/sr, times the image"),
+      field<&L::power>("power", kNonNegative, "W for unit intensity; 0 = not normalised"),
+  };
+  static constexpr TypeSchema schema{.name = "goniometric", .fields = fields,
+                                     .help = "a point light shaped by an image"};
 };
 
 // Parallel light from infinitely far away, travelling along `direction`; `radiance` is the
@@ -174,6 +238,9 @@ struct EnvironmentMap {
   RGB scale{1.0f};
   Transform to_world;  // from the map's local frame to the world (rotations only are meaningful)
   bool mis_compensation = false;  // sample by luminance minus its mean (environment_light.h)
+  // Between texel centres: bilinear (Mitsuba's envmap), or the nearest texel (pbrt-v4's image
+  // infinite light, whose sampling density is then exactly proportional to the radiance).
+  TextureFilter filter = TextureFilter::Bilinear;
 };
 template <>
 struct SchemaOf<EnvironmentMap> {
@@ -183,11 +250,13 @@ struct SchemaOf<EnvironmentMap> {
       enum_field<&L::mapping>("mapping"),
       field<&L::scale>("scale", kNonNegative),
       field<&L::mis_compensation>("mis_compensation"),
+      enum_field<&L::filter>("filter", "bilinear between texel centres, or the nearest texel"),
       field<&L::to_world>("transform", kAnyValue, "rotations only"),
   };
   static constexpr TypeSchema schema{.name = "environment", .fields = fields, .help = "an environment image"};
 };
 
-using LightDesc = std::variant<PointLight, SkyLight, SpotLight, DistantLight, EnvironmentMap, ProjectorLight>;
+using LightDesc =
+    std::variant<PointLight, SkyLight, SpotLight, DistantLight, EnvironmentMap, ProjectorLight, GoniometricLight>;
 
 }  // namespace candela

@@ -34,8 +34,27 @@ constexpr std::string_view enum_name(VolumeBorder v) {
   }
   return {};
 }
+// pbrt-v4's procedural cloud (its "cloud" medium, CloudMedium): a density in [0, 1] at every point p of
+// the cloud's own space, pbrt-v4's definition step by step:
+//   1. q = frequency p, displaced (where wispiness > 0) by two octaves of the noise's gradient (pbrt-v4's
+//      DNoise, a forward difference over 0.01): q += 0.05 wispiness 0.5^i grad noise(10 x 1.99^i q), i = 0, 1;
+//   2. s = sum over five octaves i of 0.5^(i + 1) noise(1.99^i q) (Perlin noise, textures/noise.h);
+//   3. the altitude falloff: clamp((1 - p.y) 4.5 density s, 0, 1) + 2 max(0, 0.5 - p.y), clamped to [0, 1]
+//      (so 1 wherever p.y <= 0, and no cloud from the noise's positive values above p.y = 1).
+// The cloud fills the box [box_min, box_max] of its space and nothing outside it. Its parameters carry
+// pbrt-v4's names and defaults.
+struct CloudDensity {
+  float density = 1;    // how strongly the noise turns into cloud (any finite value)
+  float wispiness = 1;  // how far the noise's gradient displaces the lookup point; <= 0: not at all
+  float frequency = 5;  // the noise's lattice cells per unit length of the cloud's space
+  Point3 box_min{0.0f}, box_max{1.0f};  // the box the cloud fills (pbrt-v4's p0 and p1, sorted per axis)
+  // The unit cube onto the box: a cloud's VolumeDesc::to_world is the cloud's placement times this.
+  Transform unit_cube_to_cloud() const { return Transform::translate(box_min) * Transform::scale(box_max - box_min); }
+  bool operator==(const CloudDensity&) const = default;
+};
+
 struct VolumeDesc {
-  RGB constant{1.0f};  // the value everywhere when there is no grid
+  RGB constant{1.0f};  // the value everywhere when there is no grid and no cloud
   std::array<int, 3> resolution{0, 0, 0};
   int channels = 1;  // 1 (a scalar) or 3 (RGB)
   // nx ny nz channels floats, a sample's channels together, x fastest, then y, then z; null = constant.
@@ -47,16 +66,20 @@ struct VolumeDesc {
   // The part of to_world that the file itself gives (a VDB grid's voxel placement; identity for .vol
   // files and inline grids): to_world = the scene's own placement x file_to_world.
   Transform file_to_world;
-  bool is_constant() const { return !values; }
+  // pbrt-v4's procedural cloud in place of samples (values stays null; a density only): the density at
+  // unit-cube point u is the cloud's at unit_cube_to_cloud() u, and to_world = the cloud's placement x
+  // unit_cube_to_cloud().
+  std::optional<CloudDensity> cloud;
+  bool is_constant() const { return !values && !cloud; }
 };
 
-// A participating medium (pbrt-v4's homogeneous and uniformgrid, Mitsuba 3's homogeneous and
-// heterogeneous): extinction sigma_t(p) = scale * sigma_t * density(p), of which the fraction
+// A participating medium (pbrt-v4's homogeneous, uniformgrid, nanovdb and cloud, Mitsuba 3's homogeneous
+// and heterogeneous): extinction sigma_t(p) = scale * sigma_t * density(p), of which the fraction
 // albedo(p) scatters (sigma_s = albedo sigma_t) and the rest is absorbed (sigma_a = sigma_t - sigma_s).
-// A medium whose density is a grid has no density outside the grid's cube (Mitsuba bounds a
-// heterogeneous medium by its volume's box). It emits radiance Le(p) (`emission`, or a temperature's
-// blackbody, times an emission scale) in proportion to absorption (the source term sigma_a Le, as
-// pbrt-v4 defines Le). Light scatters by Henyey-Greenstein's phase
+// A medium whose density is a grid or a cloud has no density outside its unit cube (Mitsuba bounds a
+// heterogeneous medium by its volume's box; pbrt-v4 a cloud by its box). It emits radiance Le(p)
+// (`emission`, or a temperature's blackbody, times an emission scale) in proportion to absorption (the
+// source term sigma_a Le, as pbrt-v4 defines Le). Light scatters by Henyey-Greenstein's phase
 // function with mean cosine g in (-1, 1) (0: isotropic).
 struct MediumDesc {
   RGB sigma_t{1.0f};    // per unit length, times density and scale
@@ -74,7 +97,8 @@ struct MediumDesc {
   float g = 0;
   // A density grid's majorant: the largest density over cells of this many samples along each axis
   // (at most 64 cells per axis), traversed cell by cell; 0 = one majorant for the whole grid (what
-  // Mitsuba does by default, majorant_resolution_factor = 0). Changes the noise, not the expectation.
+  // Mitsuba does by default, majorant_resolution_factor = 0). A cloud's majorant: a bound per slab of
+  // altitude (32 of them) when > 0, else one (pbrt-v4's, 1). Changes the noise, not the expectation.
   int majorant_cell_samples = 4;
   std::string name;      // for messages
   SourceLocation where;  // where the scene file declares it
@@ -89,7 +113,8 @@ struct SchemaOf<MediumDesc> {
   static constexpr Field fields[] = {
       field<&T::sigma_t>("sigma_t", kNonNegative, "extinction per unit length, times density and scale"),
       volume_field<&T::albedo>("albedo", true, kAlbedo, "the fraction of extinction that scatters"),
-      volume_field<&T::density>("density", false, kNonNegative, "multiplies sigma_t; a grid for a \"grid\" medium"),
+      volume_field<&T::density>("density", false, kNonNegative,
+                                "multiplies sigma_t; a grid or a procedural cloud for a \"grid\" medium"),
       field<&T::scale>("scale", kNonNegative, "multiplies sigma_t"),
       field<&T::g>("g", ValueRange{.lo = -1, .hi = 1, .lo_open = true, .hi_open = true},
                    "Henyey-Greenstein's mean cosine"),

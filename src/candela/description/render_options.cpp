@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <limits>
 #include <regex>
 #include <tuple>
@@ -114,6 +115,28 @@ std::vector<RenderOption> make_table() {
        .help = "mlt: probability of a caustic perturbation (only the direction leaving the light moves; default 0)",
        .reads = "mlt", .scene_key = "mlt.caustic", .extract = [](S d, R& r) { r.mlt_caustic = d.settings.mlt.caustic; },
        .apply = [](Q r, SceneDesc& d) { d.settings.mlt.caustic = *r.mlt_caustic; }},
+      {.name = "ao_max_distance", .field = &R::ao_max_distance, .rule = PositiveValue{},
+       .help = "ambient_occlusion: occluders farther than this along an occlusion ray do not count (default: "
+               "every occluder counts)",
+       .reads = "ambient_occlusion", .scene_key = "ambient_occlusion.max_distance",
+       .extract = [](S d, R& r) {
+         if (std::isfinite(d.settings.ambient_occlusion.max_distance))
+           r.ao_max_distance = d.settings.ambient_occlusion.max_distance;
+       },
+       .apply = [](Q r, SceneDesc& d) { d.settings.ambient_occlusion.max_distance = *r.ao_max_distance; },
+       // Ambient occlusion's parameters go into the fingerprint as one entry, where it may render.
+       .fingerprint_key = "ambient-occlusion",
+       .fingerprint = [](S d, Q) -> std::optional<std::string> {
+         if (!may_read_setting(*find_integrator_traits(d.settings.integrator), "ambient_occlusion"))
+           return std::nullopt;
+         return d.settings.ambient_occlusion.describe();
+       }},
+      {.name = "ao_sampling", .field = &R::ao_sampling, .rule = ChoiceValue{{"cosine", "uniform"}},
+       .help = "ambient_occlusion: occlusion rays cosine-weighted over the hemisphere (the default) or uniform "
+               "(the same image, noisier)",
+       .reads = "ambient_occlusion", .scene_key = "ambient_occlusion.sampling",
+       .extract = [](S d, R& r) { r.ao_sampling = d.settings.ambient_occlusion.cosine_sampling ? "cosine" : "uniform"; },
+       .apply = [](Q r, SceneDesc& d) { d.settings.ambient_occlusion.cosine_sampling = r.ao_sampling == "cosine"; }},
       {.name = "sampler", .field = &R::sampler, .rule = choices_of<SamplerType>({"random"}),
        .help = "Pixel sampler: random (independent), stratified (jittered, every dimension), poisson "
                "(Poisson-disc pixel positions), zsobol (Owen-scrambled Sobol' in Morton order)",

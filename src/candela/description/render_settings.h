@@ -168,7 +168,23 @@ struct MltSettings {
   }
 };
 
-// What a render does. The fields outside `path` and `mlt` are read by more than one integrator;
+// Ambient occlusion's settings (integrator "ambient_occlusion"; pbrt-v4's AOIntegrator, whose
+// "maxdistance" and "cossample" they are).
+struct AmbientOcclusionSettings {
+  // Occluders farther than this from the shaded point along an occlusion ray do not count (world
+  // units); infinity: every occluder counts.
+  float max_distance = std::numeric_limits<float>::infinity();
+  // Occlusion rays drawn cosine-weighted over the hemisphere (true) or uniformly (false): the same
+  // expected image, the cosine-weighted one with less noise.
+  bool cosine_sampling = true;
+  bool operator==(const AmbientOcclusionSettings&) const = default;
+  // For image metadata and checkpoint fingerprints.
+  std::string describe() const {
+    return fmt::format("max-distance {} sampling {}", max_distance, cosine_sampling ? "cosine" : "uniform");
+  }
+};
+
+// What a render does. The fields outside `path`, `mlt` and `ambient_occlusion` are read by more than one integrator;
 // integrators/integrator.h's registry says which integrator reads which, and the readers and the
 // command line reject a setting the chosen integrator does not read.
 struct RenderSettings {
@@ -205,6 +221,7 @@ struct RenderSettings {
   }
   PathSettings path;
   MltSettings mlt;
+  AmbientOcclusionSettings ambient_occlusion;
 };
 
 }  // namespace candela

@@ -70,7 +70,9 @@ TEST(Aovs, ParsesNamesAndRefusesUnknownOnes) {
     parse_aovs("albedo,colour");
     FAIL() << "an unknown name was accepted";
   } catch (const UsageError& e) {
-    EXPECT_STREQ(e.what(), "unknown AOV 'colour' (valid: albedo, normal, depth, position, spp, variance, all)");
+    EXPECT_STREQ(e.what(),
+                 "unknown AOV 'colour' (valid: albedo, normal, depth, position, spp, variance, geometric_normal, uv, "
+                 "depth_derivatives, relative_variance, all, gbuffer, camera_space, world_space)");
   }
   EXPECT_THROW(parse_aovs("albedo,,normal"), UsageError);
 }
@@ -327,9 +329,11 @@ TEST(Aovs, CommandLineWritesNamedExrLayers) {
   std::vector<std::string> names = read_channel_names(out);
   for (const char* expected : {"R", "G", "B", "Albedo.R", "Albedo.G", "Albedo.B", "Normal.X", "Normal.Y", "Normal.Z",
                                "Depth.Z", "Position.X", "Position.Y", "Position.Z", "SampleCount.X", "Variance.R",
-                               "Variance.G", "Variance.B"})
+                               "Variance.G", "Variance.B", "GeometricNormal.X", "GeometricNormal.Y",
+                               "GeometricNormal.Z", "UV.U", "UV.V", "DepthDerivatives.X", "DepthDerivatives.Y",
+                               "RelativeVariance.R", "RelativeVariance.G", "RelativeVariance.B"})
     EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
-  EXPECT_EQ(names.size(), 17u);
+  EXPECT_EQ(names.size(), 27u);
   const FloatChannels depth = read_float_channels(out, "Depth.");
   ASSERT_EQ(depth.values.size(), 16u * 12u);
   EXPECT_NEAR(depth.values[6 * 16 + 8], 2.0f, 0.01f);  // the sphere's front, 2 from the camera
@@ -348,7 +352,8 @@ TEST(Aovs, CommandLineRefusesUnknownNamesAndUnkeptCombinations) {
   std::ofstream(scene) << kSphereJson;
   testing::CommandResult r = testing::run_command(run_cli("render " + scene + " -o " + out + " --aov albedo,colour -q"));
   EXPECT_EQ(r.exit_code, kExitUsage) << r.output;
-  EXPECT_NE(r.output.find("--aov: unknown AOV 'colour' (valid: albedo, normal, depth, position, spp, variance, all)"),
+  EXPECT_NE(r.output.find("--aov: unknown AOV 'colour' (valid: albedo, normal, depth, position, spp, variance, "
+                          "geometric_normal, uv, depth_derivatives, relative_variance, all, gbuffer"),
             std::string::npos)
       << r.output;
   EXPECT_FALSE(fs::exists(out));
@@ -385,5 +390,175 @@ TEST(Aovs, SceneSettingNamesTheLayers) {
   fs::remove_all(dir);
 }
 
+
+TEST(Aovs, GbufferSelectsPbrtsLayersInCameraSpace) {
+  const AovSelection gbuffer = parse_aov_selection("gbuffer");
+  EXPECT_EQ(gbuffer.layers, std::vector<Aov>(std::begin(kPbrtGbufferAovs), std::end(kPbrtGbufferAovs)));
+  EXPECT_EQ(gbuffer.naming, AovNaming::PbrtGbuffer);
+  EXPECT_EQ(gbuffer.space, AovSpace::Camera);
+  EXPECT_EQ(parse_aov_selection(" gbuffer , world_space").space, AovSpace::World);
+  const AovSelection own = parse_aov_selection("position, camera_space, uv");
+  EXPECT_EQ(own.layers, (std::vector<Aov>{Aov::Position, Aov::Uv}));
+  EXPECT_EQ(own.naming, AovNaming::Candela);
+  EXPECT_EQ(own.space, AovSpace::Camera);
+  EXPECT_EQ(parse_aov_selection("normal").space, AovSpace::World);
+  EXPECT_THROW(parse_aov_selection("gbuffer,albedo"), UsageError);           // a fixed set
+  EXPECT_THROW(parse_aov_selection("albedo,camera_space,world_space"), UsageError);
+  EXPECT_THROW(parse_aov_selection("camera_space"), UsageError);             // no layer
+}
+
+// A plane tilted towards the camera, z = 4 + y / 2 in camera space, seen by a pinhole camera at
+// (1, 2, 3) looking along world -z (camera x = world x, y = world y, z = world -z): one sample
+// through each pixel's centre gives the analytic position, normals and dz/dx, dz/dy (the plane is its
+// own tangent plane, so the neighbouring pixels' rays meet it where the differentials say).
+struct TiltedPlaneGbuffer {
+  static constexpr int kWidth = 8, kHeight = 6;
+};
+
+SceneDesc tilted_plane_gbuffer_scene() {
+  SceneDesc d = testing::empty_scene(testing::look_at_camera({1, 2, 3}, {1, 2, 0}, 50), TiltedPlaneGbuffer::kWidth,
+                                     TiltedPlaneGbuffer::kHeight, 1, 2);
+  d.materials = {DiffuseMaterial{RGB(0.5f)}};
+  ShapeDesc plane;
+  // Camera-space normal (0, -1/2, 1) at camera-space (0, 0, 4) = world (1, 2, -1): world (0, -1/2, -1).
+  plane.geometry = PlaneShape{{1, 2, -1}, normalize(Vec3(0, -0.5f, -1))};
+  plane.material = 0;
+  d.shapes = {plane};
+  d.lights = {SkyLight{RGB(1.0f), RGB(1.0f), RGB(1.0f), {0, 1, 0}}};
+  return d;
+}
+
+// Where the camera ray through film position `film` meets the tilted plane, in camera space.
+Point3 tilted_plane_hit_in_camera_space(const Camera& camera, Vec2 film) {
+  const Ray ray = camera.generate_ray(film, {0.5f, 0.5f}, 0);
+  const Vec3 d(ray.direction.x, ray.direction.y, -ray.direction.z);  // camera space
+  const float t = 4 / (d.z - 0.5f * d.y);
+  return {t * d.x, t * d.y, t * d.z};
+}
+
+std::vector<AovLayer> tilted_plane_gbuffer_layers(const AovSelection& selection, int samples_per_pixel) {
+  const SceneDesc desc = tilted_plane_gbuffer_scene();
+  Scene scene(desc);
+  const int w = TiltedPlaneGbuffer::kWidth, h = TiltedPlaneGbuffer::kHeight;
+  Film film(w, h);
+  AovFilm aovs(w, h, selection, aov_camera_frame(scene.camera()));
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const Ray ray = scene.camera().generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}, 0);
+      const AovSample s = first_hit_aovs(scene, ray, true, x, y, 0, 7);
+      for (int k = 0; k < samples_per_pixel; ++k) {
+        film.add_sample(x, y, RGB(1.0f));
+        aovs.add_sample(x, y, s, 1);
+      }
+    }
+  return aovs.images(film);
+}
+
+TEST(Aovs, TiltedPlaneGivesAnalyticCameraSpaceGbuffer) {
+  const SceneDesc desc = tilted_plane_gbuffer_scene();
+  const Camera camera(desc.camera, desc.film.width, desc.film.height);
+  const AovCameraFrame frame = aov_camera_frame(camera);
+  EXPECT_NEAR(frame.x.x, 1, 1e-5f);
+  EXPECT_NEAR(frame.y.y, 1, 1e-5f);
+  EXPECT_NEAR(frame.z.z, -1, 1e-5f);
+  // pbrt-v4's layout; 64 samples per pixel scale the differentials by max(1/8, 1/sqrt(64)) = 1/8.
+  const std::vector<AovLayer> layers = tilted_plane_gbuffer_layers(parse_aov_selection("gbuffer"), 64);
+  const AovLayer& p = layer(layers, Aov::Position);
+  const AovLayer& n = layer(layers, Aov::GeometricNormal);
+  const AovLayer& ns = layer(layers, Aov::Normal);
+  const AovLayer& dz = layer(layers, Aov::DepthDerivatives);
+  EXPECT_EQ(p.name, "P");
+  EXPECT_EQ(n.name, "N");
+  EXPECT_EQ(ns.name, "Ns");
+  EXPECT_EQ(dz.name, "");
+  const Vec3 normal = normalize(Vec3(0, 0.5f, -1));  // facing the camera
+  for (int y = 0; y < p.height; ++y)
+    for (int x = 0; x < p.width; ++x) {
+      const Point3 expected = tilted_plane_hit_in_camera_space(camera, {x + 0.5f, y + 0.5f});
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(p.at(x, y, c), expected[c], 1e-4f) << x << "," << y << " channel " << c;
+        EXPECT_NEAR(n.at(x, y, c), normal[c], 1e-5f) << x << "," << y;
+        EXPECT_NEAR(ns.at(x, y, c), normal[c], 1e-5f) << x << "," << y;
+      }
+      const float dzdx = tilted_plane_hit_in_camera_space(camera, {x + 1.5f, y + 0.5f}).z - expected.z;
+      const float dzdy = tilted_plane_hit_in_camera_space(camera, {x + 0.5f, y + 1.5f}).z - expected.z;
+      EXPECT_NEAR(dz.at(x, y, 0), std::abs(dzdx) / 8, 1e-4f) << x << "," << y;
+      EXPECT_NEAR(dz.at(x, y, 1), std::abs(dzdy) / 8, 1e-4f) << x << "," << y;
+      EXPECT_GT(dz.at(x, y, 1), 0.002f);  // the tilt is about x: z changes down the image
+    }
+}
+
+TEST(Aovs, TiltedPlaneGivesWorldSpaceGbufferOnRequest) {
+  const SceneDesc desc = tilted_plane_gbuffer_scene();
+  const Camera camera(desc.camera, desc.film.width, desc.film.height);
+  const std::vector<AovLayer> layers = tilted_plane_gbuffer_layers(parse_aov_selection("gbuffer,world_space"), 1);
+  const AovLayer& p = layer(layers, Aov::Position);
+  const AovLayer& n = layer(layers, Aov::GeometricNormal);
+  const AovLayer& dz = layer(layers, Aov::DepthDerivatives);
+  const Vec3 normal = normalize(Vec3(0, 0.5f, 1));  // camera-space (0, 1/2, -1) in world space
+  for (int y = 0; y < p.height; ++y)
+    for (int x = 0; x < p.width; ++x) {
+      const Point3 c = tilted_plane_hit_in_camera_space(camera, {x + 0.5f, y + 0.5f});
+      const Point3 world(1 + c.x, 2 + c.y, 3 - c.z);
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(p.at(x, y, k), world[k], 1e-4f) << x << "," << y;
+        EXPECT_NEAR(n.at(x, y, k), normal[k], 1e-5f) << x << "," << y;
+      }
+      // World z runs against camera z here: the same magnitudes, unscaled with one sample per pixel.
+      const float dzdx = tilted_plane_hit_in_camera_space(camera, {x + 1.5f, y + 0.5f}).z - c.z;
+      EXPECT_NEAR(dz.at(x, y, 0), std::abs(dzdx), 1e-4f) << x << "," << y;
+    }
+}
+
+TEST(Aovs, GbufferMissesAreZeroAndUvIsTheHits) {
+  // The sky fills the image: every pixel is 0 in every geometric layer.
+  SceneDesc empty = testing::empty_scene(testing::look_at_camera({0, 0, 0}, {0, 0, 1}, 50), 4, 3, 2, 2);
+  empty.lights = {SkyLight{RGB(1.0f), RGB(1.0f), RGB(1.0f), {0, 1, 0}}};
+  AovRender r = render_with_aovs(empty, parse_aovs("all"));
+  for (Aov aov : {Aov::Position, Aov::GeometricNormal, Aov::Uv, Aov::DepthDerivatives, Aov::Normal})
+    for (float v : layer(r.layers, aov).values) EXPECT_EQ(v, 0.0f) << aov_name(aov);
+  // uv: the hit's own parameterisation, averaged over the one sample through each pixel centre.
+  const SceneDesc desc = tilted_plane_gbuffer_scene();
+  Scene scene(desc);
+  const std::vector<AovLayer> layers = tilted_plane_gbuffer_layers(parse_aov_selection("uv"), 1);
+  const AovLayer& uv = layer(layers, Aov::Uv);
+  EXPECT_EQ(uv.name, "UV");
+  for (int y = 0; y < uv.height; ++y)
+    for (int x = 0; x < uv.width; ++x) {
+      SurfaceHit hit;
+      Ray ray = scene.camera().generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}, 0);
+      ASSERT_TRUE(scene.intersect(ray, hit));
+      EXPECT_FLOAT_EQ(uv.at(x, y, 0), hit.uv.x);
+      EXPECT_FLOAT_EQ(uv.at(x, y, 1), hit.uv.y);
+    }
+}
+
+// pbrt-v4's gbuffer EXR: its channel names (an empty layer name leaves the channels alone).
+TEST(Aovs, GbufferExrChannelsArePbrtsNames) {
+  const std::vector<AovLayer> layers = tilted_plane_gbuffer_layers(parse_aov_selection("gbuffer"), 4);
+  const FloatChannels channels = exr_channels(layers);
+  EXPECT_EQ(channels.names,
+            (std::vector<std::string>{"Albedo.R", "Albedo.G", "Albedo.B", "P.X", "P.Y", "P.Z", "dzdx", "dzdy", "N.X",
+                                      "N.Y", "N.Z", "Ns.X", "Ns.Y", "Ns.Z", "u", "v", "Variance.R", "Variance.G",
+                                      "Variance.B", "RelativeVariance.R", "RelativeVariance.G",
+                                      "RelativeVariance.B"}));
+}
+
+TEST(Aovs, CommandLineWritesPbrtGbufferExr) {
+  const fs::path dir = testing::fresh_test_directory("candela_aov_cli");
+  const std::string scene = (dir / "sphere.json").string(), out = (dir / "out.exr").string();
+  std::ofstream(scene) << kSphereJson;
+  testing::CommandResult r = testing::run_command(run_cli("render " + scene + " -o " + out + " --aov gbuffer -q"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::vector<std::string> names = read_channel_names(out);
+  EXPECT_EQ(names.size(), 25u);
+  for (const char* expected : {"R", "G", "B", "P.Z", "dzdx", "N.X", "Ns.Z", "u", "v", "RelativeVariance.B"})
+    EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
+  const FloatChannels p = read_float_channels(out, "P.");
+  ASSERT_EQ(p.values.size(), 16u * 12u * 3u);
+  EXPECT_NEAR(p.values[(6 * 16 + 8) * 3 + 2], 2.0f, 0.02f);  // the sphere's front, 2 along the view
+  EXPECT_EQ(p.values[2], 0.0f);                               // the sky in the corner
+  fs::remove_all(dir);
+}
 }  // namespace
 }  // namespace candela

@@ -17,9 +17,10 @@ namespace candela {
 std::vector<const IntegratorEntry*> auto_candidates(const RenderSettings& settings, bool has_media) {
   std::vector<const IntegratorEntry*> candidates;
   // With media only the integrators that render them apply; without, volpath is the path tracer
-  // with one shadow ray and adds nothing to compare.
+  // with one shadow ray and adds nothing to compare. Ambient occlusion and the light tracer render
+  // another image.
   for (const IntegratorEntry& entry : integrators()) {
-    if (entry.chooses || (has_media ? !entry.participating_media : entry.render == render_volpath)) continue;
+    if (entry.chooses || entry.geometric || entry.partial_transport || (has_media ? !entry.participating_media : entry.render == render_volpath)) continue;
     if (set_but_unread(entry, settings).empty()) candidates.push_back(&entry);
   }
   return candidates;

@@ -699,7 +699,7 @@ RGB BdptIntegrator::radiance(const Ray& ray, Sampler& sampler, RayCounts& counts
       Connection c = connect(lv, cv, s, t, sampler, counts, ray.time, wl);
       if (t == 1) {
         if (!c.L.is_black()) {
-          const RGB v = to_rgb(c.L);
+          const RGB v = scene_.film_sensor().respond(to_rgb(c.L));
           target.film->splats().add(c.raster, v, *target.filter);
           if (first_half) target.film->half_splats().add(c.raster, v, *target.filter);
         }

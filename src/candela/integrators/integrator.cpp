@@ -5,8 +5,10 @@
 #include <algorithm>
 
 #include "candela/base/error.h"
+#include "candela/integrators/ambient_occlusion.h"
 #include "candela/integrators/auto_integrator.h"
 #include "candela/integrators/bdpt.h"
+#include "candela/integrators/light_path.h"
 #include "candela/integrators/mlt.h"
 #include "candela/integrators/path_integrator.h"
 #include "candela/integrators/volpath.h"
@@ -30,6 +32,8 @@ std::vector<IntegratorEntry> bind_traits() {
       {.name = "bdpt", .render = render_bdpt, .make_strategy_images = make_bdpt_strategy_images},
       {.name = "mlt", .render = render_mlt},
       {.name = "volpath", .render = render_volpath},
+      {.name = "ambient_occlusion", .render = render_ambient_occlusion},
+      {.name = "light_path", .render = render_light_path},
       {.name = "auto", .candidates = auto_candidates, .choose = choose_integrator},
   };
   std::vector<IntegratorEntry> entries;

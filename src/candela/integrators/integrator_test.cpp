@@ -16,8 +16,8 @@ namespace {
 using Keys = std::vector<std::string_view>;
 
 TEST(IntegratorRegistry, NamesComeFromTheTable) {
-  EXPECT_EQ(integrator_names(), "path, bdpt, mlt, volpath");
-  EXPECT_EQ(integrator_names(/*and_choosers=*/true), "path, bdpt, mlt, volpath, auto");
+  EXPECT_EQ(integrator_names(), "path, bdpt, mlt, volpath, ambient_occlusion, light_path");
+  EXPECT_EQ(integrator_names(/*and_choosers=*/true), "path, bdpt, mlt, volpath, ambient_occlusion, light_path, auto");
   EXPECT_EQ(integrators_with(&IntegratorTraits::strategy_images), "bdpt");
   for (const IntegratorEntry& entry : integrators()) {
     EXPECT_EQ(find_integrator(entry.name), &entry);
@@ -67,7 +67,8 @@ TEST(IntegratorRegistry, SetButUnreadListsWhatDiffersFromTheDefaultsAndTheIntegr
   EXPECT_EQ(set_but_unread(*find_integrator("bdpt"), settings), (Keys{"mis", "light_selection=paper", "mlt"}));
   EXPECT_EQ(set_but_unread(*find_integrator("mlt"), settings), (Keys{"mis", "light_selection=paper", "adaptive"}));
   EXPECT_EQ(unread_setting_message(*find_integrator("mlt"), "adaptive"),
-            "the mlt integrator does not read adaptive (adaptive sampling; read by: path, bdpt, volpath)");
+            "the mlt integrator does not read adaptive (adaptive sampling; read by: path, bdpt, volpath, "
+            "ambient_occlusion)");
 }
 
 TEST(IntegratorRegistry, RenderRefusesWhatTheIntegratorCannotDo) {
@@ -114,7 +115,8 @@ TEST(IntegratorRegistry, CapabilityChecksNameTheFlagAndTheIntegrator) {
   EXPECT_EQ(message("mlt", {.one_pixel = true}),
             "--pixel cannot be used with the mlt integrator (it cannot render one pixel alone)");
   EXPECT_EQ(message("mlt", {.part = true}),
-            "--part: the mlt integrator does not render tile by tile (path, bdpt, volpath do)");
+            "--part: the mlt integrator does not render tile by tile (path, bdpt, volpath, "
+            "ambient_occlusion, light_path do)");
   EXPECT_EQ(message("path", {.strategy_images = true}),
             "--bdpt-strategies: the path integrator writes no strategy images (bdpt does)");
   EXPECT_EQ(message("mlt", {.adaptive = true}), "adaptive sampling does not apply to the mlt integrator");

@@ -588,7 +588,9 @@ class MltRender {
       // regions that chains seldom visit are estimated by the large steps instead.
       float large = c.sampler.large_step() ? 1.0f : 0.0f;
       float floor_density = large_step_probability * c.brightness;
-      auto deposit = [&](Vec2 raster, const RGB& v) {
+      const FilmSensor& sensor = scene_.film_sensor();
+      auto deposit = [&](Vec2 raster, const RGB& radiance) {
+        const RGB v = sensor.respond(radiance);
         if (!film.splats().add(raster, v, filter)) {
           non_finite.fetch_add(1, std::memory_order_relaxed);
         } else if (c.first_half) {

@@ -194,7 +194,49 @@ TEST(JsonMedia, ShapesAndTheCameraNameTheirMedia) {
   EXPECT_EQ(read("{}").camera.medium, -1);
 }
 
+// pbrt-v4's procedural cloud as a grid medium's density: its parameters and box, placed by "transform".
+TEST(JsonMedia, ProceduralCloud) {
+  SceneDesc scene = read(with_media(R"({
+    "cloud": {"type": "grid", "sigma_a": 0.1, "sigma_s": 1, "g": 0.3,
+              "density": {"cloud": {"density": 3, "wispiness": 0.5, "frequency": 4, "min": [-1, 0, -2],
+                                    "max": [1, 2, 2]},
+                          "transform": [{"translate": [0, 1, 0]}]}},
+    "defaults": {"type": "grid", "sigma_t": 1, "density": {"cloud": {}}}})"));
+  ASSERT_EQ(scene.media.size(), 2u);
+  const MediumDesc& m = scene.media[0];
+  EXPECT_FALSE(m.is_homogeneous());
+  ASSERT_TRUE(m.density.cloud);
+  EXPECT_FALSE(m.density.values);
+  EXPECT_FLOAT_EQ(m.density.cloud->density, 3);
+  EXPECT_FLOAT_EQ(m.density.cloud->wispiness, 0.5f);
+  EXPECT_FLOAT_EQ(m.density.cloud->frequency, 4);
+  EXPECT_EQ(m.density.cloud->box_min, Point3(-1, 0, -2));
+  EXPECT_EQ(m.density.cloud->box_max, Point3(1, 2, 2));
+  // The volume's unit cube is the box, then "transform" places the cloud's space.
+  expect_near(m.density.to_world.point({0, 0, 0}), {-1, 1, -2});
+  expect_near(m.density.to_world.point({1, 1, 1}), {1, 3, 2});
+  EXPECT_EQ(*scene.media[1].density.cloud, CloudDensity{});  // pbrt-v4's defaults
+  expect_near(scene.media[1].density.to_world.point({1, 1, 1}), {1, 1, 1});
+}
+
 // ---------------------------------------------------------------- errors
+
+TEST(JsonMedia, ProceduralCloudErrors) {
+  auto cloud = [](const std::string& density) {
+    return with_medium(R"({"type": "grid", "sigma_t": 1, "density": )" + density + "}");
+  };
+  expect_error_containing(cloud(R"({"cloud": {"min": [0, 0, 0], "max": [1, 0, 1]}})"),
+                          "at /media/m/density/cloud/max: the cloud's box must have volume");
+  expect_error_containing(cloud(R"({"cloud": {"wispyness": 1}})"),
+                          "at /media/m/density/cloud/wispyness: unknown key (did you mean \"wispiness\"?)");
+  expect_error_containing(cloud(R"({"cloud": {}, "resolution": [1, 1, 1]})"),
+                          "at /media/m/density/resolution: unknown key");
+  expect_error_containing(cloud(R"({"cloud": {"frequency": "high"}})"), "at /media/m/density/cloud/frequency");
+  expect_error_containing(with_medium(R"({"type": "grid", "sigma_t": 1, "density": 1, "albedo": {"cloud": {}}})"),
+                          "at /media/m/albedo/cloud: only a medium's density may be a procedural cloud, not its albedo");
+  expect_error_containing(with_medium(R"({"type": "homogeneous", "sigma_t": 1, "density": {"cloud": {}}})"),
+                          "a homogeneous medium's density is a constant");
+}
 
 TEST(JsonMedia, CoefficientErrors) {
   expect_error_containing(with_medium(R"({"type": "homogeneous", "sigma_a": 1, "sigma_t": 1})"),

@@ -259,7 +259,7 @@ TEST(JsonReader, UnknownTypesAreErrors) {
                           "at /materials/m/type: unknown material type \"velvet\"");
   expect_error_containing(with_light(R"({"type": "laser"})"),
                           "at /lights/0/type: unknown light type \"laser\"; expected one of: point, sky, spot, "
-                          "distant, environment, projector, sphere, rectangle");
+                          "distant, environment, projector, goniometric, sphere, rectangle");
 }
 
 TEST(JsonReader, BadMaterialValuesAreErrors) {

@@ -98,7 +98,8 @@ TEST(JsonReader, ReadsCameraAndRenderSettings) {
 // integrator and those that read it (integrators/integrator.h); an unknown integrator is an error.
 TEST(JsonReader, ARenderKeyTheIntegratorDoesNotReadIsAnError) {
   expect_error_containing(R"({"render": {"integrator": "whitted"}})",
-                          "at /render/integrator: unknown integrator \"whitted\" (known: path, bdpt, mlt, volpath)");
+                          "at /render/integrator: unknown integrator \"whitted\" (known: path, bdpt, mlt, volpath, "
+                          "ambient_occlusion, light_path)");
   const std::pair<const char*, const char*> cases[] = {
       {R"({"render": {"integrator": "bdpt", "mis": false}})", "at /render/mis: the bdpt integrator does not read mis"},
       {R"({"render": {"integrator": "bdpt", "direction_sampling": "cosine"}})",
@@ -110,7 +111,8 @@ TEST(JsonReader, ARenderKeyTheIntegratorDoesNotReadIsAnError) {
       {R"({"render": {"integrator": "mlt", "rr_start_depth": 2}})",
        "at /render/rr_start_depth: the mlt integrator does not read rr_start_depth"},
       {R"({"render": {"integrator": "mlt", "adaptive": {"threshold": 0.1}}})",
-       "at /render/adaptive: the mlt integrator does not read adaptive (adaptive sampling; read by: path, bdpt, volpath)"},
+       "at /render/adaptive: the mlt integrator does not read adaptive (adaptive sampling; read by: path, bdpt, volpath, "
+       "ambient_occlusion)"},
       {R"({"render": {"mlt": {"chains": 10}}})", "at /render/mlt: the path integrator does not read mlt"},
   };
   for (const auto& [text, message] : cases) EXPECT_NE(error_of(text).find(message), std::string::npos) << text;

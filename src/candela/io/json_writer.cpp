@@ -74,9 +74,18 @@ void write_roughness(const Roughness& r, Json& j, std::string_view prefix) {
 }
 
 // A grid from a file is written as its file name, one made in memory (pbrt's uniformgrid, an inline
-// grid) with its samples.
+// grid) with its samples, a procedural cloud as its parameters and box.
 Json volume_json(const VolumeDesc& v) {
   Json j = Json::object();
+  if (v.cloud) {
+    const CloudDensity& c = *v.cloud;
+    j["cloud"] = Json{{"density", c.density}, {"wispiness", c.wispiness}, {"frequency", c.frequency},
+                      {"min", vec3(c.box_min)}, {"max", vec3(c.box_max)}};
+    // The cloud's own placement: to_world less the unit cube's mapping onto the box.
+    const Transform placement = v.to_world * c.unit_cube_to_cloud().inverse();
+    if (!placement.is_identity()) j["transform"] = matrix(placement);
+    return j;
+  }
   if (!v.filename.empty()) {
     j["filename"] = absolute(v.filename);
     if (!v.grid_name.empty()) j["grid"] = v.grid_name;
@@ -245,6 +254,9 @@ Json camera_json(const SceneDesc& scene, const std::vector<std::string>& media) 
   j["height"] = scene.film.height;
   if (const auto& crop = scene.film.crop)
     j["crop"] = Json::array({crop->x, crop->y, crop->full_width, crop->full_height});
+  if (const FilmDesc::Sensor& sensor = scene.film.sensor; !sensor.changes_nothing())
+    j["sensor"] = Json{{"exposure", sensor.exposure}, {"white_balance", sensor.white_balance},
+                       {"max_component", sensor.max_component}};
   if (c.lens_radius != 0) {
     j["lens_radius"] = c.lens_radius;
     j["focus_distance"] = c.focus_distance;

@@ -10,6 +10,9 @@
 #include "candela/geometry/sdf_grid.h"
 #include "candela/io/pbrt_reader.h"
 #include "candela/io/scene_reader.h"
+#include "candela/media/medium.h"
+#include "candela/sampling/rng.h"
+#include "candela/testing/json_reader_helpers.h"
 #include "candela/testing/render_helpers.h"
 
 namespace candela {
@@ -122,6 +125,13 @@ void expect_same_volume(const VolumeDesc& back, const VolumeDesc& original) {
   EXPECT_EQ(back.is_constant(), original.is_constant());
   EXPECT_EQ(back.constant, original.constant);
   if (original.is_constant()) return;
+  EXPECT_EQ(back.cloud, original.cloud);
+  if (original.cloud) {
+    // The file holds the cloud's placement (to_world less the box), so to_world comes back rounded.
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) EXPECT_NEAR(back.to_world.matrix().m[r][c], original.to_world.matrix().m[r][c], 1e-6f);
+    return;
+  }
   EXPECT_EQ(back.resolution, original.resolution);
   EXPECT_EQ(back.channels, original.channels);
   EXPECT_EQ(*back.values, *original.values);
@@ -146,6 +156,31 @@ void expect_same_media(const SceneDesc& back, const SceneDesc& original) {
     EXPECT_EQ(b.temperature_scale, o.temperature_scale) << i;
     EXPECT_EQ(b.temperature_offset, o.temperature_offset) << i;
     EXPECT_EQ(b.temperature_cutoff, o.temperature_cutoff) << i;
+  }
+}
+
+// pbrt-v4's procedural cloud, read from pbrt and written as JSON: the same description back, and the
+// same density everywhere.
+TEST(ConvertJson, CloudMediumRoundTrip) {
+  SceneDesc scene = read_pbrt_string(
+      "WorldBegin\nRotate 30 0 1 0\nTranslate 0.5 1 -2\n"
+      "MakeNamedMedium \"c\" \"string type\" \"cloud\" \"float density\" 3 \"float wispiness\" 0.7 "
+      "\"float frequency\" 6 \"rgb sigma_s\" [ 1 1 1 ] \"rgb sigma_a\" [ 0.1 0.2 0.3 ] \"float g\" 0.4 "
+      "\"point3 p0\" [ -0.8 0 -0.8 ] \"point3 p1\" [ 0.8 1.6 0.8 ]\n",
+      "cloud.pbrt", fs::temp_directory_path());
+  ASSERT_EQ(scene.media.size(), 1u);
+  const std::string text = scene_to_json(scene);
+  EXPECT_NE(text.find("\"cloud\""), std::string::npos) << text;
+  SceneDesc back = read_json_scene(text, "converted.json", fs::temp_directory_path());
+  expect_same_media(back, scene);
+  EXPECT_EQ(back.media.at(0).density.cloud->box_max, Point3(0.8f, 1.6f, 0.8f));
+  const Medium original(scene.media[0]), converted(back.media[0]);
+  const Transform& to_world = scene.media[0].density.to_world;
+  Rng rng(5, 7);
+  for (int i = 0; i < 100; ++i) {
+    const Point3 p = to_world.point({1.2f * rng.next_float() - 0.1f, 1.2f * rng.next_float() - 0.1f,
+                                     1.2f * rng.next_float() - 0.1f});
+    EXPECT_NEAR(converted.density(p), original.density(p), 1e-3f) << i;
   }
 }
 
@@ -223,6 +258,23 @@ TEST(ConvertJson, MediaRoundTrip) {
   SceneDesc empty = read_json_scene(scene_to_json(SceneDesc{}), "converted.json", fs::temp_directory_path());
   EXPECT_TRUE(empty.media.empty());
   EXPECT_EQ(empty.camera.medium, -1);
+}
+
+// pbrt-v4's pixel sensor (exposure, white balance, limit) survives `candela convert`; the default
+// sensor writes nothing.
+TEST(ConvertJson, FilmSensorRoundTrips) {
+  SceneDesc scene;
+  EXPECT_EQ(scene_to_json(scene).find("\"sensor\""), std::string::npos);
+  scene.film.sensor = FilmDesc::Sensor{.exposure = 2.5f, .white_balance = 5200, .max_component = 10};
+  const SceneDesc back = read_json_scene(scene_to_json(scene), "converted.json", fs::temp_directory_path());
+  EXPECT_FLOAT_EQ(back.film.sensor.exposure, 2.5f);
+  EXPECT_FLOAT_EQ(back.film.sensor.white_balance, 5200);
+  EXPECT_FLOAT_EQ(back.film.sensor.max_component, 10);
+  using testing::json_reader::expect_error_containing;
+  expect_error_containing(R"({"camera": {"sensor": {"white_balance": 500}}})",
+                          "at /camera/sensor/white_balance: expected 0 (none) or a colour temperature");
+  expect_error_containing(R"({"camera": {"sensor": {"exposure": 0}}})", "at /camera/sensor/exposure");
+  expect_error_containing(R"({"camera": {"sensor": {"iso": 400}}})", "at /camera/sensor/iso: unknown key");
 }
 
 // A camera's screen window and the projections of textures survive `candela convert`.

@@ -311,13 +311,11 @@ TEST(PbrtMedia, TypeErrors) {
   expect_error({"WorldBegin", "MakeNamedMedium \"m\" \"rgb sigma_a\" [ 1 1 1 ]"}, 2, "MakeNamedMedium",
                "MakeNamedMedium \"m\": \"string type\" is required");
   expect_error({"WorldBegin", "MakeNamedMedium \"m\" \"string type\" \"fog\""}, 2, "\"string type\"",
-               "unknown medium type \"fog\" (supported: \"homogeneous\", \"uniformgrid\", \"nanovdb\")");
+               "unknown medium type \"fog\" (supported: \"homogeneous\", \"uniformgrid\", \"nanovdb\", \"cloud\")");
   expect_error({"WorldBegin", "MakeNamedMedium \"m\" \"string type\" \"nanovdb\" \"string filename\" \"a.nvdb\""}, 2,
                "\"string filename\"", "a.nvdb");
   expect_error({"WorldBegin", "MakeNamedMedium \"m\" \"string type\" \"rgbgrid\""}, 2, "\"string type\"",
                "medium type \"rgbgrid\" is not supported: grids of RGB coefficients are not supported yet");
-  expect_error({"WorldBegin", "MakeNamedMedium \"m\" \"string type\" \"cloud\""}, 2, "\"string type\"",
-               "medium type \"cloud\" is not supported: pbrt's procedural clouds are not supported yet");
   expect_error({"WorldBegin", "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float density\" 2"}, 2,
                "\"float density\"", "unused parameter \"float density\"");
 }
@@ -358,6 +356,54 @@ TEST(PbrtMedia, GridErrors) {
                "must be finite and not negative, got -1");
   expect_error({"WorldBegin", grid + "\"float density\" 1 \"string preset\" \"Apple\""}, 2, "\"string preset\"",
                "unused parameter \"string preset\"");
+}
+
+// ---------------------------------------------------------------- cloud
+
+// pbrt-v4's CloudMedium: its parameters, the box in the medium's space placed by the CTM.
+TEST(PbrtMedia, CloudReadsPbrtV4sParametersAndPlacesItsBox) {
+  Warned read = read_warned({"WorldBegin", "Translate 1 2 3",
+                             "MakeNamedMedium \"c\" \"string type\" \"cloud\" \"float density\" 3 "
+                             "\"float wispiness\" 0.5 \"float frequency\" 4",
+                             "  \"rgb sigma_a\" [ 0.1 0.1 0.1 ] \"rgb sigma_s\" [ 1 1 1 ] \"float g\" 0.2",
+                             "  \"point3 p0\" [ 0.8 1.6 0.8 ] \"point3 p1\" [ -0.8 0 -0.8 ]", "Translate 5 5 5"});
+  EXPECT_TRUE(read.warnings.empty()) << joined(read.warnings);
+  const MediumDesc& c = read.scene.media.at(0);
+  EXPECT_FALSE(c.is_homogeneous());
+  expect_rgb_near(c.sigma_t, RGB(1.1f));
+  expect_rgb_near(c.albedo.constant, RGB(1 / 1.1f));
+  EXPECT_FLOAT_EQ(c.scale, 1);
+  EXPECT_FLOAT_EQ(c.g, 0.2f);
+  EXPECT_EQ(c.emission, RGB(0.0f));
+  ASSERT_TRUE(c.density.cloud);
+  EXPECT_FALSE(c.density.values);
+  EXPECT_FLOAT_EQ(c.density.cloud->density, 3);
+  EXPECT_FLOAT_EQ(c.density.cloud->wispiness, 0.5f);
+  EXPECT_FLOAT_EQ(c.density.cloud->frequency, 4);
+  // The box between the corners, whichever way round, then the CTM at MakeNamedMedium.
+  EXPECT_EQ(c.density.cloud->box_min, Point3(-0.8f, 0, -0.8f));
+  EXPECT_EQ(c.density.cloud->box_max, Point3(0.8f, 1.6f, 0.8f));
+  expect_near(c.density.to_world.point({0, 0, 0}), {0.2f, 2, 2.2f});
+  expect_near(c.density.to_world.point({1, 1, 1}), {1.8f, 3.6f, 3.8f});
+
+  SceneDesc defaults = read_lines({"WorldBegin", "MakeNamedMedium \"c\" \"string type\" \"cloud\""});
+  const MediumDesc& d = defaults.media.at(0);
+  EXPECT_EQ(d.sigma_t, RGB(2.0f));  // sigma_a = sigma_s = 1
+  EXPECT_EQ(*d.density.cloud, CloudDensity{});
+  EXPECT_EQ(d.density.cloud->frequency, 5);
+  expect_near(d.density.to_world.point({1, 1, 1}), {1, 1, 1});
+}
+
+TEST(PbrtMedia, CloudErrors) {
+  const std::string cloud = "MakeNamedMedium \"m\" \"string type\" \"cloud\" ";
+  expect_error({"WorldBegin", cloud + "\"float scale\" 2"}, 2, "\"float scale\"",
+               "\"scale\" is not a parameter of a \"cloud\" medium");
+  expect_error({"WorldBegin", cloud + "\"point3 p0\" [ 0 0 0 ] \"point3 p1\" [ 1 1 0 ]"}, 2, "\"point3 p1\"",
+               "the cloud's box has no volume");
+  expect_error({"WorldBegin", cloud + "\"float g\" 1"}, 2, "\"float g\"", "must be between -1 and 1, exclusive");
+  expect_error({"WorldBegin", cloud + "\"rgb Le\" [ 1 1 1 ]"}, 2, "\"rgb Le\"", "unused parameter \"rgb Le\"");
+  expect_error({"WorldBegin", cloud + "\"float density\" [ 1 2 ]"}, 2, "\"float density\"",
+               "\"float density\" takes exactly 1 value, got 2");
 }
 
 // Errors in an included file name that file and where it was included from.

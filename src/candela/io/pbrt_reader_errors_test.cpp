@@ -1,11 +1,13 @@
 // Tests of the pbrt-v4 reader's errors and warnings at file:line:column, and pbrt options mapped onto candela's.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "candela/base/error.h"
+#include "candela/film/aov_film.h"
 #include "candela/io/pbrt_reader.h"
 #include "candela/description/scene_desc.h"
 #include "candela/testing/pbrt_reader_helpers.h"
@@ -209,14 +211,11 @@ TEST(PbrtReader, UnknownAndUnsupportedTypes) {
   expect_error({"WorldBegin", "MakeNamedMaterial \"m\" \"string type\" \"hair\""}, 2, "\"string type\"",
                "not supported");
   expect_error({"WorldBegin", "LightSource \"sun\""}, 2, "\"sun\"", "unknown light type \"sun\"");
-  for (std::string type : {"goniometric", "projection"})
-    expect_error({"WorldBegin", "LightSource \"" + type + "\""}, 2, "\"" + type + "\"",
-                 "light type \"" + type + "\" is not supported");
   expect_error({"Integrator \"whitted\"", "WorldBegin"}, 1, "\"whitted\"", "unknown integrator type \"whitted\"");
   expect_error({"Accelerator \"octree\"", "WorldBegin"}, 1, "\"octree\"", "unknown accelerator type");
   expect_error({"WorldBegin", "AreaLightSource \"glow\""}, 2, "\"glow\"", "unknown area light type");
   expect_error({"Camera \"realistic\"", "WorldBegin"}, 1, "\"realistic\"", "not supported yet");
-  expect_error({"Film \"gbuffer\"", "WorldBegin"}, 1, "\"gbuffer\"", "not supported yet");
+  expect_error({"Film \"spectral\"", "WorldBegin"}, 1, "\"spectral\"", "not supported yet");
 }
 
 TEST(PbrtReader, UnsupportedFeaturesOfSupportedTypes) {
@@ -325,7 +324,7 @@ TEST(PbrtReader, BdptAndMltAreCandelasOwn) {
 
 TEST(PbrtReader, OtherPbrtIntegratorsAreRenderedWithOneThatConvergesToTheSameImage) {
   EXPECT_TRUE(read_warned({"Integrator \"path\" \"integer maxdepth\" 9", "WorldBegin"}).warnings.empty());
-  for (std::string type : {"sppm", "lightpath", "randomwalk", "simplepath"}) {
+  for (std::string type : {"sppm", "randomwalk", "simplepath"}) {
     SCOPED_TRACE(type);
     std::vector<std::string> lines = {"Integrator \"" + type + "\" \"integer maxdepth\" 9", "WorldBegin"};
     expect_warning(lines, 1, "\"" + type + "\"",
@@ -334,9 +333,12 @@ TEST(PbrtReader, OtherPbrtIntegratorsAreRenderedWithOneThatConvergesToTheSameIma
     EXPECT_EQ(scene.settings.integrator, "path");
     EXPECT_EQ(scene.settings.max_depth, 9);
   }
-  // pbrt-v4's light tracer renders an image of its own: the warning says so.
-  expect_warning({"Integrator \"lightpath\"", "WorldBegin"}, 1, "\"lightpath\"",
-                 "pbrt-v4's light tracer renders a different image of this scene");
+  // pbrt-v4's light tracer is candela's light_path, with its maxdepth, without a warning.
+  Warned lightpath = read_warned({"Integrator \"lightpath\" \"integer maxdepth\" 4", "WorldBegin"});
+  EXPECT_TRUE(lightpath.warnings.empty()) << joined(lightpath.warnings);
+  EXPECT_EQ(lightpath.scene.settings.integrator, "light_path");
+  EXPECT_EQ(lightpath.scene.settings.max_depth, 4);
+  EXPECT_EQ(read_lines({"Integrator \"lightpath\"", "WorldBegin"}).settings.max_depth, 5);  // pbrt's default
   Warned volpath = read_warned({"Integrator \"volpath\" \"integer maxdepth\" 7", "WorldBegin"});
   EXPECT_TRUE(volpath.warnings.empty()) << joined(volpath.warnings);
   EXPECT_EQ(volpath.scene.settings.integrator, "volpath");
@@ -344,7 +346,22 @@ TEST(PbrtReader, OtherPbrtIntegratorsAreRenderedWithOneThatConvergesToTheSameIma
   expect_warning({"Integrator \"simplevolpath\"", "WorldBegin"}, 1, "\"simplevolpath\"",
                  "Integrator \"simplevolpath\": using candela's volpath integrator with maxdepth 5");
   EXPECT_EQ(read_lines({"Integrator \"simplevolpath\"", "WorldBegin"}).settings.integrator, "volpath");
-  EXPECT_THROW(read_lines({"Integrator \"ambientocclusion\"", "WorldBegin"}), SceneError);
+  // ambientocclusion is candela's ambient_occlusion with pbrt-v4's two parameters, without a warning.
+  Warned ao = read_warned({"Integrator \"ambientocclusion\" \"bool cossample\" false \"float maxdistance\" 0.5",
+                           "WorldBegin"});
+  EXPECT_TRUE(ao.warnings.empty()) << joined(ao.warnings);
+  EXPECT_EQ(ao.scene.settings.integrator, "ambient_occlusion");
+  EXPECT_FALSE(ao.scene.settings.ambient_occlusion.cosine_sampling);
+  EXPECT_EQ(ao.scene.settings.ambient_occlusion.max_distance, 0.5f);
+  const SceneDesc ao_defaults = read_lines({"Integrator \"ambientocclusion\"", "WorldBegin"});
+  EXPECT_EQ(ao_defaults.settings.integrator, "ambient_occlusion");
+  EXPECT_TRUE(ao_defaults.settings.ambient_occlusion.cosine_sampling);
+  EXPECT_TRUE(std::isinf(ao_defaults.settings.ambient_occlusion.max_distance));
+  expect_error({"Integrator \"ambientocclusion\" \"float maxdistance\" 0", "WorldBegin"}, 1,
+               "\"float maxdistance\"", "must be positive");
+  // It has no depth: pbrt-v4 refuses "maxdepth" as an unused parameter, and so does candela.
+  expect_error({"Integrator \"ambientocclusion\" \"integer maxdepth\" 5", "WorldBegin"}, 1,
+               "\"integer maxdepth\"", "unused parameter");
   Warned sppm = read_warned({"Integrator \"sppm\" \"integer photonsperiteration\" 1000 \"float radius\" 0.1",
                              "WorldBegin"});
   ASSERT_EQ(sppm.warnings.size(), 3u) << joined(sppm.warnings);
@@ -362,10 +379,61 @@ TEST(PbrtReader, ColorSpaceFilmAndAcceleratorOptions) {
   EXPECT_TRUE(read_warned({"ColorSpace \"srgb\"", "Accelerator \"bvh\" \"integer maxnodeprims\" 4", "WorldBegin"})
                   .warnings.empty());
   expect_warning({"ColorSpace \"aces2065-1\"", "WorldBegin"}, 1, "\"aces2065-1\"", "reads every colour as linear sRGB");
-  expect_warning({"Film \"rgb\" \"float maxcomponentvalue\" 10", "WorldBegin"}, 1, "\"float maxcomponentvalue\"",
-                 "\"maxcomponentvalue\" is ignored");
   expect_error({"WorldBegin", "Accelerator \"bvh\""}, 2, "Accelerator", "not allowed after WorldBegin");
 }
 
+// pbrt-v4's PixelSensor: the exposure is the shutter interval x ISO / 100, a camera sensor becomes
+// the CIE 1931 one white-balanced to 6500 K (with a warning), maxcomponentvalue limits the sensor.
+TEST(PbrtReader, FilmSensorIsoWhiteBalanceAndLimit) {
+  const SceneDesc plain = read_lines({"WorldBegin"});
+  EXPECT_TRUE(plain.film.sensor.changes_nothing());
+  const SceneDesc iso = read_lines({"Camera \"perspective\" \"float shutteropen\" 0.25 \"float shutterclose\" 0.75",
+                                    "Film \"rgb\" \"float iso\" 400 \"float whitebalance\" 5000 "
+                                    "\"float maxcomponentvalue\" 2",
+                                    "WorldBegin"});
+  EXPECT_FLOAT_EQ(iso.film.sensor.exposure, 2);
+  EXPECT_FLOAT_EQ(iso.film.sensor.white_balance, 5000);
+  EXPECT_FLOAT_EQ(iso.film.sensor.max_component, 2);
+  // The Film may come before the Camera: the exposure is settled at WorldBegin.
+  EXPECT_FLOAT_EQ(read_lines({"Film \"rgb\" \"float iso\" 200", "Camera \"perspective\" \"float shutterclose\" 0.5",
+                              "WorldBegin"}).film.sensor.exposure, 1);
+  EXPECT_FLOAT_EQ(read_lines({"Film \"rgb\" \"string sensor\" \"cie1931\"", "WorldBegin"}).film.sensor.white_balance, 0);
+  expect_warning({"Film \"rgb\" \"string sensor\" \"canon_eos_5d_mkiv\"", "WorldBegin"}, 1,
+                 "\"string sensor\"", "using the CIE 1931 sensor white-balanced to 6500 K");
+  EXPECT_FLOAT_EQ(read_warned({"Film \"rgb\" \"string sensor\" \"nikon_d850\"", "WorldBegin"})
+                      .scene.film.sensor.white_balance, 6500);
+  expect_error({"Film \"rgb\" \"string sensor\" \"leica_m11\"", "WorldBegin"}, 1, "\"string sensor\"",
+               "unknown sensor \"leica_m11\" (pbrt-v4 has \"cie1931\" and the cameras \"canon_eos_100d\"");
+  expect_error({"Film \"rgb\" \"float iso\" 0", "WorldBegin"}, 1, "\"float iso\"", "must be positive");
+  expect_error({"Film \"rgb\" \"float whitebalance\" 500", "WorldBegin"}, 1, "\"float whitebalance\"",
+               "[1000, 100000] kelvin");
+  expect_error({"Film \"rgb\" \"float maxcomponentvalue\" -1", "WorldBegin"}, 1, "\"float maxcomponentvalue\"",
+               "must be positive");
+  expect_error({"Camera \"perspective\" \"float shutteropen\" 0.5 \"float shutterclose\" 0.5", "WorldBegin"}, 1,
+               "\"float shutterclose\"", "the shutter does not open");
+}
+
+
+// pbrt-v4's gbuffer film: the rgb film's parameters (sensor included) plus its coordinate system,
+// read as pbrt's gbuffer AOVs (film/aov_film.h).
+TEST(PbrtReader, GbufferFilmSelectsPbrtsLayers) {
+  const SceneDesc camera_space = read_lines({"Film \"gbuffer\" \"integer xresolution\" 32 \"float iso\" 200 "
+                                             "\"string filename\" \"out.EXR\"",
+                                             "WorldBegin"});
+  EXPECT_EQ(camera_space.film.aovs, "gbuffer");
+  EXPECT_EQ(camera_space.film.width, 32);
+  EXPECT_EQ(parse_aov_selection(camera_space.film.aovs).space, AovSpace::Camera);
+  const SceneDesc world = read_lines({"Film \"gbuffer\" \"string coordinatesystem\" \"world\"", "WorldBegin"});
+  EXPECT_EQ(world.film.aovs, "gbuffer,world_space");
+  EXPECT_EQ(parse_aov_selection(world.film.aovs).space, AovSpace::World);
+  EXPECT_EQ(read_lines({"Film \"rgb\"", "WorldBegin"}).film.aovs, "");
+  expect_error({"Film \"gbuffer\"", "  \"string coordinatesystem\" \"screen\"", "WorldBegin"}, 2,
+               "\"string coordinatesystem\"", "Film \"gbuffer\": unknown \"coordinatesystem\" \"screen\"");
+  expect_error({"Film \"rgb\" \"string coordinatesystem\" \"camera\"", "WorldBegin"}, 1,
+               "\"string coordinatesystem\"", "");
+  expect_error({"Film \"gbuffer\" \"string filename\" \"out.png\"", "WorldBegin"}, 1, "\"string filename\"",
+               "the gbuffer film writes EXR files only");
+  expect_error({"Film \"gbuffer\" \"float iso\" 0", "WorldBegin"}, 1, "\"float iso\"", "Film \"gbuffer\"");
+}
 }  // namespace
 }  // namespace candela

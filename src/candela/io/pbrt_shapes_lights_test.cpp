@@ -169,8 +169,30 @@ TEST(PbrtReader, AreaLightPowerIsPerPrimitiveAsInPbrt) {
   EXPECT_NEAR(scene.shapes[3].emission->radiance.r, 3 * 10 / (pi * 2 * 1), 1e-4f);
   EXPECT_NEAR(scene.shapes[4].emission->radiance.r, 3 * 10 / (pi * 2 * 2), 1e-4f);
   EXPECT_NEAR(mesh_area(mesh_of(scene.shapes[4])), 2, 1e-6);
-  expect_error({"WorldBegin", "AreaLightSource \"diffuse\" \"string filename\" \"e.exr\""}, 2, "\"string filename\"",
-               "textured area lights are not supported");
+}
+
+// pbrt-v4's image area light: the emission is "scale" times the image at the hit's uv, clamped at the
+// image's edges; "L" and "power" do not go with an image.
+TEST(PbrtReader, AreaLightWithAnImageIsATexturedEmitter) {
+  ScratchFile image("glow.png");
+  SceneDesc scene = read_lines({"WorldBegin", "AreaLightSource \"diffuse\" \"string filename\" \"glow.png\" "
+                                "\"float scale\" 4 \"bool twosided\" true",
+                                "Shape \"sphere\""});
+  ASSERT_EQ(scene.shapes.size(), 1u);
+  const AreaEmission& emission = *scene.shapes[0].emission;
+  EXPECT_TRUE(emission.two_sided);
+  EXPECT_EQ(emission.radiance.r, 4);
+  EXPECT_EQ(emission.radiance.b, 4);
+  ASSERT_EQ(emission.texture, 0);
+  const auto& texture = std::get<ImageTexture>(scene.textures[0]);
+  EXPECT_EQ(fs::path(texture.filename).filename(), "glow.png");
+  EXPECT_EQ(texture.wrap, TextureWrap::Clamp);
+  expect_error({"WorldBegin", "AreaLightSource \"diffuse\" \"string filename\" \"glow.png\" \"rgb L\" [1 1 1]"}, 2,
+               "\"string filename\"", "cannot be given together with \"L\"");
+  expect_error({"WorldBegin", "AreaLightSource \"diffuse\" \"string filename\" \"glow.png\" \"float power\" 3"}, 2,
+               "\"float power\"", "not supported with an image");
+  expect_error({"WorldBegin", "AreaLightSource \"diffuse\" \"string filename\" \"none.png\""}, 2,
+               "\"string filename\"", "none.png");
 }
 
 // ---------------------------------------------------------------- shapes
@@ -332,10 +354,23 @@ TEST(PbrtReader, LoopSubdivisionSurfaces) {
 TEST(PbrtReader, AlphaAndOtherShapeParameters) {
   SceneDesc scene = read_lines({"WorldBegin", "Shape \"sphere\" \"float alpha\" 1"});
   EXPECT_EQ(scene.shapes.size(), 1u);
-  expect_error({"WorldBegin", "Shape \"sphere\" \"float alpha\" 0.5"}, 2, "\"float alpha\"",
-               "below 1 is not supported");
-  expect_error({"WorldBegin", "Texture \"a\" \"float\" \"constant\"", "Shape \"sphere\" \"texture alpha\" \"a\""}, 3,
-               "\"texture alpha\"", "textures are not supported: an alpha texture cuts the surface out");
+  EXPECT_EQ(scene.shapes[0].material, -1);  // alpha 1 is no cut-out
+  // Alpha below 1 wraps the shape's material (pbrt's default diffuse where none is set) in a mask of
+  // that opacity, one per material and alpha however many shapes share them.
+  SceneDesc cut = read_lines({"WorldBegin", "Texture \"holes\" \"float\" \"checkerboard\"",
+                              "Shape \"sphere\" \"float alpha\" 0.5", "Shape \"disk\" \"float alpha\" 0.5",
+                              "Material \"conductor\"", "Shape \"sphere\" \"texture alpha\" \"holes\""});
+  ASSERT_EQ(cut.shapes.size(), 3u);
+  EXPECT_EQ(cut.shapes[0].material, cut.shapes[1].material);
+  const auto& half = std::get<MaskMaterial>(cut.materials[size_t(cut.shapes[0].material)]);
+  EXPECT_EQ(half.opacity.value, 0.5f);
+  EXPECT_TRUE(std::holds_alternative<DiffuseMaterial>(cut.materials[size_t(half.material)]));
+  const auto& holes = std::get<MaskMaterial>(cut.materials[size_t(cut.shapes[2].material)]);
+  EXPECT_EQ(holes.opacity.texture, 0);
+  EXPECT_TRUE(std::holds_alternative<ConductorMaterial>(cut.materials[size_t(holes.material)]));
+  expect_error({"WorldBegin", "Shape \"sphere\" \"float alpha\" 1.5"}, 2, "\"float alpha\"", "must be in [0, 1]");
+  expect_error({"WorldBegin", "AreaLightSource \"diffuse\"", "Shape \"sphere\" \"float alpha\" 0.5"}, 3,
+               "\"float alpha\"", "on an area light is not supported");
   expect_warning({"WorldBegin", "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0 ] "
                   "\"vector3 S\" [ 1 0 0  1 0 0  1 0 0 ]"},
                  2, "\"vector3 S\"", "\"S\" is ignored");

@@ -37,6 +37,7 @@ struct EnvironmentLight::Data {
   int width = 0, height = 0;
   EnvironmentMapping mapping = EnvironmentMapping::Equirectangular;
   std::vector<RGB> texels;  // scaled, row-major, top row first
+  bool nearest = false;     // lookups take the texel the point falls in, not a bilinear blend
   Distribution2D distribution;
   std::array<Vec3, 3> world_from_light, light_from_world;
   float scene_radius = 1;
@@ -67,6 +68,14 @@ struct EnvironmentLight::Data {
       x = std::clamp(x, 0, width - 1);
       y = std::clamp(y, 0, height - 1);
     }
+    return texels[size_t(y) * size_t(width) + size_t(x)];
+  }
+
+  // The radiance at uv: the nearest texel's, or the bilinear blend of the four around uv.
+  RGB lookup(Vec2 uv) const {
+    if (!nearest) return bilinear(uv);
+    const int x = std::clamp(int(uv.x * float(width)), 0, width - 1);
+    const int y = std::clamp(int(uv.y * float(height)), 0, height - 1);
     return texels[size_t(y) * size_t(width) + size_t(x)];
   }
 
@@ -124,7 +133,8 @@ struct EnvironmentLight::Data {
 };
 
 EnvironmentLight::EnvironmentLight(const Image& image, EnvironmentMapping mapping, const RGB& scale,
-                                   const Transform& world_from_light, float scene_radius, bool mis_compensation) {
+                                   const Transform& world_from_light, float scene_radius, bool mis_compensation,
+                                   bool nearest) {
   if (image.width <= 0 || image.height <= 0 || image.rgb.size() < size_t(image.width) * size_t(image.height) * 3)
     throw SceneError("environment map: the image is empty");
   if (mapping == EnvironmentMapping::EqualAreaOctahedral && image.width != image.height)
@@ -139,6 +149,8 @@ EnvironmentLight::EnvironmentLight(const Image& image, EnvironmentMapping mappin
   d->width = w;
   d->height = h;
   d->mapping = mapping;
+  // Pole rows blend between the rows' centres by construction: they stay bilinear.
+  d->nearest = nearest && mapping != EnvironmentMapping::EquirectangularPoleRows;
   d->scene_radius = scene_radius;
   d->world_from_light = rows_of(world_from_light.matrix());
   d->light_from_world = rows_of(world_from_light.inverse_matrix());
@@ -184,7 +196,9 @@ EnvironmentLight::EnvironmentLight(const Image& image, EnvironmentMapping mappin
       cell_solid_angle = 2 * pi / w * (std::cos(pi * y / cells_y) - std::cos(pi * (y + 1) / cells_y));
     for (int x = 0; x < w; ++x) {
       double lum = 0;
-      if (d->pole_rows()) {
+      if (d->nearest) {
+        lum = d->texel(x, y).luminance();  // constant over the cell
+      } else if (d->pole_rows()) {
         lum = 0.25 * (double(d->texel(x, y).luminance()) + d->texel(x + 1, y).luminance() +
                       d->texel(x, y + 1).luminance() + d->texel(x + 1, y + 1).luminance());
       } else {
@@ -218,13 +232,13 @@ Vec3 EnvironmentLight::to_local(const Vec3& world_dir) const {
 Vec3 EnvironmentLight::to_world(const Vec3& local_dir) const {
   return normalize(apply(data_->world_from_light, local_dir));
 }
-RGB EnvironmentLight::lookup(Vec2 uv) const { return data_->bilinear(uv); }
+RGB EnvironmentLight::lookup(Vec2 uv) const { return data_->lookup(uv); }
 float EnvironmentLight::average_luminance() const { return data_->average_luminance; }
 
 RGB EnvironmentLight::radiance(const Vec3& world_dir) const {
   Vec3 local = to_local(world_dir);
   if (!is_finite(local)) return RGB(0.0f);
-  return data_->bilinear(data_->direction_to_uv(local));
+  return data_->lookup(data_->direction_to_uv(local));
 }
 
 LightSample EnvironmentLight::sample_li(const LightSampleContext& ctx, Vec2 u) const {
@@ -239,7 +253,7 @@ LightSample EnvironmentLight::sample_li(const LightSampleContext& ctx, Vec2 u) c
   if (!(pdf > 0) || !std::isfinite(pdf)) return {};
   Vec3 wi = to_world(local);
   LightSample ls;
-  ls.radiance = d.bilinear(uv);
+  ls.radiance = d.lookup(uv);
   ls.wi = wi;
   ls.distance = std::numeric_limits<float>::infinity();
   ls.pdf = pdf;
@@ -282,7 +296,8 @@ EnvironmentLight make_environment_light(const EnvironmentMap& desc, float scene_
     throw SceneError(fmt::format("environment map: {}", e.what()));
   }
   try {
-    return EnvironmentLight(*image, desc.mapping, desc.scale, desc.to_world, scene_radius, desc.mis_compensation);
+    return EnvironmentLight(*image, desc.mapping, desc.scale, desc.to_world, scene_radius, desc.mis_compensation,
+                            desc.filter == TextureFilter::Nearest);
   } catch (const SceneError& e) {
     throw SceneError(fmt::format("{}: {}", desc.filename, e.what()));
   }

@@ -33,8 +33,10 @@ class EnvironmentLight {
   // mis_compensation: sample in proportion to max(luminance - its mean, 0) instead (Mitsuba's
   // envmap option, after Karlik et al. 2019), leaving the directions that BSDF sampling finds well
   // to it under MIS; every direction with radiance keeps a small density.
+  // nearest: each texel's radiance is constant over its cell (pbrt-v4's lookups), not bilinear.
   EnvironmentLight(const Image& image, EnvironmentMapping mapping, const RGB& scale,
-                   const Transform& world_from_light, float scene_radius, bool mis_compensation = false);
+                   const Transform& world_from_light, float scene_radius, bool mis_compensation = false,
+                   bool nearest = false);
 
   // Radiance arriving along -world_dir, i.e. seen looking in direction world_dir (for rays that
   // escape the scene). world_dir need not be normalised.

@@ -325,6 +325,38 @@ TEST(EnvironmentLight, MisCompensationSamplesLuminanceAboveTheMeanAndStaysUnbias
   EXPECT_NEAR(mean, reference.g, 4 * se + 1e-3 * reference.g);
 }
 
+// pbrt-v4's lookups (filter "nearest"): the radiance anywhere in a texel is that texel's, and on an
+// equal-area map the sampling density is exactly proportional to the luminance there (radiance
+// luminance / pdf is the same for every sample but those of the floor under dim texels).
+TEST(EnvironmentLight, NearestTexelLookupsAndExactlyProportionalSampling) {
+  for (EnvironmentMapping m : {EnvironmentMapping::Equirectangular, EnvironmentMapping::EqualAreaOctahedral}) {
+    const Image img = testing::environment_test_map(m);
+    const EnvironmentLight light(img, m, RGB(1.5f, 1.0f, 0.5f), test_rotation(), 3.0f, false, true);
+    for (auto [x, y] : {std::pair{3, 2}, std::pair{img.width / 2 + 3, img.height / 4}, std::pair{10, 7}}) {
+      // Three points inside the texel, away from its centre.
+      for (Vec2 offset : {Vec2(0.1f, 0.1f), Vec2(0.9f, 0.2f), Vec2(0.4f, 0.85f)}) {
+        const Vec2 uv((float(x) + offset.x) / float(img.width), (float(y) + offset.y) / float(img.height));
+        const RGB got = light.radiance(test_rotation().vector(light.uv_to_direction(uv)));
+        const RGB expected = img.at(x, y) * RGB(1.5f, 1.0f, 0.5f);
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], expected[c], 1e-5f * (1 + expected[c])) << name(m);
+      }
+    }
+    // Equal-area cells have equal solid angles; a latitude-longitude cell's density follows sin(theta)
+    // within it, so only the equal-area map is exactly proportional.
+    if (m != EnvironmentMapping::EqualAreaOctahedral) continue;
+    LightSampleContext ctx{{0, 0, 0}, Normal3(0.0f)};
+    Rng rng(5, 6);
+    float ratio = -1;
+    for (int i = 0; i < 2000; ++i) {
+      const LightSample s = light.sample_li(ctx, {rng.next_float(), rng.next_float()});
+      if (s.pdf == 0 || s.radiance.luminance() < 1e-2f) continue;  // the floor under dim texels
+      const float r = s.radiance.luminance() / s.pdf;
+      if (ratio < 0) ratio = r;
+      ASSERT_NEAR(r, ratio, 1e-3f * ratio) << name(m);
+    }
+  }
+}
+
 TEST(EnvironmentLight, ConstantMapIsSampledUniformly) {
   Image img(8, 8);
   for (int y = 0; y < 8; ++y)

@@ -10,7 +10,7 @@
 //   pdf_le(p, n, w, S)        the densities sample_le gives the ray from p along w
 //   static constexpr flags    what kind of emitter the type is (light_flags.h)
 // Lights that surround the scene (LightFlags::Infinite: sky, environment map) also offer radiance(dir)
-// for rays that escape the scene; delta lights (point, spot, projector, distant) are reached only by
+// for rays that escape the scene; delta lights (point, spot, projector, goniometric, distant) are reached only by
 // sampling them.
 // The closed list of lights is the variant `Light`; dispatch happens once, here.
 #include <limits>
@@ -19,6 +19,7 @@
 #include "candela/lights/area_lights.h"
 #include "candela/lights/distant_light.h"
 #include "candela/lights/environment_light.h"
+#include "candela/lights/goniometric_light.h"
 #include "candela/lights/point_light.h"
 #include "candela/lights/projector_light.h"
 #include "candela/lights/sky_light.h"
@@ -28,7 +29,7 @@ namespace candela {
 
 using Light = std::variant<PointLightSource, TriangleLight, RectangleLight, SphereLight, SkyLightSource,
                            SpotLightSource, DistantLightSource, EnvironmentLight, DiskLight, CylinderLight,
-                           ProjectorLightSource, PartialSphereLight>;
+                           ProjectorLightSource, PartialSphereLight, GoniometricLightSource>;
 
 inline LightSample light_sample_li(const Light& l, const LightSampleContext& ctx, Vec2 u) {
   return std::visit([&](const auto& x) { return x.sample_li(ctx, u); }, l);

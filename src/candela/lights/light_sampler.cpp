@@ -69,6 +69,10 @@ std::optional<LightBounds> light_bounds(const Light& light) {
             return LightBounds{point_bounds(l.position), l.intensity.luminance(), l.frame.n, l.cos_falloff_start,
                                std::cos(std::max(0.0f, theta_end - theta_start)), false};
           },
+          [](const GoniometricLightSource& l) -> std::optional<LightBounds> {
+            // As pbrt-v4 bounds it: an isotropic point light of the same power.
+            return omnidirectional(point_bounds(l.position), l.power() / (4 * kPi));
+          },
           [](const ProjectorLightSource& l) -> std::optional<LightBounds> {
             // As bright as a point light of the same power, in every direction (a loose but safe cone).
             return omnidirectional(point_bounds(l.position), l.power() / (4 * kPi));

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "candela/spectral/blackbody.h"
+#include "candela/textures/noise.h"
 
 namespace candela {
 
@@ -14,8 +15,23 @@ namespace {
 
 bool valid_rgb(const RGB& c) { return c.is_finite() && c.min_component() >= 0; }
 
+// Why a cloud cannot be rendered: a parameter that is not finite, or a box without volume.
+std::string cloud_problem(const CloudDensity& c) {
+  for (auto [name, value] : {std::pair{"density", c.density}, std::pair{"wispiness", c.wispiness},
+                             std::pair{"frequency", c.frequency}})
+    if (!std::isfinite(value)) return fmt::format("the cloud's {} {} must be finite", name, value);
+  const Point3 &lo = c.box_min, &hi = c.box_max;
+  if (!is_finite(lo) || !is_finite(hi) || !(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z))
+    return fmt::format("the cloud's box from ({}, {}, {}) to ({}, {}, {}) must be finite and have volume", lo.x,
+                       lo.y, lo.z, hi.x, hi.y, hi.z);
+  return "";
+}
+
 std::string volume_problem(const VolumeDesc& v, const char* what, bool scalar_only, float max_value,
                            float min_value = 0) {
+  if (v.cloud)
+    return std::string_view(what) == "density" ? cloud_problem(*v.cloud)
+                                               : fmt::format("{} is a procedural cloud; only a density may be one", what);
   const std::string source = v.filename.empty() ? std::string(what) : fmt::format("{} grid \"{}\"", what, v.filename);
   if (v.is_constant()) {
     if (!v.constant.is_finite() || v.constant.min_component() < min_value || v.constant.max_component() > max_value)
@@ -60,13 +76,64 @@ std::string medium_problem(const MediumDesc& m) {
   return volume_problem(m.albedo, "albedo", false, 1.0f);
 }
 
+namespace {
+
+// pbrt-v4's DNoise: the noise's gradient at p as forward differences over 0.01 (not the analytic
+// gradient: the cloud's displacement is defined by these differences).
+Vec3 cloud_noise_forward_gradient(const Point3& p) {
+  constexpr float kStep = 0.01f;
+  const float n = perlin_noise(p);
+  return Vec3(perlin_noise(p + Vec3(kStep, 0, 0)) - n, perlin_noise(p + Vec3(0, kStep, 0)) - n,
+              perlin_noise(p + Vec3(0, 0, kStep)) - n) /
+         kStep;
+}
+
+}  // namespace
+
+float cloud_density(const CloudDensity& cloud, const Point3& p) {
+  // Step 1: the lookup point, scaled by the frequency and displaced by two octaves of the noise's
+  // gradient (amplitude 0.05 wispiness, halving; frequency 10, times 1.99 per octave).
+  Point3 q = p * cloud.frequency;
+  if (cloud.wispiness > 0) {
+    float amplitude = 0.05f * cloud.wispiness, frequency = 10;
+    for (int octave = 0; octave < 2; ++octave) {
+      q += amplitude * cloud_noise_forward_gradient(q * frequency);
+      amplitude *= 0.5f;
+      frequency *= 1.99f;
+    }
+  }
+  // Step 2: five octaves of noise of amplitude 0.5^(i + 1) and frequency 1.99^i, which is half of
+  // fbm with omega 0.5 (the same products in the same order, halved exactly).
+  const float noise = 0.5f * fbm(q, 0.5f, 5);
+  // Step 3: the altitude falloff, the noise's cloud thinning towards p.y = 1 and a floor of full
+  // density rising below p.y = 0.5.
+  const float from_noise = std::clamp((1 - p.y) * 4.5f * cloud.density * noise, 0.0f, 1.0f);
+  return std::min(from_noise + 2 * std::max(0.0f, 0.5f - p.y), 1.0f);
+}
+
+float cloud_density_bound(const CloudDensity& cloud, float y_lo, float y_hi) {
+  // Each octave of noise is a convex combination (faded trilinear weights) of corner values +-u +- v
+  // with offsets |u|, |v| <= 1, so within [-2, 2] wherever the lookup point is; the five octaves'
+  // amplitudes sum to 1 - 1/32. The 1e-3 covers rounding in the noise and the products.
+  constexpr float kNoiseBound = 2 * (1 - 1.0f / 32) * (1 + 1e-3f);
+  const float lever = std::max(std::abs(1 - y_lo), std::abs(1 - y_hi));  // |1 - p.y| at most
+  const float from_noise = std::min(lever * 4.5f * std::abs(cloud.density) * kNoiseBound, 1.0f);
+  return std::min(from_noise + 2 * std::max(0.0f, 0.5f - y_lo), 1.0f);
+}
+
 Volume::Volume(const VolumeDesc& desc)
     : constant_(desc.constant),
       resolution_(desc.resolution),
       channels_(desc.channels),
       values_(desc.values),
       world_to_grid_(desc.to_world.inverse()),
-      border_(desc.border) {}
+      border_(desc.border),
+      cloud_(desc.cloud) {}
+
+float Volume::cloud_at(const Point3& g) const {
+  // The unit cube's point in the cloud's own space (CloudDensity::unit_cube_to_cloud).
+  return cloud_density(*cloud_, cloud_->box_min + g * (cloud_->box_max - cloud_->box_min));
+}
 
 float Volume::sample(int x, int y, int z, int c) const {
   const int nx = resolution_[0], ny = resolution_[1], nz = resolution_[2];
@@ -96,6 +163,7 @@ float Volume::lookup(const Point3& g, int c) const {
 }
 
 RGB Volume::at(const Point3& p) const {
+  if (cloud_) return RGB(cloud_at(world_to_grid_.point(p)));
   if (!values_) return constant_;
   Point3 g = world_to_grid_.point(p);
   if (channels_ == 1) return RGB(lookup(g, 0));
@@ -103,11 +171,20 @@ RGB Volume::at(const Point3& p) const {
 }
 
 float Volume::scalar_at(const Point3& p) const {
+  if (cloud_) return cloud_at(world_to_grid_.point(p));
   if (!values_) return constant_.r;
   return lookup(world_to_grid_.point(p), 0);
 }
 
 float Volume::max_in(const Point3& lo, const Point3& hi) const {
+  if (cloud_) {
+    // The cloud's bound depends on altitude only. The cell a tracking step lands in and the altitude
+    // of its point are rounded separately, so the altitude range is widened a little.
+    const float y0 = cloud_->box_min.y, extent = cloud_->box_max.y - cloud_->box_min.y;
+    const float y_lo = y0 + lo.y * extent, y_hi = y0 + hi.y * extent;
+    const float pad = 1e-3f * (y_hi - y_lo) + 1e-5f * (1 + std::max(std::abs(y_lo), std::abs(y_hi)));
+    return cloud_density_bound(*cloud_, y_lo - pad, y_hi + pad);
+  }
   if (!values_) return constant_.r;
   // The samples a lookup in [lo, hi] interpolates: from floor(lo n - 1/2) to floor(hi n - 1/2) + 1.
   int first[3], last[3];
@@ -155,10 +232,15 @@ Medium::Medium(const MediumDesc& desc)
   if (density_.is_constant()) return;
   // The majorant grid: a cell per majorant_cell_samples^3 samples of the density (4 by default), at
   // most 64 per axis and at least one (pbrt-v4 uses a fixed 16^3; scaling with the grid keeps empty
-  // space skippable in large clouds).
+  // space skippable in large clouds). A cloud's bound varies with altitude only: slabs along the
+  // cloud's y axis (its box's y is the unit cube's), or one bound as pbrt-v4 has.
   const int k = desc.majorant_cell_samples;
-  for (int a = 0; a < 3; ++a)
-    majorant_resolution_[a] = k > 0 ? std::clamp((density_.resolution()[a] + k - 1) / k, 1, 64) : 1;
+  constexpr int kCloudAltitudeSlabs = 32;
+  if (density_.is_cloud())
+    majorant_resolution_ = {1, k > 0 ? kCloudAltitudeSlabs : 1, 1};
+  else
+    for (int a = 0; a < 3; ++a)
+      majorant_resolution_[a] = k > 0 ? std::clamp((density_.resolution()[a] + k - 1) / k, 1, 64) : 1;
   const auto& r = majorant_resolution_;
   majorant_.resize(size_t(r[0]) * size_t(r[1]) * size_t(r[2]));
   for (int z = 0; z < r[2]; ++z)
@@ -168,12 +250,20 @@ Medium::Medium(const MediumDesc& desc)
         Point3 hi(float(x + 1) / float(r[0]), float(y + 1) / float(r[1]), float(z + 1) / float(r[2]));
         majorant_[(size_t(z) * size_t(r[1]) + size_t(y)) * size_t(r[0]) + size_t(x)] = density_.max_in(lo, hi);
       }
+  // A dense cloud's slabs all reach the bound of 1: one cell then, which the tracking crosses without
+  // stopping at every slab.
+  if (density_.is_cloud() &&
+      std::all_of(majorant_.begin(), majorant_.end(), [&](float bound) { return bound == majorant_.front(); })) {
+    majorant_resolution_ = {1, 1, 1};
+    majorant_.resize(1);
+  }
 }
 
 float Medium::density(const Point3& p) const {
   if (density_.is_constant()) return density_.constant().r;
   Point3 g = density_.world_to_grid().point(p);
-  // No medium outside the grid's cube (Mitsuba bounds a heterogeneous medium by its volume's box).
+  // No medium outside the grid's cube (Mitsuba bounds a heterogeneous medium by its volume's box,
+  // pbrt-v4 a cloud by its box).
   if (g.x < 0 || g.y < 0 || g.z < 0 || g.x > 1 || g.y > 1 || g.z > 1) return 0;
   return density_.scalar_at(p);
 }

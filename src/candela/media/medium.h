@@ -10,6 +10,7 @@
 #include <bit>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,12 +29,21 @@ namespace candela {
 // neither scalar nor RGB, or a grid value that is negative or not finite (a temperature: not finite). Readers call it to point at the place in the file.
 std::string medium_problem(const MediumDesc& medium);
 
+// pbrt-v4's cloud density (description/media.h's CloudDensity, steps 1 to 3) at point p of the cloud's
+// own space, whether or not p lies in the cloud's box (the medium clips to it). Within [0, 1].
+float cloud_density(const CloudDensity& cloud, const Point3& p);
+
+// An upper bound of cloud_density over every point of the cloud's space whose altitude p.y lies in
+// [y_lo, y_hi], from a bound of the noise alone (so it holds for any x, z and displacement): at most 1.
+float cloud_density_bound(const CloudDensity& cloud, float y_lo, float y_hi);
+
 // A VolumeDesc ready for lookups at world points.
 class Volume {
  public:
   Volume() = default;
   explicit Volume(const VolumeDesc& desc);
-  bool is_constant() const { return values_ == nullptr; }
+  bool is_constant() const { return values_ == nullptr && !cloud_; }
+  bool is_cloud() const { return cloud_.has_value(); }
   const RGB& constant() const { return constant_; }
   // Trilinear lookup at world point p (a scalar grid's value in all three channels).
   RGB at(const Point3& p) const;
@@ -42,10 +52,13 @@ class Volume {
   // From world space to the grid's unit cube.
   const Transform& world_to_grid() const { return world_to_grid_; }
   const std::array<int, 3>& resolution() const { return resolution_; }
-  // The largest channel-0 value any lookup inside the grid-space box [lo, hi] can return.
+  // The largest channel-0 value any lookup inside the grid-space box [lo, hi] can return (a cloud's:
+  // an upper bound of it).
   float max_in(const Point3& lo, const Point3& hi) const;
 
  private:
+  // A cloud's density at grid-space (unit-cube) point g.
+  float cloud_at(const Point3& grid_p) const;
   // Sample (x, y, z), channel c, with the border rule outside the grid.
   float sample(int x, int y, int z, int c) const;
   float lookup(const Point3& grid_p, int c) const;
@@ -56,6 +69,7 @@ class Volume {
   std::shared_ptr<const std::vector<float>> values_;
   Transform world_to_grid_;
   VolumeBorder border_ = VolumeBorder::Clamp;
+  std::optional<CloudDensity> cloud_;  // a procedural density in place of samples
 };
 
 // The coefficients at a point, per unit length.
@@ -69,7 +83,7 @@ class Medium {
 
   // scale * sigma_t: the extinction at density 1.
   const RGB& sigma_t() const { return sigma_t_; }
-  // The density at p (0 outside a grid's cube; the constant of a homogeneous medium).
+  // The density at p (0 outside a grid's or a cloud's cube; the constant of a homogeneous medium).
   float density(const Point3& p) const;
   RGB albedo(const Point3& p) const { return albedo_.at(p); }
   bool has_albedo_grid() const { return !albedo_.is_constant(); }
@@ -98,7 +112,8 @@ class Medium {
   bool has_temperature_ = false, emissive_ = false;
   float temperature_scale_ = 1, temperature_offset_ = 0, temperature_cutoff_ = 100;
   HenyeyGreenstein phase_;
-  // Density grids: the largest density over each cell of a coarse grid over the unit cube.
+  // Density grids and clouds: the largest density (a cloud's: a bound of it) over each cell of a
+  // coarse grid over the unit cube.
   std::array<int, 3> majorant_resolution_{1, 1, 1};
   std::vector<float> majorant_;
 };

@@ -75,7 +75,10 @@ class CameraSampleTiles final : public TileIntegrator {
         context.non_finite.fetch_add(1, std::memory_order_relaxed);
         context.non_finite_log.add(x, y, s);
         L = RGB(0.0f);
-      } else if (context.clamp > 0) {
+      } else {
+        L = context.scene.film_sensor().respond(L);
+      }
+      if (context.clamp > 0) {
         float m = L.max_component();
         if (m > context.clamp) L *= context.clamp / m;
       }

@@ -1,6 +1,7 @@
 #include "candela/render/first_hit_aovs.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "candela/render/camera_sample_tiles.h"
@@ -23,7 +24,43 @@ Ray continue_ray(const SurfaceHit& hit, const Vec3& direction, float time) {
   return Ray{offset_ray_origin(hit.p, hit.ng, direction), direction, std::numeric_limits<float>::infinity(), time};
 }
 
+// The offset of the point where the ray (origin, direction) meets the plane through `p` with normal
+// `n` from p: one of pbrt-v4's ray-differential footprints (0 for a ray parallel to the plane).
+Vec3 tangent_plane_offset(const Point3& origin, const Vec3& direction, const Point3& p, const Vec3& n) {
+  const float along_normal = dot(n, direction);
+  if (along_normal == 0 || !std::isfinite(along_normal)) return {0, 0, 0};
+  const float t = dot(n, p - origin) / along_normal;
+  const Vec3 offset = (origin + direction * t) - p;
+  return std::isfinite(offset.x) && std::isfinite(offset.y) && std::isfinite(offset.z) ? offset : Vec3(0, 0, 0);
+}
+
+// A camera ray's point at unit depth along the viewing axis `forward` (its origin for an
+// orthographic ray, whose direction is the axis): how it moves from pixel to pixel gives the steps.
+Point3 unit_depth_point(const Ray& ray, const Vec3& forward) {
+  return ray.origin + ray.direction / dot(ray.direction, forward);
+}
+
 }  // namespace
+
+AovCameraFrame aov_camera_frame(const Camera& camera) {
+  AovCameraFrame frame;
+  const Vec2 centre(0.5f * float(camera.width()), 0.5f * float(camera.height()));
+  const Vec2 lens_centre(0.5f, 0.5f);
+  const float time = camera.shutter_open();
+  const Ray r0 = camera.generate_ray(centre, lens_centre, time);
+  const Ray rx = camera.generate_ray(centre + Vec2(1, 0), lens_centre, time);
+  const Ray ry = camera.generate_ray(centre + Vec2(0, 1), lens_centre, time);
+  frame.orthographic = camera.is_orthographic();
+  frame.z = normalize(camera.forward());
+  const Point3 q0 = unit_depth_point(r0, frame.z);
+  frame.pixel_dx = unit_depth_point(rx, frame.z) - q0;
+  frame.pixel_dy = unit_depth_point(ry, frame.z) - q0;
+  // Film y grows downwards; the camera's y axis points up.
+  frame.x = normalize(frame.pixel_dx);
+  frame.y = normalize(-frame.pixel_dy);
+  frame.origin = r0.origin;
+  return frame;
+}
 
 AovSample first_hit_aovs(const Scene& scene, const Ray& camera_ray, bool shade, int x, int y, uint64_t sample,
                          uint64_t seed) {
@@ -46,6 +83,19 @@ AovSample first_hit_aovs(const Scene& scene, const Ray& camera_ray, bool shade, 
       out.hit = true;
       out.position = hit.p;
       out.depth = dot(hit.p - camera_ray.origin, forward);
+      const Vec3 n(hit.ng.x, hit.ng.y, hit.ng.z);
+      out.geometric_normal = dot(n, ray.direction) > 0 ? -n : n;
+      out.uv = hit.uv;
+      // pbrt-v4's ray differentials: the camera rays one pixel right and one pixel down, met with
+      // the hit's tangent plane.
+      const AovCameraFrame frame = aov_camera_frame(scene.camera());
+      const Vec3 unit_depth_direction = camera_ray.direction / dot(camera_ray.direction, frame.z);
+      for (int axis = 0; axis < 2; ++axis) {
+        const Vec3 step = axis == 0 ? frame.pixel_dx : frame.pixel_dy;
+        const Point3 origin = frame.orthographic ? camera_ray.origin + step : camera_ray.origin;
+        const Vec3 direction = frame.orthographic ? camera_ray.direction : unit_depth_direction + step;
+        (axis == 0 ? out.dpdx : out.dpdy) = tangent_plane_offset(origin, direction, hit.p, n);
+      }
     };
     // Only the hit is wanted, and nothing can be seen through this surface.
     if (!shade && !scene.may_pass_through(hit)) {

@@ -20,6 +20,12 @@
 //   smooth coat over a base) are estimated at the hit, whichever lobe the sample picks.
 // - normal: the world-space shading normal (normal and bump maps included) of the surface whose
 //   albedo is taken, turned to face the ray.
+// - geometric_normal, uv, dpdx, dpdy: at the hit depth and position are taken at. The geometric
+//   normal faces the ray (pbrt-v4's FaceForward(n, wo)). dpdx and dpdy follow pbrt-v4's ray
+//   differentials of a camera ray: the rays through the film position one pixel to the right and one
+//   pixel down (same lens point; an orthographic ray's origin moves instead) are intersected with the
+//   hit's tangent plane, and the offsets of those points from the hit are dpdx and dpdy (zero where an
+//   offset ray runs parallel to the plane).
 // - A ray that escapes, directly or after delta bounces, has albedo 0 and normal 0. OIDN's
 //   documentation says nothing about the albedo of escaped rays (its examples show none for the
 //   background), and a zero normal is its "no surface". A camera ray that escapes has no depth or
@@ -38,6 +44,10 @@
 namespace candela {
 
 inline constexpr int kAovMaxSpecularBounces = 4;
+
+// The camera's frame and per-pixel ray steps (film/aov_film.h), from rays through the film's centre
+// and the positions one pixel right and one down, through the lens centre at shutter open.
+AovCameraFrame aov_camera_frame(const Camera& camera);
 
 // The AOVs of the camera ray of sample `sample` of pixel (x, y). Without `shade` only the hit is
 // found (depth and position), not the BSDF (albedo and normal stay 0).

@@ -131,10 +131,12 @@ uint64_t texture_image_bytes(const TextureDesc& texture, const SourceLocation& w
 }
 
 // The image a light reads, in memory with its sampling distribution (an environment map's two
-// floats per texel). Spot and projector lights name textures, counted with the textures.
+// floats per texel; a goniometric light's one-channel copy and its distribution, three). Spot and
+// projector lights name textures, counted with the textures.
 uint64_t light_image_bytes(const LightDesc& light, const SourceLocation& where) {
   return std::visit(
       overloaded{[&](const EnvironmentMap& env) { return image_bytes(env.filename, 2 * sizeof(float), where); },
+                 [&](const GoniometricLight& g) { return image_bytes(g.filename, 3 * sizeof(float), where); },
                  [](const PointLight&) { return uint64_t(0); }, [](const SkyLight&) { return uint64_t(0); },
                  [](const SpotLight&) { return uint64_t(0); }, [](const DistantLight&) { return uint64_t(0); },
                  [](const ProjectorLight&) { return uint64_t(0); }},

@@ -135,6 +135,7 @@ void Scene::build(const SceneDesc& desc, SceneDesc* take_meshes) {
             },
             [&](const SpotLight& spot) -> Light { return make_spot_light(spot, &textures_); },
             [&](const ProjectorLight& projector) -> Light { return make_projector_light(projector, &textures_); },
+            [&](const GoniometricLight& goniometric) -> Light { return make_goniometric_light(goniometric); },
             [&](const DistantLight& distant) -> Light { return make_distant_light(distant, radius); },
             [&](const EnvironmentMap& env) -> Light { return make_environment_light(env, radius); }},
         l); });
@@ -168,6 +169,7 @@ void Scene::build(const SceneDesc& desc, SceneDesc* take_meshes) {
   // Camera rays reach the filter's radius beyond the outermost pixel centres.
   Vec2 r = desc.settings.filter.radius;
   camera_ = PerspectiveCamera(desc.camera, w, h, {std::max(0.0f, r.x - 0.5f), std::max(0.0f, r.y - 0.5f)});
+  film_sensor_ = FilmSensor(desc.film.sensor);
   bounding_sphere_ = {bounds_.empty() ? Point3(0.0f) : bounds_.center(), radius};
   for (const auto& rec : shapes_) {
     has_interfaces_ = has_interfaces_ || materials_.is_interface(rec.material);

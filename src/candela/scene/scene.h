@@ -13,6 +13,7 @@
 #include "candela/materials/material.h"
 #include "candela/media/medium.h"
 #include "candela/description/scene_desc.h"
+#include "candela/film/sensor.h"
 #include "candela/textures/texture.h"
 
 namespace candela {
@@ -125,6 +126,8 @@ class Scene {
     return light_escaped_radiance(lights_[light], dir);
   }
   const PerspectiveCamera& camera() const { return camera_; }
+  // What the film's sensor makes of each sample's radiance (FilmDesc::Sensor).
+  const FilmSensor& film_sensor() const { return film_sensor_; }
   const Bounds3& bounds() const { return bounds_; }
   // The sphere around bounds(): light paths from lights at infinity start on a disk of its radius.
   const SceneSphere& bounding_sphere() const { return bounding_sphere_; }
@@ -171,6 +174,7 @@ class Scene {
   template <typename Make>
   auto with_place(const SourceLocation& where, Make make) const -> decltype(make());
   EmbreeScene embree_;
+  FilmSensor film_sensor_;
   std::vector<ShapeRecord> shapes_;  // indexed by Embree geometry id (world and object shapes alike)
   struct InstanceRecord {
     Transform to_world;

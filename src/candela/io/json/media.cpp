@@ -25,7 +25,8 @@ void JsonSceneReader::read_media(const Json& value, const std::string& pointer) 
 }
 
 // "homogeneous": the same coefficients everywhere. "grid": a density (and optionally an albedo) that
-// varies over a grid's box; the medium has no density outside the density grid's box. The fields
+// varies over a grid's box, or a procedural cloud's density over its box; the medium has no density
+// outside the density's box. The fields
 // are the medium's schema (description/media.h); "sigma_a" and "sigma_s" are another way to give
 // sigma_t and the albedo.
 MediumDesc JsonSceneReader::read_medium(const Json& value, const std::string& pointer) {
@@ -64,10 +65,34 @@ MediumDesc JsonSceneReader::read_medium(const Json& value, const std::string& po
 }
 
 // A grid of values over the unit cube of its space, which "transform" places: a Mitsuba .vol file, an
-// OpenVDB or NanoVDB grid, or the samples inline. `what` is "density" or "emission_scale" (1 channel,
+// OpenVDB or NanoVDB grid, or the samples inline; or, for a density, pbrt-v4's procedural "cloud". `what` is "density" or "emission_scale" (1 channel,
 // values >= 0), "temperature" (1 channel, finite values) or "albedo" (1 or 3 channels, values in [0, 1]).
 VolumeDesc JsonSceneReader::read_volume(const Json& value, const std::string& pointer, std::string_view what) const {
   CheckedObject v(report_, value, pointer);
+  // pbrt-v4's procedural cloud (CloudDensity) instead of samples: its parameters and its box in the
+  // cloud's own space, which "transform" places; the volume's unit cube is that box.
+  if (const Json* cloud_value = v.find("cloud")) {
+    if (what != "density")
+      report_.fail(v.pointer_of("cloud"), "only a medium's density may be a procedural cloud, not its {}", what);
+    CheckedObject c(report_, *cloud_value, v.pointer_of("cloud"));
+    CloudDensity cloud;
+    cloud.density = c.number_or("density", cloud.density);
+    cloud.wispiness = c.number_or("wispiness", cloud.wispiness);
+    cloud.frequency = c.number_or("frequency", cloud.frequency);
+    cloud.box_min = c.vec3_or("min", cloud.box_min);
+    cloud.box_max = c.vec3_or("max", cloud.box_max);
+    if (!(cloud.box_max.x > cloud.box_min.x && cloud.box_max.y > cloud.box_min.y && cloud.box_max.z > cloud.box_min.z))
+      report_.fail(c.has("max") ? c.pointer_of("max") : c.pointer(),
+                   "the cloud's box must have volume: \"max\" ({}, {}, {}) must exceed \"min\" ({}, {}, {}) on every "
+                   "axis", cloud.box_max.x, cloud.box_max.y, cloud.box_max.z, cloud.box_min.x, cloud.box_min.y,
+                   cloud.box_min.z);
+    c.finish();
+    VolumeDesc volume;
+    volume.to_world = read_transform_key(v) * cloud.unit_cube_to_cloud();
+    volume.cloud = cloud;
+    v.finish();
+    return volume;
+  }
   const bool is_albedo = what == "albedo", is_temperature = what == "temperature";
   const bool from_file = v.has("filename");
   const bool inline_data = v.has("resolution") || v.has("values") || v.has("channels");

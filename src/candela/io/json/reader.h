@@ -55,6 +55,7 @@ class JsonSceneReader {
   void read_lens_and_shutter(CheckedObject& camera);
   std::array<float, 4> read_screen_window(const Json& value, const std::string& pointer) const;
   void read_crop(const Json& value, const std::string& pointer);
+  void read_sensor(const Json& value, const std::string& pointer);
   void check_view_direction(const CheckedObject& camera, Point3 position, Point3 look_at, Vec3 up) const;
   void read_render(const Json& value, const std::string& pointer);
   void read_render_option(const RenderOption& option, const Json& value, const std::string& pointer,

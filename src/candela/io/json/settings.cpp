@@ -40,6 +40,7 @@ void JsonSceneReader::read_camera(const Json& value, const std::string& pointer)
   scene_.film.width = camera.integer_or("width", scene_.film.width, 1, kMaxResolution);
   scene_.film.height = camera.integer_or("height", scene_.film.height, 1, kMaxResolution);
   if (const Json* crop = camera.find("crop")) read_crop(*crop, camera.pointer_of("crop"));
+  if (const Json* sensor = camera.find("sensor")) read_sensor(*sensor, camera.pointer_of("sensor"));
   read_lens_and_shutter(camera);
   scene_.camera.medium = medium_reference(camera, "medium");
   camera.finish();
@@ -84,6 +85,19 @@ void JsonSceneReader::read_crop(const Json& value, const std::string& pointer) {
     report_.fail(pointer, "the {} x {} image at ({}, {}) does not fit in {} x {}", film.width, film.height, c[0], c[1],
                  c[2], c[3]);
   scene_.film.crop = FilmDesc::Crop{c[0], c[1], c[2], c[3]};
+}
+
+// {"exposure", "white_balance", "max_component"} (FilmDesc::Sensor).
+void JsonSceneReader::read_sensor(const Json& value, const std::string& pointer) {
+  CheckedObject object(report_, value, pointer);
+  FilmDesc::Sensor& sensor = scene_.film.sensor;
+  sensor.exposure = object.number_or("exposure", sensor.exposure, Bound::Positive);
+  sensor.white_balance = object.number_or("white_balance", sensor.white_balance, Bound::NonNegative);
+  if (sensor.white_balance != 0 && !(sensor.white_balance >= 1000 && sensor.white_balance <= 100000))
+    report_.fail(object.pointer_of("white_balance"),
+                 "expected 0 (none) or a colour temperature in [1000, 100000] kelvin, got {}", sensor.white_balance);
+  sensor.max_component = object.number_or("max_component", sensor.max_component, Bound::NonNegative);
+  object.finish();
 }
 
 void JsonSceneReader::read_lens_and_shutter(CheckedObject& camera) {

@@ -26,8 +26,9 @@ enum ActiveTransforms : uint8_t { kStartTransform = 1, kEndTransform = 2, kAllTr
 // The current AreaLightSource. With "power", the radiance depends on the area of each shape, so
 // it is computed per shape.
 struct AreaLightSpec {
-  RGB radiance{1.0f};  // L * scale
+  RGB radiance{1.0f};  // L * scale (with an image: scale)
   bool two_sided = false;
+  int texture = -1;  // the image ("filename") as a texture in SceneDesc::textures, looked up at the hit's uv
   std::optional<float> power;
   SourceLocation where;
 };

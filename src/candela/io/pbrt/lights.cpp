@@ -96,6 +96,7 @@ void SceneParser::light_source(const Token& d) {
       EnvironmentMap map;
       map.filename = file.string();
       map.mapping = EnvironmentMapping::EqualAreaOctahedral;
+      map.filter = TextureFilter::Nearest;  // pbrt-v4 looks its image lights up at the nearest texel
       map.scale = RGB(scale);
       map.to_world = ctm;
       add_light(map, at(d));
@@ -108,9 +109,61 @@ void SceneParser::light_source(const Token& d) {
       sky.zenith = sky.horizon = sky.ground = radiance;
       add_light(sky, at(d));
     }
+  } else if (type.text == "goniometric") {
+    // pbrt-v4's GoniometricLight: intensity I x scale times a square equal-area image of the
+    // directions, the CTM's y axis at the image's centre (pbrt swaps y and z; GoniometricLight in
+    // description/lights.h). pbrt-v4 only warns about a missing image and then has none to look up.
+    RGB intensity = read_light_scale(params, read_emission(params, "I").value_or(RGB(1.0f)));
+    if (!params.has("filename")) params.fail("filename", "is required: name the square equal-area image");
+    const std::string name = params.get_string("filename", "");
+    GoniometricLight light;
+    light.filename =
+        resolve_path(name, params.where("filename"), fmt::format("{}: \"filename\"", params.owner())).string();
+    light.intensity = intensity;
+    // pbrt-v4's "power": I times power / (4 pi x the image's mean), applied when the image is read.
+    const float power = params.get_float("power", -1);
+    if (power > 0) light.power = power;
+    light.to_world = ctm;
+    params.reject_unused();
+    require_static_light(d, type);
+    add_light(light, at(d));
+  } else if (type.text == "projection") {
+    // pbrt-v4's ProjectionLight: the intensity is scale x the image's nearest texel inside a pinhole
+    // frustum along the CTM's +z, with "fov" on the image's shorter axis. pbrt reads the image at
+    // screen position ((x + aspect tan) / (2 aspect tan), (tan - y) / (2 tan)) of the CTM-space
+    // direction (x, y, 1) (it flips y; row 0 the top): the projector's Mitsuba uv mirrored in both
+    // axes, and texture t = 1 is the top row, so the texture reads (1 - u, 1 - v).
+    float scale = params.get_float("scale", 1);
+    if (scale < 0) params.fail("scale", "must not be negative, got {}", scale);
+    const float fov = params.get_float("fov", 90);
+    if (!(fov > 0 && fov < 180)) params.fail("fov", "must be in (0, 180) degrees, got {}", fov);
+    if (!params.has("filename")) params.fail("filename", "is required: name the projected image");
+    ImageTexture image;
+    const std::string name = params.get_string("filename", "");
+    image.filename =
+        resolve_path(name, params.where("filename"), fmt::format("{}: \"filename\"", params.owner())).string();
+    image.filter = TextureFilter::Nearest;
+    image.wrap = TextureWrap::Clamp;
+    image.mapping.su = -1;
+    image.mapping.du = 1;
+    image.mapping.sv = -1;
+    image.mapping.dv = 1;
+    ProjectorLight light;
+    light.to_world = ctm;
+    light.fov_degrees = fov;
+    light.fov_axis = ProjectorFovAxis::Smaller;
+    light.radiometry = ProjectorRadiometry::Intensity;
+    light.scale = RGB(scale);
+    // pbrt-v4's "power": scale times power / (the power with scale 1), applied when the image is read.
+    const float power = params.get_float("power", -1);
+    if (power > 0) light.power = power;
+    params.reject_unused();
+    require_static_light(d, type);
+    light.irradiance = add_texture(image, at(d));
+    add_light(light, at(d));
   } else {
-    reject_type(at(type), "light", type.text, {"point", "spot", "distant", "infinite"}, {"goniometric", "projection"},
-                "candela has no emitter shaped by an image");
+    reject_type(at(type), "light", type.text, {"point", "spot", "distant", "infinite", "goniometric", "projection"},
+                {});
   }
 }
 
@@ -119,9 +172,24 @@ void SceneParser::area_light_source(const Token& d) {
   Token type = expect_string(d, "the area light type");
   if (type.text != "diffuse") reject_type(at(type), "area light", type.text, {"diffuse"}, {});
   ParamList params = read_params(d, "AreaLightSource \"diffuse\"", kLightAttributes);
-  if (params.has("filename")) params.fail("filename", "names an image: textured area lights are not supported");
   AreaLightSpec light;
-  light.radiance = read_light_scale(params, read_emission(params, "L").value_or(RGB(1.0f)));
+  if (params.has("filename")) {
+    // pbrt-v4's image area light: radiance scale x the image's linear RGB at the hit's (u, 1 - v),
+    // clamped at the image's edges.
+    if (params.has("L")) params.fail("filename", "cannot be given together with \"L\" (as in pbrt-v4)");
+    if (params.has("power"))
+      params.fail("power", "is not supported with an image (\"filename\"): it would need the image's mean "
+                  "luminance; give \"scale\" instead");
+    ImageTexture image;
+    const std::string name = params.get_string("filename", "");
+    image.filename =
+        resolve_path(name, params.where("filename"), fmt::format("{}: \"filename\"", params.owner())).string();
+    image.wrap = TextureWrap::Clamp;
+    light.texture = add_texture(image, at(d));
+    light.radiance = read_light_scale(params, RGB(1.0f));
+  } else {
+    light.radiance = read_light_scale(params, read_emission(params, "L").value_or(RGB(1.0f)));
+  }
   light.two_sided = params.get_bool("twosided", false);
   float power = params.get_float("power", -1);
   if (power > 0) light.power = power;

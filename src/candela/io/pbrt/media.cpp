@@ -1,9 +1,11 @@
-// Participating media: MakeNamedMedium ("homogeneous" and "uniformgrid"), MediumInterface, and the
-// media the shapes and the camera get from it.
+// Participating media: MakeNamedMedium ("homogeneous", "uniformgrid", "nanovdb" and "cloud"),
+// MediumInterface, and the media the shapes and the camera get from it.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <tuple>
+#include <utility>
 
 #include "candela/io/pbrt/scene_parser.h"
 #include "candela/io/grid_files.h"
@@ -81,6 +83,36 @@ const ScatteringPreset* find_scattering_preset(std::string_view name) {
   return nullptr;
 }
 
+// Bounds3f(p0, p1) in pbrt: the box between the two corners, whichever way round; it must have volume
+// (`what` names the box in the message).
+std::pair<Point3, Point3> read_medium_box(ParamList& params, std::string_view what) {
+  const Point3 p0 = params.get_point3("p0", Point3(0.0f)), p1 = params.get_point3("p1", Point3(1.0f));
+  const Point3 lo(std::min(p0.x, p1.x), std::min(p0.y, p1.y), std::min(p0.z, p1.z));
+  const Point3 hi(std::max(p0.x, p1.x), std::max(p0.y, p1.y), std::max(p0.z, p1.z));
+  for (int axis = 0; axis < 3; ++axis)
+    if (!(hi[axis] > lo[axis]))
+      params.fail("p1", "must differ from \"p0\" on every axis ({} has no volume), got {} {} {} and {} {} {}", what,
+                  p0.x, p0.y, p0.z, p1.x, p1.y, p1.z);
+  return {lo, hi};
+}
+
+// pbrt-v4's CloudMedium's own parameters (CloudDensity; its defaults): "density" (1), "wispiness" (1),
+// "frequency" (5) (finite: the tokenizer takes no other numbers), and the box from "p0" (0 0 0) to
+// "p1" (1 1 1) in the medium's space, which the CTM at MakeNamedMedium (`medium_to_world`) places. The
+// noise and the altitude falloff are taken in the medium's space, as pbrt-v4 takes them (its
+// renderFromMedium's inverse).
+VolumeDesc read_cloud_density(ParamList& params, const Transform& medium_to_world) {
+  CloudDensity cloud;
+  cloud.density = params.get_float("density", cloud.density);
+  cloud.wispiness = params.get_float("wispiness", cloud.wispiness);
+  cloud.frequency = params.get_float("frequency", cloud.frequency);
+  std::tie(cloud.box_min, cloud.box_max) = read_medium_box(params, "the cloud's box");
+  VolumeDesc density;
+  density.to_world = medium_to_world * cloud.unit_cube_to_cloud();
+  density.cloud = cloud;
+  return density;
+}
+
 std::string scattering_preset_names() {
   std::string names;
   for (const ScatteringPreset& preset : kScatteringPresets)
@@ -146,7 +178,8 @@ void SceneParser::make_named_medium(const Token& d) {
 
   const Param* type = params.take("type", {"string"});
   if (!type)
-    throw_scene_error(at(d), "{}: \"string type\" is required (\"homogeneous\" or \"uniformgrid\")", params.owner());
+    throw_scene_error(at(d), "{}: \"string type\" is required (\"homogeneous\", \"uniformgrid\", \"nanovdb\" or "
+                      "\"cloud\")", params.owner());
   params.expect_count(*type, 1);
   MediumDesc medium;
   if (type->strings[0] == "homogeneous") {
@@ -155,11 +188,18 @@ void SceneParser::make_named_medium(const Token& d) {
     medium = make_grid_medium(params);
   } else if (type->strings[0] == "nanovdb") {
     medium = make_nanovdb_medium(params);
+  } else if (type->strings[0] == "cloud") {
+    // pbrt-v4's CloudMedium: sigma_a, sigma_s and g as every medium, no "scale" (its density stays
+    // within [0, 1]; pbrt-v4 reports "scale" unused) and no emission.
+    if (params.has_own("scale"))
+      params.fail("scale", "is not a parameter of a \"cloud\" medium (as in pbrt-v4): scale \"sigma_a\" and "
+                  "\"sigma_s\" instead");
+    read_scattering(params, medium, std::nullopt, std::nullopt);
+    medium.scale = 1;  // an Attribute "medium" "scale" does not reach a cloud either
+    medium.density = read_cloud_density(params, state_.ctm.start);
   } else {
-    const std::string& t = type->strings[0];
-    reject_type(type->where, "medium", t, {"homogeneous", "uniformgrid", "nanovdb"}, {"rgbgrid", "cloud"},
-                t == "rgbgrid" ? "grids of RGB coefficients are not supported yet"
-                               : "pbrt's procedural clouds are not supported yet");
+    reject_type(type->where, "medium", type->strings[0], {"homogeneous", "uniformgrid", "nanovdb", "cloud"},
+                {"rgbgrid"}, "grids of RGB coefficients are not supported yet");
   }
   params.reject_unused();
   medium.name = name.text;
@@ -248,14 +288,8 @@ MediumDesc SceneParser::make_grid_medium(ParamList& params) {
                       params.owner());
   std::vector<float> values = read_voxels(*density, false);
 
-  // Bounds3f(p0, p1) in pbrt: the box between the two corners, whichever way round.
-  Point3 p0 = params.get_point3("p0", Point3(0.0f)), p1 = params.get_point3("p1", Point3(1.0f));
-  Point3 lo(std::min(p0.x, p1.x), std::min(p0.y, p1.y), std::min(p0.z, p1.z));
-  Point3 hi(std::max(p0.x, p1.x), std::max(p0.y, p1.y), std::max(p0.z, p1.z));
-  for (int axis = 0; axis < 3; ++axis)
-    if (!(hi[axis] > lo[axis]))
-      params.fail("p1", "must differ from \"p0\" on every axis (the grid's box has no volume), got {} {} {} and "
-                  "{} {} {}", p0.x, p0.y, p0.z, p1.x, p1.y, p1.z);
+  const std::pair<Point3, Point3> box = read_medium_box(params, "the grid's box");
+  const Point3 lo = box.first, hi = box.second;
 
   MediumDesc medium;
   read_scattering(params, medium, std::nullopt, std::nullopt);

@@ -15,6 +15,23 @@ namespace {
 constexpr int kMaxResolutionPerSide = 65536;
 constexpr int64_t kMaxPixels = int64_t{1} << 28;
 
+// The camera sensors pbrt-v4 knows by name (each with measured red, green and blue response curves).
+constexpr std::string_view kPbrtCameraSensors[] = {
+    "canon_eos_100d",    "canon_eos_1dx_mkii", "canon_eos_200d",  "canon_eos_200d_mkii", "canon_eos_5d",
+    "canon_eos_5d_mkii", "canon_eos_5d_mkiii", "canon_eos_5d_mkiv", "canon_eos_5ds",     "canon_eos_m",
+    "hasselblad_l1d_20c", "nikon_d810",        "nikon_d850",      "sony_ilce_6400",      "sony_ilce_7m3",
+    "sony_ilce_7rm3",    "sony_ilce_9"};
+
+bool is_pbrt_camera_sensor(std::string_view name) {
+  return std::find(std::begin(kPbrtCameraSensors), std::end(kPbrtCameraSensors), name) != std::end(kPbrtCameraSensors);
+}
+
+std::string pbrt_camera_sensor_list() {
+  std::string list;
+  for (std::string_view name : kPbrtCameraSensors) list += fmt::format("{}\"{}\"", list.empty() ? "" : ", ", name);
+  return list;
+}
+
 }  // namespace
 
 void SceneParser::camera(const Token& d) {
@@ -42,9 +59,13 @@ void SceneParser::camera(const Token& d) {
   if (!(focus_distance > 0)) params.fail("focaldistance", "must be positive, got {}", focus_distance);
   float shutter_open = params.get_float("shutteropen", 0);
   float shutter_close = params.get_float("shutterclose", 1);
-  // pbrt swaps the two with a warning; candela has no warnings, so this is an error.
+  // pbrt-v4 refuses a shutter that does not open: the exposure time (shutterclose - shutteropen)
+  // scales the film's sensor, so the image would be black.
   if (shutter_close < shutter_open)
     params.fail("shutterclose", "must not be less than \"shutteropen\" ({}), got {}", shutter_open, shutter_close);
+  if (shutter_close == shutter_open)
+    params.fail("shutterclose", "equals \"shutteropen\" ({}): the shutter does not open, and pbrt-v4's film "
+                "scales the image by the exposure time (a black image; pbrt-v4 refuses it too)", shutter_open);
   params.reject_unused();
   if (state_.ctm.is_animated())
     throw_scene_error(at(d),
@@ -69,8 +90,13 @@ void SceneParser::camera(const Token& d) {
 void SceneParser::film(const Token& d) {
   require_options(d);
   Token type = expect_string(d, "the film type");
-  if (type.text != "rgb") reject_type(at(type), "film", type.text, {"rgb"}, {"gbuffer", "spectral"});
-  ParamList params = read_params(d, "Film \"rgb\"");
+  // pbrt-v4's gbuffer film is its rgb film (the same parameters, the same colour) plus per-pixel
+  // geometry layers in the EXR: candela's AOVs with pbrt's layout (film/aov_film.h's "gbuffer").
+  if (type.text != "rgb" && type.text != "gbuffer")
+    reject_type(at(type), "film", type.text, {"rgb", "gbuffer"}, {"spectral"});
+  const bool gbuffer = type.text == "gbuffer";
+  const std::string film_name = fmt::format("Film \"{}\"", type.text);
+  ParamList params = read_params(d, film_name.c_str());
   int width = params.get_int("xresolution", 1280);
   int height = params.get_int("yresolution", 720);
   if (width < 1 || width > kMaxResolutionPerSide)
@@ -79,7 +105,7 @@ void SceneParser::film(const Token& d) {
     params.fail("yresolution", "must be between 1 and {}, got {}", kMaxResolutionPerSide, height);
   if (int64_t{width} * height > kMaxPixels)
     throw_scene_error(params.where(params.has("yresolution") ? "yresolution" : "xresolution"),
-                      "Film \"rgb\": {} x {} is too many pixels (at most 2^28 = {})", width, height, kMaxPixels);
+                      "{}: {} x {} is too many pixels (at most 2^28 = {})", film_name, width, height, kMaxPixels);
   std::string filename = params.get_string("filename", "");
   params.get_bool("savefp16", true);  // the precision of the output file only
   // The film's diagonal in mm only sizes pbrt-v4's realistic camera's sensor.
@@ -96,8 +122,8 @@ void SceneParser::film(const Token& d) {
       params.fail("pixelbounds", "[{} {} {} {}] is not a non-empty part of the {} x {} image", b[0], b[1], b[2], b[3],
                   width, height);
     if (params.has("cropwindow"))
-      warn(params.where("cropwindow"), "Film \"rgb\": both \"pixelbounds\" and \"cropwindow\" are given; "
-           "\"pixelbounds\" is used, as in pbrt-v4");
+      warn(params.where("cropwindow"), "{}: both \"pixelbounds\" and \"cropwindow\" are given; "
+           "\"pixelbounds\" is used, as in pbrt-v4", film_name);
     params.take_any("cropwindow");
     pixel_bounds_ = {b[0], b[1], b[2], b[3]};
   } else if (params.has("cropwindow")) {
@@ -113,9 +139,58 @@ void SceneParser::film(const Token& d) {
                   height);
     pixel_bounds_ = b;
   }
-  ignore_param(params, "maxcomponentvalue", "candela does not clamp sample values (pbrt would, trading energy "
-               "for fewer fireflies)");
+  // pbrt-v4's PixelSensor: its CIE 1931 sensor, ISO and white balance, and the limit on a sample's
+  // largest sensor component. world_begin multiplies in the exposure time, the camera's shutter interval.
+  FilmDesc::Sensor sensor;
+  film_iso_ = params.get_float("iso", 100);
+  if (!(film_iso_ > 0) || !std::isfinite(film_iso_)) params.fail("iso", "must be positive, got {}", film_iso_);
+  sensor.white_balance = params.get_float("whitebalance", 0);
+  if (!(sensor.white_balance == 0 || (sensor.white_balance >= 1000 && sensor.white_balance <= 100000)))
+    params.fail("whitebalance", "must be 0 (none) or a colour temperature in [1000, 100000] kelvin, got {}",
+                sensor.white_balance);
+  if (params.has("sensor")) {
+    const SourceLocation where = params.where("sensor");
+    const std::string name = params.get_string("sensor", "cie1931");
+    if (name != "cie1931") {
+      if (!is_pbrt_camera_sensor(name))
+        throw_scene_error(where, "{}: unknown sensor \"{}\" (pbrt-v4 has \"cie1931\" and the cameras {})",
+                          film_name, name, pbrt_camera_sensor_list());
+      // pbrt-v4 white-balances a camera's sensor to 6500 K unless told otherwise.
+      if (sensor.white_balance == 0) sensor.white_balance = 6500;
+      warn(where, "{}: sensor \"{}\": candela has no camera response curves; using the CIE 1931 "
+           "sensor white-balanced to {} K (colours within a few percent of the camera's)", film_name, name,
+           sensor.white_balance);
+    }
+  }
+  if (params.has("maxcomponentvalue")) {
+    sensor.max_component = params.get_float("maxcomponentvalue", 0);
+    if (!(sensor.max_component > 0))
+      params.fail("maxcomponentvalue", "must be positive, got {}", sensor.max_component);
+    if (std::isinf(sensor.max_component)) sensor.max_component = 0;  // pbrt-v4's default: no limit
+  }
+  // The gbuffer film's layers: positions, normals and dz/dx, dz/dy in camera space (pbrt-v4's
+  // default) or world space; pbrt-v4 writes them to EXR files only.
+  std::string gbuffer_aovs;
+  if (gbuffer) {
+    const SourceLocation where = params.where("coordinatesystem");
+    const std::string system = params.get_string("coordinatesystem", "camera");
+    if (system != "camera" && system != "world")
+      throw_scene_error(where, "{}: unknown \"coordinatesystem\" \"{}\" (pbrt-v4 has \"camera\" and \"world\")",
+                        film_name, system);
+    gbuffer_aovs = system == "camera" ? "gbuffer" : "gbuffer,world_space";
+    // pbrt-v4's HasExtension: ".exr" in any case.
+    auto is_exr_name = [](const std::string& name) {
+      if (name.size() <= 4) return false;
+      const char* ext = name.c_str() + name.size() - 4;
+      return ext[0] == '.' && (ext[1] | 0x20) == 'e' && (ext[2] | 0x20) == 'x' && (ext[3] | 0x20) == 'r';
+    };
+    if (!filename.empty() && !is_exr_name(filename))
+      throw_scene_error(params.where("filename"), "{}: \"{}\": the gbuffer film writes EXR files only", film_name,
+                        filename);
+  }
   params.reject_unused();
+  scene_.film.aovs = gbuffer_aovs;
+  scene_.film.sensor = sensor;
   scene_.film.width = width;
   scene_.film.height = height;
   scene_.film.filename = filename;
@@ -172,9 +247,10 @@ void SceneParser::sampler(const Token& d) {
   if (params.has("seed")) options_.seed = static_cast<uint64_t>(seed);
 }
 
-// pbrt-v4's path, volpath, bdpt and mlt are rendered with candela's integrator of that name; the
-// others with the one that converges to the same image (volpath for simplevolpath, path for the rest),
-// at the scene's "maxdepth". Parameters candela has no use for are accepted with a warning.
+// pbrt-v4's path, volpath, bdpt and mlt are rendered with candela's integrator of that name,
+// ambientocclusion with its ambient_occlusion and lightpath with its light_path; the others with the one that converges to the same
+// image (volpath for simplevolpath, path for the rest), at the scene's "maxdepth". Parameters candela
+// has no use for are accepted with a warning.
 void SceneParser::integrator(const Token& d) {
   require_options(d);
   Token type = expect_string(d, "the integrator type");
@@ -189,15 +265,24 @@ void SceneParser::integrator(const Token& d) {
       {"simplepath", {"samplelights", "samplebsdf"}},
       {"simplevolpath", {}},
   };
-  // Ambient occlusion is a different image altogether, not another way to the same one.
-  if (type.text == "ambientocclusion")
-    throw_scene_error(at(type), "Integrator \"ambientocclusion\" is not supported: candela renders global "
-                      "illumination, which would be a different image (use \"path\")");
+  // Ambient occlusion reads its own two parameters and no "maxdepth" (pbrt-v4 rejects that as unused).
+  if (type.text == "ambientocclusion") {
+    ParamList params = read_params(d, "Integrator \"ambientocclusion\"");
+    AmbientOcclusionSettings ao;
+    ao.cosine_sampling = params.get_bool("cossample", ao.cosine_sampling);
+    ao.max_distance = params.get_float("maxdistance", ao.max_distance);
+    if (!(ao.max_distance > 0)) params.fail("maxdistance", "must be positive, got {}", ao.max_distance);
+    params.reject_unused();
+    options_.integrator = "ambient_occlusion";
+    options_.integrator_given = true;
+    options_.ambient_occlusion = ao;
+    return;
+  }
   auto known = kOwnParameters.find(type.text);
   if (known == kOwnParameters.end())
     reject_type(at(type), "integrator", type.text,
                 {"path", "volpath", "bdpt", "mlt", "sppm", "lightpath", "randomwalk",
-                 "simplepath", "simplevolpath"},
+                 "simplepath", "simplevolpath", "ambientocclusion"},
                 {});
   ParamList params = read_params(d, fmt::format("Integrator \"{}\"", type.text));
   int max_depth = params.get_int("maxdepth", 5);
@@ -229,18 +314,17 @@ void SceneParser::integrator(const Token& d) {
     if (!(sigma > 0 && sigma <= 1)) params.fail("sigma", "must be in (0, 1], got {}", sigma);
     options_.spp = mutations;
     options_.mlt = RenderDirectives::Metropolis{bootstrap, chains, large_step, sigma};
+  } else if (type.text == "lightpath") {
+    // pbrt-v4's light tracer is candela's light_path (the same estimator: its image, black where the
+    // camera sees glass, mirrors, emitters or the sky).
+    integrator = "light_path";
   } else {
     if (type.text == "volpath" || type.text == "simplevolpath") integrator = "volpath";
     for (std::string_view name : known->second)
       ignore_param(params, name, fmt::format("candela's {} integrator has no such setting", integrator));
   }
   params.reject_unused();
-  // pbrt-v4's lightpath renders an image of its own (on the feature probe, 78% brighter than its path
-  // tracer's: docs/pbrt-format.md), so the warning does not promise the same image there.
-  if (type.text == "lightpath")
-    warn(at(type), "Integrator \"lightpath\": using candela's {} integrator with maxdepth {}; pbrt-v4's light "
-         "tracer renders a different image of this scene (brighter: see docs/pbrt-format.md)", integrator, max_depth);
-  else if (type.text != integrator)
+  if (type.text != integrator && type.text != "lightpath")
     warn(at(type), "Integrator \"{}\": using candela's {} integrator with maxdepth {} (it converges to the "
          "same image, with different noise)", type.text, integrator, max_depth);
   options_.integrator = integrator;
@@ -336,6 +420,7 @@ void SceneParser::write_render_settings(RenderSettings& settings) const {
   // pbrt-v4's default integrator (volpath) chooses lights with its BVH.
   if (options_.light_sampler) settings.light_selection = *options_.light_sampler;
   else if (!options_.integrator_given) settings.light_selection = LightSelection::Bvh;
+  settings.ambient_occlusion = options_.ambient_occlusion;
   if (options_.mlt) {
     settings.mlt.bootstrap = options_.mlt->bootstrap;
     settings.mlt.chains = options_.mlt->chains;

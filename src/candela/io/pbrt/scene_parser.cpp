@@ -461,6 +461,8 @@ void SceneParser::world_begin(const Token& d) {
                                       : std::array<float, 4>{-1, 1, -1 / aspect, 1 / aspect};
   }
   if (pixel_bounds_) crop_film(*pixel_bounds_);
+  // pbrt-v4's imaging ratio: the exposure time (the shutter interval) times ISO / 100.
+  scene_.film.sensor.exposure = (camera.shutter_close - camera.shutter_open) * film_iso_ / 100;
   world_begin_ = at(d);
   state_.ctm = {};
   state_.active_transforms = kAllTransforms;

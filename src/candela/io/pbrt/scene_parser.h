@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <tuple>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -89,6 +90,7 @@ struct RenderDirectives {
     float large_step = 0, sigma = 0;
   };
   std::optional<Metropolis> mlt;
+  AmbientOcclusionSettings ambient_occlusion;  // "ambientocclusion"'s "maxdistance" and "cossample"
 };
 
 enum class Section { Options, World };
@@ -195,6 +197,8 @@ class SceneParser {
   void write_render_settings(RenderSettings& settings) const;
   // The Film's pixelbounds or cropwindow as pixels [x0, x1) x [y0, y1) of the full image, if given.
   std::optional<std::array<int, 4>> pixel_bounds_;
+  // The Film's "iso" (100 by default).
+  float film_iso_ = 100;
   // Makes the film that part of the full image: the camera's screen window narrowed to it.
   void crop_film(const std::array<int, 4>& bounds);
 
@@ -235,6 +239,9 @@ class SceneParser {
   MaterialDesc make_material(const std::string& type, const SourceLocation& type_where, ParamList& params);
   ColorInput scaled(ColorInput c, float scale, const SourceLocation& where);
   int add_material(MaterialDesc material, const SourceLocation& where);
+  int masked_material(int material, const FloatInput& alpha, const SourceLocation& where);
+  // The mask materials made for "alpha": (material, alpha texture, constant alpha) -> material.
+  std::map<std::tuple<int, int, float>, int> masked_materials_;
   void add_light(LightDesc light, const SourceLocation& where);
   BuiltGeometry make_sphere(ParamList& params);
   BuiltGeometry make_cylinder(ParamList& params);

@@ -307,7 +307,7 @@ TriangleMesh submesh(const TriangleMesh& mesh, const std::vector<uint32_t>& tria
 void SceneParser::add_emissive_shape(ShapeDesc shape, const BuiltGeometry& built, const Token& directive) {
   const AreaLightSpec& light = *state_.area_light;
   if (!light.power) {
-    shape.emission = AreaEmission{light.radiance, light.two_sided};
+    shape.emission = AreaEmission{light.radiance, light.two_sided, light.texture};
     add_shape(std::move(shape), directive);
     return;
   }
@@ -396,15 +396,17 @@ void SceneParser::shape(const Token& d) {
     reject_type(at(type), "shape", type.text,
                 {"sphere", "cylinder", "trianglemesh", "plymesh", "disk", "bilinearmesh", "loopsubdiv"}, {"curve"},
                 "candela has no primitive or tessellation for it");
-  if (const Param* alpha = params.take("alpha", {"float", "texture"})) {
-    params.expect_count(*alpha, 1);
-    if (alpha->type == "texture")
-      params.fail("alpha", "textures are not supported: an alpha texture cuts the surface out where it is "
-                  "below 1, and candela's surfaces are opaque");
-    if (alpha->numbers[0] < 1)
-      params.fail("alpha", "below 1 is not supported: it makes the surface transparent, and candela's surfaces "
-                  "are opaque");
+  // pbrt-v4's alpha: where it is below 1 the surface is there only with that probability (0: a hole),
+  // for camera and shadow rays alike; candela's mask material does exactly that around the material.
+  std::optional<FloatInput> alpha = read_float_texture(params, "alpha");
+  if (alpha && alpha->is_constant()) {
+    if (!(alpha->value >= 0 && alpha->value <= 1))
+      params.fail("alpha", "must be in [0, 1], got {}", alpha->value);
+    if (alpha->value == 1) alpha.reset();
   }
+  if (alpha && state_.area_light)
+    params.fail("alpha", "on an area light is not supported: candela's emitters emit wherever they are hit (pbrt-v4 "
+                "cuts the emission out too); give the emitter no alpha");
   params.reject_unused();
   ShapeDesc desc;
   desc.geometry = built.geometry;
@@ -418,7 +420,7 @@ void SceneParser::shape(const Token& d) {
                         "animated); animate the ObjectInstance instead", open_object_->name);
     desc.to_world_end = state_.ctm.end;
   }
-  desc.material = state_.material;
+  desc.material = alpha ? masked_material(state_.material, *alpha, at(d)) : state_.material;
   desc.reverse_orientation = state_.reverse_orientation;
   desc.interior_medium = state_.inside_medium;
   desc.exterior_medium = state_.outside_medium;
@@ -428,6 +430,17 @@ void SceneParser::shape(const Token& d) {
     add_emissive_shape(std::move(desc), built, d);
   else
     add_shape(std::move(desc), d);
+}
+
+// The material `material` (-1: pbrt's default diffuse) cut out by `alpha` (a MaskMaterial of that
+// opacity), one per pair however many shapes share it.
+int SceneParser::masked_material(int material, const FloatInput& alpha, const SourceLocation& where) {
+  const auto key = std::make_tuple(material, alpha.texture, alpha.is_constant() ? alpha.value : 0.0f);
+  if (auto found = masked_materials_.find(key); found != masked_materials_.end()) return found->second;
+  if (material < 0) material = add_material(DiffuseMaterial{}, where);
+  const int masked = add_material(MaskMaterial{.opacity = alpha, .material = material}, where);
+  masked_materials_.emplace(key, masked);
+  return masked;
 }
 
 // ---------------------------------------------------------------- object instancing
