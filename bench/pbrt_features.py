@@ -2,7 +2,7 @@
 """Renders every pbrt-v4 feature probe of ../shared/scenes/pbrt-v4-features with candela and compares
 it with pbrt-v4's own render (refs/NAME.exr) by the probes' agreement rule (issue 47): the image mean
 per channel within 3% of the reference's, and at least 9 in 10 of the 8x8-pixel blocks within 10% of
-(reference block mean + 0.02) in every channel. The scenes of refused-by-pbrt-v4/ must be refused.
+(reference block mean + 0.02) in every channel (R, G, B, and a spectral film's wavelength buckets). The scenes of refused-by-pbrt-v4/ must be refused.
 
 Prints one line per scene (agrees / differs, with the numbers / refused, with candela's message) and a
 Markdown table for docs/pbrt-format.md with --markdown.
@@ -25,13 +25,15 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 FEATURES = os.path.normpath(os.path.join(HERE, "..", "..", "shared", "scenes", "pbrt-v4-features"))
 
 
-def read_rgb(path):
+def read_compared_channels(path):
     image = oiio.ImageBuf(path)
     if image.has_error:
         raise RuntimeError(image.geterror())
     spec = image.spec()
     names = list(spec.channelnames)
     channels = [names.index(c) for c in ("R", "G", "B")] if all(c in names for c in "RGB") else [0, 1, 2]
+    # A spectral film's wavelength buckets (the OpenEXR spectral layout's S0.*) are compared too.
+    channels += [i for i, name in enumerate(names) if name.startswith("S0.")]
     pixels = image.get_pixels(oiio.FLOAT)  # the data window, [y][x][channel]
     return pixels[:, :, channels], (spec.x, spec.y, spec.width, spec.height)
 
@@ -40,12 +42,13 @@ def compare(candela, reference):
     """(agrees, mean error per channel (max), fraction of blocks that agree)."""
     if candela.shape != reference.shape:
         return False, float("inf"), 0.0
-    mean_c = candela.reshape(-1, 3).mean(axis=0)
-    mean_r = reference.reshape(-1, 3).mean(axis=0)
+    n = reference.shape[-1]
+    mean_c = candela.reshape(-1, n).mean(axis=0)
+    mean_r = reference.reshape(-1, n).mean(axis=0)
     mean_error = float(np.max(np.abs(mean_c - mean_r) / np.maximum(mean_r, 1e-6)))
     h, w = (reference.shape[0] // 8) * 8, (reference.shape[1] // 8) * 8
     def blocks(img):
-        return img[:h, :w].reshape(h // 8, 8, w // 8, 8, 3).mean(axis=(1, 3))
+        return img[:h, :w].reshape(h // 8, 8, w // 8, 8, n).mean(axis=(1, 3))
     bc, br = blocks(candela), blocks(reference)
     block_ok = np.all(np.abs(bc - br) <= 0.10 * (br + 0.02), axis=-1)
     fraction = float(block_ok.mean()) if block_ok.size else 0.0
@@ -94,8 +97,8 @@ def main():
             if out is None:
                 rows.append((stem, "refused", message, seconds))
             else:
-                candela, _ = read_rgb(out)
-                reference, _ = read_rgb(os.path.join(FEATURES, "refs", stem + ".exr"))
+                candela, _ = read_compared_channels(out)
+                reference, _ = read_compared_channels(os.path.join(FEATURES, "refs", stem + ".exr"))
                 agrees, mean_error, fraction = compare(candela, reference)
                 detail = ("size {} vs {}".format(candela.shape[1::-1], reference.shape[1::-1])
                           if candela.shape != reference.shape

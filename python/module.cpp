@@ -249,9 +249,12 @@ std::unique_ptr<PyScene> make_scene(SceneDesc&& desc, std::string name) {
   };
   for (const TextureDesc& texture : scene->desc.textures)
     if (const auto* image = std::get_if<ImageTexture>(&texture)) hold([&] { return read_texture_image(*image); });
-  for (const LightDesc& light : scene->desc.lights)
+  for (const LightDesc& light : scene->desc.lights) {
     if (const auto* map = std::get_if<EnvironmentMap>(&light))
       hold([&] { return read_image_shared(map->filename, IntegerEncoding::SRGB); });
+    if (const auto* goniometric = std::get_if<GoniometricLight>(&light))
+      hold([&] { return read_image_shared(goniometric->filename, IntegerEncoding::SRGB); });
+  }
   return scene;
 }
 

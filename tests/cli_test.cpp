@@ -202,9 +202,27 @@ TEST_F(CommandLine, BidirectionalAndMetropolisIntegrators) {
   EXPECT_EQ(meta["candela:mlt"], "bootstrap 500 chains 16 sigma 0.02 large-step 0.5 lens 0.2 caustic 0.1");
 }
 
+TEST_F(CommandLine, PhotonMappingIntegrator) {
+  std::string scene = write("good.json", kGoodJson);
+  RunResult sppm = run_cli("render " + scene + " -o " + out() + " --integrator sppm --spp 3 --sppm-photons 500 "
+                           "--sppm-radius 0.2 -q");
+  ASSERT_EQ(sppm.exit_code, 0) << sppm.output;
+  EXPECT_THAT_MATCHES(sppm.output, "16x12, 3 iterations in");
+  auto meta = read_image_metadata(out());
+  EXPECT_EQ(meta["candela:integrator"], "sppm");
+  EXPECT_EQ(meta["candela:sppm"], "photons-per-iteration 500 radius 0.2");
+  write("out.exr", "previous render");
+  expect_failure("render " + scene + " -o " + out() + " --integrator sppm --target-error 0.01",
+                 "--target-error: the sppm integrator gives no error estimate");
+  expect_failure("render " + scene + " -o " + out() + " --sppm-radius 0.2",
+                 "--sppm-radius: the path integrator does not read sppm");
+  expect_failure("render " + scene + " -o " + out() + " --integrator sppm --sppm-radius 0",
+                 "--sppm-radius");
+}
+
 TEST_F(CommandLine, IntegratorOptionsAreChecked) {
   std::string scene = write("good.json", kGoodJson);
-  expect_failure("render " + scene + " -o " + out() + " --integrator whitted", "unknown integrator 'whitted' \\(known: path, bdpt, mlt, volpath, ambient_occlusion, light_path, auto\\)");
+  expect_failure("render " + scene + " -o " + out() + " --integrator whitted", "unknown integrator 'whitted' \\(known: path, bdpt, mlt, volpath, ambient_occlusion, light_path, sppm, auto\\)");
   expect_failure("render " + scene + " -o " + out() + " --bdpt-strategies " + dir_.string(),
                  "--bdpt-strategies: the path integrator writes no strategy images \\(bdpt does\\)");
   expect_failure("render " + scene + " -o " + out() + " --integrator bdpt --bdpt-strategies " + (dir_ / "nope").string(),

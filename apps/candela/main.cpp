@@ -272,6 +272,12 @@ AovSelection plan_aovs(const RenderCommand& cmd, const CommandPlan& plan, Cluste
       layers = AovSelection{};
     }
   }
+  if (layers.wants_spectral()) {
+    // The buckets hold the values at each sample's wavelengths: only a spectral render has them.
+    if (!plan.desc.settings.spectral)
+      throw UsageError("the spectral layer needs spectral transport (--transport spectral, or the scene's render.spectral)");
+    check_capabilities(*plan.render.integrator, {.spectral_layer = true});
+  }
   if (!layers.empty() && !plan.render.one_pixel() && !cmd.quiet && cluster.is_root())
     for (const fs::path& f : plan.outputs)
       if (!is_exr(f)) {
@@ -520,11 +526,17 @@ void write_images(const RenderCommand& cmd, const CommandPlan& plan, const Scene
       image.full_height = crop->full_height;
     }
     const FloatChannels aov_channels = aov_film ? exr_channels(aov_film->images(film)) : FloatChannels{};
+    // The spectral layer's EXRs say so as the OpenEXR spectral layout asks (and pbrt-v4 writes).
+    std::map<std::string, std::string> exr_metadata = metadata;
+    if (aov_film && aov_film->spectral().count > 0) {
+      exr_metadata["spectralLayoutVersion"] = "1.0";
+      exr_metadata["emissiveUnits"] = "W.m^-2.sr^-1";
+    }
     for (const auto& f : plan.outputs) {
       if (aov_channels.names.empty() || !is_exr(f))
         write_image(f, image, metadata);
       else
-        write_image(f, image, metadata, aov_channels);
+        write_image(f, image, exr_metadata, aov_channels);
     }
   }
   if (integrator_outputs) integrator_outputs->write(film, metadata);

@@ -8,9 +8,9 @@ namespace candela {
 
 Camera::Camera(const CameraDesc& desc, int width, int height, Vec2 margin)
     : world_from_camera_(desc.world_from_camera),
-      orthographic_(desc.projection == Projection::Orthographic),
+      projection_(desc.projection),
       near_clip_(std::max(0.0f, desc.near_clip)),
-      lens_radius_(desc.projection == Projection::Orthographic ? 0.0f : desc.lens_radius),
+      lens_radius_(desc.projection == Projection::Perspective ? desc.lens_radius : 0.0f),
       focus_distance_(desc.focus_distance),
       shutter_open_(desc.shutter_open),
       shutter_close_(desc.shutter_close),
@@ -25,7 +25,8 @@ Camera::Camera(const CameraDesc& desc, int width, int height, Vec2 margin)
   // [-1, 1] x [-1 / aspect, 1 / aspect]. A screen window replaces either.
   float aspect = float(width) / float(height);
   float t = std::tan(radians(desc.fov_degrees) / 2);
-  if (orthographic_) {
+  const bool orthographic = is_orthographic();
+  if (orthographic) {
     screen_half_ = {1, 1 / aspect};
   } else {
     FovAxis axis = desc.fov_axis;
@@ -42,9 +43,11 @@ Camera::Camera(const CameraDesc& desc, int width, int height, Vec2 margin)
       }
     }
   }
-  if (desc.screen_window) {
+  if (desc.screen_window && is_spherical()) {
+    uv_window_ = *desc.screen_window;
+  } else if (desc.screen_window) {
     const auto [x0, x1, y0, y1] = *desc.screen_window;
-    const float unit = orthographic_ ? 1.0f : t;  // screen space to camera space at unit distance
+    const float unit = orthographic ? 1.0f : t;  // screen space to camera space at unit distance
     screen_center_ = {unit * 0.5f * (x0 + x1), unit * 0.5f * (y0 + y1)};
     screen_half_ = {unit * 0.5f * (x1 - x0), unit * 0.5f * (y1 - y0)};
   }
@@ -62,9 +65,35 @@ float Camera::near_t(const Point3& o, const Vec3& d) const {
   return length(world_from_camera_.point(on_plane) - world_from_camera_.point(o));
 }
 
+Vec3 Camera::spherical_direction(Vec2 film) const {
+  // The full image's (u, v) = (x, y) over its size; a screen window is the part the film covers.
+  Vec2 uv{lerp(film.x / float(width_), uv_window_[0], uv_window_[1]),
+          lerp(film.y / float(height_), uv_window_[2], uv_window_[3])};
+  if (projection_ == Projection::Equirectangular) {
+    const float theta = kPi * uv.y, phi = 2 * kPi * uv.x;
+    const float sin_theta = std::sin(theta);
+    return {sin_theta * std::cos(phi), std::cos(theta), sin_theta * std::sin(phi)};
+  }
+  // Film positions beyond the image's edges (the reconstruction filter's margin) continue across the
+  // square's folded edges, as pbrt-v4's WrapEqualAreaSquare continues them.
+  if (uv.x < 0) uv = {-uv.x, 1 - uv.y};
+  if (uv.x > 1) uv = {2 - uv.x, 1 - uv.y};
+  if (uv.y < 0) uv = {1 - uv.x, -uv.y};
+  if (uv.y > 1) uv = {1 - uv.x, 2 - uv.y};
+  const Vec3 d = equal_area_square_to_sphere(uv);
+  return {d.x, d.z, d.y};  // pbrt-v4 swaps y and z: the square's +z hemisphere looks up
+}
+
 Ray Camera::generate_ray(Vec2 film, Vec2 lens, float time) const {
   const float inf = std::numeric_limits<float>::infinity();
-  if (orthographic_) {
+  if (is_spherical()) {
+    // The near clip is a sphere of that radius (in camera space) around the origin.
+    const Vec3 w = world_from_camera_.vector(spherical_direction(film));
+    Ray ray{origin_, normalize(w), inf, time};
+    if (near_clip_ > 0) ray.t_min = near_clip_ * length(w);
+    return ray;
+  }
+  if (is_orthographic()) {
     Point3 o((2 * film.x / float(width_) - 1) * screen_half_.x + screen_center_.x,
              (1 - 2 * film.y / float(height_)) * screen_half_.y + screen_center_.y, 0);
     Vec3 d(0, 0, 1);
@@ -93,7 +122,7 @@ Ray Camera::generate_ray(Vec2 film, Vec2 lens, float time) const {
 }
 
 float Camera::importance(const Point3& lens_point, const Vec3& w, Vec2* raster) const {
-  if (orthographic_) return 0;  // a delta in direction: no ray found by chance carries any
+  if (is_delta_direction()) return 0;  // orthographic: a delta in direction; spherical: no importance
   float cos_theta = dot(w, forward_);
   if (!(cos_theta > 0)) return 0;
   // Where the ray meets the plane of focus (the unit plane for a pinhole), in camera space: that
@@ -115,7 +144,7 @@ float Camera::importance(const Point3& lens_point, const Vec3& w, Vec2* raster) 
 }
 
 Camera::ImportancePdf Camera::pdf_importance(const Point3& lens_point, const Vec3& w) const {
-  if (orthographic_) return {};  // delta in direction (see is_delta_direction)
+  if (is_delta_direction()) return {};  // see is_delta_direction
   if (importance(lens_point, w, nullptr) == 0) return {};
   float cos_theta = dot(w, forward_);
   float film_area = importance_film_area();
@@ -123,7 +152,7 @@ Camera::ImportancePdf Camera::pdf_importance(const Point3& lens_point, const Vec
 }
 
 std::optional<Camera::LensSample> Camera::sample_lens(const Point3& ref, Vec2 u) const {
-  if (orthographic_) return std::nullopt;  // no point is connected to an orthographic camera
+  if (is_delta_direction()) return std::nullopt;  // no point is connected to these cameras
   Point3 p = origin_;
   if (lens_radius_ > 0) {
     Vec2 d = square_to_concentric_disk(u);

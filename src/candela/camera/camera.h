@@ -10,7 +10,10 @@
 //
 // An orthographic camera's importance is a delta in direction: no connection can reach it, so it
 // has no importance() or sample_lens() (they return 0 and nothing), and bidirectional methods treat
-// its vertex as delta (is_delta_direction()).
+// its vertex as delta (is_delta_direction()). Spherical cameras (pbrt-v4's, equirectangular or
+// equal-area: CameraDesc's Projection) are not joined to light paths either, as pbrt-v4's are not:
+// the same answers, so their light reaches the film through camera paths alone.
+#include <array>
 #include <optional>
 
 #include "candela/geometry/ray.h"
@@ -26,11 +29,15 @@ class Camera {
   // the margin still add to the pixels whose filter overlaps it.
   Camera(const CameraDesc& desc, int width, int height, Vec2 margin = {0, 0});
 
-  bool is_orthographic() const { return orthographic_; }
-  // Whether the camera's rays come from a delta distribution in direction (orthographic): light
-  // paths cannot be connected to it (no t = 1 strategy).
-  bool is_delta_direction() const { return orthographic_; }
+  bool is_orthographic() const { return projection_ == Projection::Orthographic; }
+  bool is_spherical() const {
+    return projection_ == Projection::Equirectangular || projection_ == Projection::EqualArea;
+  }
+  // Whether light paths cannot be connected to the camera (no t = 1 strategy): its rays come from a
+  // delta distribution in direction (orthographic), or it has no importance function (spherical).
+  bool is_delta_direction() const { return projection_ != Projection::Perspective; }
   float near_clip() const { return near_clip_; }
+  const Transform& world_from_camera() const { return world_from_camera_; }
 
   // `lens` in [0,1)^2 picks the point on the lens (ignored for a pinhole); `time` is the ray's time.
   Ray generate_ray(Vec2 film, Vec2 lens, float time) const;
@@ -65,7 +72,7 @@ class Camera {
   Vec2 margin() const { return margin_; }
   // The viewing direction (the lens normal) in world space, and the lens area (1 for a pinhole).
   const Vec3& forward() const { return forward_; }
-  bool has_lens() const { return lens_radius_ > 0 && !orthographic_; }
+  bool has_lens() const { return lens_radius_ > 0; }
   float lens_area() const { return lens_radius_ > 0 ? kPi * lens_radius_ * lens_radius_ : 1.0f; }
 
   float shutter_open() const { return shutter_open_; }
@@ -89,8 +96,11 @@ class Camera {
             (1 - 2 * film.y / float(height_)) * screen_half_.y + screen_center_.y, 1};
   }
 
+  // The spherical cameras' ray direction in camera space for film position `film`.
+  Vec3 spherical_direction(Vec2 film) const;
+
   Transform world_from_camera_, camera_from_world_;
-  bool orthographic_ = false;
+  Projection projection_ = Projection::Perspective;
   float near_clip_ = 0;
   Vec3 forward_{0, 0, 1};
   Point3 origin_;
@@ -98,6 +108,8 @@ class Camera {
   // The film's centre and half extents on the plane z = 1 (perspective) or z = 0 (orthographic), in
   // camera space.
   Vec2 screen_center_{0, 0}, screen_half_{1, 1};
+  // Spherical cameras: the part [u0, u1] x [v0, v1] of the full image's (u, v) the film covers.
+  std::array<float, 4> uv_window_{0, 1, 0, 1};
   float lens_radius_ = 0, focus_distance_ = 1;
   float shutter_open_ = 0, shutter_close_ = 1;
   int width_ = 1, height_ = 1;

@@ -26,7 +26,15 @@ enum class Projection {
   // Parallel rays along +z; the film covers camera-space x in [-1, 1] and y in [-1 / aspect,
   // 1 / aspect] (aspect = width / height), as Mitsuba's orthographic sensor; world_from_camera
   // scales it.
-  Orthographic
+  Orthographic,
+  // pbrt-v4's spherical camera: every direction around the camera's origin, the whole image being
+  // the sphere. Equirectangular: film (x, y) / (width, height) = (phi / 2 pi, theta / pi), the
+  // direction (sin theta cos phi, cos theta, sin theta sin phi) in camera space (theta from +y, up;
+  // +z, the view, at a quarter of the width). EqualArea: the image is Clarberg's equal-area square
+  // (sampling/warp.h), its +z hemisphere turned to +y (pbrt-v4 swaps y and z). No fov, lens or screen
+  // window; light paths cannot be joined to it (no t = 1 strategy).
+  Equirectangular,
+  EqualArea
 };
 constexpr std::string_view enum_name(FovAxis v) {
   switch (v) {
@@ -42,6 +50,8 @@ constexpr std::string_view enum_name(Projection v) {
   switch (v) {
     case Projection::Perspective: return "perspective";
     case Projection::Orthographic: return "orthographic";
+    case Projection::Equirectangular: return "equirectangular";
+    case Projection::EqualArea: return "equal_area";
   }
   return {};
 }
@@ -59,6 +69,8 @@ struct CameraDesc {
   // screen space is camera space for orthographic cameras, and camera space at unit distance over
   // tan(fov / 2) for perspective ones. An off-centre window shifts the view without tilting the film.
   // Unset: the film is centred and framed by the fov (perspective) or spans x in [-1, 1] (orthographic).
+  // Spherical projections: the part [u0, u1] x [v0, v1] of the full image's (u, v) = (x / width,
+  // y / height) the film covers, v down the image's rows (a cropped spherical image); unset: all of it.
   std::optional<std::array<float, 4>> screen_window;
   // Thin lens (depth of field): 0 = pinhole. Points at focus_distance along +z are sharp.
   float lens_radius = 0;

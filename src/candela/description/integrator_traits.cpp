@@ -12,7 +12,8 @@ const std::vector<IntegratorTraits>& integrator_traits() {
        .description = "path tracing (Häkkinen 2002): next-event estimation, MIS, Russian roulette",
        .reads = {"direction_sampling", "mis", "shadow_rays", "light_selection=paper", "rr_start_depth", "adaptive"},
        .resumable = true,
-       .single_pixel = true},
+       .single_pixel = true,
+       .spectral_layer = true},
       {.name = "bdpt",
        .description = "bidirectional path tracing: every connection strategy, MIS, light tracing splatted",
        .reads = {"rr_start_depth", "adaptive"},
@@ -30,7 +31,8 @@ const std::vector<IntegratorTraits>& integrator_traits() {
        .reads = {"rr_start_depth", "adaptive"},
        .resumable = true,
        .single_pixel = true,
-       .participating_media = true},
+       .participating_media = true,
+       .spectral_layer = true},
       // Media are ignored, as pbrt-v4's does: the occlusion of the surfaces by surfaces is what it shows.
       {.name = "ambient_occlusion",
        .description = "ambient occlusion (pbrt-v4's ambientocclusion): the cosine-weighted unoccluded fraction of the "
@@ -39,7 +41,8 @@ const std::vector<IntegratorTraits>& integrator_traits() {
        .resumable = true,
        .single_pixel = true,
        .participating_media = true,
-       .geometric = true},
+       .geometric = true,
+       .spectral_layer = true},
       // Light subpaths as bdpt traces them (Russian roulette included), each vertex joined to the lens
       // (t = 1 alone, unweighted) and splatted. Media: the light subpaths scatter in them as bdpt's do.
       {.name = "light_path",
@@ -49,6 +52,12 @@ const std::vector<IntegratorTraits>& integrator_traits() {
        .resumable = true,
        .participating_media = true,
        .partial_transport = true},
+      // Surfaces only, as pbrt-v4's: a scene with media is refused.
+      {.name = "sppm",
+       .description = "stochastic progressive photon mapping (pbrt-v4's sppm; --spp is then iterations): photons "
+                      "gathered at the first diffuse surface each camera path meets, for caustics",
+       .reads = {"sppm"},
+       .progressive = true},
       {.name = "auto",
        .description = "short pilots of each measure which reaches the lowest error in the budget: --time-limit, "
                       "--target-error, or the path tracer's time for --spp; the pilots aim at 10%",

@@ -43,6 +43,8 @@ inline constexpr SelectiveSetting kSelectiveSettings[] = {
      [](const RenderSettings& s) { return s.mlt != MltSettings{}; }},
     {"ambient_occlusion", "ambient occlusion's parameters",
      [](const RenderSettings& s) { return s.ambient_occlusion != AmbientOcclusionSettings{}; }},
+    {"sppm", "stochastic progressive photon mapping's parameters",
+     [](const RenderSettings& s) { return s.sppm != SppmSettings{}; }},
 };
 
 struct IntegratorTraits {
@@ -62,6 +64,13 @@ struct IntegratorTraits {
   // delta surface, no emitter seen directly): a different image wherever the camera sees those, so
   // the one that chooses never chooses it and the furnace tests leave it out.
   bool partial_transport = false;
+  // Converges only as its iterations accumulate, biased for any finite number of them (photon density
+  // estimation, sppm.h), and its pixels hold no two independent halves: the film gives no error
+  // estimate, so the one that chooses never chooses it and --target-error does not apply.
+  bool progressive = false;
+  // Every contribution is a camera sample added to its own pixel (no splats, no AOV pass of its
+  // own), so the sample's values at its wavelengths can fill a spectral film's buckets (aov_film.h).
+  bool spectral_layer = false;
   // Renders nothing itself but chooses one of the others for the scene and the budget ("auto": short
   // pilots, integrators/auto_integrator.h): a name a request may give, not a scene file. Reads what
   // the one it chooses reads (the candidates are those that read every setting given).

@@ -299,6 +299,43 @@ struct SchemaOf<DiffuseTransmissionMaterial> {
                                      .help = "Lambertian reflection and transmission"};
 };
 
+// Hair and fur (pbrt-v4's "hair": d'Eon et al. 2011 and Chiang et al. 2016, materials/hair.h): a
+// rough dielectric fibre with an absorbing interior. The fibre runs along the hit's dp/du (a curve's
+// tangent) and the hit's v across it (h = -1 + 2 v, as pbrt-v4's curves give it). Its absorption is,
+// by precedence, `sigma_a` (per unit of the fibre's radius), else that of the colour `reflectance`
+// (Chiang et al.'s fit, which depends on beta_n), else that of the melanin concentrations
+// (pbrt-v4's default: eumelanin 1.3, brown hair). beta_m and beta_n are the longitudinal and
+// azimuthal roughness (pbrt-v4 clamps them to at least 0.01), alpha the tilt of the cuticle's scales
+// in degrees, eta the fibre's index of refraction.
+struct HairMaterial {
+  std::optional<ColorInput> sigma_a;
+  std::optional<ColorInput> reflectance;
+  FloatInput eumelanin{1.3f};
+  FloatInput pheomelanin{0.0f};
+  FloatInput eta{1.55f};
+  FloatInput beta_m{0.3f};
+  FloatInput beta_n{0.3f};
+  FloatInput alpha{2.0f};
+};
+template <>
+struct SchemaOf<HairMaterial> {
+  using M = HairMaterial;
+  static constexpr Field fields[] = {
+      field<&M::sigma_a>("sigma_a", kNonNegative, "absorption inside the fibre, per unit of its radius"),
+      field<&M::reflectance>("reflectance", kAlbedo, "the fibre's colour, instead of sigma_a").ignored_where("sigma_a"),
+      field<&M::eumelanin>("eumelanin", kNonNegative, "concentration of the brown-black pigment")
+          .ignored_where("sigma_a", "reflectance"),
+      field<&M::pheomelanin>("pheomelanin", kNonNegative, "concentration of the red-yellow pigment")
+          .ignored_where("sigma_a", "reflectance"),
+      field<&M::eta>("eta", kPositive, "index of refraction of the fibre"),
+      field<&M::beta_m>("beta_m", kUnitInterval, "longitudinal roughness"),
+      field<&M::beta_n>("beta_n", kUnitInterval, "azimuthal roughness"),
+      field<&M::alpha>("alpha", kAnyValue, "tilt of the cuticle's scales, in degrees"),
+  };
+  static constexpr TypeSchema schema{.name = "hair", .fields = fields,
+                                     .help = "hair and fur: pbrt-v4's hair BSDF, on curves"};
+};
+
 // Absorbs everything: for pure emitters and light blockers.
 struct BlackMaterial {};
 template <>
@@ -477,6 +514,6 @@ using MaterialDesc = std::variant<DiffuseMaterial, PhongMaterial, MirrorMaterial
                                   ConductorMaterial, CoatedDiffuseMaterial, DiffuseTransmissionMaterial,
                                   InterfaceMaterial, PrincipledMaterial, OneSidedMaterial, MaskMaterial,
                                   BlendMaterial, NormalMapMaterial, BumpMapMaterial, TwoSidedMaterial,
-                                  LayeredDiffuseMaterial, LayeredConductorMaterial>;
+                                  LayeredDiffuseMaterial, LayeredConductorMaterial, HairMaterial>;
 
 }  // namespace candela

@@ -100,6 +100,11 @@ struct MediumDesc {
   // Mitsuba does by default, majorant_resolution_factor = 0). A cloud's majorant: a bound per slab of
   // altitude (32 of them) when > 0, else one (pbrt-v4's, 1). Changes the noise, not the expectation.
   int majorant_cell_samples = 4;
+  // A subsurface medium (pbrt-v4's "subsurface" material: a dielectric boundary around it): a path's
+  // whole excursion inside counts as one bounce, as pbrt-v4's BSSRDF does. Its scattering events, and
+  // the surfaces it meets while inside (the boundary's internal reflections and the way out), do not
+  // count towards max_depth; the bounce that entered it does (integrators/volpath.cpp).
+  bool subsurface = false;
   std::string name;      // for messages
   SourceLocation where;  // where the scene file declares it
   bool is_homogeneous() const { return density.is_constant() && albedo.is_constant(); }
@@ -127,6 +132,8 @@ struct SchemaOf<MediumDesc> {
       field<&T::temperature_cutoff>("temperature_cutoff"),
       field<&T::majorant_cell_samples>("majorant_cell_samples", ValueRange{.lo = 0, .hi = 1 << 20},
                                        "a density grid's samples per majorant cell along each axis; 0: one majorant"),
+      field<&T::subsurface>("subsurface", kAnyValue,
+                            "a path's excursion inside counts as one bounce (volpath), as a BSSRDF's does"),
   };
   static constexpr TypeSchema schema{.name = "homogeneous", .fields = fields, .help = "a participating medium"};
 };

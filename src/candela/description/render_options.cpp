@@ -137,6 +137,24 @@ std::vector<RenderOption> make_table() {
        .reads = "ambient_occlusion", .scene_key = "ambient_occlusion.sampling",
        .extract = [](S d, R& r) { r.ao_sampling = d.settings.ambient_occlusion.cosine_sampling ? "cosine" : "uniform"; },
        .apply = [](Q r, SceneDesc& d) { d.settings.ambient_occlusion.cosine_sampling = r.ao_sampling == "cosine"; }},
+      {.name = "sppm_photons", .field = &R::sppm_photons, .rule = ValueRange{1, kIntMax},
+       .help = "sppm: photons traced per iteration (default: one per pixel)", .reads = "sppm",
+       .scene_key = "sppm.photons_per_iteration",
+       .extract = [](S d, R& r) {
+         if (d.settings.sppm.photons_per_iteration > 0) r.sppm_photons = d.settings.sppm.photons_per_iteration;
+       },
+       .apply = [](Q r, SceneDesc& d) { d.settings.sppm.photons_per_iteration = *r.sppm_photons; },
+       // Photon mapping's parameters go into the fingerprint as one entry, where it may render.
+       .fingerprint_key = "sppm",
+       .fingerprint = [](S d, Q) -> std::optional<std::string> {
+         if (!may_read_setting(*find_integrator_traits(d.settings.integrator), "sppm")) return std::nullopt;
+         return d.settings.sppm.describe();
+       }},
+      {.name = "sppm_radius", .field = &R::sppm_radius, .rule = PositiveValue{},
+       .help = "sppm: the search radius each pixel's visible point starts with, in world units (default 1)",
+       .reads = "sppm", .scene_key = "sppm.radius",
+       .extract = [](S d, R& r) { r.sppm_radius = d.settings.sppm.radius; },
+       .apply = [](Q r, SceneDesc& d) { d.settings.sppm.radius = *r.sppm_radius; }},
       {.name = "sampler", .field = &R::sampler, .rule = choices_of<SamplerType>({"random"}),
        .help = "Pixel sampler: random (independent), stratified (jittered, every dimension), poisson "
                "(Poisson-disc pixel positions), zsobol (Owen-scrambled Sobol' in Morton order)",

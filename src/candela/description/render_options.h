@@ -50,6 +50,8 @@ struct RenderRequest {
   std::optional<float> mlt_sigma, mlt_large_step, mlt_lens, mlt_caustic;
   std::optional<float> ao_max_distance;
   std::string ao_sampling;  // "cosine" or "uniform"
+  std::optional<int> sppm_photons;
+  std::optional<float> sppm_radius;
   bool quiet = false;  // no progress bar, no notes (the command line's -q; Python renders quietly)
   // What only the command line asks (flags of its own, no Python keywords), checked by plan_render
   // with the rest because each asks something of the integrator.

@@ -184,7 +184,23 @@ struct AmbientOcclusionSettings {
   }
 };
 
-// What a render does. The fields outside `path`, `mlt` and `ambient_occlusion` are read by more than one integrator;
+// Stochastic progressive photon mapping's settings (integrator "sppm"; pbrt-v4's SPPMIntegrator, whose
+// "photonsperiteration" and "radius" they are; its "seed" is RenderSettings::seed). RenderSettings::spp
+// is then the number of iterations.
+struct SppmSettings {
+  // Photons traced per iteration; 0: one per pixel of the image (pbrt-v4's default, its -1).
+  int photons_per_iteration = 0;
+  // The search radius every pixel's visible point starts with, in world units; it shrinks as photons
+  // arrive.
+  float radius = 1;
+  bool operator==(const SppmSettings&) const = default;
+  // For image metadata and checkpoint fingerprints.
+  std::string describe() const {
+    return fmt::format("photons-per-iteration {} radius {}", photons_per_iteration, radius);
+  }
+};
+
+// What a render does. The fields outside `path`, `mlt`, `ambient_occlusion` and `sppm` are read by more than one integrator;
 // integrators/integrator.h's registry says which integrator reads which, and the readers and the
 // command line reject a setting the chosen integrator does not read.
 struct RenderSettings {
@@ -222,6 +238,7 @@ struct RenderSettings {
   PathSettings path;
   MltSettings mlt;
   AmbientOcclusionSettings ambient_occlusion;
+  SppmSettings sppm;
 };
 
 }  // namespace candela

@@ -147,7 +147,10 @@ struct Field {
   std::string_view help;
   // The key of another field that, where given, makes this one meaningless (a conductor's eta and k
   // where its reflectance is given): the two may not be given together, and it is not written then.
+  // `unless_also`: a second such key (a hair's melanin concentrations, meaningless where either
+  // sigma_a or reflectance is given).
   std::string_view unless;
+  std::string_view unless_also;
   bool required = false;           // the readers fail without it; the writer always writes it
   const EnumNames* names = nullptr;  // Enum fields
   bool (*given)(const void* object) = nullptr;  // OptionalScalarVolume fields: whether it holds a value
@@ -160,6 +163,11 @@ struct Field {
   constexpr Field ignored_where(std::string_view other) const {
     Field f = *this;
     f.unless = other;
+    return f;
+  }
+  constexpr Field ignored_where(std::string_view other, std::string_view another) const {
+    Field f = ignored_where(other);
+    f.unless_also = another;
     return f;
   }
 };
@@ -379,6 +387,13 @@ inline bool field_given(const TypeSchema& schema, std::string_view key, const vo
       return true;
     }
   return false;
+}
+
+// Whether another given field makes the object's field `f` meaningless (Field::unless), so that it
+// is not written.
+inline bool field_ignored(const TypeSchema& schema, const Field& f, const void* object) {
+  return (!f.unless.empty() && field_given(schema, f.unless, object)) ||
+         (!f.unless_also.empty() && field_given(schema, f.unless_also, object));
 }
 
 // The schema of the type a variant holds.

@@ -224,8 +224,93 @@ struct SchemaOf<SdfGridShape> {
                                      .help = "a signed distance grid (a Mitsuba .vol file, or inline)"};
 };
 
-using ShapeGeometry =
-    std::variant<SphereShape, PlaneShape, BoxShape, RectangleShape, MeshShape, DiskShape, CylinderShape, SdfGridShape>;
+// How a curve's width is laid out across it (pbrt-v4's curve "type").
+enum class CurveType {
+  Flat,      // a ribbon that always faces the ray (Embree's flat curves)
+  Cylinder,  // a round tube of the curve's width (Embree's round curves; pbrt-v4 fakes it with a ribbon
+             // whose shading normal bends across it, which looks the same)
+  Ribbon     // a flat band turned by the given normals (Embree's normal-oriented curves)
+};
+constexpr std::string_view enum_name(CurveType v) {
+  switch (v) {
+    case CurveType::Flat: return "flat";
+    case CurveType::Cylinder: return "cylinder";
+    case CurveType::Ribbon: return "ribbon";
+  }
+  return {};
+}
+
+// How a curve's points are read (pbrt-v4's curve "basis").
+enum class CurveBasis {
+  Bezier,  // Bézier segments sharing their end points: degree + 1 points, then degree more per segment
+  BSpline  // a uniform B-spline: each point after the first degree + 1 adds a segment
+};
+constexpr std::string_view enum_name(CurveBasis v) {
+  switch (v) {
+    case CurveBasis::Bezier: return "bezier";
+    case CurveBasis::BSpline: return "bspline";
+  }
+  return {};
+}
+
+// A curve (pbrt-v4's Shape "curve"): a chain of polynomial segments of degree 2 or 3 through object
+// space, of width `width0` at its start and `width1` at its end (linear along the chain: segment k of
+// n goes from lerp(k / n) to lerp((k + 1) / n), and linearly in its own parameter between), the width
+// scaled by the transform as object-space lengths are (by |det|^(1/3), exact for similarity
+// transforms). Each segment has its own parameter u in [0, 1]; v goes across the width from 0 to 1
+// (pbrt-v4's: v grows towards cross(ray direction, tangent), 0.5 on the axis). A ribbon needs one
+// normal per segment end (segment_count() + 1); the width lies along cross(normal, tangent), the
+// normal between the ends turning as pbrt-v4 turns it (a spherical interpolation). Curves cannot emit
+// light, and are no boundary between media.
+struct CurveShape {
+  std::vector<Point3> points;
+  CurveBasis basis = CurveBasis::Bezier;
+  int degree = 3;
+  CurveType type = CurveType::Flat;
+  float width0 = 1, width1 = 1;
+  std::vector<Normal3> normals;  // ribbons only
+
+  // The number of segments the points make, or 0 where their number does not fit the basis and degree.
+  size_t segment_count() const {
+    if ((degree != 2 && degree != 3) || points.size() < size_t(degree) + 1) return 0;
+    if (basis == CurveBasis::BSpline) return points.size() - size_t(degree);
+    return (points.size() - 1) % size_t(degree) == 0 ? (points.size() - 1) / size_t(degree) : 0;
+  }
+  // What the number of points must be, for messages: "3k + 1 (4, 7, 10, ...)" or "at least 4".
+  std::string expected_point_count() const {
+    if (basis == CurveBasis::BSpline) return fmt::format("at least {}", degree + 1);
+    return fmt::format("{}k + 1 ({}, {}, {}, ...)", degree, degree + 1, 2 * degree + 1, 3 * degree + 1);
+  }
+};
+inline std::optional<SchemaViolation> check_curve(const void* object) {
+  const auto& c = *static_cast<const CurveShape*>(object);
+  const size_t segments = c.segment_count();
+  if (segments == 0)
+    return SchemaViolation{"points", fmt::format("a degree {} {} curve needs {} points, got {}", c.degree,
+                                                 c.basis == CurveBasis::BSpline ? "B-spline" : "Bézier",
+                                                 c.expected_point_count(), c.points.size())};
+  if (c.type == CurveType::Ribbon && c.normals.size() != segments + 1)
+    return SchemaViolation{"normals", fmt::format("a ribbon of {} segments needs {} normals (one at each end of each "
+                                                  "segment), got {}", segments, segments + 1, c.normals.size())};
+  if (c.type != CurveType::Ribbon && !c.normals.empty())
+    return SchemaViolation{"normals", fmt::format("only a ribbon has normals; this curve is {}", enum_name(c.type))};
+  return std::nullopt;
+}
+template <>
+struct SchemaOf<CurveShape> {
+  using T = CurveShape;
+  static constexpr Field fields[] = {
+      enum_field<&T::basis>("basis", "how the points make segments: Bézier or uniform B-spline"),
+      field<&T::degree>("degree", ValueRange{.lo = 2, .hi = 3}, "2 (quadratic) or 3 (cubic) segments"),
+      enum_field<&T::type>("curve_type", "flat (facing the ray), cylinder (a round tube) or ribbon (turned by normals)"),
+      field<&T::width0>("width0", kNonNegative, "the width at the curve's start"),
+      field<&T::width1>("width1", kNonNegative, "the width at the curve's end")};
+  static constexpr TypeSchema schema{.name = "curve", .fields = fields, .check = check_curve,
+                                     .help = "a curve of Bézier or B-spline segments (hair, fur, grass)"};
+};
+
+using ShapeGeometry = std::variant<SphereShape, PlaneShape, BoxShape, RectangleShape, MeshShape, DiskShape,
+                                   CylinderShape, SdfGridShape, CurveShape>;
 
 // Diffuse emission attached to a shape (an area light). One-sided: emits on the side the surface
 // normal points to, unless two_sided.

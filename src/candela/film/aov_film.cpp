@@ -31,6 +31,8 @@ const LayerNames& names_of(Aov aov) {
       {"uv", "UV", {"U", "V"}},
       {"depth_derivatives", "DepthDerivatives", {"X", "Y"}},
       {"relative_variance", "RelativeVariance", {"R", "G", "B"}},
+      // The OpenEXR spectral layout's emissive layer; its channels are the buckets (SpectralBuckets).
+      {"spectral", "S0", {}},
   };
   return table[size_t(aov)];
 }
@@ -61,6 +63,49 @@ Vec3 normalized_or_zero(double x, double y, double z) {
   return {float(x / length), float(y / length), float(z / length)};
 }
 
+// "spectral", "spectral:N" or "spectral:N:MIN:MAX" (nullopt for a name that is not spectral).
+std::optional<SpectralBuckets> parse_spectral_buckets(std::string_view name) {
+  constexpr std::string_view kName = "spectral";
+  if (name.substr(0, kName.size()) != kName || (name.size() > kName.size() && name[kName.size()] != ':'))
+    return std::nullopt;
+  SpectralBuckets buckets;
+  buckets.count = 16;  // pbrt-v4's default "nbuckets"
+  if (name.size() == kName.size()) return buckets;
+  std::vector<double> numbers;
+  std::string_view rest = name.substr(kName.size() + 1);
+  while (true) {
+    const size_t colon = rest.find(':');
+    const std::string part(rest.substr(0, colon));
+    size_t used = 0;
+    double v = 0;
+    try {
+      v = std::stod(part, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (part.empty() || used != part.size() || !std::isfinite(v))
+      throw UsageError(fmt::format("'{}': '{}' is not a number (spectral, spectral:N or spectral:N:MIN:MAX)", name, part));
+    numbers.push_back(v);
+    if (colon == std::string_view::npos) break;
+    rest = rest.substr(colon + 1);
+  }
+  if (numbers.size() != 1 && numbers.size() != 3)
+    throw UsageError(fmt::format("'{}': give spectral, spectral:N or spectral:N:MIN:MAX", name));
+  if (numbers[0] != std::floor(numbers[0]) || numbers[0] < 1 || numbers[0] > 1000)
+    throw UsageError(fmt::format("'{}': the number of buckets must be a whole number from 1 to 1000", name));
+  buckets.count = int(numbers[0]);
+  if (numbers.size() == 3) {
+    buckets.lambda_min = float(numbers[1]);
+    buckets.lambda_max = float(numbers[2]);
+    if (!(buckets.lambda_min >= cie::kLambdaMin && buckets.lambda_max <= cie::kLambdaMax &&
+          buckets.lambda_min < buckets.lambda_max))
+      throw UsageError(fmt::format("'{}': the wavelength range must lie in [{}, {}] nm with MIN < MAX (candela's "
+                                   "spectral transport samples no others)",
+                                   name, cie::kLambdaMin, cie::kLambdaMax));
+  }
+  return buckets;
+}
+
 std::string_view trim(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
   while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
@@ -69,17 +114,31 @@ std::string_view trim(std::string_view s) {
 
 }  // namespace
 
+int SpectralBuckets::bucket_of(float lambda) const {
+  if (!(lambda >= lambda_min && lambda <= lambda_max)) return -1;
+  return std::min(count - 1, int(float(count) * (lambda - lambda_min) / (lambda_max - lambda_min)));
+}
+
+std::string SpectralBuckets::channel_name(int i) const {
+  // The layout names a channel by its bucket's centre ("S0.<lambda>nm", OpenEXR's '.' as a decimal
+  // comma), as pbrt-v4 writes it (three decimals).
+  std::string centre = fmt::format("{:.3f}", lambda_min + (float(i) + 0.5f) / float(count) * (lambda_max - lambda_min));
+  std::replace(centre.begin(), centre.end(), '.', ',');
+  return centre + "nm";
+}
+
 std::string_view aov_name(Aov aov) { return names_of(aov).option; }
 
 std::string aov_names() {
   std::string names;
   for (Aov aov : kAllAovs) names += std::string(aov_name(aov)) + ", ";
-  return names + "all, gbuffer, camera_space, world_space";
+  return names + "spectral[:N[:MIN:MAX]], all, gbuffer, camera_space, world_space";
 }
 
 AovSelection parse_aov_selection(std::string_view list) {
   std::vector<bool> chosen(std::size(kAllAovs), false);
   bool gbuffer = false, any_layer_name = false;
+  SpectralBuckets spectral;
   std::optional<AovSpace> space;
   auto set_space = [&](AovSpace s) {
     if (space && *space != s)
@@ -99,6 +158,9 @@ AovSelection parse_aov_selection(std::string_view list) {
       set_space(AovSpace::Camera);
     } else if (name == "world_space") {
       set_space(AovSpace::World);
+    } else if (std::optional<SpectralBuckets> buckets = parse_spectral_buckets(name)) {
+      if (spectral.count > 0) throw UsageError(fmt::format("'{}': the spectral layer is given twice", list));
+      spectral = *buckets;
     } else {
       auto it = std::find_if(std::begin(kAllAovs), std::end(kAllAovs), [&](Aov a) { return aov_name(a) == name; });
       if (it == std::end(kAllAovs))
@@ -113,7 +175,7 @@ AovSelection parse_aov_selection(std::string_view list) {
   AovSelection selection;
   if (gbuffer) {
     // pbrt-v4's gbuffer film is a fixed set: layer names beside it would leave its layout.
-    if (any_layer_name)
+    if (any_layer_name || spectral.count > 0)
       throw UsageError(fmt::format("'{}': gbuffer (pbrt-v4's gbuffer film) is a fixed set of layers; only "
                                    "camera_space or world_space can be given beside it", list));
     selection.layers.assign(std::begin(kPbrtGbufferAovs), std::end(kPbrtGbufferAovs));
@@ -121,10 +183,14 @@ AovSelection parse_aov_selection(std::string_view list) {
     selection.space = space.value_or(AovSpace::Camera);  // pbrt-v4's default "coordinatesystem"
     return selection;
   }
-  if (!any_layer_name)
+  if (!any_layer_name && spectral.count == 0)
     throw UsageError(fmt::format("'{}' names no AOV layer (valid: {})", list, aov_names()));
   for (Aov aov : kAllAovs)
     if (chosen[size_t(aov)]) selection.layers.push_back(aov);
+  if (spectral.count > 0) {
+    selection.layers.push_back(Aov::Spectral);
+    selection.spectral = spectral;
+  }
   selection.space = space.value_or(AovSpace::World);
   return selection;
 }
@@ -152,6 +218,10 @@ AovFilm::AovFilm(int width, int height, const AovSelection& selection, const Aov
   for (auto it = order_begin; it != order_end; ++it)
     if (std::find(selection.layers.begin(), selection.layers.end(), *it) != selection.layers.end())
       layers_.push_back(*it);
+  if (selection.wants_spectral()) {
+    layers_.push_back(Aov::Spectral);  // last: after R, G, B and the others, as pbrt-v4's film writes them
+    spectral_ = selection.spectral;
+  }
   auto keep = [&](int& offset, size_t n) {
     offset = int(stride_);
     stride_ += n;
@@ -165,6 +235,7 @@ AovFilm::AovFilm(int width, int height, const AovSelection& selection, const Aov
   if (wants(Aov::GeometricNormal)) keep(geometric_normal_, 3);
   if (wants(Aov::Uv)) keep(uv_, 2);
   if (wants(Aov::DepthDerivatives)) keep(depth_derivatives_, 2);
+  if (spectral_.count > 0) keep(spectral_offset_, 2 * size_t(spectral_.count));
   sums_.assign(size_t(width) * size_t(height) * stride_, 0.0);
 }
 
@@ -207,10 +278,29 @@ void AovFilm::add_sample(int x, int y, const AovSample& s, float weight) {
   }
 }
 
+void AovFilm::add_spectral_sample(int x, int y, const RGB& values, const Wavelengths& wl, float weight,
+                                  float max_component) {
+  double* px = sums(x, y) + spectral_offset_;
+  // pbrt-v4 compares the radiance in its own units (luminance over the CIE Y integral) with the limit.
+  double scale = 1;
+  if (max_component > 0) {
+    float largest = 0;
+    for (int i = 0; i < Wavelengths::kCount; ++i) largest = std::max(largest, values[i]);
+    const double in_pbrt_units = double(largest) / cie::y_integral();
+    if (in_pbrt_units > max_component) scale = max_component / in_pbrt_units;
+  }
+  for (int i = 0; i < Wavelengths::kCount; ++i) {
+    const int b = spectral_.bucket_of(wl.lambda[i]);
+    if (b < 0 || !(wl.pdf[i] > 0)) continue;
+    const double w = double(weight) / wl.pdf[i];
+    px[2 * b] += w * scale * values[i];
+    px[2 * b + 1] += w;
+  }
+}
+
 bool AovFilm::empty() const {
-  for (size_t i = 0; i < sums_.size(); i += stride_)
-    if (sums_[i] != 0) return false;
-  return true;
+  // Every layer's sums are weights or weighted values: nothing added leaves them all 0.
+  return std::all_of(sums_.begin(), sums_.end(), [](double v) { return v == 0; });
 }
 
 void AovFilm::clear() { std::fill(sums_.begin(), sums_.end(), 0.0); }
@@ -233,7 +323,9 @@ std::vector<AovLayer> AovFilm::images(const Film& film) const {
   for (Aov aov : layers_) {
     const LayerNames& names = pbrt ? pbrt_gbuffer_names_of(aov) : names_of(aov);
     AovLayer layer{aov, std::string(names.layer), names.channels, width_, height_, {}};
-    const size_t n = names.channels.size();
+    if (aov == Aov::Spectral)
+      for (int i = 0; i < spectral_.count; ++i) layer.channels.push_back(spectral_.channel_name(i));
+    const size_t n = layer.channels.size();
     layer.values.resize(size_t(width_) * size_t(height_) * n);
     for (int y = 0; y < height_; ++y)
       for (int x = 0; x < width_; ++x) {
@@ -286,6 +378,13 @@ std::vector<AovLayer> AovFilm::images(const Film& film) const {
             for (int c = 0; c < 3; ++c) out[c] = m[c] != 0 ? v[c] / m[c] : 0.0f;
             break;
           }
+          case Aov::Spectral:
+            // A bucket no wavelength fell in stays 0, as in pbrt-v4.
+            for (int b = 0; b < spectral_.count; ++b) {
+              const double w = px[spectral_offset_ + 2 * b + 1];
+              out[b] = w > 0 ? float(px[spectral_offset_ + 2 * b] / w) : 0.0f;
+            }
+            break;
         }
       }
     result.push_back(std::move(layer));

@@ -14,6 +14,11 @@
 //   depth_derivatives DepthDerivatives.X, .Y             |dz/dx|, |dz/dy|: how the first hit's z changes
 //                                                        per pixel step right and down (on its tangent plane)
 //   relative_variance RelativeVariance.R, .G, .B         the variance layer over the pixel's mean
+//   spectral:N[:MIN:MAX] S0.389,375nm, ...             pbrt-v4's Film "spectral": the radiance in N equal
+//                                                        wavelength buckets over [MIN, MAX] nm (16 over
+//                                                        [360, 830] by default), in the OpenEXR spectral
+//                                                        layout of Fichet et al. 2021 (JCGT 10(3)); needs
+//                                                        spectral transport
 // Positions, normals and z are in world space, or with camera_space in the camera's frame: x to the
 // image's right, y up, z along the viewing direction, origin at the camera (pbrt-v4's camera space).
 // "gbuffer" asks for pbrt-v4's Film "gbuffer" instead: its layers, definitions and channel names
@@ -39,6 +44,8 @@
 #include "candela/film/image_io.h"
 #include "candela/math/color.h"
 #include "candela/math/vec.h"
+#include "candela/spectral/cie.h"
+#include "candela/spectral/wavelengths.h"
 
 namespace candela {
 
@@ -52,7 +59,8 @@ enum class Aov : uint8_t {
   GeometricNormal,
   Uv,
   DepthDerivatives,
-  RelativeVariance
+  RelativeVariance,
+  Spectral  // not in kAllAovs: "all" stays renderable without spectral transport
 };
 inline constexpr Aov kAllAovs[] = {Aov::Albedo,   Aov::Normal,          Aov::Depth, Aov::Position,
                                    Aov::SampleCount, Aov::Variance,      Aov::GeometricNormal, Aov::Uv,
@@ -69,23 +77,41 @@ enum class AovSpace : uint8_t {
 // Whose layer definitions and EXR channel names: candela's ("Normal.X") or pbrt-v4's gbuffer film's ("Ns.X").
 enum class AovNaming : uint8_t { Candela, PbrtGbuffer };
 
+// pbrt-v4's spectral film's buckets: `count` equal wavelength intervals over [lambda_min, lambda_max]
+// nm. Each bucket's value is the filter-weighted mean of the radiance at the pixel's sampled
+// wavelengths that fall in it (each wavelength weighted by one over its density, so that candela's
+// importance-sampled wavelengths give the bucket's plain mean, as pbrt-v4's uniform ones do), in
+// the spectral values' units: a constant spectrum of luminance Y reads Y in every bucket.
+struct SpectralBuckets {
+  int count = 0;  // 0: no spectral layer
+  float lambda_min = cie::kLambdaMin, lambda_max = cie::kLambdaMax;  // within what spectral transport samples
+  // The bucket of `lambda`, or -1 outside [lambda_min, lambda_max].
+  int bucket_of(float lambda) const;
+  // The EXR channel name of bucket i: "S0." and its centre with a decimal comma, "S0.389,375nm".
+  std::string channel_name(int i) const;
+};
+
 // What an AOV list asks for.
 struct AovSelection {
-  std::vector<Aov> layers;  // in the order written, each once
+  std::vector<Aov> layers;  // in the order written, each once (Aov::Spectral: see `spectral`)
   AovSpace space = AovSpace::World;
   AovNaming naming = AovNaming::Candela;
+  SpectralBuckets spectral;  // with Aov::Spectral in `layers`
   bool empty() const { return layers.empty(); }
+  bool wants_spectral() const { return spectral.count > 0; }
 };
 
 // The name --aov and the scene's "aovs" take: "albedo", "normal", "depth", "position", "spp",
-// "variance", "geometric_normal", "uv", "depth_derivatives", "relative_variance".
+// "variance", "geometric_normal", "uv", "depth_derivatives", "relative_variance", "spectral".
 std::string_view aov_name(Aov aov);
 // The names above (and "all", "gbuffer", "camera_space", "world_space"), for messages.
 std::string aov_names();
 // Comma-separated names (spaces around them ignored) as layers in the order above, each once. "all"
-// is every layer; "camera_space" or "world_space" (the default) sets the space; "gbuffer" is
-// pbrt-v4's gbuffer film (kPbrtGbufferAovs, pbrt's names, camera space unless world_space is given)
-// and takes no layer names beside it. Throws UsageError naming an unknown or empty name and the valid ones.
+// is every layer but the spectral one; "camera_space" or "world_space" (the default) sets the space;
+// "gbuffer" is pbrt-v4's gbuffer film (kPbrtGbufferAovs, pbrt's names, camera space unless
+// world_space is given) and takes no layer names beside it; "spectral", "spectral:N" or
+// "spectral:N:MIN:MAX" is the spectral layer (N in 1..1000, 360 <= MIN < MAX <= 830). Throws
+// UsageError naming an unknown or empty name and the valid ones, or what is wrong with a spectral one.
 AovSelection parse_aov_selection(std::string_view list);
 // parse_aov_selection's layers.
 std::vector<Aov> parse_aovs(std::string_view list);
@@ -152,8 +178,18 @@ class AovFilm {
   bool needs_shading() const { return wants(Aov::Albedo) || wants(Aov::Normal); }
   // Whether any layer is added up from camera samples (all but spp, variance, relative_variance).
   bool has_sample_layers() const { return stride_ > 1; }
+  // Whether any layer needs what the camera ray sees first (render/first_hit_aovs.h): all of those
+  // but the spectral one.
+  bool has_first_hit_layers() const { return stride_ - 2 * size_t(spectral_.count) > 1; }
+  const SpectralBuckets& spectral() const { return spectral_; }
 
   void add_sample(int x, int y, const AovSample& s, float weight);
+  // The spectral layer's share of a camera sample: `values` at the wavelengths `wl` (a spectral
+  // render's sample before it becomes RGB), with the sample's filter weight; `max_component` > 0
+  // scales values whose largest lane over the CIE Y integral exceeds it down to it (pbrt-v4's
+  // spectral film applies maxcomponentvalue so).
+  void add_spectral_sample(int x, int y, const RGB& values, const Wavelengths& wl, float weight,
+                           float max_component);
   // No sample added to any pixel yet.
   bool empty() const;
   // Clears every sum.
@@ -177,6 +213,9 @@ class AovFilm {
   // Offsets into a pixel's sums (-1: not kept). [0] is always the sum of the weights.
   int albedo_ = -1, normal_ = -1, hit_weight_ = -1, depth_ = -1, position_ = -1, geometric_normal_ = -1, uv_ = -1,
       depth_derivatives_ = -1;
+  // The spectral layer: per bucket the sums of w L / pdf and of w / pdf (their ratio is the bucket's mean).
+  int spectral_offset_ = -1;
+  SpectralBuckets spectral_;
   size_t stride_ = 1;
   std::vector<double> sums_;
 };

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <regex>
 #include <stdexcept>
 
@@ -16,6 +17,7 @@
 #include "candela/film/image_io.h"
 #include "candela/integrators/integrator.h"
 #include "candela/render/first_hit_aovs.h"
+#include "candela/spectral/cie.h"
 #include "candela/testing/command_line.h"
 #include "candela/testing/render_helpers.h"
 
@@ -72,7 +74,7 @@ TEST(Aovs, ParsesNamesAndRefusesUnknownOnes) {
   } catch (const UsageError& e) {
     EXPECT_STREQ(e.what(),
                  "unknown AOV 'colour' (valid: albedo, normal, depth, position, spp, variance, geometric_normal, uv, "
-                 "depth_derivatives, relative_variance, all, gbuffer, camera_space, world_space)");
+                 "depth_derivatives, relative_variance, spectral[:N[:MIN:MAX]], all, gbuffer, camera_space, world_space)");
   }
   EXPECT_THROW(parse_aovs("albedo,,normal"), UsageError);
 }
@@ -353,7 +355,7 @@ TEST(Aovs, CommandLineRefusesUnknownNamesAndUnkeptCombinations) {
   testing::CommandResult r = testing::run_command(run_cli("render " + scene + " -o " + out + " --aov albedo,colour -q"));
   EXPECT_EQ(r.exit_code, kExitUsage) << r.output;
   EXPECT_NE(r.output.find("--aov: unknown AOV 'colour' (valid: albedo, normal, depth, position, spp, variance, "
-                          "geometric_normal, uv, depth_derivatives, relative_variance, all, gbuffer"),
+                          "geometric_normal, uv, depth_derivatives, relative_variance, spectral[:N[:MIN:MAX]], all, gbuffer"),
             std::string::npos)
       << r.output;
   EXPECT_FALSE(fs::exists(out));
@@ -558,6 +560,110 @@ TEST(Aovs, CommandLineWritesPbrtGbufferExr) {
   ASSERT_EQ(p.values.size(), 16u * 12u * 3u);
   EXPECT_NEAR(p.values[(6 * 16 + 8) * 3 + 2], 2.0f, 0.02f);  // the sphere's front, 2 along the view
   EXPECT_EQ(p.values[2], 0.0f);                               // the sky in the corner
+  fs::remove_all(dir);
+}
+
+// pbrt-v4's spectral film as an AOV layer: "spectral", "spectral:N", "spectral:N:MIN:MAX".
+TEST(Aovs, SpectralLayerParsesBucketsAndRefusesBadOnes) {
+  const AovSelection plain = parse_aov_selection("spectral");
+  EXPECT_EQ(plain.layers, std::vector<Aov>{Aov::Spectral});
+  EXPECT_EQ(plain.spectral.count, 16);
+  EXPECT_EQ(plain.spectral.lambda_min, 360.0f);
+  EXPECT_EQ(plain.spectral.lambda_max, 830.0f);
+  const AovSelection mixed = parse_aov_selection("albedo, spectral:8:400:700");
+  EXPECT_EQ(mixed.layers, (std::vector<Aov>{Aov::Albedo, Aov::Spectral}));
+  EXPECT_EQ(mixed.spectral.count, 8);
+  EXPECT_EQ(mixed.spectral.lambda_min, 400.0f);
+  // "all" leaves it out: it needs spectral transport.
+  EXPECT_FALSE(parse_aov_selection("all").wants_spectral());
+  for (const char* bad : {"spectral:0", "spectral:2.5", "spectral:8:400", "spectral:8:300:700", "spectral:8:700:400",
+                          "spectral:x", "spectral,spectral:4", "gbuffer,spectral", "spectrals"})
+    EXPECT_THROW(parse_aov_selection(bad), UsageError) << bad;
+}
+
+TEST(Aovs, SpectralBucketsAreNamedByTheirCentresAsPbrtNamesThem) {
+  SpectralBuckets b{8, 360, 830};
+  EXPECT_EQ(b.channel_name(0), "389,375nm");
+  EXPECT_EQ(b.channel_name(7), "800,625nm");
+  EXPECT_EQ(b.bucket_of(360), 0);
+  EXPECT_EQ(b.bucket_of(830), 7);
+  EXPECT_EQ(b.bucket_of(418.75f + 0.01f), 1);
+  EXPECT_EQ(b.bucket_of(359), -1);
+  const AovFilm film(1, 1, parse_aov_selection("spectral:8"), AovCameraFrame{});
+  Film colour(1, 1);
+  const std::vector<AovLayer> layers = film.images(colour);
+  ASSERT_EQ(layers.size(), 1u);
+  EXPECT_EQ(exr_channels(layers).names[0], "S0.389,375nm");  // the OpenEXR spectral layout's names, as pbrt-v4's
+}
+
+// Each bucket is the mean of the spectrum over it, although candela's wavelengths are importance
+// sampled (not uniform, as pbrt-v4's spectral film draws them): the 1 / pdf weights make it so.
+TEST(Aovs, SpectralBucketsAreTheSpectrumsMeanOverEachBucket) {
+  const SpectralBuckets buckets{6, 360, 830};
+  AovFilm film(1, 1, parse_aov_selection("spectral:6"), AovCameraFrame{});
+  auto spectrum = [](float lambda) { return 2.0f + std::sin(lambda / 40.0f); };
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  const int n = 20000;
+  for (int i = 0; i < n; ++i) {
+    const Wavelengths wl = sample_visible_wavelengths(uniform(rng));
+    const RGB values = RGB::from_lanes([&](int k) { return spectrum(wl.lambda[k]); });
+    film.add_spectral_sample(0, 0, values, wl, 0.5f + uniform(rng), 0);
+  }
+  const AovLayer layer = film.images(Film(1, 1))[0];
+  for (int b = 0; b < buckets.count; ++b) {
+    const double lo = 360 + b * (470.0 / 6), hi = lo + 470.0 / 6;
+    double mean = 0;  // the exact mean over the bucket, by the midpoint rule
+    for (int k = 0; k < 1000; ++k) mean += spectrum(float(lo + (k + 0.5) * (hi - lo) / 1000)) / 1000;
+    // The ratio estimator's error: the spectrum varies by at most 1 within a bucket, and the
+    // outermost buckets get the fewest wavelengths (about 1% of 80000): 5 standard errors.
+    EXPECT_NEAR(layer.values[size_t(b)], mean, 5 * 0.5 / std::sqrt(800.0)) << "bucket " << b;
+  }
+}
+
+TEST(Aovs, SpectralMaxComponentScalesAsPbrtsSpectralFilm) {
+  AovFilm film(1, 1, parse_aov_selection("spectral:1"), AovCameraFrame{});
+  Wavelengths wl;
+  for (int k = 0; k < Wavelengths::kCount; ++k) wl.lambda[k] = 500, wl.pdf[k] = 1;
+  // The limit applies to the largest lane in pbrt-v4's units (over the CIE Y integral).
+  const float y = float(cie::y_integral());
+  EXPECT_TRUE(film.empty());
+  film.add_spectral_sample(0, 0, RGB(4 * y, 2 * y, 2 * y, 2 * y), wl, 1, 2);
+  EXPECT_FALSE(film.empty());  // (no separate AOV pass then doubles its weights)
+  EXPECT_NEAR(film.images(Film(1, 1))[0].values[0], (2 * y + 3 * y) / 4, 1e-3 * y);  // scaled by 1/2
+}
+
+// A sky of radiance 1 seen everywhere: every bucket is D65 (normalised to luminance 1) averaged over
+// the bucket, as pbrt-v4's spectral film records an RGB illuminant; the EXR says it is spectral.
+TEST(Aovs, CommandLineWritesTheSpectralLayout) {
+  const fs::path dir = testing::fresh_test_directory("candela_aov_spectral");
+  const std::string scene = (dir / "sky.json").string(), out = (dir / "out.exr").string();
+  std::ofstream(scene) << R"({
+  "camera": {"position": [0, 0, -3], "look_at": [0, 0, 0], "fov": 40, "width": 16, "height": 12},
+  "render": {"spp": 16, "spectral": true},
+  "lights": [{"type": "sky", "radiance": 1}]
+})";
+  testing::CommandResult r = testing::run_command(run_cli("render " + scene + " -o " + out + " --aov spectral:4 -q"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(read_channel_names(out),
+            (std::vector<std::string>{"R", "G", "B", "S0.418,750nm", "S0.536,250nm", "S0.653,750nm", "S0.771,250nm"}));
+  const FloatChannels s = read_float_channels(out, "S0.");
+  ASSERT_EQ(s.values.size(), 16u * 12u * 4u);
+  for (int b = 0; b < 4; ++b) {
+    double measured = 0;
+    for (size_t p = 0; p < 16 * 12; ++p) measured += s.values[p * 4 + size_t(b)] / (16.0 * 12.0);
+    double expected = 0;
+    for (int k = 0; k < 1000; ++k) expected += cie::d65(360 + 117.5 * (b + (k + 0.5) / 1000)) / 1000;
+    // 3072 wavelengths per bucket; D65 varies by under 40% within one: well inside 3%.
+    EXPECT_NEAR(measured, expected, 0.03 * expected) << "bucket " << b;
+  }
+  // Refused without spectral transport, and with an integrator that splats.
+  r = testing::run_command(run_cli("render " + scene + " -o " + out + " --aov spectral --transport rgb -q"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("needs spectral transport"), std::string::npos) << r.output;
+  r = testing::run_command(run_cli("render " + scene + " -o " + out + " --aov spectral --integrator bdpt -q"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("not kept by the bdpt integrator"), std::string::npos) << r.output;
   fs::remove_all(dir);
 }
 }  // namespace

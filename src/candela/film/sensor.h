@@ -36,6 +36,8 @@ class FilmSensor {
     if (changes_nothing_) return L;
     return respond_slow(L);
   }
+  // pbrt-v4's maxcomponentvalue (0: no limit); a spectral film's buckets apply it too (aov_film.h).
+  float max_component() const { return max_component_; }
 
  private:
   RGB respond_slow(const RGB& L) const;

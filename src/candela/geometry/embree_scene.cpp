@@ -442,6 +442,58 @@ void EmbreeScene::add_sdf_grid(uint32_t id, const SdfGridGeometry& sdf, int obje
                        sdf_intersect, sdf_occluded, object);
 }
 
+namespace {
+
+// Round curves are seen from outside only: a hit whose outward normal faces along the ray is the
+// inside of a tube, left by a ray that starts on (or in) it.
+void cull_tube_insides(const RTCFilterFunctionNArguments* args) {
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const float facing = RTCRayN_dir_x(args->ray, args->N, i) * RTCHitN_Ng_x(args->hit, args->N, i) +
+                         RTCRayN_dir_y(args->ray, args->N, i) * RTCHitN_Ng_y(args->hit, args->N, i) +
+                         RTCRayN_dir_z(args->ray, args->N, i) * RTCHitN_Ng_z(args->hit, args->N, i);
+    if (facing > 0) args->valid[i] = 0;
+  }
+}
+
+}  // namespace
+
+void EmbreeScene::add_curves(uint32_t id, const CurveGeometry& c, int object) {
+  static constexpr RTCGeometryType kTypes[] = {RTC_GEOMETRY_TYPE_FLAT_BEZIER_CURVE, RTC_GEOMETRY_TYPE_ROUND_BEZIER_CURVE,
+                                               RTC_GEOMETRY_TYPE_NORMAL_ORIENTED_BEZIER_CURVE};
+  RTCGeometry geom = rtcNewGeometry(device_, kTypes[int(c.kind)]);
+  const size_t segments = c.segment_count();
+  auto* first = static_cast<uint32_t*>(
+      rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(uint32_t), segments));
+  for (size_t s = 0; s < segments; ++s) first[s] = uint32_t(4 * s);
+  auto set_normals = [&](unsigned slot, const std::vector<Normal3>& normals) {
+    // Copied: Embree may read 16 bytes from the last 12-byte normal.
+    auto* out = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_NORMAL, slot, RTC_FORMAT_FLOAT3,
+                                                            sizeof(Normal3), normals.size()));
+    std::copy_n(&normals[0].x, 3 * normals.size(), out);
+  };
+  if (c.moving()) {
+    rtcSetGeometryTimeStepCount(geom, 2);
+    for (unsigned slot = 0; slot < 2; ++slot) {
+      const std::vector<float>& control = slot == 0 ? c.control : c.control_end;
+      auto* out = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, slot, RTC_FORMAT_FLOAT4,
+                                                              4 * sizeof(float), control.size() / 4));
+      std::copy(control.begin(), control.end(), out);
+      if (c.kind == CurveGeometry::Kind::Ribbon) set_normals(slot, slot == 0 ? c.normals : c.normals_end);
+    }
+  } else {
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, c.control.data(), 0,
+                               4 * sizeof(float), c.control.size() / 4);
+    if (c.kind == CurveGeometry::Kind::Ribbon) set_normals(0, c.normals);
+  }
+  rtcSetGeometryTessellationRate(geom, float(c.tessellation));
+  if (c.kind == CurveGeometry::Kind::Round) {
+    rtcSetGeometryIntersectFilterFunction(geom, cull_tube_insides);
+    rtcSetGeometryOccludedFilterFunction(geom, cull_tube_insides);
+  }
+  attach(geom, id, object);
+}
+
 void EmbreeScene::add_plane(uint32_t id, const PlaneGeometry& plane, float extent) {
   planes_.push_back(std::make_unique<PlaneRecord>(PlaneRecord{plane, extent}));
   attach_user_geometry(id, planes_.back().get(), 1, false, plane_bounds, plane_intersect, plane_occluded);
@@ -480,7 +532,8 @@ bool EmbreeScene::intersect(const Ray& r, EmbreeHit& hit) const {
   if (ray_log_) [[unlikely]] ray_log_->add(rayhit.ray, false);
   rtcIntersect1(scene_, &context, &rayhit);
   if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-  hit = {rayhit.ray.tfar, rayhit.hit.geomID, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v, -1};
+  hit = {rayhit.ray.tfar, rayhit.hit.geomID, rayhit.hit.primID, rayhit.hit.u, rayhit.hit.v, -1,
+         Vec3(rayhit.hit.Ng_x, rayhit.hit.Ng_y, rayhit.hit.Ng_z)};
   if (hit.geometry < triangle_pairs_.size() && triangle_pairs_[hit.geometry]) {
     // A quad of paired triangles: report the triangle and its own barycentrics.
     TriangleHit th = quad_hit_to_triangle(triangle_pairs_[hit.geometry]->halves[hit.primitive], hit.u, hit.v);

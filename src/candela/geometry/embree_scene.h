@@ -26,8 +26,9 @@ struct EmbreeHit {
   float t;
   uint32_t geometry;   // the id returned by add_*
   uint32_t primitive;  // triangle index
-  float u, v;          // Embree barycentrics: p = (1-u-v) p0 + u p1 + v p2
+  float u, v;          // Embree barycentrics: p = (1-u-v) p0 + u p1 + v p2 (curves: u along the segment)
   int instance = -1;   // the instance the geometry was reached through (index of add_instance), or -1
+  Vec3 ng{0.0f};       // Embree's geometric normal, not normalised, in the geometry's own space (used for curves)
 };
 
 // The transform (1-t) start + t end, t in [0,1]; nullopt where the interpolated matrix is singular.
@@ -73,6 +74,24 @@ struct SdfGridGeometry {
   std::optional<Transform> to_world_at(float time) const;
   std::optional<Transform> index_to_world(float time) const;
 };
+// Curves (geometry/curves.h): cubic Bézier segments of 4 control points each, (x, y, z, radius) as
+// Embree takes them, in world space (an object's space for shapes of an object).
+struct CurveGeometry {
+  // Embree's flat (ray-facing ribbons), round (tubes) and normal-oriented curves.
+  enum class Kind : uint8_t { Flat, Round, Ribbon };
+  Kind kind = Kind::Flat;
+  std::vector<float> control;      // 16 floats per segment
+  std::vector<float> control_end;  // a moving curve's at Embree time 1 (empty: static)
+  // Ribbons: the control normals of each segment's normal curve (4 per segment, Embree's normal
+  // buffer), and the unit normals at its ends (2 per segment, pbrt-v4's, interpolated by slerp_normal);
+  // the same at time 1 for a moving ribbon.
+  std::vector<Normal3> normals, normals_end;
+  std::vector<Normal3> end_normals, end_normals_end;
+  unsigned tessellation = 4;  // flat curves: the pieces of Embree's polyline per segment
+  size_t segment_count() const { return control.size() / 16; }
+  bool moving() const { return !control_end.empty(); }
+};
+
 struct PlaneGeometry {
   Point3 point;
   Normal3 normal;  // unit length, world space
@@ -118,6 +137,11 @@ class EmbreeScene {
   void add_quadric(uint32_t id, const QuadricGeometry& q, int object = -1);  // moving when q.to_world_end is set
   void add_sdf_grid(uint32_t id, const SdfGridGeometry& sdf, int object = -1);  // moving when sdf.to_world_end is set
   void add_plane(uint32_t id, const PlaneGeometry& plane, float extent);
+  // Curves, read in place where static: `curve` (its control array) must outlive this scene unchanged
+  // and unmoved. Round curves are hit only from outside (rays that leave a tube's surface, inwards or
+  // outwards, pass through it: a fibre is crossed, as pbrt-v4's ray offsets cross it); Embree ignores
+  // flat curves closer to a ray's origin than twice their radius.
+  void add_curves(uint32_t id, const CurveGeometry& curve, int object = -1);
   // Objects for instancing: a separate acceleration structure, built once, placed by instances.
   int add_object();
   // Places `object` (complete by now) in the world under `to_world`, moving to `to_world_end` over

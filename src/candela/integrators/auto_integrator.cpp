@@ -18,9 +18,9 @@ std::vector<const IntegratorEntry*> auto_candidates(const RenderSettings& settin
   std::vector<const IntegratorEntry*> candidates;
   // With media only the integrators that render them apply; without, volpath is the path tracer
   // with one shadow ray and adds nothing to compare. Ambient occlusion and the light tracer render
-  // another image.
+  // another image; photon mapping's film has no error estimate for the pilots to compare.
   for (const IntegratorEntry& entry : integrators()) {
-    if (entry.chooses || entry.geometric || entry.partial_transport || (has_media ? !entry.participating_media : entry.render == render_volpath)) continue;
+    if (entry.chooses || entry.geometric || entry.partial_transport || entry.progressive || (has_media ? !entry.participating_media : entry.render == render_volpath)) continue;
     if (set_but_unread(entry, settings).empty()) candidates.push_back(&entry);
   }
   return candidates;

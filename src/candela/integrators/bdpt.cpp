@@ -302,7 +302,12 @@ int BdptIntegrator::random_walk(Ray ray, Sampler& sampler, RayCounts& counts, RG
     RGB weight = bs->weight;
     if (mode == Transport::Importance) {
       // The adjoint BSDF: importance is not compressed at refractions; shading normals are corrected.
-      if (bs->eta != 1) weight *= bs->eta * bs->eta;
+      // A BSDF that is not reciprocal (hair) was sampled by f(wo, .): its sample is weighted by the
+      // adjoint f(., wo) it carries importance with.
+      if (!bs->is_delta && !v.bsdf.is_reciprocal())
+        weight = bsdf_eval_adjoint(v.bsdf, wo_local, bs->wi) * (std::abs(bs->wi.z) / bs->pdf);
+      else if (bs->eta != 1)
+        weight *= bs->eta * bs->eta;
       weight *= shading_normal_correction(v, v.wo, wi);
     } else if (bs->eta != 1) {
       eta_scale *= bs->eta * bs->eta;

@@ -11,6 +11,7 @@
 #include "candela/integrators/light_path.h"
 #include "candela/integrators/mlt.h"
 #include "candela/integrators/path_integrator.h"
+#include "candela/integrators/sppm.h"
 #include "candela/integrators/volpath.h"
 #include "candela/render/first_hit_aovs.h"
 
@@ -34,6 +35,7 @@ std::vector<IntegratorEntry> bind_traits() {
       {.name = "volpath", .render = render_volpath},
       {.name = "ambient_occlusion", .render = render_ambient_occlusion},
       {.name = "light_path", .render = render_light_path},
+      {.name = "sppm", .render = render_sppm},
       {.name = "auto", .candidates = auto_candidates, .choose = choose_integrator},
   };
   std::vector<IntegratorEntry> entries;
@@ -89,11 +91,18 @@ void check_capabilities(const IntegratorTraits& integrator, const CapabilityNeed
     if (needs.strategy_images)
       throw UsageError(fmt::format("--bdpt-strategies needs --integrator {}, not {}",
                                    integrators_with(&IntegratorTraits::strategy_images), name));
+    if (needs.spectral_layer)
+      throw UsageError(fmt::format("the spectral layer needs --integrator {}, not {} (it may choose one that splats)",
+                                   integrators_with(&IntegratorTraits::spectral_layer), name));
     return;
   }
   if (needs.strategy_images && !integrator.strategy_images)
     throw UsageError(fmt::format("--bdpt-strategies: the {} integrator writes no strategy images ({})", name,
                                  those_that_do(&IntegratorTraits::strategy_images)));
+  if (needs.spectral_layer && !integrator.spectral_layer)
+    throw UsageError(fmt::format("the spectral layer (pbrt-v4's spectral film) is not kept by the {} integrator, whose "
+                                 "light reaches the film other than as camera samples ({})",
+                                 name, those_that_do(&IntegratorTraits::spectral_layer)));
   if (needs.continues_film && !integrator.resumable)
     throw UsageError(fmt::format(
         "--checkpoint and --resume are not supported with the {} integrator (it cannot continue a partly rendered film)",
@@ -106,6 +115,10 @@ void check_capabilities(const IntegratorTraits& integrator, const CapabilityNeed
                                  those_that_do(&IntegratorTraits::resumable)));
   if (needs.adaptive && !integrator.reads_setting("adaptive"))
     throw UsageError(fmt::format("adaptive sampling does not apply to the {} integrator", name));
+  if (needs.target_error && integrator.progressive)
+    throw UsageError(fmt::format("--target-error: the {} integrator gives no error estimate (its pixels have no two "
+                                 "independent halves)",
+                                 name));
   if (needs.media && !integrator.participating_media)
     throw UsageError(fmt::format(
         "the scene has participating media, which the {} integrator does not render: use --integrator volpath", name));
@@ -134,7 +147,8 @@ RenderStats render(const Scene& scene, const RenderSettings& settings, Film& fil
                                    .one_pixel = options.only_x >= 0,
                                    .part = options.part_count > 1,
                                    .adaptive = settings.adaptive(),
-                                   .media = scene.has_media()});
+                                   .media = scene.has_media(),
+                                   .target_error = options.target_error > 0});
   return render_with(*integrator, scene, settings, film, options);
 }
 

@@ -51,6 +51,8 @@ struct CapabilityNeeds {
   bool strategy_images = false;  // per-strategy images (--bdpt-strategies)
   bool adaptive = false;         // adaptive sampling
   bool media = false;            // a scene with participating media
+  bool target_error = false;     // stop at an error target (--target-error), from the film's two halves
+  bool spectral_layer = false;   // a spectral film's buckets (pbrt-v4's Film "spectral", --aov spectral)
 };
 
 // Throws UsageError for the first of `needs` that `integrator` cannot do, naming the flag that asks

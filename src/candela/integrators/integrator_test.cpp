@@ -16,8 +16,9 @@ namespace {
 using Keys = std::vector<std::string_view>;
 
 TEST(IntegratorRegistry, NamesComeFromTheTable) {
-  EXPECT_EQ(integrator_names(), "path, bdpt, mlt, volpath, ambient_occlusion, light_path");
-  EXPECT_EQ(integrator_names(/*and_choosers=*/true), "path, bdpt, mlt, volpath, ambient_occlusion, light_path, auto");
+  EXPECT_EQ(integrator_names(), "path, bdpt, mlt, volpath, ambient_occlusion, light_path, sppm");
+  EXPECT_EQ(integrator_names(/*and_choosers=*/true),
+            "path, bdpt, mlt, volpath, ambient_occlusion, light_path, sppm, auto");
   EXPECT_EQ(integrators_with(&IntegratorTraits::strategy_images), "bdpt");
   for (const IntegratorEntry& entry : integrators()) {
     EXPECT_EQ(find_integrator(entry.name), &entry);
@@ -120,6 +121,8 @@ TEST(IntegratorRegistry, CapabilityChecksNameTheFlagAndTheIntegrator) {
   EXPECT_EQ(message("path", {.strategy_images = true}),
             "--bdpt-strategies: the path integrator writes no strategy images (bdpt does)");
   EXPECT_EQ(message("mlt", {.adaptive = true}), "adaptive sampling does not apply to the mlt integrator");
+  EXPECT_EQ(message("sppm", {.target_error = true}),
+            "--target-error: the sppm integrator gives no error estimate (its pixels have no two independent halves)");
   EXPECT_EQ(message("path", {.media = true}),
             "the scene has participating media, which the path integrator does not render: use --integrator volpath");
   EXPECT_EQ(message("auto", {.part = true}),

@@ -1,7 +1,10 @@
 #include "candela/integrators/light_path.h"
 
+#include <fmt/format.h>
+
 #include <vector>
 
+#include "candela/base/error.h"
 #include "candela/render/camera_sample_tiles.h"
 #include "candela/sampling/samplers.h"
 
@@ -37,6 +40,12 @@ RGB LightPathIntegrator::trace(const Ray& ray, Sampler& sampler, RayCounts& coun
 
 RenderStats render_light_path(const Scene& scene, const RenderSettings& settings, Film& film,
                               const RenderOptions& options) {
+  // Its image is made of light paths joined to the lens alone: a camera none can be joined to would
+  // give a black image.
+  if (scene.camera().is_delta_direction())
+    throw UsageError(fmt::format("the light_path integrator joins light paths to the camera, which an {} camera "
+                                 "cannot be: use the path or bdpt integrator",
+                                 scene.camera().is_orthographic() ? "orthographic" : "spherical"));
   if (!film.has_splats()) film.enable_splats();
   const LightPathIntegrator tracer(scene, settings);
   const Filter filter(settings.filter);

@@ -30,13 +30,7 @@ testing::MeanEstimate light_path_seed_mean(SceneDesc d, const std::string& integ
     d.settings.seed = uint64_t(seed);
     means.push_back(testing::region_mean(testing::render_description(d).mean_image(), -1, region).mean);
   }
-  testing::MeanEstimate e;
-  for (double m : means) e.mean += m / seeds;
-  double v = 0;
-  for (double m : means) v += (m - e.mean) * (m - e.mean) / (seeds - 1);
-  e.standard_error = std::sqrt(v / seeds);
-  e.pixels = seeds;
-  return e;
+  return testing::mean_of_estimates(means);
 }
 
 // Pixels well inside the silhouette of sphere_under_sky's sphere seen with a 20-degree view (it

@@ -27,8 +27,10 @@ PathIntegrator::PathIntegrator(const Scene& scene, const RenderSettings& setting
       shadow_rays_(std::max(1, settings.path.shadow_rays)) {}
 
 template <typename Sampler>
-RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, const Wavelengths* wl) const {
+RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, const Wavelengths* wl,
+                             PathVertexVisitor* visitor) const {
   RGB L(0.0f), beta(1.0f);
+  int max_depth = max_depth_;  // a visitor may end the path earlier
   bool specular_bounce = false;
   float eta_scale = 1;
   float prev_bsdf_pdf = 0;
@@ -78,7 +80,7 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, const
     }
 
     // Terminate the path at the maximum depth.
-    if (depth == max_depth_) break;
+    if (depth == max_depth) break;
     ++depth;
     // The BSDF and its shading frame (normal or bump mapped). A mask's "absent" part is a delta
     // event of this BSDF: it continues the path straight on and counts as a bounce (as Mitsuba does).
@@ -96,6 +98,7 @@ RGB PathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, const
 
     // Sample direct illumination with shadow rays (next-event estimation).
     if (bsdf_has_non_delta(bsdf) && !scene_.lights().empty()) L += beta * direct_light(vertex, sampler, counts);
+    if (visitor && visitor->visit(PathVertexView{hit, shading, wo, beta, depth})) max_depth = depth;
 
     // Choose the next direction; the material's Russian roulette over its modes happens inside
     // (the paper's d, s, t).
@@ -226,7 +229,7 @@ RenderStats render_path(const Scene& scene, const RenderSettings& settings, Film
 
 // One instantiation per sampler type of the variant.
 #define CANDELA_INSTANTIATE(S) \
-  template RGB PathIntegrator::radiance<S>(Ray, S&, RayCounts&, const Wavelengths*) const;
+  template RGB PathIntegrator::radiance<S>(Ray, S&, RayCounts&, const Wavelengths*, PathVertexVisitor*) const;
 CANDELA_FOR_EACH_SAMPLER(CANDELA_INSTANTIATE)
 #undef CANDELA_INSTANTIATE
 

@@ -17,14 +17,37 @@
 
 namespace candela {
 
+// A scattering vertex of a camera path, as PathIntegrator::radiance shows it to a PathVertexVisitor:
+// after its direct light has been estimated, before the next direction is drawn.
+struct PathVertexView {
+  const SurfaceHit& hit;
+  const Shading& shading;  // the BSDF (at the path's wavelengths) and its shading frame
+  Vec3 wo;                 // unit, towards the previous vertex
+  RGB beta;                // the path's throughput up to this vertex
+  int depth;               // 1 at the first scattering vertex
+};
+
+// Sees every scattering vertex of a path (stochastic progressive photon mapping stores its visible
+// points this way, sppm.h). visit() returning true makes the vertex the path's last scattering one:
+// its direction is still drawn and the emission found along it added, as at the maximum depth.
+class PathVertexVisitor {
+ public:
+  virtual bool visit(const PathVertexView& vertex) = 0;
+
+ protected:
+  ~PathVertexVisitor() = default;
+};
+
 class PathIntegrator {
  public:
   PathIntegrator(const Scene& scene, const RenderSettings& settings);
 
   // Radiance arriving along the camera ray: RGB, or with wavelengths (a spectral render) the values
-  // at those wavelengths (spectral/wavelengths.h).
+  // at those wavelengths (spectral/wavelengths.h). With a visitor, each scattering vertex is shown
+  // to it (PathVertexVisitor).
   template <typename Sampler>
-  RGB radiance(Ray ray, Sampler& sampler, RayCounts& counts, const Wavelengths* wl = nullptr) const;
+  RGB radiance(Ray ray, Sampler& sampler, RayCounts& counts, const Wavelengths* wl = nullptr,
+               PathVertexVisitor* visitor = nullptr) const;
 
  private:
   struct Vertex;  // what direct lighting needs to know about the current path vertex

@@ -181,7 +181,8 @@ RenderPlan plan_render(const RenderRequest& request, SceneDesc& scene) {
                                         .part = !request.part.empty(),
                                         .strategy_images = !request.bdpt_strategies.empty(),
                                         .adaptive = scene.settings.adaptive(),
-                                        .media = !scene.media.empty()});
+                                        .media = !scene.media.empty(),
+                                        .target_error = request.target_error.has_value()});
   plan_outputs(request, plan);
   plan.time_limit_seconds = request.time_limit.empty() ? 0 : parse_duration("--time-limit", request.time_limit);
   plan.target_error = request.target_error.value_or(0.0);
@@ -254,6 +255,7 @@ SampleCountText describe_samples(const RenderSettings& settings, const Film& fil
   const bool stopped = outcome.stats.cancelled || outcome.stats.time_limited;
   if (find_integrator(settings.integrator)->samples_are_mutations)
     return {fmt::format("{:.2f} mutations per pixel", double(outcome.stats.samples) / pixels), ""};
+  if (find_integrator(settings.integrator)->progressive) return {fmt::format("{} iterations", min_spp), ""};
   if (settings.adaptive() && !stopped) return {fmt::format("adaptive, {:.2f} spp on average", mean_spp), ""};
   if (min_spp == max_spp) return {std::to_string(min_spp)};
   return {fmt::format("min {}, mean {:.2f}", min_spp, mean_spp)};
@@ -290,6 +292,7 @@ std::map<std::string, std::string> image_metadata(const std::string& scene_name,
   if (options.clamp > 0) metadata["candela:clamp"] = fmt::format("{}", options.clamp);
   if (non_finite_samples > 0) metadata["candela:non_finite_samples"] = std::to_string(non_finite_samples);
   if (find_integrator(settings.integrator)->reads_setting("mlt")) metadata["candela:mlt"] = settings.mlt.describe();
+  if (find_integrator(settings.integrator)->reads_setting("sppm")) metadata["candela:sppm"] = settings.sppm.describe();
   if (outcome.choice) metadata["candela:auto"] = outcome.choice->summary();
   return metadata;
 }

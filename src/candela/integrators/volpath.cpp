@@ -14,6 +14,10 @@ namespace candela {
 namespace {
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
+// Real scattering events one excursion through a subsurface medium may have before the path ends: a
+// guard against walks that would not end in any reasonable time (a non-absorbing medium many thousands
+// of mean free paths across), far beyond what any medium that lets light out again needs.
+constexpr int kMaxSubsurfaceScatterings = 1 << 16;
 
 // exp(-sigma dt) per lane; 1 where sigma is 0, also over an infinite distance.
 RGB exp_neg(const RGB& sigma, float dt) {
@@ -117,6 +121,7 @@ RGB VolPathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, co
   LightSampleContext prev_ctx;
   int medium = scene_.camera_medium();
   int depth = 0;
+  int subsurface_scatterings = 0;  // in the current excursion through a subsurface medium
   ++counts.camera;
 
   // Possibly terminate the path with Russian roulette (after a real scattering event); survivors
@@ -174,7 +179,8 @@ RGB VolPathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, co
             const RGB sigma_t = mp.sigma_a + mp.sigma_s;
             if (rng.next_float() < sigma_t[hero] / sigma_maj[hero]) {
               // Real scattering: estimate direct light, then continue along a phase-function sample.
-              if (depth++ >= max_depth_) {
+              // In a subsurface medium the whole excursion is one bounce: the one that entered it.
+              if (m.is_subsurface() ? ++subsurface_scatterings > kMaxSubsurfaceScatterings : depth++ >= max_depth_) {
                 terminated = true;
                 return false;
               }
@@ -266,8 +272,10 @@ RGB VolPathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, co
     if (wo_local.z == 0) break;
 
     // Sample direct illumination where the BSDF is not purely specular, if one more scattering
-    // event is allowed.
-    const bool may_scatter = depth < max_depth_;
+    // event is allowed. Surfaces met from inside a subsurface medium (its boundary's internal
+    // reflections and the way out) belong to the bounce that entered it.
+    const bool inside_subsurface = medium >= 0 && scene_.media()[size_t(medium)].is_subsurface();
+    const bool may_scatter = inside_subsurface || depth < max_depth_;
     const Normal3 gather_n = bsdf.has_non_delta_transmission() ? Normal3(0.0f) : wo_local.z > 0 ? frame.n : -frame.n;
     const LightSampleContext ctx{hit.p, gather_n};
     if (may_scatter && bsdf.has_non_delta() && !scene_.lights().empty()) {
@@ -293,11 +301,12 @@ RGB VolPathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, co
     const Vec3 wi = normalize(frame.to_world(bs->wi));
     beta *= bs->weight;
     medium = scene_.medium_after(hit, wi, medium);
+    if (medium < 0 || !scene_.media()[size_t(medium)].is_subsurface()) subsurface_scatterings = 0;
     ray = Ray{offset_ray_origin(hit.p, hit.ng, wi), wi, kInfinity, ray.time};
     // Light passing straight on is not a bounce: the MIS state of the last real scattering holds.
     if (bs->passes_through) continue;
     if (!may_scatter) break;
-    ++depth;
+    if (!inside_subsurface) ++depth;
     r_l = bs->is_delta ? r_u : r_u / bs->pdf;
     specular_bounce = bs->is_delta;
     prev_ctx = ctx;

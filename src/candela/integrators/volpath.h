@@ -19,6 +19,10 @@
 //   - Media emit (source term sigma_a Le) where their emission is non-zero; light emitted on a
 //     segment after k scattering events is a path of depth k, counted while k <= max_depth.
 //   - Russian roulette on the throughput over the unidirectional density.
+//   - A subsurface medium (MediumDesc::subsurface, pbrt-v4's "subsurface" material) is random-walked
+//     like any other, but the path's whole excursion inside counts as the one bounce that entered it,
+//     as pbrt-v4's BSSRDF does: its scattering events and the surfaces met from inside do not count
+//     towards max_depth.
 // Surfaces that let light pass straight on (interfaces; a mask's absent part; a thin sheet's
 // transmission) do not count as bounces, as in Mitsuba 3's volpath. Without media the result
 // equals the path tracer's (same estimator for surfaces, one shadow ray per vertex).

@@ -1,8 +1,9 @@
 // The volumetric path tracer against analytic answers: transmittance through a chromatic slab,
 // furnaces of media in closed enclosures (albedo 1 inside an emitter; an emitting, absorbing medium;
 // Kirchhoff's equilibrium of emitting walls and an emitting, scattering medium), a heterogeneous
-// grid's transmittance by ratio tracking and by delta tracking against quadrature, and the refusal
-// of scenes with media by integrators that do not render them. Each render is repeated over seeds;
+// grid's transmittance by ratio tracking and by delta tracking against quadrature, a subsurface
+// slab's reflectance against the exact transport (adding-doubling), and the refusal of scenes with
+// media by integrators that do not render them. Each render is repeated over seeds;
 // tolerances are 5 standard errors of the mean over seeds (Student's t, 7 degrees of freedom).
 #include "candela/integrators/volpath.h"
 
@@ -17,6 +18,7 @@
 #include "candela/base/error.h"
 #include "candela/integrators/integrator.h"
 #include "candela/io/scene_reader.h"
+#include "candela/media/subsurface_albedo.h"
 #include "candela/sampling/rng.h"
 #include "candela/testing/render_helpers.h"
 
@@ -350,6 +352,52 @@ TEST(VolPath, TheMediaExampleScenesRender) {
     EXPECT_GT(sum, 0) << file;
   }
   fs::remove_all(dir);
+}
+
+// ---------------------------------------------------------------- subsurface media
+
+// A slab 60 mean free paths deep and 120 wide of a subsurface medium (sigma_t = 1, the albedo per
+// channel, Henyey-Greenstein g) inside a smooth dielectric of index eta, its top face at z = 0, seen
+// along its normal by an orthographic camera under a uniform white sky. By reciprocity it reflects the
+// albedo for light arriving along the normal: F0 + (1 - F0) rho_eff, the boundary's Fresnel
+// reflectance and the light it lets in that comes back out (media/subsurface_albedo.h's effective
+// albedo, the exact transport by adding-doubling).
+void expect_subsurface_slab_reflectance(const RGB& albedo, float g, float eta, int max_depth) {
+  SceneDesc d = volpath_scene(4, 128);
+  d.settings.max_depth = max_depth;
+  d.camera.projection = Projection::Orthographic;
+  d.camera.world_from_camera = Transform::look_at_right_handed({0, 0, -3}, {0, 0, 0}, {0, 1, 0});
+  MediumDesc medium;
+  medium.sigma_t = RGB(1.0f);
+  medium.albedo.constant = albedo;
+  medium.g = g;
+  medium.subsurface = true;
+  d.media = {medium};
+  DielectricMaterial boundary;
+  boundary.ior = eta;
+  d.materials = {boundary};
+  ShapeDesc slab;
+  slab.geometry = BoxShape{{-60, -60, 0}, {60, 60, 60}};
+  slab.material = 0;
+  slab.interior_medium = 0;
+  d.shapes = {slab};
+  d.lights = {SkyLight{RGB(1.0f), RGB(1.0f), RGB(1.0f), {0, 1, 0}}};
+  const float f0 = ((eta - 1) / (eta + 1)) * ((eta - 1) / (eta + 1));
+  auto reflectance = [&](int c) { return f0 + (1 - f0) * float(subsurface_effective_albedo(albedo[c], g, eta)); };
+  expect_channels(render_means(d), RGB(reflectance(0), reflectance(1), reflectance(2)), "subsurface slab", 2e-3f);
+}
+
+TEST(VolPath, IsotropicSubsurfaceSlabReflectsTheExactTransportsEffectiveAlbedo) {
+  expect_subsurface_slab_reflectance({0.3f, 0.8f, 0.97f}, 0, 1.33f, 5);
+}
+
+TEST(VolPath, ForwardScatteringSubsurfaceSlabReflectsTheExactTransportsEffectiveAlbedo) {
+  expect_subsurface_slab_reflectance({0.5f, 0.9f, 0.95f}, 0.5f, 1.5f, 5);
+}
+
+// Dozens of scattering events inside, yet max_depth 1 (the bounce that entered) renders all of them.
+TEST(VolPath, ASubsurfaceExcursionIsOneBounce) {
+  expect_subsurface_slab_reflectance({0.6f, 0.9f, 0.97f}, 0.2f, 1.33f, 1);
 }
 
 }  // namespace

@@ -380,6 +380,45 @@ TEST(JsonReader, ReadsDiffuseTransmissionAndInterface) {
   EXPECT_TRUE(std::holds_alternative<InterfaceMaterial>(scene.materials[3]));
 }
 
+TEST(JsonReader, ReadsHair) {
+  SceneDesc scene = read(with_material(R"({"type": "hair"},
+      "dyed": {"type": "hair", "sigma_a": [0.2, 0.5, 1.5], "eta": 1.5, "beta_m": 0.2, "beta_n": 0.5, "alpha": 3},
+      "blond": {"type": "hair", "reflectance": [0.8, 0.6, 0.3]},
+      "red": {"type": "hair", "eumelanin": 0.3, "pheomelanin": {"type": "checkerboard", "tex1": 0.5, "tex2": 2}})"));
+  const auto& brown = std::get<HairMaterial>(scene.materials[0]);
+  EXPECT_FALSE(brown.sigma_a || brown.reflectance);
+  EXPECT_EQ(brown.eumelanin.value, 1.3f);
+  EXPECT_EQ(brown.pheomelanin.value, 0.0f);
+  EXPECT_EQ(brown.eta.value, 1.55f);
+  EXPECT_EQ(brown.beta_m.value, 0.3f);
+  EXPECT_EQ(brown.beta_n.value, 0.3f);
+  EXPECT_EQ(brown.alpha.value, 2.0f);
+  const auto& dyed = std::get<HairMaterial>(scene.materials[1]);
+  EXPECT_EQ(dyed.sigma_a->value, RGB(0.2f, 0.5f, 1.5f));
+  EXPECT_EQ(dyed.eta.value, 1.5f);
+  EXPECT_EQ(dyed.beta_m.value, 0.2f);
+  EXPECT_EQ(dyed.beta_n.value, 0.5f);
+  EXPECT_EQ(dyed.alpha.value, 3.0f);
+  EXPECT_EQ(std::get<HairMaterial>(scene.materials[2]).reflectance->value, RGB(0.8f, 0.6f, 0.3f));
+  const auto& red = std::get<HairMaterial>(scene.materials[3]);
+  EXPECT_EQ(red.eumelanin.value, 0.3f);
+  EXPECT_GE(red.pheomelanin.texture, 0);
+  expect_error_containing(with_material(R"({"type": "hair", "sigma_a": 1, "reflectance": 0.5})"),
+                          "at /materials/m/reflectance: give either \"reflectance\" or \"sigma_a\", not both");
+  expect_error_containing(with_material(R"({"type": "hair", "reflectance": 0.5, "eumelanin": 2})"),
+                          "at /materials/m/eumelanin: give either \"eumelanin\" or \"reflectance\", not both");
+  expect_error_containing(with_material(R"({"type": "hair", "sigma_a": 1, "pheomelanin": 2})"),
+                          "at /materials/m/pheomelanin: give either \"pheomelanin\" or \"sigma_a\", not both");
+  expect_error_containing(with_material(R"({"type": "hair", "reflectance": 1.5})"),
+                          "at /materials/m/reflectance: a reflectance must be <= 1");
+  expect_error_containing(with_material(R"({"type": "hair", "sigma_a": -1})"),
+                          "at /materials/m/sigma_a: colour components must be >= 0");
+  expect_error_containing(with_material(R"({"type": "hair", "beta_m": 1.5})"),
+                          "at /materials/m/beta_m: expected a number in [0, 1], got 1.5");
+  expect_error_containing(with_material(R"({"type": "hair", "eta": 0})"),
+                          "at /materials/m/eta: expected a positive number, got 0");
+}
+
 TEST(JsonReader, BadMicrofacetMaterialValuesAreErrors) {
   expect_error_containing(with_material(R"({"type": "conductor", "roughness": -0.1})"),
                           "at /materials/m/roughness: expected a number >= 0, got -0.1");

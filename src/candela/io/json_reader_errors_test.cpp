@@ -254,7 +254,7 @@ TEST(JsonReader, UnknownMaterialNameIsAnError) {
 TEST(JsonReader, UnknownTypesAreErrors) {
   expect_error_containing(with_shape(R"({"type": "torus"})"),
                           "at /shapes/0/type: unknown shape type \"torus\"; expected one of: sphere, plane, box, "
-                          "rectangle, mesh, disk, cylinder, sdfgrid, instance");
+                          "rectangle, mesh, disk, cylinder, sdfgrid, curve, instance");
   expect_error_containing(with_material(R"({"type": "velvet"})"),
                           "at /materials/m/type: unknown material type \"velvet\"");
   expect_error_containing(with_light(R"({"type": "laser"})"),

@@ -99,7 +99,7 @@ TEST(JsonReader, ReadsCameraAndRenderSettings) {
 TEST(JsonReader, ARenderKeyTheIntegratorDoesNotReadIsAnError) {
   expect_error_containing(R"({"render": {"integrator": "whitted"}})",
                           "at /render/integrator: unknown integrator \"whitted\" (known: path, bdpt, mlt, volpath, "
-                          "ambient_occlusion, light_path)");
+                          "ambient_occlusion, light_path, sppm)");
   const std::pair<const char*, const char*> cases[] = {
       {R"({"render": {"integrator": "bdpt", "mis": false}})", "at /render/mis: the bdpt integrator does not read mis"},
       {R"({"render": {"integrator": "bdpt", "direction_sampling": "cosine"}})",
@@ -114,6 +114,9 @@ TEST(JsonReader, ARenderKeyTheIntegratorDoesNotReadIsAnError) {
        "at /render/adaptive: the mlt integrator does not read adaptive (adaptive sampling; read by: path, bdpt, volpath, "
        "ambient_occlusion)"},
       {R"({"render": {"mlt": {"chains": 10}}})", "at /render/mlt: the path integrator does not read mlt"},
+      {R"({"render": {"sppm": {"radius": 0.1}}})", "at /render/sppm: the path integrator does not read sppm"},
+      {R"({"render": {"integrator": "sppm", "adaptive": {"threshold": 0.1}}})",
+       "at /render/adaptive: the sppm integrator does not read adaptive"},
   };
   for (const auto& [text, message] : cases) EXPECT_NE(error_of(text).find(message), std::string::npos) << text;
   // What each integrator reads is accepted; power and uniform light selection by all.
@@ -121,6 +124,12 @@ TEST(JsonReader, ARenderKeyTheIntegratorDoesNotReadIsAnError) {
                                       "direction_sampling": "cosine", "rr_start_depth": 1, "adaptive": {"spp": 32}}})"));
   EXPECT_NO_THROW(read(R"({"render": {"integrator": "bdpt", "rr_start_depth": 1, "light_selection": "uniform"}})"));
   EXPECT_NO_THROW(read(R"({"render": {"integrator": "mlt", "mlt": {"chains": 10}, "light_selection": "power"}})"));
+  const SceneDesc sppm =
+      read(R"({"render": {"integrator": "sppm", "sppm": {"photons_per_iteration": 5000, "radius": 0.25}}})");
+  EXPECT_EQ(sppm.settings.sppm.photons_per_iteration, 5000);
+  EXPECT_EQ(sppm.settings.sppm.radius, 0.25f);
+  EXPECT_NE(error_of(R"({"render": {"integrator": "sppm", "sppm": {"radius": 0}}})").find("/render/sppm/radius"),
+            std::string::npos);
 }
 
 TEST(JsonReader, ReadsMetropolisSettings) {

@@ -109,7 +109,7 @@ Json scalar_or_grid(const VolumeDesc& v) { return v.is_constant() ? Json(v.const
 // from others (a sky's gradient) never come into play.
 void write_fields(const TypeSchema& schema, const void* object, Json& j) {
   for (const Field& f : schema.fields) {
-    if (!f.unless.empty() && field_given(schema, f.unless, object)) continue;
+    if (field_ignored(schema, f, object)) continue;
     switch (f.kind) {
       case FieldKind::Color: j[f.key] = color(field_value<ColorInput>(f, object)); break;
       case FieldKind::OptionalColor:
@@ -191,10 +191,20 @@ Json mesh_json(const TriangleMesh& mesh) {
   return j;
 }
 
-// The geometry's schema fields; a mesh's and an SDF grid's data beside them.
+// The geometry's schema fields; a mesh's, an SDF grid's and a curve's data beside them.
 Json geometry_json(const ShapeGeometry& geometry) {
   Json j = schema_json(geometry);
   if (const auto* m = std::get_if<MeshShape>(&geometry)) j.update(mesh_json(m->mesh));
+  if (const auto* c = std::get_if<CurveShape>(&geometry)) {
+    Json points = Json::array();
+    for (const Point3& p : c->points) points.push_back(vec3(p));
+    j["points"] = std::move(points);
+    if (!c->normals.empty()) {
+      Json normals = Json::array();
+      for (const Normal3& n : c->normals) normals.push_back(vec3(n));
+      j["normals"] = std::move(normals);
+    }
+  }
   if (const auto* g = std::get_if<SdfGridShape>(&geometry)) {
     if (!g->filename.empty()) {
       j["filename"] = absolute(g->filename);
@@ -246,8 +256,13 @@ Json shape_json(const ShapeDesc& shape, const std::vector<std::string>& media) {
 
 Json camera_json(const SceneDesc& scene, const std::vector<std::string>& media) {
   const CameraDesc& c = scene.camera;
-  Json j{{"transform", matrix(c.world_from_camera)}, {"fov", c.fov_degrees}, {"fov_axis", enum_name(c.fov_axis)}};
-  if (c.projection == Projection::Orthographic) j["projection"] = "orthographic";
+  const bool spherical = c.projection == Projection::Equirectangular || c.projection == Projection::EqualArea;
+  Json j{{"transform", matrix(c.world_from_camera)}};
+  if (!spherical) {  // a spherical camera has no field of view (nor a lens: its lens_radius is 0)
+    j["fov"] = c.fov_degrees;
+    j["fov_axis"] = enum_name(c.fov_axis);
+  }
+  if (c.projection != Projection::Perspective) j["projection"] = enum_name(c.projection);
   if (c.near_clip != 0) j["near_clip"] = c.near_clip;
   if (c.screen_window) j["screen_window"] = *c.screen_window;
   j["width"] = scene.film.width;
@@ -257,7 +272,7 @@ Json camera_json(const SceneDesc& scene, const std::vector<std::string>& media) 
   if (const FilmDesc::Sensor& sensor = scene.film.sensor; !sensor.changes_nothing())
     j["sensor"] = Json{{"exposure", sensor.exposure}, {"white_balance", sensor.white_balance},
                        {"max_component", sensor.max_component}};
-  if (c.lens_radius != 0) {
+  if (c.lens_radius != 0 && !spherical) {
     j["lens_radius"] = c.lens_radius;
     j["focus_distance"] = c.focus_distance;
   }

@@ -73,7 +73,11 @@ INSTANTIATE_TEST_SUITE_P(Scenes, ConvertRoundTrip,
                                            "meshes/cornell-box/CornellBox-Glossy.obj",
                                            // pbrt-v4's layered materials (materials/layered.h)
                                            "scenes/pbrt-v4-features/mat_coateddiffuse.pbrt",
-                                           "scenes/pbrt-v4-features/mat_coatedconductor.pbrt"),
+                                           "scenes/pbrt-v4-features/mat_coatedconductor.pbrt",
+                                           // a dielectric filled with a subsurface medium
+                                           "scenes/pbrt-v4-features/mat_subsurface_named.pbrt",
+                                           // pbrt-v4's hair on curves (materials/hair.h)
+                                           "scenes/pbrt-v4-features/mat_hair_on_curves.pbrt"),
                          [](const ::testing::TestParamInfo<const char*>& info) {
                            fs::path file(info.param);
                            std::string name = file.parent_path().filename().string() + "_" + file.stem().string();
@@ -277,6 +281,30 @@ TEST(ConvertJson, FilmSensorRoundTrips) {
   expect_error_containing(R"({"camera": {"sensor": {"iso": 400}}})", "at /camera/sensor/iso: unknown key");
 }
 
+// Photon mapping's parameters survive `candela convert` (pbrt-v4's sppm included); other integrators'
+// scenes write none (their readers would refuse them).
+TEST(ConvertJson, SppmSettingsRoundTrip) {
+  SceneDesc scene;
+  scene.settings.integrator = "sppm";
+  scene.settings.sppm = SppmSettings{.photons_per_iteration = 20000, .radius = 0.125f};
+  const SceneDesc back = read_json_scene(scene_to_json(scene), "converted.json", fs::temp_directory_path());
+  EXPECT_EQ(back.settings.integrator, "sppm");
+  EXPECT_EQ(back.settings.sppm, scene.settings.sppm);
+  scene.settings.sppm = SppmSettings{};  // one photon per pixel: no key
+  EXPECT_EQ(read_json_scene(scene_to_json(scene), "converted.json", fs::temp_directory_path()).settings.sppm,
+            SppmSettings{});
+  scene.settings.integrator = "path";
+  scene.settings.sppm.radius = 0.5f;
+  EXPECT_EQ(scene_to_json(scene).find("\"sppm\""), std::string::npos);
+  const SceneDesc pbrt = read_pbrt_string(
+      "Integrator \"sppm\" \"integer photonsperiteration\" 777 \"float radius\" 0.3\nWorldBegin\n", "sppm.pbrt",
+      fs::temp_directory_path());
+  const SceneDesc pbrt_back = read_json_scene(scene_to_json(pbrt), "converted.json", fs::temp_directory_path());
+  EXPECT_EQ(pbrt_back.settings.integrator, "sppm");
+  EXPECT_EQ(pbrt_back.settings.sppm.photons_per_iteration, 777);
+  EXPECT_EQ(pbrt_back.settings.sppm.radius, 0.3f);
+}
+
 // A camera's screen window and the projections of textures survive `candela convert`.
 TEST(ConvertJson, ScreenWindowsCropsSincFiltersAndTextureProjectionsRoundTrip) {
   SceneDesc scene;
@@ -319,6 +347,71 @@ TEST(ConvertJson, ScreenWindowsCropsSincFiltersAndTextureProjectionsRoundTrip) {
 }
 
 // pbrt's media convert too: a uniformgrid's samples are written inline.
+// pbrt-v4's hair, read from pbrt and written as JSON (`candela convert`): the same materials back,
+// and the same image bit for bit (on spheres, where h runs over v as on a curve).
+TEST(ConvertJson, HairRoundTrip) {
+  Warnings warnings;
+  SceneDesc pbrt = read_pbrt_string(
+      "LookAt 0 0 6  0 0 0  0 1 0\n"
+      "Camera \"perspective\" \"float fov\" 40\n"
+      "Film \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 24\n"
+      "WorldBegin\n"
+      "LightSource \"infinite\" \"rgb L\" [ 0.4 0.4 0.5 ]\n"
+      "LightSource \"distant\" \"point3 from\" [ 1 2 3 ] \"rgb L\" [ 3 3 3 ]\n"
+      "Texture \"pigment\" \"float\" \"checkerboard\" \"float tex1\" 0.2 \"float tex2\" 3\n"
+      "Material \"hair\"\n"
+      "Translate -1.5 0 0\n"
+      "Shape \"sphere\" \"float radius\" 0.7\n"
+      "Material \"hair\" \"rgb sigma_a\" [ 0.2 0.5 1.5 ] \"float beta_m\" 0.15 \"float alpha\" 4\n"
+      "Translate 1 0 0\n"
+      "Shape \"sphere\" \"float radius\" 0.5\n"
+      "Material \"hair\" \"rgb reflectance\" [ 0.8 0.5 0.2 ] \"float beta_n\" 0.6 \"float eta\" 1.5\n"
+      "Translate 1 0 0\n"
+      "Shape \"sphere\" \"float radius\" 0.5\n"
+      "Material \"hair\" \"texture eumelanin\" \"pigment\" \"float pheomelanin\" 0.7\n"
+      "Translate 1 0 0\n"
+      "Shape \"sphere\" \"float radius\" 0.5\n",
+      "hair.pbrt", fs::temp_directory_path(), warnings);
+  SceneDesc back = read_json_scene(scene_to_json(pbrt), "converted.json", fs::temp_directory_path());
+  ASSERT_EQ(back.materials.size(), pbrt.materials.size());
+  int hairs = 0;
+  for (size_t i = 0; i < pbrt.materials.size(); ++i) {
+    const auto* o = std::get_if<HairMaterial>(&pbrt.materials[i]);
+    if (!o) continue;
+    ++hairs;
+    const auto& b = std::get<HairMaterial>(back.materials[i]);
+    EXPECT_EQ(b.sigma_a.has_value(), o->sigma_a.has_value()) << i;
+    if (o->sigma_a) {
+      EXPECT_EQ(b.sigma_a->value, o->sigma_a->value) << i;
+    }
+    EXPECT_EQ(b.reflectance.has_value(), o->reflectance.has_value()) << i;
+    if (o->reflectance) {
+      EXPECT_EQ(b.reflectance->value, o->reflectance->value) << i;
+    }
+    if (!o->sigma_a && !o->reflectance) {
+      EXPECT_EQ(b.eumelanin.value, o->eumelanin.value) << i;
+      EXPECT_EQ(b.eumelanin.texture >= 0, o->eumelanin.texture >= 0) << i;
+      EXPECT_EQ(b.pheomelanin.value, o->pheomelanin.value) << i;
+    }
+    for (auto member : {&HairMaterial::eta, &HairMaterial::beta_m, &HairMaterial::beta_n, &HairMaterial::alpha})
+      EXPECT_EQ((b.*member).value, (o->*member).value) << i;
+  }
+  EXPECT_EQ(hairs, 4);
+  for (SceneDesc* d : {&pbrt, &back}) {
+    d->settings.spp = 8;
+    d->settings.seed = 3;
+  }
+  Image a = testing::render_description(pbrt).mean_image();
+  Image b = testing::render_description(back).mean_image();
+  ASSERT_EQ(a.rgb.size(), b.rgb.size());
+  double sum = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) {
+    ASSERT_EQ(a.rgb[i], b.rgb[i]) << i;
+    sum += a.rgb[i];
+  }
+  EXPECT_GT(sum, 0);
+}
+
 TEST(ConvertJson, PbrtMediaRoundTrip) {
   Warnings warnings;
   SceneDesc pbrt = read_pbrt_string(

@@ -264,6 +264,59 @@ TEST(PbrtReader, MixMaterialSelectsOrBlends) {
                "must name exactly two materials");
 }
 
+TEST(PbrtReader, HairMaterialAsPbrtV4ReadsIt) {
+  Warned read = read_warned(
+      {"WorldBegin", "Texture \"m\" \"float\" \"checkerboard\" \"float tex1\" 0.5 \"float tex2\" 4",
+       "Material \"hair\"",
+       "Material \"hair\" \"rgb sigma_a\" [ 0.1 0.2 0.3 ] \"float eumelanin\" 2 \"float eta\" 1.6 "
+       "\"float beta_m\" 0.2 \"float beta_n\" 0.005 \"float alpha\" 3",
+       "Material \"hair\" \"rgb reflectance\" [ 0.4 0.3 0.2 ] \"float pheomelanin\" 1",
+       "Material \"hair\" \"float pheomelanin\" 0.8",
+       "Material \"hair\" \"texture eumelanin\" \"m\" \"texture beta_m\" \"m\"",
+       "Material \"hair\" \"rgb color\" [ 0.5 0.5 0.5 ]"});
+  const SceneDesc& scene = read.scene;
+  ASSERT_EQ(scene.materials.size(), 6u);
+  // pbrt-v4's default: eumelanin 1.3, and its other defaults.
+  const auto& brown = std::get<HairMaterial>(scene.materials[0]);
+  EXPECT_FALSE(brown.sigma_a || brown.reflectance);
+  EXPECT_FLOAT_EQ(brown.eumelanin.value, 1.3f);
+  EXPECT_FLOAT_EQ(brown.pheomelanin.value, 0);
+  EXPECT_FLOAT_EQ(brown.eta.value, 1.55f);
+  EXPECT_FLOAT_EQ(brown.beta_m.value, 0.3f);
+  EXPECT_FLOAT_EQ(brown.beta_n.value, 0.3f);
+  EXPECT_FLOAT_EQ(brown.alpha.value, 2);
+  // sigma_a wins (the melanin is ignored with a warning); beta_n clamped to pbrt-v4's 0.01.
+  const auto& given = std::get<HairMaterial>(scene.materials[1]);
+  ASSERT_TRUE(given.sigma_a);
+  EXPECT_EQ(given.sigma_a->value, RGB(0.1f, 0.2f, 0.3f));
+  EXPECT_FLOAT_EQ(given.eta.value, 1.6f);
+  EXPECT_FLOAT_EQ(given.beta_m.value, 0.2f);
+  EXPECT_FLOAT_EQ(given.beta_n.value, 0.01f);
+  EXPECT_FLOAT_EQ(given.alpha.value, 3);
+  const auto& coloured = std::get<HairMaterial>(scene.materials[2]);
+  ASSERT_TRUE(coloured.reflectance);
+  EXPECT_FALSE(coloured.sigma_a);
+  EXPECT_EQ(coloured.reflectance->value, RGB(0.4f, 0.3f, 0.2f));
+  // One concentration given alone leaves the other at 0 (pbrt-v4's null texture).
+  const auto& red = std::get<HairMaterial>(scene.materials[3]);
+  EXPECT_FLOAT_EQ(red.eumelanin.value, 0);
+  EXPECT_FLOAT_EQ(red.pheomelanin.value, 0.8f);
+  const auto& textured = std::get<HairMaterial>(scene.materials[4]);
+  EXPECT_EQ(textured.eumelanin.texture, 0);
+  EXPECT_EQ(textured.beta_m.texture, 0);
+  // Older pbrt-v4 scenes name the colour "color".
+  const auto& older = std::get<HairMaterial>(scene.materials[5]);
+  ASSERT_TRUE(older.reflectance);
+  EXPECT_EQ(older.reflectance->value, RGB(0.5f));
+  const std::string warnings = joined(read.warnings);
+  EXPECT_NE(warnings.find("\"eumelanin\" is ignored because \"sigma_a\" is given"), std::string::npos) << warnings;
+  EXPECT_NE(warnings.find("\"pheomelanin\" is ignored because \"reflectance\" is given"), std::string::npos)
+      << warnings;
+  expect_error({"WorldBegin", "Material \"hair\" \"float eta\" 0"}, 2, "\"float eta\"", "must be positive");
+  expect_error({"WorldBegin", "Material \"hair\" \"rgb reflectance\" [ 1 1 1 ] \"rgb color\" [ 1 1 1 ]"}, 2,
+               "\"rgb color\"", "cannot be given together with \"reflectance\"");
+}
+
 // ---------------------------------------------------------------- textures
 
 TEST(PbrtReader, ImageTextures) {

@@ -201,21 +201,18 @@ TEST(PbrtReader, BadSampleCountsAndDepth) {
 TEST(PbrtReader, UnknownAndUnsupportedTypes) {
   expect_error({"WorldBegin", "Shape \"spere\""}, 2, "\"spere\"",
                "unknown shape type \"spere\" (did you mean \"sphere\"?) (supported: \"sphere\", \"cylinder\", "
-               "\"trianglemesh\", \"plymesh\", \"disk\", \"bilinearmesh\", \"loopsubdiv\")");
-  expect_error({"WorldBegin", "Shape \"curve\""}, 2, "\"curve\"",
-               "shape type \"curve\" is not supported: candela has no primitive or tessellation for it");
+               "\"trianglemesh\", \"plymesh\", \"disk\", \"bilinearmesh\", \"loopsubdiv\", \"curve\")");
   expect_error({"WorldBegin", "Material \"plastic\""}, 2, "\"plastic\"", "unknown material type \"plastic\"");
-  for (std::string type : {"hair", "measured", "subsurface"})
-    expect_error({"WorldBegin", "Material \"" + type + "\""}, 2, "\"" + type + "\"",
-                 "material type \"" + type + "\" is not supported: candela has no BSDF for it");
-  expect_error({"WorldBegin", "MakeNamedMaterial \"m\" \"string type\" \"hair\""}, 2, "\"string type\"",
+  expect_error({"WorldBegin", "Material \"measured\""}, 2, "\"measured\"",
+               "material type \"measured\" is not supported: candela has no BSDF for it");
+  expect_error({"WorldBegin", "MakeNamedMaterial \"m\" \"string type\" \"measured\""}, 2, "\"string type\"",
                "not supported");
   expect_error({"WorldBegin", "LightSource \"sun\""}, 2, "\"sun\"", "unknown light type \"sun\"");
   expect_error({"Integrator \"whitted\"", "WorldBegin"}, 1, "\"whitted\"", "unknown integrator type \"whitted\"");
   expect_error({"Accelerator \"octree\"", "WorldBegin"}, 1, "\"octree\"", "unknown accelerator type");
   expect_error({"WorldBegin", "AreaLightSource \"glow\""}, 2, "\"glow\"", "unknown area light type");
   expect_error({"Camera \"realistic\"", "WorldBegin"}, 1, "\"realistic\"", "not supported yet");
-  expect_error({"Film \"spectral\"", "WorldBegin"}, 1, "\"spectral\"", "not supported yet");
+  expect_error({"Film \"photographic\"", "WorldBegin"}, 1, "\"photographic\"", "unknown film type");
 }
 
 TEST(PbrtReader, UnsupportedFeaturesOfSupportedTypes) {
@@ -324,7 +321,7 @@ TEST(PbrtReader, BdptAndMltAreCandelasOwn) {
 
 TEST(PbrtReader, OtherPbrtIntegratorsAreRenderedWithOneThatConvergesToTheSameImage) {
   EXPECT_TRUE(read_warned({"Integrator \"path\" \"integer maxdepth\" 9", "WorldBegin"}).warnings.empty());
-  for (std::string type : {"sppm", "randomwalk", "simplepath"}) {
+  for (std::string type : {"randomwalk", "simplepath"}) {
     SCOPED_TRACE(type);
     std::vector<std::string> lines = {"Integrator \"" + type + "\" \"integer maxdepth\" 9", "WorldBegin"};
     expect_warning(lines, 1, "\"" + type + "\"",
@@ -362,10 +359,23 @@ TEST(PbrtReader, OtherPbrtIntegratorsAreRenderedWithOneThatConvergesToTheSameIma
   // It has no depth: pbrt-v4 refuses "maxdepth" as an unused parameter, and so does candela.
   expect_error({"Integrator \"ambientocclusion\" \"integer maxdepth\" 5", "WorldBegin"}, 1,
                "\"integer maxdepth\"", "unused parameter");
-  Warned sppm = read_warned({"Integrator \"sppm\" \"integer photonsperiteration\" 1000 \"float radius\" 0.1",
+  // sppm is candela's sppm with pbrt-v4's parameters, without a warning; -1 photons (the default)
+  // are one per pixel (candela's 0), and its seed is the render's.
+  Warned sppm = read_warned({"Integrator \"sppm\" \"integer photonsperiteration\" 1000 \"float radius\" 0.1 "
+                             "\"integer seed\" 7 \"integer maxdepth\" 6",
                              "WorldBegin"});
-  ASSERT_EQ(sppm.warnings.size(), 3u) << joined(sppm.warnings);
-  EXPECT_NE(sppm.warnings[0].find("\"photonsperiteration\" is ignored"), std::string::npos) << sppm.warnings[0];
+  EXPECT_TRUE(sppm.warnings.empty()) << joined(sppm.warnings);
+  EXPECT_EQ(sppm.scene.settings.integrator, "sppm");
+  EXPECT_EQ(sppm.scene.settings.sppm.photons_per_iteration, 1000);
+  EXPECT_EQ(sppm.scene.settings.sppm.radius, 0.1f);
+  EXPECT_EQ(sppm.scene.settings.seed, 7u);
+  EXPECT_EQ(sppm.scene.settings.max_depth, 6);
+  const SceneDesc sppm_defaults = read_lines({"Integrator \"sppm\"", "WorldBegin"});
+  EXPECT_EQ(sppm_defaults.settings.sppm, SppmSettings{});
+  EXPECT_EQ(sppm_defaults.settings.max_depth, 5);
+  expect_error({"Integrator \"sppm\" \"float radius\" 0", "WorldBegin"}, 1, "\"float radius\"", "must be positive");
+  expect_error({"Integrator \"sppm\" \"integer photonsperiteration\" 0", "WorldBegin"}, 1,
+               "\"integer photonsperiteration\"", "must be positive or -1");
   Warned regularized = read_warned({"Integrator \"path\" \"bool regularize\" true", "WorldBegin"});
   ASSERT_EQ(regularized.warnings.size(), 1u);
   EXPECT_NE(regularized.warnings[0].find(":1:19: warning: Integrator \"path\": \"regularize\" is ignored"),
@@ -434,6 +444,32 @@ TEST(PbrtReader, GbufferFilmSelectsPbrtsLayers) {
   expect_error({"Film \"gbuffer\" \"string filename\" \"out.png\"", "WorldBegin"}, 1, "\"string filename\"",
                "the gbuffer film writes EXR files only");
   expect_error({"Film \"gbuffer\" \"float iso\" 0", "WorldBegin"}, 1, "\"float iso\"", "Film \"gbuffer\"");
+}
+
+// pbrt-v4's spectral film: the rgb film's parameters plus its buckets, read as candela's spectral
+// AOV layer (film/aov_film.h).
+TEST(PbrtReader, SpectralFilmSelectsTheSpectralLayer) {
+  const SceneDesc defaults = read_lines({"Film \"spectral\" \"string filename\" \"out.exr\"", "WorldBegin"});
+  EXPECT_EQ(defaults.film.aovs, "spectral:16:360:830");  // pbrt-v4's nbuckets, Lambda_min, Lambda_max
+  const AovSelection selection = parse_aov_selection(defaults.film.aovs);
+  EXPECT_EQ(selection.spectral.count, 16);
+  EXPECT_EQ(selection.layers, std::vector<Aov>{Aov::Spectral});
+  const SceneDesc narrow = read_lines({"Film \"spectral\" \"integer nbuckets\" 8 \"float lambdamin\" 400 "
+                                       "\"float lambdamax\" 700.5 \"float iso\" 200",
+                                       "WorldBegin"});
+  const SpectralBuckets b = parse_aov_selection(narrow.film.aovs).spectral;
+  EXPECT_EQ(b.count, 8);
+  EXPECT_EQ(b.lambda_min, 400.0f);
+  EXPECT_EQ(b.lambda_max, 700.5f);
+  expect_error({"Film \"spectral\" \"integer nbuckets\" 0", "WorldBegin"}, 1, "\"integer nbuckets\"",
+               "must be between 1 and 1000");
+  expect_error({"Film \"spectral\" \"float lambdamin\" 300", "WorldBegin"}, 1, "\"float lambdamin\"",
+               "must be at least 360 nm");
+  expect_error({"Film \"spectral\" \"float lambdamax\" 900", "WorldBegin"}, 1, "\"float lambdamax\"",
+               "must be at most 830 nm");
+  expect_error({"Film \"spectral\" \"string filename\" \"out.png\"", "WorldBegin"}, 1, "\"string filename\"",
+               "the spectral film writes EXR files only");
+  expect_error({"Film \"rgb\" \"integer nbuckets\" 4", "WorldBegin"}, 1, "\"integer nbuckets\"", "");
 }
 }  // namespace
 }  // namespace candela

@@ -106,7 +106,7 @@ TEST(PbrtReader, SceneWithOnlyWorldBeginGetsTheDefaults) {
 }
 
 TEST(PbrtReader, OtherIntegratorsBecomePathAndStratifiedSampleCounts) {
-  SceneDesc scene = read_lines({"Integrator \"sppm\" \"integer maxdepth\" 7",
+  SceneDesc scene = read_lines({"Integrator \"randomwalk\" \"integer maxdepth\" 7",
                                 "Sampler \"stratified\" \"integer xsamples\" 3 \"integer ysamples\" 5 "
                                 "\"bool jitter\" false",
                                 "WorldBegin"});

@@ -59,6 +59,18 @@ inline float uniform_emitter_power(const RGB& radiance, float area, bool two_sid
   return radiance.luminance() * area * kPi * (two_sided ? 2 : 1);
 }
 
+// Estimated irradiance at ctx from a sphere whose surface emits `luminance`: that times the projected
+// solid angle of the cone the sphere subtends (pi from inside it), for choosing lights by importance.
+inline float sphere_irradiance_estimate(const Point3& center, float radius, float luminance,
+                                        const LightSampleContext& ctx) {
+  const Vec3 d = center - ctx.p;
+  const float d2 = length_squared(d);
+  if (d2 <= radius * radius * 1.0001f) return luminance * kPi;
+  const float sin2 = radius * radius / d2;
+  const float cos_p = ctx.n == Normal3(0.0f) ? 1.0f : std::max(0.0f, dot(ctx.n, d / std::sqrt(d2)));
+  return luminance * kPi * sin2 * cos_p;
+}
+
 // The light sample for a point p drawn uniformly by area on a flat emitter, seen from ctx.
 inline LightSample flat_light_sample(const Point3& p, const Normal3& n, float area, const RGB& radiance,
                                      bool two_sided, const LightSampleContext& ctx) {
@@ -217,14 +229,9 @@ struct SphereLight {
     if (outside(ctx.p)) return uniform_cone_pdf(cone_cos_max(ctx.p));
     return area_to_solid_angle_pdf(1 / (4 * kPi * radius * radius), ctx.p, p, normalize(p - center));
   }
-  float power() const { return radiance.luminance() * 4 * kPi * radius * radius * kPi * (two_sided ? 2 : 1); }
-  // Estimated irradiance at ctx: L times the projected solid angle of the subtended cone.
+  float power() const { return uniform_emitter_power(radiance, 4 * kPi * radius * radius, two_sided); }
   float importance(const LightSampleContext& ctx) const {
-    if (!outside(ctx.p)) return radiance.luminance() * kPi;
-    Vec3 w = normalize(center - ctx.p);
-    float cos_max = cone_cos_max(ctx.p);
-    float cos_p = ctx.n == Normal3(0.0f) ? 1.0f : std::max(0.0f, dot(ctx.n, w));
-    return radiance.luminance() * kPi * (1 - cos_max * cos_max) * cos_p;
+    return sphere_irradiance_estimate(center, radius, radiance.luminance(), ctx);
   }
 };
 
@@ -294,17 +301,10 @@ struct PartialSphereLight {
     return area_to_solid_angle_pdf(1 / area, ctx.p, p, emitting_normal(p));
   }
   float power() const { return uniform_emitter_power(radiance, area, two_sided); }
-  // Estimated irradiance at ctx: the whole sphere's estimate (SphereLight::importance) times the
-  // fraction of its area kept.
+  // The whole sphere's estimate times the fraction of its area kept.
   float importance(const LightSampleContext& ctx) const {
-    float fraction = area / (4 * kPi * radius * radius);
-    Vec3 d = center - ctx.p;
-    float d2 = length_squared(d);
-    if (d2 <= radius * radius * 1.0001f) return radiance.luminance() * kPi * fraction;
-    Vec3 w = d / std::sqrt(d2);
-    float sin2 = radius * radius / d2;
-    float cos_p = ctx.n == Normal3(0.0f) ? 1.0f : std::max(0.0f, dot(ctx.n, w));
-    return radiance.luminance() * kPi * sin2 * cos_p * fraction;
+    return sphere_irradiance_estimate(center, radius, radiance.luminance(), ctx) * area /
+           (4 * kPi * radius * radius);
   }
 };
 

@@ -26,6 +26,7 @@
 #include "candela/materials/dielectric.h"
 #include "candela/materials/diffuse.h"
 #include "candela/materials/diffuse_transmission.h"
+#include "candela/materials/hair.h"
 #include "candela/materials/layered.h"
 #include "candela/materials/phong.h"
 #include "candela/materials/principled.h"
@@ -35,7 +36,7 @@ namespace candela {
 
 using Bsdf = std::variant<DiffuseBsdf, PhongBsdf, MirrorBsdf, DielectricBsdf, BlackBsdf, ConductorBsdf,
                           CoatedDiffuseBsdf, DiffuseTransmissionBsdf, PrincipledBsdf, PrincipledThinBsdf,
-                          LayeredDiffuseBsdf, LayeredConductorBsdf>;
+                          LayeredDiffuseBsdf, LayeredConductorBsdf, HairBsdf>;
 
 inline RGB bsdf_eval(const Bsdf& b, const Vec3& wo, const Vec3& wi) {
   return std::visit([&](const auto& x) { return x.eval(wo, wi); }, b);
@@ -70,6 +71,20 @@ inline float bsdf_adjoint_scale(const Bsdf& b, const Vec3& wo, const Vec3& wi) {
           return etap * etap;
         } else {
           return 1;
+        }
+      },
+      b);
+}
+// The adjoint BSDF f*(wo, wi) = f(wi, wo) itself (wo the direction the path arrived from): eval()
+// times bsdf_adjoint_scale, or, for BSDFs that are not reciprocal (BsdfFlags::NonReciprocal),
+// eval() with the directions swapped.
+inline RGB bsdf_eval_adjoint(const Bsdf& b, const Vec3& wo, const Vec3& wi) {
+  return std::visit(
+      [&](const auto& x) -> RGB {
+        if constexpr (has(std::decay_t<decltype(x)>::flags, BsdfFlags::NonReciprocal)) {
+          return x.eval(wi, wo);
+        } else {
+          return x.eval(wo, wi) * bsdf_adjoint_scale(b, wo, wi);
         }
       },
       b);

@@ -280,6 +280,32 @@ std::vector<ContractCase> cases_of<LayeredConductorBsdf>() {
            each({direction(30), below(direction(70))}, 0), 2000}};
 }
 
+// pbrt-v4's hair: fibres along x, hit at several offsets h, smooth and rough, tilted scales or not;
+// seen from both sides of the shading normal and along the fibre.
+HairBsdf contract_hair(float h, const RGB& sigma_a, float beta_m, float beta_n, float alpha) {
+  return HairBsdf(h, 1.55f, sigma_a, beta_m, beta_n, alpha);
+}
+
+template <>
+std::vector<ContractCase> cases_of<HairBsdf>() {
+  auto wos = each({direction(0), direction(50), direction(85, 0), below(direction(30, 120)),
+                   normalize(Vec3(0.95f, 0.1f, 0.3f))},
+                  9900);
+  const RGB brown = hair_sigma_a_from_concentration(1.3f, 0);
+  return {{"hair brown", [=] { return Bsdf(contract_hair(0.3f, brown, 0.3f, 0.3f, 2)); }, wos, 10000, 1e-4f},
+          {"hair white", [] { return Bsdf(contract_hair(-0.8f, RGB(0.0f), 0.3f, 0.6f, 2)); }, wos, 10000, 1e-4f},
+          {"hair narrow tilted", [=] { return Bsdf(contract_hair(0.9f, brown * 0.2f, 0.05f, 0.1f, 8)); }, wos, 10000, 1e-4f},
+          {"hair rough from colour",
+           [] {
+             HairBsdf b(-0.2f, 1.55f, RGB(0.0f), 0.8f, 0.9f, 0);
+             b.color = RGB(0.8f, 0.6f, 0.3f);
+             b.sigma_a_from_color = true;
+             b.resolve_color();
+             return Bsdf(b);
+           },
+           wos, 10000, 1e-4f}};
+}
+
 // Every alternative's cases, in the variant's order.
 template <typename... Bs>
 std::vector<ContractCase> cases_of_every(const std::variant<Bs...>*) {

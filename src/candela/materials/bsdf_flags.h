@@ -23,6 +23,9 @@ enum class BsdfFlags : uint8_t {
   // approximation that multiple importance sampling can use; sample()'s weight is unbiased for
   // f |cos| / density but is not eval() |cos| / pdf() of any one call.
   Stochastic = 1 << 5,
+  // f(wo, wi) and f(wi, wo) differ beyond refraction's scale (hair: its attenuation and azimuths
+  // follow wo): the adjoint BSDF evaluates it with the directions swapped (bsdf_eval_adjoint).
+  NonReciprocal = 1 << 6,
 };
 
 constexpr BsdfFlags operator|(BsdfFlags a, BsdfFlags b) { return BsdfFlags(uint8_t(a) | uint8_t(b)); }

@@ -108,7 +108,8 @@ MaterialTable::MaterialTable(const std::vector<MaterialDesc>& descs, const Textu
   std::vector<bool> constant(entries_.size(), true);
   for (size_t i = 0; i < entries_.size(); ++i) {
     Entry& e = entries_[i];
-    constant[i] = has_constant_inputs(e.desc);
+    // A hair's BSDF depends on where across the fibre the hit lies (its v), whatever its inputs.
+    constant[i] = has_constant_inputs(e.desc) && !std::holds_alternative<HairMaterial>(e.desc);
     if (const auto* coated = std::get_if<CoatedDiffuseMaterial>(&e.desc); coated && coated->tabulated_coat) {
       if (!is_constant(coated->roughness))
         throw SceneError(fmt::format("{}: a tabulated coat needs a constant roughness", name(i)));
@@ -365,6 +366,23 @@ Bsdf MaterialTable::build(const Entry& entry, const TextureEvalContext& ctx) con
             p.eta = principled_eta_from_specular(has_trans && specular == 0 ? 1e-3f : specular);
           }
           return PrincipledBsdf(p);
+        } else if constexpr (std::is_same_v<T, HairMaterial>) {
+          // As pbrt-v4's HairMaterial: h = -1 + 2 v across the fibre, beta_m and beta_n at least
+          // 0.01, sigma_a by precedence from sigma_a, the colour or the melanin concentrations.
+          const float beta_n = std::clamp(tex.eval(m.beta_n, ctx), 0.01f, 1.0f);
+          HairBsdf b(2 * ctx.uv.y - 1, std::max(tex.eval(m.eta, ctx), 1e-3f), RGB(0.0f),
+                     std::clamp(tex.eval(m.beta_m, ctx), 0.01f, 1.0f), beta_n, tex.eval(m.alpha, ctx));
+          if (m.sigma_a) {
+            b.sigma_a = color(*m.sigma_a).map([](float x) { return std::max(x, 0.0f); });
+          } else if (m.reflectance) {
+            b.color = albedo(*m.reflectance);
+            b.sigma_a_from_color = true;
+            b.resolve_color();
+          } else {
+            b.sigma_a = hair_sigma_a_from_concentration(std::max(tex.eval(m.eumelanin, ctx), 0.0f),
+                                                        std::max(tex.eval(m.pheomelanin, ctx), 0.0f));
+          }
+          return b;
         } else if constexpr (std::is_same_v<T, BlackMaterial>) {
           return BlackBsdf{};
         } else if constexpr (std::is_same_v<T, InterfaceMaterial>) {

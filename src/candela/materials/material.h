@@ -1,7 +1,8 @@
 #pragma once
 // Materials turn into BSDFs at each hit: a material's parameters may be textures, so the BSDF is
 // built from the description with every input evaluated at the hit's (uv, p). Materials without
-// textures build their BSDF once, up front.
+// textures build their BSDF once, up front (but hair, whose BSDF depends on where across the fibre
+// the hit lies: its v).
 //
 // Wrappers (one-sided, mask, blend: materials/surface_bsdf.h) resolve into a SurfaceBsdf, a mixture
 // of at most SurfaceBsdf::kMaxComponents BSDFs; normal and bump maps tilt the shading frame of the

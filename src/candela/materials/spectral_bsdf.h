@@ -2,7 +2,7 @@
 // A BSDF's RGB parameters turned into their values at a spectral sample's wavelengths
 // (spectral/wavelengths.h), as pbrt-v4 reads RGB material parameters: colours as reflectance
 // spectra, a conductor's eta and k as unbounded ones. Weights, roughness and indices of refraction
-// are scalars and stay as they are.
+// are scalars and stay as they are; a hair fibre's absorption is an unbounded spectrum.
 #include "candela/materials/surface_bsdf.h"
 #include "candela/spectral/wavelengths.h"
 
@@ -41,6 +41,16 @@ inline void bsdf_at_wavelengths(Bsdf& bsdf, const Wavelengths& wl) {
           reflectance(b.specular);
         } else if constexpr (std::is_same_v<T, PrincipledBsdf> || std::is_same_v<T, PrincipledThinBsdf>) {
           reflectance(b.base_color);
+        } else if constexpr (std::is_same_v<T, HairBsdf>) {
+          // As pbrt-v4's HairMaterial: sigma_a (given, or from melanin concentrations) is an
+          // unbounded spectrum; a colour is a reflectance spectrum, turned into sigma_a per wavelength.
+          b.lanes = Wavelengths::kCount;
+          if (b.sigma_a_from_color) {
+            reflectance(b.color);
+            b.resolve_color();
+          } else {
+            b.sigma_a = unbounded_at(b.sigma_a, wl);
+          }
         } else {
           static_assert(std::is_same_v<T, BlackBsdf>, "a BSDF with colours must say how they become spectra");
         }

@@ -105,15 +105,14 @@ struct SurfaceBsdf {
     return f * terminator(wi);
   }
 
-  // The adjoint f*(wo, wi) (paths carrying importance; bsdf.h's bsdf_adjoint_scale per component).
+  // The adjoint f*(wo, wi) (paths carrying importance; bsdf.h's bsdf_eval_adjoint per component).
   RGB eval_adjoint(const Vec3& wo, const Vec3& wi) const {
-    if (is_plain()) return bsdf_eval(components[0].bsdf, wo, wi) * bsdf_adjoint_scale(components[0].bsdf, wo, wi);
+    if (is_plain()) return bsdf_eval_adjoint(components[0].bsdf, wo, wi);
     RGB f(0.0f);
     if (!side_ok(wi)) return f;
     for (int k = 0; k < count; ++k) {
       const Component& c = components[size_t(k)];
-      if (c.weight > 0 && faces(c, wo, wi))
-        f += bsdf_eval(c.bsdf, wo, wi) * (c.weight * bsdf_adjoint_scale(c.bsdf, wo, wi));
+      if (c.weight > 0 && faces(c, wo, wi)) f += bsdf_eval_adjoint(c.bsdf, wo, wi) * c.weight;
     }
     return f * terminator(wi);
   }
@@ -186,6 +185,14 @@ struct SurfaceBsdf {
       if (c.weight > 0) p += c.weight * component_non_delta(c, wo);
     }
     return p / total();
+  }
+  // Whether every component is reciprocal but for refraction's scale (bsdf_flags.h): else the
+  // adjoint is not eval() times a scale, and importance-carrying samples are weighted by eval_adjoint().
+  bool is_reciprocal() const {
+    for (int k = 0; k < count; ++k)
+      if (components[size_t(k)].weight > 0 && has(bsdf_flags(components[size_t(k)].bsdf), BsdfFlags::NonReciprocal))
+        return false;
+    return true;
   }
   // Scatters nothing whatever the directions (paths end here).
   bool is_black() const {

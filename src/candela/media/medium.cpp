@@ -226,6 +226,7 @@ Medium::Medium(const MediumDesc& desc)
       temperature_offset_(desc.temperature_offset),
       temperature_cutoff_(desc.temperature_cutoff),
       phase_{desc.g} {
+  subsurface_ = desc.subsurface;
   // Emissive unless the scale is 0 everywhere, or nothing is emitted where it is not.
   const bool scale_is_zero = emission_scale_.is_constant() && !(emission_scale_.constant().r > 0);
   emissive_ = !scale_is_zero && (has_temperature_ || !emission_.is_black());

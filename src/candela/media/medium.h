@@ -95,6 +95,8 @@ class Medium {
   bool is_homogeneous() const { return density_.is_constant() && albedo_.is_constant(); }
   // The extinction is the same everywhere (the albedo may still vary).
   bool has_constant_density() const { return density_.is_constant(); }
+  // A subsurface medium (MediumDesc::subsurface): a path's excursion inside counts as one bounce.
+  bool is_subsurface() const { return subsurface_; }
 
   // Visits the majorant along `ray` over [t_min, t_max): visit(t0, t1, density_bound) for
   // consecutive pieces in order, where the density stays at most density_bound (the majorant of
@@ -109,7 +111,7 @@ class Medium {
  private:
   Volume density_, albedo_, emission_scale_, temperature_;
   RGB sigma_t_{1.0f}, emission_{0.0f};
-  bool has_temperature_ = false, emissive_ = false;
+  bool has_temperature_ = false, emissive_ = false, subsurface_ = false;
   float temperature_scale_ = 1, temperature_offset_ = 0, temperature_cutoff_ = 100;
   HenyeyGreenstein phase_;
   // Density grids and clouds: the largest density (a cloud's: a bound of it) over each cell of a

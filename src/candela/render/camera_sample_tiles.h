@@ -69,15 +69,19 @@ class CameraSampleTiles final : public TileIntegrator {
       Wavelengths storage;
       const Wavelengths* wl = sample_wavelengths_if(context.spectral, sampler, storage);
       const bool first_half = context.first_half(s);
-      RGB L = wavelengths_to_rgb(radiance_(ray, sampler, counts, PixelSample{x, y, fs.weight, first_half}, wl), wl);
-      if (!L.is_finite()) {
+      RGB values = radiance_(ray, sampler, counts, PixelSample{x, y, fs.weight, first_half}, wl);
+      RGB L = wavelengths_to_rgb(values, wl);
+      if (!L.is_finite() || !values.is_finite()) {
         // Never reaches the film: counted, the first few logged, and the sample counts as black.
         context.non_finite.fetch_add(1, std::memory_order_relaxed);
         context.non_finite_log.add(x, y, s);
-        L = RGB(0.0f);
+        L = values = RGB(0.0f);
       } else {
         L = context.scene.film_sensor().respond(L);
       }
+      // pbrt-v4's spectral film: the values at the wavelengths themselves, before they become RGB.
+      if (wl && context.aovs && context.aovs->spectral().count > 0)
+        context.aovs->add_spectral_sample(x, y, values, *wl, fs.weight, context.scene.film_sensor().max_component());
       if (context.clamp > 0) {
         float m = L.max_component();
         if (m > context.clamp) L *= context.clamp / m;
@@ -85,7 +89,7 @@ class CameraSampleTiles final : public TileIntegrator {
       context.film.add_sample(x, y, L, fs.weight, first_half);
       // The AOV layers of the same camera ray, with the same filter weight (their random numbers
       // are their own: the sampler above is untouched).
-      if (context.aovs && context.aovs->has_sample_layers())
+      if (context.aovs && context.aovs->has_first_hit_layers())
         context.aovs->add_sample(
             x, y, first_hit_aovs(context.scene, ray, context.aovs->needs_shading(), x, y, s, context.seed), fs.weight);
     }

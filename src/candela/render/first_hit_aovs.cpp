@@ -44,6 +44,15 @@ Point3 unit_depth_point(const Ray& ray, const Vec3& forward) {
 
 AovCameraFrame aov_camera_frame(const Camera& camera) {
   AovCameraFrame frame;
+  if (camera.is_spherical()) {
+    // No image plane: the camera's own axes, and no per-pixel step of a plane (depth derivatives 0).
+    const Transform& to_world = camera.world_from_camera();
+    frame.x = normalize(to_world.vector(Vec3(1, 0, 0)));
+    frame.y = normalize(to_world.vector(Vec3(0, 1, 0)));
+    frame.z = normalize(camera.forward());
+    frame.origin = to_world.point(Point3(0.0f));
+    return frame;
+  }
   const Vec2 centre(0.5f * float(camera.width()), 0.5f * float(camera.height()));
   const Vec2 lens_centre(0.5f, 0.5f);
   const float time = camera.shutter_open();

@@ -88,6 +88,15 @@ ShapeCost shape_cost(const ShapeDesc& shape) {
                                         kBytesPerSimpleShape),
                                     0};
                  },
+                 [&](const CurveShape& curve) {
+                   // Per segment: 4 control points of 4 floats per time step (shared with Embree where
+                   // static, copied where moving), ribbons' 6 normals per step, Embree's index and a BVH leaf.
+                   const uint64_t steps = moving ? 2 : 1;
+                   uint64_t per_segment = steps * 16 * sizeof(float) * (moving ? 2 : 1) + sizeof(uint32_t) +
+                                          steps * kEmbreeBvhBytesPerTriangle;
+                   if (curve.type == CurveType::Ribbon) per_segment += steps * 10 * sizeof(Normal3);
+                   return ShapeCost{add(mul(curve.segment_count(), per_segment), kBytesPerSimpleShape), 0};
+                 },
                  [&](const SphereShape&) { return simple; }, [&](const PlaneShape&) { return simple; },
                  [&](const DiskShape&) { return simple; }, [&](const CylinderShape&) { return simple; }},
       shape.geometry);

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "candela/film/image_io.h"
+#include "candela/geometry/curves.h"
 #include "candela/geometry/quadric_uv.h"
 #include "candela/geometry/sdf_grid.h"
 #include "candela/base/error.h"
@@ -324,6 +325,15 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int object, TriangleM
                   "{}: an SDF grid cannot emit light (as in Mitsuba: it has no area to sample)", rec.name));
             add_sdf_grid(std::move(rec), g, T, T_end, object);
           },
+          [&](const CurveShape& c) {
+            if (desc.emission)
+              throw SceneError(fmt::format("{}: a curve cannot emit light (nor can it in pbrt-v4, which has no way "
+                                           "to sample points on a curve)", rec.name));
+            if (desc.is_medium_transition())
+              throw SceneError(fmt::format("{}: a curve has no inside, so it cannot bound a medium: give it the "
+                                           "same medium on both sides", rec.name));
+            add_curve(std::move(rec), c, T, T_end, object);
+          },
           [&](const BoxShape& b) { triangles(box_mesh(b), false); },
           [&](const RectangleShape& r) { triangles(rectangle_mesh(r), true); },
           [&](const MeshShape& m) {
@@ -446,6 +456,51 @@ void Scene::add_sdf_grid(ShapeRecord rec, const SdfGridShape& grid, const Transf
     if (X)
       for (int c = 0; c < 8; ++c) bounds_.extend(X->point({float(c & 1), float(c >> 1 & 1), float(c >> 2)}));
   embree_.add_sdf_grid(uint32_t(shapes_.size()), rec.sdf, object);
+  shapes_.push_back(std::move(rec));
+}
+
+void Scene::add_curve(ShapeRecord rec, const CurveShape& shape, const Transform& T, const Transform* T_end,
+                      int object) {
+  if (std::string problem = curve_problem(shape); !problem.empty())
+    throw SceneError(fmt::format("{}: curve: {}", rec.name, problem));
+  rec.kind = ShapeRecord::Kind::Curve;
+  const BezierSegments segments = curve_bezier_segments(shape);
+  auto curve = std::make_shared<CurveGeometry>();
+  curve->kind = shape.type == CurveType::Flat       ? CurveGeometry::Kind::Flat
+                : shape.type == CurveType::Cylinder ? CurveGeometry::Kind::Round
+                                                    : CurveGeometry::Kind::Ribbon;
+  curve->tessellation = flat_curve_tessellation(segments.control, segments.width);
+  // The control points placed by X, each with its radius: half the width, linear along the segment
+  // (the Bézier interpolation of radii spaced evenly is linear in u), scaled as object-space lengths
+  // are on average (|det|^(1/3); exact for rotations and uniform scales).
+  auto place = [&](const Transform& X, std::vector<float>& control, std::vector<Normal3>& normals,
+                   std::vector<Normal3>& end_normals) {
+    const double det = X.matrix().determinant();
+    if (!(std::abs(det) > 0) || !std::isfinite(det))
+      throw SceneError(fmt::format("{}: the transform is singular", rec.name));
+    const float scale = float(std::cbrt(std::abs(det)));
+    control.reserve(16 * segments.segment_count());
+    for (size_t s = 0; s < segments.segment_count(); ++s) {
+      for (int i = 0; i < 4; ++i) {
+        const Point3 p = X.point(segments.control[4 * s + size_t(i)]);
+        const float t = float(i) / 3;
+        const float radius = 0.5f * scale * ((1 - t) * segments.width[2 * s] + t * segments.width[2 * s + 1]);
+        control.insert(control.end(), {p.x, p.y, p.z, radius});
+        bounds_.extend(p - Vec3(radius));
+        bounds_.extend(p + Vec3(radius));
+      }
+      if (curve->kind == CurveGeometry::Kind::Ribbon) {
+        const Normal3 n0 = normalize(X.normal(segments.normals[2 * s])), n1 = normalize(X.normal(segments.normals[2 * s + 1]));
+        end_normals.insert(end_normals.end(), {n0, n1});
+        const std::array<Normal3, 4> control_normals = bezier_normals(n0, n1);
+        normals.insert(normals.end(), control_normals.begin(), control_normals.end());
+      }
+    }
+  };
+  place(T, curve->control, curve->normals, curve->end_normals);
+  if (T_end) place(*T_end, curve->control_end, curve->normals_end, curve->end_normals_end);
+  embree_.add_curves(uint32_t(shapes_.size()), *curve, object);
+  rec.curve = std::move(curve);
   shapes_.push_back(std::move(rec));
 }
 
@@ -580,6 +635,9 @@ bool Scene::intersect(const Ray& world_ray, SurfaceHit& hit) const {
       break;
     case ShapeRecord::Kind::SdfGrid:
       reconstruct_sdf_hit(rec, ray, eh.t, eh.primitive, hit);
+      break;
+    case ShapeRecord::Kind::Curve:
+      reconstruct_curve_hit(rec, ray, eh, hit);
       break;
     case ShapeRecord::Kind::Plane: {
       hit.p = ray.at(eh.t);
@@ -741,6 +799,74 @@ void Scene::reconstruct_sdf_hit(const ShapeRecord& rec, const Ray& ray, float t,
   const Frame frame(hit.ns);
   hit.dpdu = frame.s;
   hit.dpdv = frame.t;
+}
+
+// A curve hit: u is the segment's own parameter (Embree's, as pbrt-v4's), v runs across the width from
+// 0 to 1 along b = cross(ray direction, tangent) (pbrt-v4's, so that a hair BSDF finds its offset
+// h = 2 v - 1 across the fibre), dp/du is the tangent and dp/dv the width along the direction v grows.
+// Normals: a tube's is the surface's own (outwards); a flat curve's faces back along the ray, square
+// to the tangent; a ribbon's is Embree's on the side of the ribbon's normal there.
+void Scene::reconstruct_curve_hit(const ShapeRecord& rec, const Ray& ray, const EmbreeHit& eh, SurfaceHit& hit) const {
+  const CurveGeometry& c = *rec.curve;
+  const size_t s = eh.primitive;
+  // A moving curve is where Embree found it: its control points interpolated at the ray's time.
+  const float time = c.moving() ? embree_.normalized_time(ray.time) : 0;
+  std::array<Point3, 4> cp;
+  std::array<float, 4> radius;
+  for (size_t i = 0; i < 4; ++i) {
+    const float* v = &c.control[16 * s + 4 * i];
+    cp[i] = Point3(v[0], v[1], v[2]);
+    radius[i] = v[3];
+    if (c.moving()) {
+      const float* e = &c.control_end[16 * s + 4 * i];
+      cp[i] = lerp(time, cp[i], Point3(e[0], e[1], e[2]));
+      radius[i] = (1 - time) * radius[i] + time * e[3];
+    }
+  }
+  const float u = std::clamp(eh.u, 0.0f, 1.0f);
+  const Point3 axis = bezier_point(cp, u);
+  Vec3 dpdu = bezier_derivative(cp, u);
+  if (!(length_squared(dpdu) > 0)) dpdu = cp[3] - cp[0];  // a segment that stops at an end: along its chord
+  const Vec3 tangent = length_squared(dpdu) > 0 ? normalize(dpdu) : Vec3(1, 0, 0);
+  const float width = 2 * bezier_point(radius, u);
+  hit.p = ray.at(eh.t);
+  const Vec3 d = normalize(ray.direction);
+  Vec3 across = cross(d, tangent);  // where pbrt-v4's v grows
+  across = length_squared(across) > 1e-12f ? normalize(across) : Frame(tangent).s;
+  Normal3 n;
+  float offset = dot(hit.p - axis, across);  // signed distance from the axis along which v grows
+  Vec3 dpdv_direction = across;
+  switch (c.kind) {
+    case CurveGeometry::Kind::Round:
+      n = length_squared(eh.ng) > 0 ? normalize(eh.ng) : normalize(hit.p - axis);
+      if (const Vec3 around = cross(tangent, n); length_squared(around) > 1e-12f) dpdv_direction = normalize(around);
+      break;
+    case CurveGeometry::Kind::Flat:
+      n = normalize(cross(across, tangent));  // -d made square to the tangent
+      break;
+    case CurveGeometry::Kind::Ribbon: {
+      const size_t e = 2 * s;
+      Normal3 n0 = c.end_normals[e], n1 = c.end_normals[e + 1];
+      if (c.moving()) {
+        n0 = normalize(lerp(time, n0, c.end_normals_end[e]));
+        n1 = normalize(lerp(time, n1, c.end_normals_end[e + 1]));
+      }
+      const Normal3 ribbon = slerp_normal(n0, n1, u);
+      n = length_squared(eh.ng) > 0 ? face_forward(normalize(eh.ng), ribbon) : ribbon;
+      // The band's width lies along cross(normal, tangent); pbrt-v4's v grows along its side facing `across`.
+      Vec3 band = cross(ribbon, tangent);
+      band = length_squared(band) > 0 ? normalize(band) : across;
+      if (dot(band, across) < 0) band = -band;
+      offset = dot(hit.p - axis, band);
+      dpdv_direction = band;
+      break;
+    }
+  }
+  hit.uv = {u, width > 0 ? std::clamp(0.5f + offset / width, 0.0f, 1.0f) : 0.5f};
+  hit.dpdu = dpdu;
+  hit.dpdv = dpdv_direction * width;
+  hit.ng = rec.flip_normal ? -n : n;
+  hit.ns = hit.ng;
 }
 
 TextureEvalContext Scene::texture_context(const SurfaceHit& hit) const {

@@ -19,7 +19,7 @@
 namespace candela {
 
 struct ShapeRecord {
-  enum class Kind : uint8_t { Triangles, Sphere, Plane, Disk, Cylinder, SdfGrid };
+  enum class Kind : uint8_t { Triangles, Sphere, Plane, Disk, Cylinder, SdfGrid, Curve };
   Kind kind = Kind::Triangles;
   uint32_t material = 0;
   int first_light = -1;  // index of the light of primitive 0 when emissive
@@ -29,7 +29,7 @@ struct ShapeRecord {
   int emission_texture = -1;  // textured emitters: index into the scene's textures
   // The media on the side opposite the oriented normal and on its side (SceneDesc::media; -1 = vacuum).
   int interior_medium = -1, exterior_medium = -1;
-  bool flip_normal = false;  // spheres, planes, disks, cylinders and SDF grids: reverse orientation
+  bool flip_normal = false;  // spheres, planes, disks, cylinders, SDF grids and curves: reverse orientation
   bool winding_swapped = false;  // triangles: indices 1 and 2 swapped to orient the normal
   // Triangles, in world space, winding baked so cross(p1-p0, p2-p0) is the oriented normal.
   std::vector<Point3> positions;
@@ -45,13 +45,15 @@ struct ShapeRecord {
   QuadricGeometry quadric;  // disks and cylinders
   SdfGridGeometry sdf;
   SdfNormals sdf_normals = SdfNormals::Smooth;
+  // Curves: their segments, which Embree reads in place (held here so that they never move).
+  std::shared_ptr<const CurveGeometry> curve;
   // Triangles: the mesh's named attributes (mesh_attribute textures), shared; null when none.
   std::shared_ptr<const std::vector<TriangleMesh::Attribute>> attributes;
   std::string name;
   bool is_emissive() const { return first_light >= 0; }
   bool is_moving() const {
     return !positions_end.empty() || sphere.to_world_end.has_value() || quadric.to_world_end.has_value() ||
-           sdf.to_world_end.has_value();
+           sdf.to_world_end.has_value() || (curve && curve->moving());
   }
 };
 
@@ -159,6 +161,8 @@ class Scene {
                    float phi_max = 2 * kPi);
   void add_sdf_grid(ShapeRecord rec, const SdfGridShape& grid, const Transform& to_world,
                     const Transform* to_world_end, int object);
+  void add_curve(ShapeRecord rec, const CurveShape& curve, const Transform& to_world, const Transform* to_world_end,
+                 int object);
   // A shape or instance at a ray's time: to_world, or where it moves (to_world_end) and the
   // interpolation exists, that interpolated transform, kept in storage.
   const Transform& transform_at(const Transform& to_world, const std::optional<Transform>& to_world_end, float time,
@@ -167,6 +171,7 @@ class Scene {
   void reconstruct_sdf_hit(const ShapeRecord& rec, const Ray& ray, float t, uint32_t voxel, SurfaceHit& hit) const;
   void reconstruct_triangle_hit(const ShapeRecord& rec, const EmbreeHit& eh, float time, SurfaceHit& hit) const;
   void reconstruct_sphere_hit(const ShapeRecord& rec, const Ray& ray, float t, SurfaceHit& hit) const;
+  void reconstruct_curve_hit(const ShapeRecord& rec, const Ray& ray, const EmbreeHit& eh, SurfaceHit& hit) const;
 
   std::string source_file_;  // for messages
   // "file:line:col" of a description entry, or the scene file where its place is unknown.

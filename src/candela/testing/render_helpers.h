@@ -3,6 +3,7 @@
 // to means with standard errors estimated from the render itself.
 #include <cmath>
 #include <functional>
+#include <vector>
 
 #include "candela/film/film.h"
 #include "candela/integrators/integrator.h"
@@ -52,6 +53,20 @@ inline MeanEstimate region_mean(const Image& img, int channel,
 }
 
 // relMSE = mean((x - y)^2 / (y^2 + eps)) over pixels and channels, y the reference (the project's metric).
+// The mean of independent estimates of one value (the image means of renders with different seeds)
+// and its standard error from their spread: for estimators whose pixels are correlated (splats,
+// photons), where the spread of the pixels would understate it.
+inline MeanEstimate mean_of_estimates(const std::vector<double>& estimates) {
+  MeanEstimate e;
+  const double n = double(estimates.size());
+  for (double m : estimates) e.mean += m / n;
+  double v = 0;
+  for (double m : estimates) v += (m - e.mean) * (m - e.mean) / (n - 1);
+  e.standard_error = std::sqrt(v / n);
+  e.pixels = int(estimates.size());
+  return e;
+}
+
 inline double rel_mse(const Image& test, const Image& ref, double eps = 0.01) {
   double sum = 0;
   for (size_t i = 0; i < test.rgb.size(); ++i) {

@@ -149,6 +149,7 @@ class JsonSceneReader {
   ShapeDesc read_shape(const Json& value, const std::string& pointer);
   ShapeGeometry read_geometry(CheckedObject& s);
   SdfGridShape read_sdf_grid(CheckedObject& s) const;
+  CurveShape read_curve(CheckedObject& s) const;
   int read_shape_material(CheckedObject& s);
   AreaEmission read_emission(const Json& value, const std::string& pointer);
 

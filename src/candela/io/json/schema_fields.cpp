@@ -6,8 +6,9 @@ namespace candela::json {
 void JsonSceneReader::read_fields(CheckedObject& m, const TypeSchema& schema, void* object) {
   for (const Field& f : schema.fields) {
     if (f.required) m.require(f.key);
-    if (!f.unless.empty() && m.has(f.key) && m.has(f.unless))
-      report_.fail(m.pointer_of(f.key), "give either \"{}\" or \"{}\", not both", f.key, f.unless);
+    for (std::string_view other : {f.unless, f.unless_also})
+      if (!other.empty() && m.has(f.key) && m.has(other))
+        report_.fail(m.pointer_of(f.key), "give either \"{}\" or \"{}\", not both", f.key, other);
     // Colours bounded above are reflectances (<= 1); the others need only be >= 0.
     const ColorKind color_kind = f.range.bounded_above() ? ColorKind::Albedo : ColorKind::NonNegative;
     switch (f.kind) {

@@ -42,6 +42,11 @@ void JsonSceneReader::read_camera(const Json& value, const std::string& pointer)
   if (const Json* crop = camera.find("crop")) read_crop(*crop, camera.pointer_of("crop"));
   if (const Json* sensor = camera.find("sensor")) read_sensor(*sensor, camera.pointer_of("sensor"));
   read_lens_and_shutter(camera);
+  if (scene_.camera.projection == Projection::Equirectangular || scene_.camera.projection == Projection::EqualArea)
+    for (const char* projective : {"fov", "fov_axis", "lens_radius", "focus_distance"})
+      if (camera.has(projective))
+        report_.fail(camera.pointer_of(projective), "a spherical camera (\"projection\": \"{}\") sees every direction: "
+                     "it has no \"{}\"", enum_name(scene_.camera.projection), projective);
   scene_.camera.medium = medium_reference(camera, "medium");
   camera.finish();
   if (int64_t(scene_.film.width) * scene_.film.height > kMaxPixels)

@@ -42,8 +42,26 @@ ShapeGeometry JsonSceneReader::read_geometry(CheckedObject& s) {
   ShapeGeometry geometry = default_of_named_type<ShapeGeometry>(s, "shape", {kInstanceType});
   if (auto* mesh = std::get_if<MeshShape>(&geometry)) *mesh = read_mesh(s);
   if (auto* grid = std::get_if<SdfGridShape>(&geometry)) *grid = read_sdf_grid(s);
+  if (auto* curve = std::get_if<CurveShape>(&geometry)) *curve = read_curve(s);
   read_schema_fields(s, geometry);
   return geometry;
+}
+
+// A curve's points and (a ribbon's) normals, beside its schema; "width" is short for equal "width0" and
+// "width1". The schema's check then matches their numbers to the basis, degree and curve_type.
+CurveShape JsonSceneReader::read_curve(CheckedObject& s) const {
+  CurveShape curve;
+  curve.points = read_vec3_list(s.require("points"), s.pointer_of("points"), "points [x, y, z]");
+  if (const Json* normals = s.find("normals")) {
+    curve.normals = read_vec3_list(*normals, s.pointer_of("normals"), "normals [x, y, z]");
+    check_nonzero_normals(curve.normals, s.pointer_of("normals"));
+  }
+  if (s.has("width")) {
+    for (std::string_view key : {"width0", "width1"})
+      if (s.has(key)) report_.fail(s.pointer_of(key), "give either \"width\" or \"width0\" and \"width1\", not both");
+    curve.width0 = curve.width1 = s.number("width", kNonNegative);
+  }
+  return curve;
 }
 
 // A Mitsuba .vol file, or the samples inline (as `candela convert` writes a grid made in memory).

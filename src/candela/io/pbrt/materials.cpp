@@ -110,6 +110,8 @@ MaterialDesc SceneParser::make_material(const std::string& type, const SourceLoc
     read_shading_normals(params);
     return m;
   }
+  if (type == "subsurface") return make_subsurface_material(params);  // io/pbrt/media.cpp
+  if (type == "hair") return make_hair_material(params);
   if (type == "interface" || type == "none" || type.empty()) return InterfaceMaterial{};
   if (type == "mix") {
     std::vector<std::string> names = params.get_strings("materials");
@@ -135,7 +137,16 @@ MaterialDesc SceneParser::make_material(const std::string& type, const SourceLoc
       pick = 0;
     else if (amount.is_constant() && amount.value >= 1)
       pick = 1;
-    if (pick >= 0) return chosen[pick] == -2 ? MaterialDesc(InterfaceMaterial{}) : scene_.materials.at(chosen[pick]);
+    if (pick >= 0) {
+      if (auto filled = subsurface_media_.find(chosen[pick]); filled != subsurface_media_.end())
+        pending_subsurface_medium_ = filled->second;  // the mix is that subsurface material
+      return chosen[pick] == -2 ? MaterialDesc(InterfaceMaterial{}) : scene_.materials.at(chosen[pick]);
+    }
+    for (int i = 0; i < 2; ++i)
+      if (subsurface_media_.contains(chosen[i]))
+        params.fail("materials", "mixes the subsurface material \"{}\" with another: candela fills a shape with a "
+                    "subsurface material's medium, which cannot change from hit to hit; give the shape one material",
+                    names[i]);
     // pbrt-v4 picks one of the two at each hit, the second with probability amount (clamped to
     // [0, 1]): in expectation the blend of the two with weight amount.
     BlendMaterial blend;
@@ -146,8 +157,59 @@ MaterialDesc SceneParser::make_material(const std::string& type, const SourceLoc
   }
   reject_type(type_where, "material", type,
               {"diffuse", "conductor", "dielectric", "thindielectric", "coateddiffuse", "coatedconductor",
-               "diffusetransmission", "interface", "mix"},
-              {"hair", "measured", "subsurface"}, "candela has no BSDF for it");
+               "diffusetransmission", "hair", "interface", "mix", "subsurface"},
+              {"measured"}, "candela has no BSDF for it");
+}
+
+// pbrt-v4's "hair" (materials/hair.h): its absorption from "sigma_a", else from the colour
+// "reflectance" (older pbrt-v4: "color"), else from "eumelanin" and "pheomelanin" (one given alone
+// leaves the other 0), else pbrt-v4's default, eumelanin 1.3; what the chosen one makes meaningless
+// is ignored with a warning, as pbrt-v4 does. Every parameter may be a texture; constants are
+// clamped as pbrt-v4 clamps them at each hit (concentrations to >= 0, beta_m and beta_n to
+// [0.01, 1]).
+MaterialDesc SceneParser::make_hair_material(ParamList& params) {
+  HairMaterial m;
+  m.sigma_a = read_color(params, "sigma_a", Role::Unbounded);
+  std::optional<ColorInput> reflectance = read_color(params, "reflectance", Role::Reflectance);
+  if (std::optional<ColorInput> color = read_color(params, "color", Role::Reflectance)) {
+    if (reflectance) params.fail("color", "cannot be given together with \"reflectance\" (its newer name)");
+    reflectance = color;
+  }
+  const char* reflectance_name = params.has("color") ? "color" : "reflectance";
+  std::optional<FloatInput> eumelanin = read_float_texture(params, "eumelanin");
+  std::optional<FloatInput> pheomelanin = read_float_texture(params, "pheomelanin");
+  auto ignored = [&](const char* name, const char* because) {
+    if (params.has(name))
+      warn(params.where(name), "{}: \"{}\" is ignored because \"{}\" is given (as in pbrt-v4)", params.owner(),
+           name, because);
+  };
+  if (m.sigma_a) {
+    ignored(reflectance_name, "sigma_a");
+    ignored("eumelanin", "sigma_a");
+    ignored("pheomelanin", "sigma_a");
+  } else if (reflectance) {
+    m.reflectance = reflectance;
+    ignored("eumelanin", reflectance_name);
+    ignored("pheomelanin", reflectance_name);
+  } else if (eumelanin || pheomelanin) {
+    auto concentration = [](FloatInput c) {
+      if (c.is_constant()) c.value = std::max(c.value, 0.0f);
+      return c;
+    };
+    m.eumelanin = concentration(eumelanin.value_or(FloatInput(0.0f)));
+    m.pheomelanin = concentration(pheomelanin.value_or(FloatInput(0.0f)));
+  }
+  m.eta = read_float_texture(params, "eta").value_or(FloatInput(1.55f));
+  if (m.eta.is_constant() && !(m.eta.value > 0)) params.fail("eta", "must be positive, got {}", m.eta.value);
+  auto roughness = [&](const char* name) {
+    FloatInput b = read_float_texture(params, name).value_or(FloatInput(0.3f));
+    if (b.is_constant()) b.value = std::clamp(b.value, 0.01f, 1.0f);
+    return b;
+  };
+  m.beta_m = roughness("beta_m");
+  m.beta_n = roughness("beta_n");
+  m.alpha = read_float_texture(params, "alpha").value_or(FloatInput(2.0f));
+  return m;
 }
 
 LayerSlab SceneParser::read_layer_slab(ParamList& params) {
@@ -199,6 +261,7 @@ void SceneParser::material(const Token& d) {
   MaterialDesc desc = make_material(type.text, at(type), params);
   params.reject_unused();
   state_.material = wrap_shading_normals(add_material(std::move(desc), at(d)), at(d));
+  claim_subsurface_medium(state_.material);
 }
 
 void SceneParser::make_named_material(const Token& d) {
@@ -215,6 +278,7 @@ void SceneParser::make_named_material(const Token& d) {
   MaterialDesc desc = make_material(type, params.where("type"), params);
   params.reject_unused();
   named_materials_[name.text] = {wrap_shading_normals(add_material(std::move(desc), at(d)), at(d)), at(name)};
+  claim_subsurface_medium(named_materials_[name.text].first);
 }
 
 void SceneParser::named_material(const Token& d) {

@@ -10,6 +10,7 @@
 #include "candela/io/pbrt/scene_parser.h"
 #include "candela/io/grid_files.h"
 #include "candela/media/medium.h"
+#include "candela/media/subsurface_albedo.h"
 
 namespace candela::pbrt {
 
@@ -366,6 +367,101 @@ MediumDesc SceneParser::make_nanovdb_medium(ParamList& params) {
     medium.temperature->to_world = state_.ctm.start * medium.temperature->to_world;
   }
   return medium;
+}
+
+// ---------------------------------------------------------------- the subsurface material
+
+// pbrt-v4's "subsurface" material (SubsurfaceMaterial) is a dielectric boundary ("eta", 1.33, and the
+// roughness parameters) over a scattering interior, which pbrt-v4 renders with a tabulated BSSRDF
+// (photon beam diffusion) and candela by random-walking a homogeneous medium inside the boundary
+// (volpath; MediumDesc::subsurface makes the excursion one bounce, as pbrt-v4's BSSRDF is). The
+// interior is given, as pbrt-v4 reads it, by one of
+//   1. "name": a scattering preset (then g = 0: the presets are reduced scattering coefficients);
+//   2. "sigma_a" and "sigma_s", both;
+//   3. "reflectance" and "mfp" (1): per channel, the albedo whose effective albedo (the share of the
+//      light let in that comes out again, media/subsurface_albedo.h) is the reflectance, and
+//      sigma_t = 1 / mfp. pbrt-v4 inverts its diffusion profile's effective albedo in the same way;
+//      candela inverts the exact transport's, which its random walk renders;
+//   4. none of them: pbrt-v4's default, the coefficients of whole milk.
+// "scale" (1) multiplies the coefficients of 1, 2 and 4, and the mean free path of 3 (as pbrt-v4
+// does); units are the scene's (pbrt-v4 converts none: the presets are per millimetre). "g" (0) is the
+// Henyey-Greenstein phase function's. Integrators other than volpath render, as pbrt-v4's do, the
+// boundary alone: a clear dielectric.
+MaterialDesc SceneParser::make_subsurface_material(ParamList& params) {
+  DielectricMaterial boundary;
+  boundary.ior = params.get_float("eta", 1.33f);
+  if (!(boundary.ior > 0)) params.fail("eta", "must be positive, got {}", boundary.ior);
+  boundary.roughness = read_roughness(params);
+  read_shading_normals(params);
+
+  float g = params.get_float("g", 0);
+  if (!(g > -1 && g < 1))
+    params.fail("g", "(Henyey-Greenstein's mean cosine) must be between -1 and 1, exclusive, got {}", g);
+  const float scale = params.get_float("scale", 1);
+  if (!(scale >= 0)) params.fail("scale", "must not be negative, got {}", scale);
+  RGB sigma_a, sigma_s;
+  const std::string name = params.get_string("name", "");
+  if (!name.empty()) {
+    const ScatteringPreset* preset = find_scattering_preset(name);
+    if (!preset)
+      params.fail("name", "names no scattering preset: \"{}\" (the presets are {})", name, scattering_preset_names());
+    if (g != 0)
+      warn(params.where("g"), "{}: \"g\" {} is ignored with a named medium: its coefficients are reduced ones, for "
+           "g = 0 (as in pbrt-v4)", params.owner(), g);
+    g = 0;
+    sigma_a = preset->sigma_a * scale;
+    sigma_s = preset->sigma_s * scale;
+  } else if (params.has("sigma_a") || params.has("sigma_s")) {
+    const std::optional<RGB> a = read_spectrum(params, "sigma_a", Role::Unbounded);
+    const std::optional<RGB> s = read_spectrum(params, "sigma_s", Role::Unbounded);
+    if (!a || !s)
+      params.fail(a ? "sigma_s" : "sigma_a", "is required with \"{}\" (as in pbrt-v4: give both coefficients)",
+                  a ? "sigma_a" : "sigma_s");
+    sigma_a = *a * scale;
+    sigma_s = *s * scale;
+  } else if (params.has("reflectance")) {
+    const RGB reflectance = read_spectrum(params, "reflectance", Role::Reflectance).value_or(RGB(0.0f));
+    const RGB mfp = read_spectrum(params, "mfp", Role::Unbounded).value_or(RGB(1.0f)) * scale;
+    float a[3], s[3];
+    for (int c = 0; c < 3; ++c) {
+      if (!(mfp[c] > 0))
+        params.fail("mfp", "times \"scale\" must be positive (the mean free path), got {} in channel {}", mfp[c], c);
+      const float albedo = static_cast<float>(
+          subsurface_albedo_from_effective(std::clamp(reflectance[c], 0.0f, 1.0f), g, boundary.ior));
+      s[c] = albedo / mfp[c];
+      a[c] = (1 - albedo) / mfp[c];
+    }
+    sigma_a = RGB(a[0], a[1], a[2]);
+    sigma_s = RGB(s[0], s[1], s[2]);
+  } else {
+    const ScatteringPreset* milk = find_scattering_preset("Wholemilk");
+    sigma_a = milk->sigma_a * scale;
+    sigma_s = milk->sigma_s * scale;
+  }
+
+  // What renders subsurface scattering: volpath, pbrt-v4's default (candela's for simplevolpath too).
+  if (options_.integrator_given && options_.integrator != "volpath") {
+    warn(params.directive(), "{}: the {} integrator does not render subsurface scattering (nor does pbrt-v4's): "
+         "the material is its dielectric boundary alone; use Integrator \"volpath\"", params.owner(),
+         options_.integrator);
+    return boundary;
+  }
+  MediumDesc medium;
+  set_sigma_a_sigma_s(medium, sigma_a, sigma_s);
+  medium.g = g;
+  medium.subsurface = true;
+  medium.name = fmt::format("subsurface at {}", params.directive().to_string());
+  medium.where = params.directive();
+  if (std::string problem = medium_problem(medium); !problem.empty())
+    throw_scene_error(params.directive(), "{}: {}", params.owner(), problem);
+  scene_.media.push_back(std::move(medium));
+  pending_subsurface_medium_ = static_cast<int>(scene_.media.size()) - 1;
+  return boundary;
+}
+
+void SceneParser::claim_subsurface_medium(int material) {
+  if (pending_subsurface_medium_ >= 0) subsurface_media_[material] = pending_subsurface_medium_;
+  pending_subsurface_medium_ = -1;
 }
 
 }  // namespace candela::pbrt

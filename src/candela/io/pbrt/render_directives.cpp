@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "candela/io/pbrt/scene_parser.h"
+#include "candela/spectral/cie.h"
 
 namespace candela::pbrt {
 
@@ -37,18 +38,36 @@ std::string pbrt_camera_sensor_list() {
 void SceneParser::camera(const Token& d) {
   require_options(d);
   Token type = expect_string(d, "the camera type");
-  if (type.text != "perspective" && type.text != "orthographic")
-    reject_type(at(type), "camera", type.text, {"perspective", "orthographic"}, {"realistic", "spherical"});
-  const bool orthographic = type.text == "orthographic";
-  ParamList params = read_params(d, fmt::format("Camera \"{}\"", type.text));
-  float fov = orthographic ? 90 : params.get_float("fov", 90);
+  if (type.text != "perspective" && type.text != "orthographic" && type.text != "spherical")
+    reject_type(at(type), "camera", type.text, {"perspective", "orthographic", "spherical"}, {"realistic"});
+  const bool orthographic = type.text == "orthographic", spherical = type.text == "spherical";
+  const std::string camera_name = fmt::format("Camera \"{}\"", type.text);
+  ParamList params = read_params(d, camera_name);
+  // pbrt-v4's spherical camera: the whole sphere of directions in an equal-area square (its default)
+  // or an equirectangular image. It reads and ignores the projective cameras' lens and screen.
+  Projection projection = orthographic ? Projection::Orthographic : Projection::Perspective;
+  if (spherical) {
+    const SourceLocation where = params.where("mapping");
+    const std::string mapping = params.get_string("mapping", "equalarea");
+    if (mapping != "equalarea" && mapping != "equirectangular")
+      throw_scene_error(where, "{}: unknown \"mapping\" \"{}\" (pbrt-v4 has \"equalarea\" and \"equirectangular\")",
+                        camera_name, mapping);
+    projection = mapping == "equalarea" ? Projection::EqualArea : Projection::Equirectangular;
+    for (const char* ignored : {"lensradius", "focaldistance", "frameaspectratio", "screenwindow"})
+      if (params.has(ignored)) {
+        warn(params.where(ignored), "{}: \"{}\" does not apply to a spherical camera and is ignored, as in pbrt-v4",
+             camera_name, ignored);
+        params.take_any(ignored);
+      }
+  }
+  float fov = orthographic || spherical ? 90 : params.get_float("fov", 90);
   if (!(fov > 0 && fov < 180)) params.fail("fov", "must be between 0 and 180 degrees, got {}", fov);
   float lens_radius = params.get_float("lensradius", 0);
   if (lens_radius < 0) params.fail("lensradius", "must not be negative, got {}", lens_radius);
   if (orthographic && lens_radius > 0)
     params.fail("lensradius", "{}: depth of field with an orthographic camera is not supported", lens_radius);
   std::optional<std::array<float, 4>> window;
-  if (params.has("screenwindow")) {
+  if (!spherical && params.has("screenwindow")) {
     const std::vector<double> w = params.get_floats("screenwindow");
     if (w.size() != 4) params.fail("screenwindow", "needs 4 values (x0 x1 y0 y1), got {}", w.size());
     if (!(w[0] < w[1] && w[2] < w[3]))
@@ -57,6 +76,7 @@ void SceneParser::camera(const Token& d) {
   }
   float focus_distance = params.get_float("focaldistance", 1e6f);
   if (!(focus_distance > 0)) params.fail("focaldistance", "must be positive, got {}", focus_distance);
+  if (spherical) lens_radius = 0, focus_distance = 1e6f;  // ignored (warned above)
   float shutter_open = params.get_float("shutteropen", 0);
   float shutter_close = params.get_float("shutterclose", 1);
   // pbrt-v4 refuses a shutter that does not open: the exposure time (shutterclose - shutteropen)
@@ -75,7 +95,7 @@ void SceneParser::camera(const Token& d) {
   // The CTM maps world space to camera space here; pbrt names the inverse "camera".
   CameraDesc& camera = scene_.camera;
   camera.world_from_camera = state_.ctm.start.inverse();
-  camera.projection = orthographic ? Projection::Orthographic : Projection::Perspective;
+  camera.projection = projection;
   camera.screen_window = window;
   camera.fov_degrees = fov;
   camera.fov_axis = FovAxis::Smaller;
@@ -90,11 +110,12 @@ void SceneParser::camera(const Token& d) {
 void SceneParser::film(const Token& d) {
   require_options(d);
   Token type = expect_string(d, "the film type");
-  // pbrt-v4's gbuffer film is its rgb film (the same parameters, the same colour) plus per-pixel
-  // geometry layers in the EXR: candela's AOVs with pbrt's layout (film/aov_film.h's "gbuffer").
-  if (type.text != "rgb" && type.text != "gbuffer")
-    reject_type(at(type), "film", type.text, {"rgb", "gbuffer"}, {"spectral"});
-  const bool gbuffer = type.text == "gbuffer";
+  // pbrt-v4's gbuffer and spectral films are its rgb film (the same parameters, the same colour)
+  // plus layers in the EXR: per-pixel geometry, or the radiance in wavelength buckets; candela's
+  // AOVs with pbrt's layout (film/aov_film.h's "gbuffer" and "spectral").
+  if (type.text != "rgb" && type.text != "gbuffer" && type.text != "spectral")
+    reject_type(at(type), "film", type.text, {"rgb", "gbuffer", "spectral"}, {});
+  const bool gbuffer = type.text == "gbuffer", spectral = type.text == "spectral";
   const std::string film_name = fmt::format("Film \"{}\"", type.text);
   ParamList params = read_params(d, film_name.c_str());
   int width = params.get_int("xresolution", 1280);
@@ -168,28 +189,43 @@ void SceneParser::film(const Token& d) {
       params.fail("maxcomponentvalue", "must be positive, got {}", sensor.max_component);
     if (std::isinf(sensor.max_component)) sensor.max_component = 0;  // pbrt-v4's default: no limit
   }
+  // pbrt-v4's HasExtension: ".exr" in any case.
+  auto is_exr_name = [](const std::string& name) {
+    if (name.size() <= 4) return false;
+    const char* ext = name.c_str() + name.size() - 4;
+    return ext[0] == '.' && (ext[1] | 0x20) == 'e' && (ext[2] | 0x20) == 'x' && (ext[3] | 0x20) == 'r';
+  };
   // The gbuffer film's layers: positions, normals and dz/dx, dz/dy in camera space (pbrt-v4's
   // default) or world space; pbrt-v4 writes them to EXR files only.
-  std::string gbuffer_aovs;
+  std::string film_aovs;
   if (gbuffer) {
     const SourceLocation where = params.where("coordinatesystem");
     const std::string system = params.get_string("coordinatesystem", "camera");
     if (system != "camera" && system != "world")
       throw_scene_error(where, "{}: unknown \"coordinatesystem\" \"{}\" (pbrt-v4 has \"camera\" and \"world\")",
                         film_name, system);
-    gbuffer_aovs = system == "camera" ? "gbuffer" : "gbuffer,world_space";
-    // pbrt-v4's HasExtension: ".exr" in any case.
-    auto is_exr_name = [](const std::string& name) {
-      if (name.size() <= 4) return false;
-      const char* ext = name.c_str() + name.size() - 4;
-      return ext[0] == '.' && (ext[1] | 0x20) == 'e' && (ext[2] | 0x20) == 'x' && (ext[3] | 0x20) == 'r';
-    };
-    if (!filename.empty() && !is_exr_name(filename))
-      throw_scene_error(params.where("filename"), "{}: \"{}\": the gbuffer film writes EXR files only", film_name,
-                        filename);
+    film_aovs = system == "camera" ? "gbuffer" : "gbuffer,world_space";
   }
+  // The spectral film's buckets: "nbuckets" equal intervals over ["lambdamin", "lambdamax"] nm,
+  // within the visible range spectral transport samples (pbrt-v4's Lambda_min and Lambda_max).
+  if (spectral) {
+    const int buckets = params.get_int("nbuckets", 16);
+    if (buckets < 1 || buckets > 1000) params.fail("nbuckets", "must be between 1 and 1000, got {}", buckets);
+    const float lambda_min = params.get_float("lambdamin", cie::kLambdaMin);
+    const float lambda_max = params.get_float("lambdamax", cie::kLambdaMax);
+    if (!(lambda_min >= cie::kLambdaMin && lambda_min < lambda_max))
+      params.fail("lambdamin", "must be at least {} nm and below \"lambdamax\" ({}), got {}", cie::kLambdaMin,
+                  lambda_max, lambda_min);
+    if (!(lambda_max <= cie::kLambdaMax))
+      params.fail("lambdamax", "must be at most {} nm (the visible range spectral transport samples), got {}",
+                  cie::kLambdaMax, lambda_max);
+    film_aovs = fmt::format("spectral:{}:{}:{}", buckets, lambda_min, lambda_max);
+  }
+  if ((gbuffer || spectral) && !filename.empty() && !is_exr_name(filename))
+    throw_scene_error(params.where("filename"), "{}: \"{}\": the {} film writes EXR files only", film_name, filename,
+                      type.text);
   params.reject_unused();
-  scene_.film.aovs = gbuffer_aovs;
+  scene_.film.aovs = film_aovs;
   scene_.film.sensor = sensor;
   scene_.film.width = width;
   scene_.film.height = height;
@@ -247,7 +283,7 @@ void SceneParser::sampler(const Token& d) {
   if (params.has("seed")) options_.seed = static_cast<uint64_t>(seed);
 }
 
-// pbrt-v4's path, volpath, bdpt and mlt are rendered with candela's integrator of that name,
+// pbrt-v4's path, volpath, bdpt, mlt and sppm are rendered with candela's integrator of that name,
 // ambientocclusion with its ambient_occlusion and lightpath with its light_path; the others with the one that converges to the same
 // image (volpath for simplevolpath, path for the rest), at the scene's "maxdepth". Parameters candela
 // has no use for are accepted with a warning.
@@ -314,6 +350,21 @@ void SceneParser::integrator(const Token& d) {
     if (!(sigma > 0 && sigma <= 1)) params.fail("sigma", "must be in (0, 1], got {}", sigma);
     options_.spp = mutations;
     options_.mlt = RenderDirectives::Metropolis{bootstrap, chains, large_step, sigma};
+  } else if (type.text == "sppm") {
+    // Stochastic progressive photon mapping: pbrt-v4's -1 photons per iteration is one per pixel
+    // (candela's 0); its "seed" seeds candela's whole render, as the sampler's does.
+    integrator = "sppm";
+    const int photons = params.get_int("photonsperiteration", -1);
+    if (photons == 0 || photons < -1) params.fail("photonsperiteration", "must be positive or -1, got {}", photons);
+    options_.sppm.photons_per_iteration = photons > 0 ? photons : 0;
+    options_.sppm.radius = params.get_float("radius", 1.0f);
+    if (!(options_.sppm.radius > 0 && std::isfinite(options_.sppm.radius)))
+      params.fail("radius", "must be positive, got {}", options_.sppm.radius);
+    if (params.has("seed")) {
+      const int seed = params.get_int("seed", 0);
+      if (seed < 0) params.fail("seed", "must not be negative, got {}", seed);
+      options_.seed = static_cast<uint64_t>(seed);
+    }
   } else if (type.text == "lightpath") {
     // pbrt-v4's light tracer is candela's light_path (the same estimator: its image, black where the
     // camera sees glass, mirrors, emitters or the sky).
@@ -324,7 +375,7 @@ void SceneParser::integrator(const Token& d) {
       ignore_param(params, name, fmt::format("candela's {} integrator has no such setting", integrator));
   }
   params.reject_unused();
-  if (type.text != integrator && type.text != "lightpath")
+  if (type.text != integrator && type.text != "lightpath" && type.text != "sppm")
     warn(at(type), "Integrator \"{}\": using candela's {} integrator with maxdepth {} (it converges to the "
          "same image, with different noise)", type.text, integrator, max_depth);
   options_.integrator = integrator;
@@ -421,6 +472,7 @@ void SceneParser::write_render_settings(RenderSettings& settings) const {
   if (options_.light_sampler) settings.light_selection = *options_.light_sampler;
   else if (!options_.integrator_given) settings.light_selection = LightSelection::Bvh;
   settings.ambient_occlusion = options_.ambient_occlusion;
+  settings.sppm = options_.sppm;
   if (options_.mlt) {
     settings.mlt.bootstrap = options_.mlt->bootstrap;
     settings.mlt.chains = options_.mlt->chains;

@@ -438,12 +438,19 @@ void SceneParser::crop_film(const std::array<int, 4>& bounds) {
   // The full image's screen window (pbrt-v4's default frames the smaller axis by [-1, 1]), of which the
   // part over the crop's pixels becomes the camera's; screen y points up, pixel rows down.
   CameraDesc& camera = scene_.camera;
-  const float aspect = float(width) / float(height);
-  const std::array<float, 4> full = camera.screen_window.value_or(
-      aspect > 1 ? std::array<float, 4>{-aspect, aspect, -1, 1} : std::array<float, 4>{-1, 1, -1 / aspect, 1 / aspect});
-  auto screen_x = [&](int px) { return full[0] + (full[1] - full[0]) * float(px) / float(width); };
-  auto screen_y = [&](int py) { return full[3] - (full[3] - full[2]) * float(py) / float(height); };
-  camera.screen_window = std::array<float, 4>{screen_x(x0), screen_x(x1), screen_y(y1), screen_y(y0)};
+  if (camera.projection == Projection::Equirectangular || camera.projection == Projection::EqualArea) {
+    // A spherical camera's window is the part of the full image's (u, v) the film covers.
+    camera.screen_window = std::array<float, 4>{float(x0) / float(width), float(x1) / float(width),
+                                                float(y0) / float(height), float(y1) / float(height)};
+  } else {
+    const float aspect = float(width) / float(height);
+    const std::array<float, 4> full = camera.screen_window.value_or(
+        aspect > 1 ? std::array<float, 4>{-aspect, aspect, -1, 1}
+                   : std::array<float, 4>{-1, 1, -1 / aspect, 1 / aspect});
+    auto screen_x = [&](int px) { return full[0] + (full[1] - full[0]) * float(px) / float(width); };
+    auto screen_y = [&](int py) { return full[3] - (full[3] - full[2]) * float(py) / float(height); };
+    camera.screen_window = std::array<float, 4>{screen_x(x0), screen_x(x1), screen_y(y1), screen_y(y0)};
+  }
   scene_.film.crop = FilmDesc::Crop{x0, y0, width, height};
   scene_.film.width = x1 - x0;
   scene_.film.height = y1 - y0;

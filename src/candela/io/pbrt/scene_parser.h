@@ -91,6 +91,7 @@ struct RenderDirectives {
   };
   std::optional<Metropolis> mlt;
   AmbientOcclusionSettings ambient_occlusion;  // "ambientocclusion"'s "maxdistance" and "cossample"
+  SppmSettings sppm;                           // "sppm"'s "photonsperiteration" and "radius"
 };
 
 enum class Section { Options, World };
@@ -216,6 +217,8 @@ class SceneParser {
   Roughness read_roughness(ParamList& params, std::string_view prefix = {});
   // The slab of pbrt-v4's layered materials: thickness, albedo, g, maxdepth, nsamples.
   LayerSlab read_layer_slab(ParamList& params);
+  // pbrt-v4's "hair" material (io/pbrt/materials.cpp).
+  MaterialDesc make_hair_material(ParamList& params);
   // A material's shading-normal parameters (every pbrt-v4 material but "mix" and "interface"):
   // read_shading_normals reads them into shading_normals_, wrap_shading_normals wraps the material
   // added after it.
@@ -250,6 +253,7 @@ class SceneParser {
   BuiltGeometry make_disk(ParamList& params);
   BuiltGeometry make_bilinear_mesh(ParamList& params);
   BuiltGeometry make_loop_subdivision(ParamList& params);
+  BuiltGeometry make_curve(ParamList& params);
   RGB read_light_scale(ParamList& params, RGB emitted);
   void require_static_light(const Token& directive, const Token& type) const;
   void add_emissive_shape(ShapeDesc shape, const BuiltGeometry& built, const Token& directive);
@@ -263,6 +267,14 @@ class SceneParser {
   MediumDesc make_homogeneous_medium(ParamList& params);
   MediumDesc make_grid_medium(ParamList& params);
   MediumDesc make_nanovdb_medium(ParamList& params);
+  // pbrt-v4's "subsurface" material: its dielectric boundary; and, where the integrator renders
+  // subsurface scattering (volpath), the medium its shapes are filled with, left in
+  // pending_subsurface_medium_ for claim_subsurface_medium.
+  MaterialDesc make_subsurface_material(ParamList& params);
+  // Records that material `material` (as shapes get it) is the subsurface material just made, if it is one.
+  void claim_subsurface_medium(int material);
+  std::map<int, int> subsurface_media_;  // material index -> the subsurface medium of its shapes
+  int pending_subsurface_medium_ = -1;
   void read_temperature_mapping(ParamList& params, MediumDesc& medium);
 
   Warnings& warnings_;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 
+#include "candela/geometry/curves.h"
 #include "candela/geometry/loop_subdivision.h"
 #include "candela/io/mesh_io.h"
 #include "candela/io/pbrt/scene_parser.h"
@@ -278,6 +279,56 @@ BuiltGeometry SceneParser::make_loop_subdivision(ParamList& params) {
   return BuiltGeometry{MeshShape{loop_subdivide(p, indices, levels, LoopRules::PbrtV4)}, {}, 0};
 }
 
+// pbrt-v4's curve (Curve::Create): "P" with "basis" "bezier" (degree + 1 points, then degree more
+// per segment) or "bspline" (each point after degree + 1 adds a segment), "degree" 2 or 3, "type" flat,
+// cylinder or ribbon (a ribbon needs "N", one normal per segment end), "width" (1), "width0" and
+// "width1" (default "width") at the ends. "splitdepth" is pbrt-v4's tessellation depth: Embree
+// intersects the curves themselves, so it is read and has no effect. Where pbrt-v4 reports an error
+// and goes on without the curve (or, for an unknown type, with a cylinder), candela stops.
+BuiltGeometry SceneParser::make_curve(ParamList& params) {
+  CurveShape curve;
+  const float width = params.get_float("width", 1);
+  curve.width0 = params.get_float("width0", width);
+  curve.width1 = params.get_float("width1", width);
+  for (std::string_view name : {"width", "width0", "width1"}) {
+    const float w = name == "width" ? width : name == "width0" ? curve.width0 : curve.width1;
+    if (!(w >= 0)) params.fail(name, "must be >= 0, got {}", w);
+  }
+  curve.degree = params.get_int("degree", 3);
+  if (curve.degree != 2 && curve.degree != 3)
+    params.fail("degree", "must be 2 or 3 (quadratic or cubic segments, as in pbrt-v4), got {}", curve.degree);
+  const std::string basis = params.get_string("basis", "bezier");
+  if (basis == "bspline") curve.basis = CurveBasis::BSpline;
+  else if (basis != "bezier") params.fail("basis", "must be \"bezier\" or \"bspline\", got \"{}\"", basis);
+  curve.points = params.get_vec3_array("P", "point3");
+  if (curve.points.empty()) params.fail("P", "is required: give the control points as \"point3 P\"");
+  const size_t segments = curve.segment_count();
+  if (segments == 0)
+    params.fail("P", "has {} points, but a degree {} {} curve needs {}", curve.points.size(), curve.degree,
+                basis == "bspline" ? "B-spline" : "Bézier", curve.expected_point_count());
+  const std::string type = params.get_string("type", "flat");
+  if (std::optional<CurveType> t = enum_from_name<CurveType>(type)) curve.type = *t;
+  else params.fail("type", "must be \"flat\", \"cylinder\" or \"ribbon\", got \"{}\"", type);
+  const bool normals_given = params.has_own("N");
+  curve.normals = params.get_vec3_array("N", "normal");
+  if (curve.type != CurveType::Ribbon) {
+    if (normals_given && !curve.normals.empty())
+      warn(params.where("N"), "{}: \"N\" is ignored: curve normals are only used with \"ribbon\" curves (as in pbrt-v4)",
+           params.owner());
+    curve.normals.clear();
+  } else if (curve.normals.empty()) {
+    params.fail("N", "is required for \"ribbon\" curves: one normal at each end of each segment ({})", segments + 1);
+  } else if (curve.normals.size() != segments + 1) {
+    params.fail("N", "has {} normals, but a ribbon of {} segments needs {} (one at each end of each segment)",
+                curve.normals.size(), segments, segments + 1);
+  }
+  (void)params.get_int("splitdepth", 3);  // pbrt-v4's tessellation: nothing to do with Embree's curves
+  if (std::string problem = curve_problem(curve); !problem.empty())
+    params.fail(curve.type == CurveType::Ribbon && problem.find("normal") != std::string::npos ? "N" : "P", "{}",
+                problem);
+  return BuiltGeometry{std::move(curve), {}, 0};
+}
+
 namespace {
 
 // The triangles `triangles` of `mesh` as a mesh of their own.
@@ -392,10 +443,17 @@ void SceneParser::shape(const Token& d) {
     built = make_bilinear_mesh(params);
   else if (type.text == "loopsubdiv")
     built = make_loop_subdivision(params);
+  else if (type.text == "curve")
+    built = make_curve(params);
   else
     reject_type(at(type), "shape", type.text,
-                {"sphere", "cylinder", "trianglemesh", "plymesh", "disk", "bilinearmesh", "loopsubdiv"}, {"curve"},
+                {"sphere", "cylinder", "trianglemesh", "plymesh", "disk", "bilinearmesh", "loopsubdiv", "curve"}, {},
                 "candela has no primitive or tessellation for it");
+  const bool curve = type.text == "curve";
+  if (curve && state_.area_light)
+    throw_scene_error(at(d), "Shape \"curve\": a curve cannot be an area light (AreaLightSource at {}): pbrt-v4 "
+                      "cannot sample points on curves either (it stops with \"Curve::Sample not implemented\")",
+                      state_.area_light->where.to_string());
   // pbrt-v4's alpha: where it is below 1 the surface is there only with that probability (0: a hole),
   // for camera and shadow rays alike; candela's mask material does exactly that around the material.
   std::optional<FloatInput> alpha = read_float_texture(params, "alpha");
@@ -424,6 +482,21 @@ void SceneParser::shape(const Token& d) {
   desc.reverse_orientation = state_.reverse_orientation;
   desc.interior_medium = state_.inside_medium;
   desc.exterior_medium = state_.outside_medium;
+  // A subsurface material fills its shape with its medium (pbrt-v4's BSSRDF never enters an inside
+  // medium the MediumInterface names, so that is not used).
+  if (auto filled = subsurface_media_.find(state_.material); filled != subsurface_media_.end()) {
+    if (desc.is_medium_transition() && desc.interior_medium >= 0)
+      warn(at(d), "Shape: the MediumInterface's inside medium \"{}\" is not used: the subsurface material (at {}) "
+           "fills the shape with its own medium, as pbrt-v4's BSSRDF does", scene_.media[desc.interior_medium].name,
+           scene_.media[filled->second].where.to_string());
+    desc.interior_medium = filled->second;
+  }
+  if (curve && desc.is_medium_transition()) {
+    // A curve has no inside: it sits in the outside medium (pbrt-v4 would switch media on crossing it).
+    warn(at(d), "Shape \"curve\": the MediumInterface's inside medium is ignored: a curve has no inside and stays "
+         "in the outside medium");
+    desc.interior_medium = desc.exterior_medium;
+  }
   desc.name = fmt::format("{} at {}", type.text, at(d).to_string());
   desc.where = at(d);
   if (state_.area_light)
