@@ -17,7 +17,8 @@
 namespace candela {
 namespace {
 
-using namespace candela::testing::pbrt_reader;
+// Qualified, not a using-directive: the unity build shares this anonymous namespace with other tests.
+namespace spherical_pbrt = candela::testing::pbrt_reader;
 
 CameraDesc spherical_desc(Projection projection, const Transform& world_from_camera = Transform()) {
   CameraDesc d;
@@ -128,21 +129,22 @@ TEST(SphericalCamera, BidirectionalAgreesWithThePathTracerAndTheLightTracerRefus
 }
 
 TEST(SphericalCamera, PbrtReaderReadsItsMappingsAndIgnoresTheLens) {
-  const SceneDesc plain = read_lines({"Camera \"spherical\"", "WorldBegin"});
+  const SceneDesc plain = spherical_pbrt::read_lines({"Camera \"spherical\"", "WorldBegin"});
   EXPECT_EQ(plain.camera.projection, Projection::EqualArea);  // pbrt-v4's default mapping
-  const Warned equirect = read_warned({"Camera \"spherical\" \"string mapping\" \"equirectangular\" "
-                                                        "\"float lensradius\" 0.5 \"float screenwindow\" [-1 1 -1 1]",
-                                                        "WorldBegin"});
+  const spherical_pbrt::Warned equirect = spherical_pbrt::read_warned(
+      {"Camera \"spherical\" \"string mapping\" \"equirectangular\" \"float lensradius\" 0.5 "
+       "\"float screenwindow\" [-1 1 -1 1]",
+       "WorldBegin"});
   EXPECT_EQ(equirect.scene.camera.projection, Projection::Equirectangular);
   EXPECT_EQ(equirect.scene.camera.lens_radius, 0);
   EXPECT_FALSE(equirect.scene.camera.screen_window.has_value());
   ASSERT_EQ(equirect.warnings.size(), 2u);
   EXPECT_NE(equirect.warnings[0].find("does not apply to a spherical camera"), std::string::npos);
-  expect_error({"Camera \"spherical\" \"string mapping\" \"cube\"", "WorldBegin"}, 1, "\"string mapping\"",
+  spherical_pbrt::expect_error({"Camera \"spherical\" \"string mapping\" \"cube\"", "WorldBegin"}, 1, "\"string mapping\"",
                "unknown \"mapping\" \"cube\"");
-  expect_error({"Camera \"spherical\" \"float fov\" 40", "WorldBegin"}, 1, "\"float fov\"", "");
+  spherical_pbrt::expect_error({"Camera \"spherical\" \"float fov\" 40", "WorldBegin"}, 1, "\"float fov\"", "");
   // A cropped film's window is its part of the full image's (u, v).
-  const SceneDesc cropped = read_lines({"Camera \"spherical\"",
+  const SceneDesc cropped = spherical_pbrt::read_lines({"Camera \"spherical\"",
                                         "Film \"rgb\" \"integer xresolution\" 40 \"integer yresolution\" 20 "
                                         "\"integer pixelbounds\" [10 20 10 20]",
                                         "WorldBegin"});
