@@ -12,16 +12,22 @@
 #include <condition_variable>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <thread>
+#include <utility>
 #include <variant>
 
 #include "candela/base/error.h"
+#include "candela/denoise/denoise_file.h"
+#include "candela/denoise/denoised_render.h"
+#include "candela/film/aov_film.h"
 #include "candela/film/film.h"
 #include "candela/film/image_io.h"
 #include "candela/io/json_writer.h"
 #include "candela/io/scene_reader.h"
 #include "candela/description/render_options.h"
 #include "candela/integrators/render_request.h"
+#include "candela/render/first_hit_aovs.h"
 #include "candela/scene/parameters.h"
 #include "candela/scene/resource_limits.h"
 #include "candela/scene/scene.h"
@@ -88,13 +94,39 @@ RenderRequest request_from(const py::dict& keywords) {
   return request;
 }
 
+// A float32 (height, width, channels) array, or (height, width) for one channel, that owns
+// `values` (row-major, no copy).
+py::array_t<float> to_array(std::vector<float>&& values, int width, int height, int channels) {
+  auto* pixels = new std::vector<float>(std::move(values));
+  py::capsule owner(pixels, [](void* p) { delete static_cast<std::vector<float>*>(p); });
+  const auto w = py::ssize_t(width), h = py::ssize_t(height), c = py::ssize_t(channels);
+  const auto f = py::ssize_t(sizeof(float));
+  if (channels == 1) return py::array_t<float>({h, w}, {w * f, f}, pixels->data(), owner);
+  return py::array_t<float>({h, w, c}, {w * c * f, c * f, f}, pixels->data(), owner);
+}
+
 // A float32 (height, width, 3) array that owns `image`'s pixels (no copy).
 py::array_t<float> to_array(Image&& image) {
-  auto* pixels = new std::vector<float>(std::move(image.rgb));
-  py::capsule owner(pixels, [](void* p) { delete static_cast<std::vector<float>*>(p); });
-  const auto w = py::ssize_t(image.width), h = py::ssize_t(image.height);
-  return py::array_t<float>({h, w, py::ssize_t(3)}, {w * 3 * py::ssize_t(sizeof(float)), 3 * py::ssize_t(sizeof(float)), py::ssize_t(sizeof(float))},
-                            pixels->data(), owner);
+  return to_array(std::move(image.rgb), image.width, image.height, 3);
+}
+
+// The denoiser's input as the keyword arguments of the package's denoise() (which render(denoise=True)
+// keeps beside its image, so that it can be denoised again): each feature a pair, one per half.
+py::dict denoise_input_arrays(DenoiseInput&& in) {
+  const int w = in.width, h = in.height;
+  py::dict arrays;
+  arrays["half_a"] = to_array(std::move(in.half_a), w, h, 3);
+  arrays["half_b"] = to_array(std::move(in.half_b), w, h, 3);
+  arrays["albedo"] = py::make_tuple(to_array(std::move(in.albedo_a), w, h, 3), to_array(std::move(in.albedo_b), w, h, 3));
+  arrays["normal"] = py::make_tuple(to_array(std::move(in.normal_a), w, h, 3), to_array(std::move(in.normal_b), w, h, 3));
+  arrays["depth"] = py::make_tuple(to_array(std::move(in.depth_a), w, h, 1), to_array(std::move(in.depth_b), w, h, 1));
+  arrays["share_a"] = to_array(std::move(in.share_a), w, h, 1);
+  return arrays;
+}
+
+// `array`'s values (C-contiguous float32, of the shape the package has checked).
+std::vector<float> array_values(const py::array_t<float, py::array::c_style>& array) {
+  return std::vector<float>(array.data(), array.data() + array.size());
 }
 
 // An (height, width, 3) float32 C-contiguous array (the package converts) into an Image.
@@ -141,7 +173,8 @@ py::tuple render_scene(PyScene& scene, const py::dict& keywords, const py::objec
   options.progress = false;
   options.progress_fraction = &fraction;
 
-  Image image;
+  Image image, noisy;
+  std::optional<DenoiseInput> denoised_from;  // with denoise=True: the denoiser's input
   std::map<std::string, std::string> metadata;
   std::exception_ptr failure;
   std::mutex mutex;
@@ -151,10 +184,21 @@ py::tuple render_scene(PyScene& scene, const py::dict& keywords, const py::objec
     try {
       Scene built(scene.desc);
       Film film(scene.desc.film.width, scene.desc.film.height);
+      // denoise=True: the denoiser's features are collected with the samples (denoise/denoised_render.h).
+      std::optional<AovFilm> features;
+      if (plan.denoise) {
+        features.emplace(film.width(), film.height(), with_denoise_features({}), aov_camera_frame(built.camera()));
+        options.aovs = &*features;
+      }
       RenderOutcome outcome = render_requested(built, scene.desc.settings, film, plan, options);
       metadata = image_metadata(scene.name, scene.desc.settings, film, outcome, options, 1,
                                 outcome.stats.non_finite_samples);
       image = film.mean_image();
+      if (features) {
+        DenoisedRender denoised = denoise_render(film, *features, &denoised_from.emplace());
+        add_denoise_metadata(metadata, denoised.result, denoised.seconds);
+        noisy = std::exchange(image, std::move(denoised.result.image));
+      }
     } catch (...) {
       failure = std::current_exception();
     }
@@ -190,7 +234,48 @@ py::tuple render_scene(PyScene& scene, const py::dict& keywords, const py::objec
   if (failure) std::rethrow_exception(failure);
   py::dict meta;
   for (const auto& [key, value] : metadata) meta[py::str(key)] = value;
-  return py::make_tuple(to_array(std::move(image)), meta);
+  // What only a denoised render has: the raw image and the denoiser's input.
+  py::dict denoising;
+  if (denoised_from) {
+    denoising["noisy"] = to_array(std::move(noisy));
+    denoising["input"] = denoise_input_arrays(std::move(*denoised_from));
+  }
+  return py::make_tuple(to_array(std::move(image)), meta, denoising);
+}
+
+// The package's denoise(): arrays it has checked for shape ((height, width, 3) colours, albedos and
+// normals; (height, width) shares and depths), in denoise_input_arrays' order with each pair split.
+// Returns the denoised image, the metadata a denoised render carries, and the estimated relMSE
+// (None where the halves give none).
+using DenoiseArray = py::array_t<float, py::array::c_style>;
+py::tuple denoise_arrays(const DenoiseArray& half_a, const DenoiseArray& half_b, const DenoiseArray& share_a,
+                         const DenoiseArray& albedo_a, const DenoiseArray& albedo_b, const DenoiseArray& normal_a,
+                         const DenoiseArray& normal_b, const DenoiseArray& depth_a, const DenoiseArray& depth_b) {
+  if (half_a.ndim() != 3) throw py::value_error("half_a: expected an array of shape (height, width, 3)");
+  DenoiseInput in;
+  in.height = int(half_a.shape(0));
+  in.width = int(half_a.shape(1));
+  in.half_a = array_values(half_a);
+  in.half_b = array_values(half_b);
+  in.share_a = array_values(share_a);
+  in.albedo_a = array_values(albedo_a);
+  in.albedo_b = array_values(albedo_b);
+  in.normal_a = array_values(normal_a);
+  in.normal_b = array_values(normal_b);
+  in.depth_a = array_values(depth_a);
+  in.depth_b = array_values(depth_b);
+  DenoisedRender denoised;
+  {
+    py::gil_scoped_release release;
+    denoised = denoise_render(in);  // check(): InternalError where a buffer's size is off
+  }
+  std::map<std::string, std::string> metadata;
+  add_denoise_metadata(metadata, denoised.result, denoised.seconds);
+  py::dict meta;
+  for (const auto& [key, value] : metadata) meta[py::str(key)] = value;
+  const ErrorEstimate& error = denoised.result.error;
+  return py::make_tuple(to_array(std::move(denoised.result.image)), meta,
+                        error.valid ? py::object(py::float_(error.relmse)) : py::object(py::none()));
 }
 
 py::object parameter_to_python(const ParameterValue& value) {
@@ -348,6 +433,7 @@ PYBIND11_MODULE(_candela, m) {
     return options;
   });
   m.def("render", &render_scene);
+  m.def("denoise", &denoise_arrays);
   m.def("write_image", [](const std::string& path, const py::array_t<float, py::array::c_style>& array,
                           const std::map<std::string, std::string>& metadata) {
     write_image(path, from_array(array), metadata);

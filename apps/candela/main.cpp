@@ -22,6 +22,8 @@
 #include <string>
 #include <vector>
 
+#include "candela/denoise/denoise_file.h"
+#include "candela/denoise/denoised_render.h"
 #include "candela/film/error_estimate.h"
 #include "candela/film/aov_film.h"
 #include "candela/film/image_io.h"
@@ -219,6 +221,7 @@ struct CommandPlan {
   std::string scene_bytes;
   std::vector<fs::path> outputs;  // the images to write
   AovSelection aovs;              // --aov, else the scene's (none with --resume or --part)
+  AovSelection film_aovs;         // the layers the AOV film collects: `aovs`, and the denoiser's with --denoise
 };
 
 AovSelection parse_aov_list(const std::string& list, const char* where) {
@@ -315,6 +318,9 @@ CommandPlan plan_command(const RenderCommand& cmd, Cluster& cluster) {
     throw UsageError("--pixel renders one pixel in one process: run it without mpirun");
   plan.outputs = output_files(cmd, plan.desc);
   plan.aovs = plan_aovs(cmd, plan, cluster);
+  plan.film_aovs = plan.render.denoise ? with_denoise_features(plan.aovs) : plan.aovs;
+  // The halves layer holds two independent estimates of each pixel: the sampler makes them.
+  if (plan.aovs.wants(Aov::Halves)) plan.desc.settings.sampler.replicas = true;
   check_command_outputs(cmd, plan, cluster);
   // Refuse what cannot fit in memory before allocating the scene and the film.
   check_resources(plan.desc);
@@ -506,26 +512,33 @@ int report_pixel(const RenderPlan& plan, const Film& film, const RenderStats& st
 }
 
 // The images: the part file (--part), else every output (with the AOVs in .exr ones); the
-// integrator's own outputs; the spp map.
+// integrator's own outputs; the spp map. With --denoise (`denoised`) the outputs get the denoised
+// image, and .exr ones the raw image as the layer Noisy.
 // `made_by` and `non_finite` go into a part file.
 void write_images(const RenderCommand& cmd, const CommandPlan& plan, const Scene& scene, Film& film,
                   const AovFilm* aov_film, const IntegratorOutputs* integrator_outputs,
                   const RenderFingerprint& made_by, uint64_t non_finite,
-                  const std::map<std::string, std::string>& metadata) {
+                  const std::map<std::string, std::string>& metadata, const DenoisedRender* denoised) {
   if (!cmd.part.empty()) {
     FilmPart part{plan.render.part_index, plan.render.part_count, made_by,
                   double(scene.camera().importance_film_pixels()), non_finite, std::move(film)};
     write_part(plan.outputs[0], part, metadata);
     film = std::move(part.film);
   } else {
-    Image image = film.mean_image();
+    Image image = denoised ? denoised->result.image : film.mean_image();
     if (const auto& crop = plan.desc.film.crop) {
       image.x = crop->x;
       image.y = crop->y;
       image.full_width = crop->full_width;
       image.full_height = crop->full_height;
     }
-    const FloatChannels aov_channels = aov_film ? exr_channels(aov_film->images(film)) : FloatChannels{};
+    // The layers asked for (the AOV film may hold the denoiser's features besides), then Noisy.
+    std::vector<AovLayer> layers = aov_film ? aov_film->images(film) : std::vector<AovLayer>{};
+    std::erase_if(layers, [&](const AovLayer& layer) {
+      return std::find(plan.aovs.layers.begin(), plan.aovs.layers.end(), layer.aov) == plan.aovs.layers.end();
+    });
+    FloatChannels aov_channels = exr_channels(layers);
+    if (denoised) aov_channels = append_channels(aov_channels, noisy_layer(film.mean_image()));
     // The spectral layer's EXRs say so as the OpenEXR spectral layout asks (and pbrt-v4 writes).
     std::map<std::string, std::string> exr_metadata = metadata;
     if (aov_film && aov_film->spectral().count > 0) {
@@ -546,7 +559,7 @@ void write_images(const RenderCommand& cmd, const CommandPlan& plan, const Scene
 // The closing lines: size, samples, time and speed; the error estimate; an MPI job's efficiency.
 void print_summary(const RenderCommand& cmd, const CommandPlan& plan, const RenderOutcome& outcome,
                    const RenderOptions& options, const SampleCountText& samples, Cluster& cluster,
-                   const std::vector<Cluster::Traffic>& traffic) {
+                   const std::vector<Cluster::Traffic>& traffic, const DenoisedRender* denoised) {
   const RenderStats& stats = outcome.stats;
   const double seconds = std::max(stats.seconds, 1e-9);
   std::string written;
@@ -555,13 +568,14 @@ void print_summary(const RenderCommand& cmd, const CommandPlan& plan, const Rend
               plan.desc.film.width, plan.desc.film.height, samples.text.c_str(), samples.spp_unit, stats.seconds,
               double(stats.samples) / seconds * 1e-6, double(stats.rays.total()) / seconds * 1e-6,
               double(stats.rays.total()) / double(std::max<uint64_t>(stats.samples, 1)), written.c_str());
-  if (outcome.error.valid || options.target_error > 0 || cmd.estimate_error)
+  if (outcome.error.valid || options.target_error > 0 || cmd.estimate_error || denoised)
     std::printf("estimated error: %s%s\n", describe(outcome.error).c_str(),
                 options.target_error <= 0 ? ""
                 : stats.reached_target
                     ? fmt::format("; target {} reached", options.target_error).c_str()
                     : fmt::format("; target {} not reached (stopped at the {})", options.target_error,
                                   stats.time_limited ? "time limit" : stats.cancelled ? "interruption" : "spp limit").c_str());
+  if (denoised) std::printf("%s\n", describe_denoised(denoised->result, denoised->seconds).c_str());
   if (!cluster.mpi_job()) return;
   // The job's parallel efficiency: the thread-seconds spent rendering over all threads x wall time.
   uint64_t most_sent = 0;
@@ -608,8 +622,8 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   Film film(desc.film.width, desc.film.height);
   const uint64_t earlier_non_finite = resumed ? restore(*resumed, film, cluster) : 0;
   std::optional<AovFilm> aov_film;
-  if (!plan.aovs.empty() && !plan.render.one_pixel())
-    aov_film.emplace(film.width(), film.height(), plan.aovs, aov_camera_frame(scene.camera()));
+  if (!plan.film_aovs.empty() && !plan.render.one_pixel())
+    aov_film.emplace(film.width(), film.height(), plan.film_aovs, aov_camera_frame(scene.camera()));
   const std::unique_ptr<IntegratorOutputs> integrator_outputs =
       plan.render.make_integrator_outputs(desc.settings, film.width(), film.height());
   RenderOptions options =
@@ -639,13 +653,19 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   if (!cluster.is_root()) return stats.cancelled ? kExitInterrupted : 0;
 
   const SampleCountText samples = describe_samples(desc.settings, film, outcome);
-  const std::map<std::string, std::string> metadata =
+  std::map<std::string, std::string> metadata =
       image_metadata(cmd.scene_file.empty() ? "<built-in cornell-box.json>" : cmd.scene_file, desc.settings, film,
                      outcome, options, cluster.size(), non_finite);
+  // --denoise: the root alone denoises the gathered film (denoise/denoised_render.h).
+  std::optional<DenoisedRender> denoised;
+  if (plan.render.denoise) {
+    denoised = denoise_render(film, *aov_film);
+    add_denoise_metadata(metadata, denoised->result, denoised->seconds);
+  }
   write_images(cmd, plan, scene, film, aov_film ? &*aov_film : nullptr, integrator_outputs.get(), made_by, non_finite,
-               metadata);
+               metadata, denoised ? &*denoised : nullptr);
   warn_non_finite(stats, non_finite, false);
-  print_summary(cmd, plan, outcome, options, samples, cluster, traffic);
+  print_summary(cmd, plan, outcome, options, samples, cluster, traffic, denoised ? &*denoised : nullptr);
   viewers.end = stats.cancelled ? LiveState::Stopped : LiveState::Finished;
   return finish_message(cmd, stats, samples);
 }
@@ -698,6 +718,43 @@ int run_merge(const std::vector<std::string>& inputs, const std::string& output)
   write_image(output, film.mean_image(), metadata);
   std::printf("merged %zu files (%s): %dx%d, %s spp -> %s\n", files.size(), merged.description.c_str(), film.width(),
               film.height(), spp_text.c_str(), output.c_str());
+  return 0;
+}
+
+// `candela denoise IN.exr -o OUT`: the image of a render written with --aov halves,
+// denoised (denoise/denoiser.h); an .exr output keeps the input's layers and the raw image as Noisy.
+int run_denoise(const std::string& input, const std::string& output) {
+  check_outputs({output});
+  const DenoiseInput in = read_denoise_input(input);
+  std::map<std::string, std::string> metadata;
+  for (const auto& [key, value] : read_image_metadata(input))
+    if (key.rfind("candela:", 0) == 0 || key == "Software") metadata[key] = value;
+  const DenoisedRender denoised = denoise_render(in);
+  const DenoiseResult& result = denoised.result;
+  const double seconds = denoised.seconds;
+  add_denoise_metadata(metadata, result, seconds);
+  g_phase.store(kWriting);
+  if (is_exr(output)) {
+    // The input's layers but its colour and an earlier Noisy layer, then the raw image as Noisy.
+    const FloatChannels all = read_float_channels(input, "");
+    FloatChannels layers;
+    std::vector<size_t> kept;
+    for (size_t k = 0; k < all.names.size(); ++k) {
+      const std::string& name = all.names[k];
+      if (name == "R" || name == "G" || name == "B" || name == "A" || name.rfind("Noisy.", 0) == 0) continue;
+      kept.push_back(k);
+      layers.names.push_back(name);
+    }
+    const size_t pixels = size_t(in.width) * size_t(in.height);
+    layers.values.resize(pixels * kept.size());
+    for (size_t i = 0; i < pixels; ++i)
+      for (size_t k = 0; k < kept.size(); ++k) layers.values[i * kept.size() + k] = all.values[i * all.names.size() + kept[k]];
+    write_image(output, result.image, metadata, append_channels(layers, noisy_layer(in.raw())));
+  } else {
+    write_image(output, result.image, metadata);
+  }
+  std::printf("%s -> %s: %dx%d\n%s\n", input.c_str(), output.c_str(), in.width, in.height,
+              describe_denoised(result, seconds).c_str());
   return 0;
 }
 
@@ -771,6 +828,13 @@ int main(int argc, char** argv) {
   convert_cmd->add_option("scene", convert_in, "The scene file to read")->required();
   convert_cmd->add_option("output", convert_out, "The JSON file to write (replaced atomically)")->required();
 
+  std::string denoise_input_file, denoise_output;
+  CLI::App* denoise_cmd = app.add_subcommand(
+      "denoise", "Denoise an .exr written with --aov halves (docs/denoising.md): the output's "
+                 "colour is denoised, the raw image kept as its layer Noisy, the denoised image's estimated relMSE reported");
+  denoise_cmd->add_option("input", denoise_input_file, "The render (.exr with the halves, albedo, normal and depth layers)")
+      ->required();
+  denoise_cmd->add_option("-o,--output", denoise_output, "The image to write (.exr, .png or .pfm)")->required();
   std::vector<std::string> merge_inputs;
   std::string merge_output;
   CLI::App* merge_cmd = app.add_subcommand(
@@ -794,6 +858,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (convert_cmd->parsed()) return cluster->is_root() ? run_convert(convert_in, convert_out) : 0;
+    if (denoise_cmd->parsed()) return cluster->is_root() ? run_denoise(denoise_input_file, denoise_output) : 0;
     if (merge_cmd->parsed()) return cluster->is_root() ? run_merge(merge_inputs, merge_output) : 0;
     return run_render(cmd, *cluster);
   } catch (const AgreedError& e) {  // every rank has it: one message

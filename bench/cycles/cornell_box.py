@@ -4,11 +4,13 @@ clamping, box pixel filter of width 1, 16 bounces of every kind, a fixed thread 
 float EXR output. Prints "cycles render seconds: S" (the render alone, scene set-up excluded).
 
 Usage: blender -b --factory-startup --python bench/cycles/cornell_box.py -- \
-           --spp 256 --threads 2 --seed 1 --resolution 512 --out cornell-cycles.exr [--fog SS,SA,G]
+           --spp 256 --threads 2 --seed 1 --resolution 512 --out cornell-cycles.exr [--fog SS,SA,G] [--oidn]
 
 --fog fills the box with a homogeneous grey medium (a cube just inside the walls whose material has only a
 volume: Volume Scatter of density SS with Henyey-Greenstein anisotropy G, plus Volume Absorption of
 density SA, per millimetre), as bench/cycles_fog_vs_candela.py builds the same fog for candela.
+--oidn denoises the render with OpenImageDenoise, fed the albedo and normal passes (bench/denoise.py); it exits
+with a message where this Blender is built without OpenImageDenoise (Debian 12's 3.4.1 is).
 """
 import argparse
 import sys
@@ -156,6 +158,19 @@ def add_fog(scene, sigma_s, sigma_a, g):
     scene.collection.objects.link(obj)
 
 
+def add_oidn(scene):
+    """Denoising of the final render by OpenImageDenoise, with the albedo and normal passes as its guides."""
+    import _cycles
+    if not _cycles.with_openimagedenoise:
+        sys.exit("this Blender is built without OpenImageDenoise (_cycles.with_openimagedenoise is False)")
+    c = scene.cycles
+    c.use_denoising = True
+    c.denoiser = "OPENIMAGEDENOISE"
+    c.denoising_input_passes = "RGB_ALBEDO_NORMAL"
+    c.denoising_prefilter = "ACCURATE"
+    scene.view_layers[0].cycles.use_denoising = True
+
+
 def main():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     p = argparse.ArgumentParser()
@@ -165,8 +180,11 @@ def main():
     p.add_argument("--resolution", type=int, default=512)
     p.add_argument("--out", required=True)
     p.add_argument("--fog", help="SIGMA_S,SIGMA_A,G: fill the box with homogeneous fog")
+    p.add_argument("--oidn", action="store_true", help="denoise with OpenImageDenoise (albedo and normal passes)")
     a = p.parse_args(argv)
     scene = build_scene(a.resolution)
+    if a.oidn:
+        add_oidn(scene)
     if a.fog:
         add_fog(scene, *[float(v) for v in a.fog.split(",")])
     scene.cycles.samples = a.spp

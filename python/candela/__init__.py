@@ -98,7 +98,7 @@ except ImportError as e:
 
 __version__ = _candela.version
 __all__ = ["Image", "Scene", "SceneError", "SceneParameters", "SceneWarning", "UsageError", "builtin_scene",
-           "load_dict", "load_file", "read_image", "render", "render_keywords", "traverse", "write_image"]
+           "denoise", "load_dict", "load_file", "read_image", "render", "render_keywords", "traverse", "write_image"]
 
 
 class SceneError(ValueError):
@@ -302,10 +302,18 @@ def builtin_scene() -> Scene:
 class Image(np.ndarray):
     """A rendered image: a float32 NumPy array (height, width, 3) of linear RGB with the render's
     metadata (``metadata``: the EXR attributes the command line writes, such as candela:spp and
-    candela:relmse_estimate). Jupyter shows it inline, tone-mapped to sRGB."""
+    candela:relmse_estimate). Jupyter shows it inline, tone-mapped to sRGB.
+
+    The image of render(..., denoise=True) is the denoised one; ``noisy`` holds the raw render (an
+    Image with the same metadata) and ``denoise_input`` the denoiser's input (a dict of the keyword
+    arguments of denoise(): half_a, half_b, share_a, and albedo, normal and depth as pairs, half A's
+    and half B's). Both are None for other
+    images, and for arrays made from this one (a slice, a sum)."""
 
     def __array_finalize__(self, obj):
         self.metadata = dict(getattr(obj, "metadata", {}) or {})
+        self.noisy = None
+        self.denoise_input = None
 
     def _repr_png_(self):
         if self.ndim != 3 or self.shape[2] != 3 or self.size == 0:
@@ -422,8 +430,13 @@ def render(scene: Scene, *, progress=None, **keywords) -> Image:
     'auto'), resolution ((w, h) or 'WxH'), threads, max_depth, sampler, filter, transport
     ('rgb'/'spectral'), light_selection, direction_sampling, shadow_rays, no_mis, clamp, bvh, rr_start_depth,
     adaptive_threshold, adaptive_spp, adaptive_batch, max_spp, time_limit (seconds or '10m'),
-    target_error, estimate_error, mlt_*; see render_keywords(). The same settings give the same
+    target_error, estimate_error, denoise, mlt_*; see render_keywords(). The same settings give the same
     bytes as `candela render`, whatever the thread count.
+
+    denoise=True returns the denoised image (docs/denoising.md), with the raw render as its ``noisy``
+    attribute and the denoiser's input as ``denoise_input`` (see Image); its metadata holds the raw
+    image's estimated relMSE (candela:relmse_estimate, which target_error also reads) and the denoised
+    one's (candela:denoised_relmse_estimate and candela:denoised_relmse_interval95).
 
     progress: None (a text bar on stderr when it is a terminal), True, False, or a callable
     progress(fraction_done, seconds_elapsed), called about 20 times a second from this thread.
@@ -447,15 +460,97 @@ def render(scene: Scene, *, progress=None, **keywords) -> Image:
     else:
         raise TypeError(f"render(): progress must be None, True, False or a callable, got {type(progress).__name__}")
     try:
-        array, metadata = _candela.render(scene._native, request, callback)
+        result = _candela.render(scene._native, request, callback)
     except UsageError as e:
         raise UsageError(_keyword_message(str(e))) from None
     finally:
         if bar is not None:
             bar.close()
+    array, metadata, denoising = result
     image = array.view(Image)
     image.metadata = metadata
+    if denoising:
+        image.noisy = denoising["noisy"].view(Image)
+        image.noisy.metadata = dict(metadata)
+        image.denoise_input = dict(denoising["input"])
     if "candela:non_finite_samples" in metadata:
         warnings.warn(f"{metadata['candela:non_finite_samples']} samples were NaN or infinite and counted as black",
                       RuntimeWarning, stacklevel=2)
     return image
+
+
+
+def _denoise_array(name: str, value, shape: tuple) -> np.ndarray:
+    try:
+        array = np.ascontiguousarray(value, dtype=np.float32)
+    except (TypeError, ValueError) as e:
+        raise TypeError(f"denoise(): {name} must be an array of numbers ({e})") from None
+    if array.shape != shape:
+        raise ValueError(f"denoise(): {name} must have shape {shape}, got {array.shape}")
+    return array
+
+
+def _denoise_pair(name: str, value, shape: tuple) -> tuple:
+    # One array for both halves, or a pair (half A's, half B's).
+    if isinstance(value, (tuple, list)) and len(value) == 2 and not np.isscalar(value[0]) \
+            and np.ndim(value[0]) == len(shape):
+        return _denoise_array(name + "[0]", value[0], shape), _denoise_array(name + "[1]", value[1], shape)
+    array = _denoise_array(name, value, shape)
+    return array, array
+
+
+def denoise(image_or_half_a, half_b=None, albedo=None, normal=None, depth=None, share_a=None):
+    """Denoises a render (docs/denoising.md) and returns (image, relmse_estimate): the denoised image
+    as an Image, and its estimated relMSE (eps 0.01), or None where the halves give no estimate.
+
+        denoised, relmse = candela.denoise(candela.render(scene, denoise=True))   # again: the same bytes
+        denoised, relmse = candela.denoise(half_a, half_b, albedo, normal, depth)  # from arrays
+
+    Takes an Image from render(..., denoise=True) (its ``denoise_input``), or arrays: half_a and
+    half_b (height, width, 3), two independent estimates of each pixel (the two halves of its
+    samples); the first hit's features albedo and normal (height, width, 3) and depth (height,
+    width; 1e10 where no sample hit), each one array or a pair (half A's, half B's); share_a (height,
+    width), half A's share of each pixel's weight (the raw image is share_a * half_a + (1 - share_a)
+    * half_b; default 0.5). Each half's own features keep the error estimate honest: features shared
+    by the halves tie each half's fit to the other's noise. The image's metadata is the given
+    Image's, if any, with candela:denoised, candela:denoised_relmse_estimate,
+    candela:denoised_relmse_interval95 and candela:denoise_seconds. Deterministic: the same input
+    gives the same bytes whatever the thread count.
+    """
+    metadata = {}
+    if isinstance(image_or_half_a, Image) and half_b is None:
+        if image_or_half_a.denoise_input is None:
+            raise ValueError("denoise(): this image carries no denoiser input: render with denoise=True, or pass the "
+                             "arrays (half_a, half_b, albedo, normal, depth)")
+        given = dict(image_or_half_a.denoise_input)
+        metadata = dict(image_or_half_a.metadata)
+    else:
+        given = {"half_a": image_or_half_a, "half_b": half_b, "albedo": albedo, "normal": normal, "depth": depth,
+                 "share_a": share_a}
+        missing = [name for name in ("half_a", "half_b", "albedo", "normal", "depth") if given[name] is None]
+        if missing:
+            raise TypeError(f"denoise() takes an Image from render(..., denoise=True), or the arrays half_a, half_b, "
+                            f"albedo, normal and depth: missing {', '.join(missing)}")
+    half_a = np.asarray(given["half_a"])
+    if half_a.ndim != 3 or half_a.shape[2] != 3 or half_a.shape[0] < 1 or half_a.shape[1] < 1:
+        raise ValueError(f"denoise(): half_a must have shape (height, width, 3), got {half_a.shape}")
+    rgb, plane = half_a.shape, half_a.shape[:2]
+    halves = {name: _denoise_array(name, given[name], rgb) for name in ("half_a", "half_b")}
+    share = given.get("share_a")
+    halves["share_a"] = np.full(plane, 0.5, dtype=np.float32) if share is None else _denoise_array("share_a", share, plane)
+    features = {"albedo": _denoise_pair("albedo", given["albedo"], rgb),
+                "normal": _denoise_pair("normal", given["normal"], rgb),
+                "depth": _denoise_pair("depth", given["depth"], plane)}
+    for name, array in [*halves.items(), ("albedo", features["albedo"][0]), ("albedo", features["albedo"][1]),
+                        ("normal", features["normal"][0]), ("normal", features["normal"][1])]:
+        if not np.all(np.isfinite(array)):
+            raise ValueError(f"denoise(): {name} has NaN or infinite values")
+    if not np.all((halves["share_a"] >= 0) & (halves["share_a"] <= 1)):
+        raise ValueError("denoise(): share_a must be within [0, 1]")
+    if any(np.any(np.isnan(d)) for d in features["depth"]):
+        raise ValueError("denoise(): depth has NaN values (use 1e10 where no sample hit)")
+    array, denoise_metadata, relmse = _candela.denoise(halves["half_a"], halves["half_b"], halves["share_a"],
+                                                       *features["albedo"], *features["normal"], *features["depth"])
+    image = array.view(Image)
+    image.metadata = {**metadata, **denoise_metadata}
+    return image, relmse

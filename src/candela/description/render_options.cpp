@@ -280,6 +280,10 @@ std::vector<RenderOption> make_table() {
       {.name = "estimate_error", .field = &R::estimate_error, .rule = AnyValue{},
        .help = "Render every pixel's samples as two independent halves and report the image's estimated relMSE "
                "with a 95% interval (always done with the random sampler and with --target-error)"},
+      {.name = "denoise", .field = &R::denoise, .rule = AnyValue{},
+       .help = "Denoise the image (feature regression on the albedo, normal and depth AOVs, filters chosen per "
+               "pixel by their error estimated from the two independent halves; docs/denoising.md) and report the "
+               "denoised image's estimated relMSE; the raw image is kept as the EXR layer Noisy"},
       {.name = "clamp", .field = &R::clamp, .rule = PositiveValue{},
        .help = "Scale each sample so its largest RGB component is at most VALUE (biased; off by default)",
        .fingerprint_key = "clamp",

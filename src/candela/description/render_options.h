@@ -43,6 +43,7 @@ struct RenderRequest {
   std::string time_limit;  // seconds ("90", "2.5") or a duration ("90s", "10m", "1h30m")
   std::optional<double> target_error;
   bool estimate_error = false;
+  bool denoise = false;  // --denoise: the image denoised (denoise/denoiser.h), the raw one kept beside it
   std::optional<float> clamp;
   std::string bdpt_strategies;  // a directory for bdpt's per-strategy images
   bool bdpt_unweighted = false;

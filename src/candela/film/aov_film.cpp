@@ -31,6 +31,9 @@ const LayerNames& names_of(Aov aov) {
       {"uv", "UV", {"U", "V"}},
       {"depth_derivatives", "DepthDerivatives", {"X", "Y"}},
       {"relative_variance", "RelativeVariance", {"R", "G", "B"}},
+      {"halves", "Halves", {"A.R", "A.G", "A.B", "B.R", "B.G", "B.B", "ShareA",
+                            "A.Albedo.R", "A.Albedo.G", "A.Albedo.B", "A.Normal.X", "A.Normal.Y", "A.Normal.Z", "A.Depth.Z",
+                            "B.Albedo.R", "B.Albedo.G", "B.Albedo.B", "B.Normal.X", "B.Normal.Y", "B.Normal.Z", "B.Depth.Z"}},
       // The OpenEXR spectral layout's emissive layer; its channels are the buckets (SpectralBuckets).
       {"spectral", "S0", {}},
   };
@@ -131,12 +134,12 @@ std::string_view aov_name(Aov aov) { return names_of(aov).option; }
 
 std::string aov_names() {
   std::string names;
-  for (Aov aov : kAllAovs) names += std::string(aov_name(aov)) + ", ";
+  for (Aov aov : kNamedAovs) names += std::string(aov_name(aov)) + ", ";
   return names + "spectral[:N[:MIN:MAX]], all, gbuffer, camera_space, world_space";
 }
 
 AovSelection parse_aov_selection(std::string_view list) {
-  std::vector<bool> chosen(std::size(kAllAovs), false);
+  std::vector<bool> chosen(std::size(kNamedAovs), false);
   bool gbuffer = false, any_layer_name = false;
   SpectralBuckets spectral;
   std::optional<AovSpace> space;
@@ -150,7 +153,7 @@ AovSelection parse_aov_selection(std::string_view list) {
     const size_t comma = list.find(',', start);
     const std::string_view name = trim(list.substr(start, comma == std::string_view::npos ? list.npos : comma - start));
     if (name == "all") {
-      chosen.assign(chosen.size(), true);
+      for (Aov aov : kAllAovs) chosen[size_t(aov)] = true;
       any_layer_name = true;
     } else if (name == "gbuffer") {
       gbuffer = true;
@@ -162,8 +165,8 @@ AovSelection parse_aov_selection(std::string_view list) {
       if (spectral.count > 0) throw UsageError(fmt::format("'{}': the spectral layer is given twice", list));
       spectral = *buckets;
     } else {
-      auto it = std::find_if(std::begin(kAllAovs), std::end(kAllAovs), [&](Aov a) { return aov_name(a) == name; });
-      if (it == std::end(kAllAovs))
+      auto it = std::find_if(std::begin(kNamedAovs), std::end(kNamedAovs), [&](Aov a) { return aov_name(a) == name; });
+      if (it == std::end(kNamedAovs))
         throw UsageError(name.empty() ? fmt::format("empty AOV name in '{}' (valid: {})", list, aov_names())
                                                  : fmt::format("unknown AOV '{}' (valid: {})", name, aov_names()));
       chosen[size_t(*it)] = true;
@@ -185,7 +188,7 @@ AovSelection parse_aov_selection(std::string_view list) {
   }
   if (!any_layer_name && spectral.count == 0)
     throw UsageError(fmt::format("'{}' names no AOV layer (valid: {})", list, aov_names()));
-  for (Aov aov : kAllAovs)
+  for (Aov aov : kNamedAovs)
     if (chosen[size_t(aov)]) selection.layers.push_back(aov);
   if (spectral.count > 0) {
     selection.layers.push_back(Aov::Spectral);
@@ -213,8 +216,8 @@ AovFilm::AovFilm(int width, int height, const AovSelection& selection, const Aov
     : width_(width), height_(height), space_(selection.space), naming_(selection.naming), camera_(camera) {
   // The written order, each once: candela's canonical order, or pbrt-v4's channel order.
   const bool pbrt = naming_ == AovNaming::PbrtGbuffer;
-  const auto order_begin = pbrt ? std::begin(kPbrtGbufferAovs) : std::begin(kAllAovs);
-  const auto order_end = pbrt ? std::end(kPbrtGbufferAovs) : std::end(kAllAovs);
+  const auto order_begin = pbrt ? std::begin(kPbrtGbufferAovs) : std::begin(kNamedAovs);
+  const auto order_end = pbrt ? std::end(kPbrtGbufferAovs) : std::end(kNamedAovs);
   for (auto it = order_begin; it != order_end; ++it)
     if (std::find(selection.layers.begin(), selection.layers.end(), *it) != selection.layers.end())
       layers_.push_back(*it);
@@ -226,11 +229,13 @@ AovFilm::AovFilm(int width, int height, const AovSelection& selection, const Aov
     offset = int(stride_);
     stride_ += n;
   };
-  if (wants(Aov::Albedo)) keep(albedo_, 3);
-  if (wants(Aov::Normal)) keep(normal_, 3);
-  if (wants(Aov::Depth) || wants(Aov::Position) || wants(Aov::Uv) || wants(Aov::DepthDerivatives))
+  const bool halves = wants(Aov::Halves);  // the denoiser's features, per half
+  if (wants(Aov::Albedo) || halves) keep(albedo_, 3);
+  if (wants(Aov::Normal) || halves) keep(normal_, 3);
+  if (wants(Aov::Depth) || wants(Aov::Position) || wants(Aov::Uv) || wants(Aov::DepthDerivatives) || halves)
     keep(hit_weight_, 1);
-  if (wants(Aov::Depth)) keep(depth_, 1);
+  if (wants(Aov::Depth) || halves) keep(depth_, 1);
+  if (halves) keep(half_features_, 9);
   if (wants(Aov::Position)) keep(position_, 3);
   if (wants(Aov::GeometricNormal)) keep(geometric_normal_, 3);
   if (wants(Aov::Uv)) keep(uv_, 2);
@@ -241,10 +246,22 @@ AovFilm::AovFilm(int width, int height, const AovSelection& selection, const Aov
 
 bool AovFilm::wants(Aov aov) const { return std::find(layers_.begin(), layers_.end(), aov) != layers_.end(); }
 
-void AovFilm::add_sample(int x, int y, const AovSample& s, float weight) {
+void AovFilm::add_sample(int x, int y, const AovSample& s, float weight, bool first_half) {
   double* px = sums(x, y);
   const double w = weight;
   px[0] += w;
+  if (half_features_ >= 0 && first_half) {
+    double* half = px + half_features_;
+    half[0] += w;
+    for (int c = 0; c < 3; ++c) half[1 + c] += w * s.albedo[c];
+    half[4] += w * s.normal.x;
+    half[5] += w * s.normal.y;
+    half[6] += w * s.normal.z;
+    if (s.hit) {
+      half[7] += w;
+      half[8] += w * s.depth;
+    }
+  }
   if (albedo_ >= 0)
     for (int c = 0; c < 3; ++c) px[albedo_ + c] += w * s.albedo[c];
   const bool camera_space = space_ == AovSpace::Camera;
@@ -297,6 +314,8 @@ void AovFilm::add_spectral_sample(int x, int y, const RGB& values, const Wavelen
     px[2 * b + 1] += w;
   }
 }
+
+bool AovSelection::wants(Aov aov) const { return std::find(layers.begin(), layers.end(), aov) != layers.end(); }
 
 bool AovFilm::empty() const {
   // Every layer's sums are weights or weighted values: nothing added leaves them all 0.
@@ -376,6 +395,37 @@ std::vector<AovLayer> AovFilm::images(const Film& film) const {
             const RGB v = pixel_variance(x, y);
             const RGB m = film.pixel(x, y).mean();
             for (int c = 0; c < 3; ++c) out[c] = m[c] != 0 ? v[c] / m[c] : 0.0f;
+            break;
+          }
+          case Aov::Halves: {
+            // A pixel without both halves: its mean twice.
+            PixelHalves halves;
+            if (!film.pixel_halves(x, y, halves)) {
+              const RGB m = film.pixel(x, y).mean();
+              for (int c = 0; c < 3; ++c) halves.a[c] = halves.b[c] = m[c];
+            }
+            for (int c = 0; c < 3; ++c) {
+              out[c] = float(halves.a[c]);
+              out[3 + c] = float(halves.b[c]);
+            }
+            out[6] = float(halves.share_a);
+            // Each half's features: A's sums, and B's as the totals less A's (a half without samples,
+            // as where the AOVs had a pass of their own: the pixel's).
+            const double* half = px + half_features_;
+            const double weight_b = weight - half[0], hit_b = hit_weight - half[7];
+            const bool split = half[0] > 0 && weight_b > 0;
+            for (int h = 0; h < 2; ++h) {
+              float* f = out + 7 + 7 * h;
+              const double wsum = !split ? weight : h == 0 ? half[0] : weight_b;
+              const double hsum = !split ? hit_weight : h == 0 ? half[7] : hit_b;
+              for (int c = 0; c < 6; ++c) {
+                const double total = px[(c < 3 ? albedo_ : normal_) + c % 3];
+                const double v = !split ? total : h == 0 ? half[1 + c] : total - half[1 + c];
+                f[c] = wsum > 0 ? float(v / wsum) : 0.0f;
+              }
+              const double depth = !split ? px[depth_] : h == 0 ? half[8] : px[depth_] - half[8];
+              f[6] = hsum > 0 ? float(depth / hsum) : kAovMissDepth;
+            }
             break;
           }
           case Aov::Spectral:

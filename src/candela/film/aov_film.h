@@ -14,6 +14,13 @@
 //   depth_derivatives DepthDerivatives.X, .Y             |dz/dx|, |dz/dy|: how the first hit's z changes
 //                                                        per pixel step right and down (on its tangent plane)
 //   relative_variance RelativeVariance.R, .G, .B         the variance layer over the pixel's mean
+//   halves            Halves.A.R, .A.G, .A.B, .B.R, .B.G, .B.B, Halves.ShareA, and per half
+//                     Halves.A.Albedo.R/G/B, Halves.A.Normal.X/Y/Z, Halves.A.Depth.Z (and B.)
+//                                                        the pixel's two independent estimates (the halves
+//                                                        of its samples: Film::pixel_halves), half A's share
+//                                                        of its weight, and each half's albedo, normal and
+//                                                        depth, for the denoiser (denoise/denoiser.h); asking
+//                                                        for it renders with two independent halves
 //   spectral:N[:MIN:MAX] S0.389,375nm, ...             pbrt-v4's Film "spectral": the radiance in N equal
 //                                                        wavelength buckets over [MIN, MAX] nm (16 over
 //                                                        [360, 830] by default), in the OpenEXR spectral
@@ -60,11 +67,16 @@ enum class Aov : uint8_t {
   Uv,
   DepthDerivatives,
   RelativeVariance,
+  Halves,   // not in kAllAovs: it changes the sampler (two independent halves)
   Spectral  // not in kAllAovs: "all" stays renderable without spectral transport
 };
 inline constexpr Aov kAllAovs[] = {Aov::Albedo,   Aov::Normal,          Aov::Depth, Aov::Position,
                                    Aov::SampleCount, Aov::Variance,      Aov::GeometricNormal, Aov::Uv,
                                    Aov::DepthDerivatives, Aov::RelativeVariance};
+// Every layer with a name of its own, in the order written (the spectral one comes last).
+inline constexpr Aov kNamedAovs[] = {Aov::Albedo,   Aov::Normal,          Aov::Depth, Aov::Position,
+                                     Aov::SampleCount, Aov::Variance,      Aov::GeometricNormal, Aov::Uv,
+                                     Aov::DepthDerivatives, Aov::RelativeVariance, Aov::Halves};
 // pbrt-v4's Film "gbuffer": its layers, in the order it lists its channels.
 inline constexpr Aov kPbrtGbufferAovs[] = {Aov::Albedo, Aov::Position, Aov::DepthDerivatives, Aov::GeometricNormal,
                                            Aov::Normal, Aov::Uv,       Aov::Variance,         Aov::RelativeVariance};
@@ -98,11 +110,12 @@ struct AovSelection {
   AovNaming naming = AovNaming::Candela;
   SpectralBuckets spectral;  // with Aov::Spectral in `layers`
   bool empty() const { return layers.empty(); }
+  bool wants(Aov aov) const;
   bool wants_spectral() const { return spectral.count > 0; }
 };
 
 // The name --aov and the scene's "aovs" take: "albedo", "normal", "depth", "position", "spp",
-// "variance", "geometric_normal", "uv", "depth_derivatives", "relative_variance", "spectral".
+// "variance", "geometric_normal", "uv", "depth_derivatives", "relative_variance", "halves", "spectral".
 std::string_view aov_name(Aov aov);
 // The names above (and "all", "gbuffer", "camera_space", "world_space"), for messages.
 std::string aov_names();
@@ -175,7 +188,7 @@ class AovFilm {
   AovNaming naming() const { return naming_; }
   bool wants(Aov aov) const;
   // Whether the layers need the surface's BSDF and shading frame (albedo, normal), or only the hit.
-  bool needs_shading() const { return wants(Aov::Albedo) || wants(Aov::Normal); }
+  bool needs_shading() const { return albedo_ >= 0 || normal_ >= 0; }
   // Whether any layer is added up from camera samples (all but spp, variance, relative_variance).
   bool has_sample_layers() const { return stride_ > 1; }
   // Whether any layer needs what the camera ray sees first (render/first_hit_aovs.h): all of those
@@ -183,7 +196,9 @@ class AovFilm {
   bool has_first_hit_layers() const { return stride_ - 2 * size_t(spectral_.count) > 1; }
   const SpectralBuckets& spectral() const { return spectral_; }
 
-  void add_sample(int x, int y, const AovSample& s, float weight);
+  // `first_half`: the sample is among the pixel's first half (Film::add_sample), which the halves
+  // layer's features keep apart.
+  void add_sample(int x, int y, const AovSample& s, float weight, bool first_half = true);
   // The spectral layer's share of a camera sample: `values` at the wavelengths `wl` (a spectral
   // render's sample before it becomes RGB), with the sample's filter weight; `max_component` > 0
   // scales values whose largest lane over the CIE Y integral exceeds it down to it (pbrt-v4's
@@ -213,6 +228,8 @@ class AovFilm {
   // Offsets into a pixel's sums (-1: not kept). [0] is always the sum of the weights.
   int albedo_ = -1, normal_ = -1, hit_weight_ = -1, depth_ = -1, position_ = -1, geometric_normal_ = -1, uv_ = -1,
       depth_derivatives_ = -1;
+  // The halves layer's sums of the first half's samples: weight, albedo, normal, hit weight, depth.
+  int half_features_ = -1;
   // The spectral layer: per bucket the sums of w L / pdf and of w / pdf (their ratio is the bucket's mean).
   int spectral_offset_ = -1;
   SpectralBuckets spectral_;

@@ -74,7 +74,7 @@ TEST(Aovs, ParsesNamesAndRefusesUnknownOnes) {
   } catch (const UsageError& e) {
     EXPECT_STREQ(e.what(),
                  "unknown AOV 'colour' (valid: albedo, normal, depth, position, spp, variance, geometric_normal, uv, "
-                 "depth_derivatives, relative_variance, spectral[:N[:MIN:MAX]], all, gbuffer, camera_space, world_space)");
+                 "depth_derivatives, relative_variance, halves, spectral[:N[:MIN:MAX]], all, gbuffer, camera_space, world_space)");
   }
   EXPECT_THROW(parse_aovs("albedo,,normal"), UsageError);
 }
@@ -355,7 +355,7 @@ TEST(Aovs, CommandLineRefusesUnknownNamesAndUnkeptCombinations) {
   testing::CommandResult r = testing::run_command(run_cli("render " + scene + " -o " + out + " --aov albedo,colour -q"));
   EXPECT_EQ(r.exit_code, kExitUsage) << r.output;
   EXPECT_NE(r.output.find("--aov: unknown AOV 'colour' (valid: albedo, normal, depth, position, spp, variance, "
-                          "geometric_normal, uv, depth_derivatives, relative_variance, spectral[:N[:MIN:MAX]], all, gbuffer"),
+                          "geometric_normal, uv, depth_derivatives, relative_variance, halves, spectral[:N[:MIN:MAX]], all, gbuffer"),
             std::string::npos)
       << r.output;
   EXPECT_FALSE(fs::exists(out));
@@ -666,5 +666,44 @@ TEST(Aovs, CommandLineWritesTheSpectralLayout) {
   EXPECT_NE(r.output.find("not kept by the bdpt integrator"), std::string::npos) << r.output;
   fs::remove_all(dir);
 }
+}  // namespace
+}  // namespace candela
+
+namespace candela {
+namespace {
+
+// The halves layer: each half's colour mean and share from the film, and each half's own features,
+// kept apart by the sample's half (a pixel's first sample in half A, its other two in half B).
+TEST(Aovs, HalvesLayerKeepsEachHalfsColourAndFeatures) {
+  Film film(1, 1);
+  AovFilm aovs(1, 1, parse_aov_selection("halves"), AovCameraFrame{});
+  EXPECT_TRUE(aovs.needs_shading());  // the features need the first hit's BSDF
+  AovSample hit_a, hit_b;
+  hit_a.hit = hit_b.hit = true;
+  hit_a.albedo = RGB(0.2f, 0.4f, 0.6f);
+  hit_b.albedo = RGB(0.8f, 0.8f, 0.8f);
+  hit_a.normal = {0, 1, 0};
+  hit_b.normal = {1, 0, 0};
+  hit_a.depth = 2;
+  hit_b.depth = 5;
+  film.add_sample(0, 0, RGB(1.0f), 1, true);
+  aovs.add_sample(0, 0, hit_a, 1, true);
+  for (int k = 0; k < 2; ++k) {
+    film.add_sample(0, 0, RGB(4.0f), 1, false);
+    aovs.add_sample(0, 0, hit_b, 1, false);
+  }
+  const std::vector<AovLayer> layers = aovs.images(film);
+  ASSERT_EQ(layers.size(), 1u);
+  const AovLayer& halves = layers[0];
+  ASSERT_EQ(halves.channels.size(), 21u);
+  EXPECT_EQ(halves.name, "Halves");
+  const std::vector<float> expected = {1, 1, 1, 4, 4, 4, 1.0f / 3,                     // A, B, ShareA
+                                       0.2f, 0.4f, 0.6f, 0, 1, 0, 2,                   // A's albedo, normal, depth
+                                       0.8f, 0.8f, 0.8f, 1, 0, 0, 5};                  // B's
+  for (size_t c = 0; c < expected.size(); ++c)
+    EXPECT_NEAR(halves.values[c], expected[c], 1e-6f) << halves.channels[c];
+  EXPECT_EQ(exr_channels(layers).names[7], "Halves.A.Albedo.R");
+}
+
 }  // namespace
 }  // namespace candela

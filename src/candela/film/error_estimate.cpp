@@ -61,38 +61,45 @@ bool floor_can_matter(const BoxSums& box, size_t at, double own, bool any_negati
 
 BoxSums box_sums(const std::vector<double>& v, int w, int h, int r) {
   const size_t row = 3 * size_t(w);
-  // Along x: each row's window sums; then along y: each output row adds the rows of its window
-  // (contiguous, so the compiler vectorises it). Rows in parallel; the same sums for any thread count.
+  // Along x: each row's window sums, as running sums; then along y, each column's running sums.
+  // Rows (then columns) in parallel, each summed in one order: the same sums for any thread count.
   std::vector<double> row_sums(v.size()), row_counts(v.size());
   tbb::parallel_for(tbb::blocked_range<int>(0, h, 16), [&](const tbb::blocked_range<int>& range) {
     for (int y = range.begin(); y < range.end(); ++y) {
       const double* in = v.data() + size_t(y) * row;
       double* sums = row_sums.data() + size_t(y) * row;
       double* counts = row_counts.data() + size_t(y) * row;
-      for (int x = 0; x < w; ++x)
-        for (int k = std::max(0, x - r); k <= std::min(w - 1, x + r); ++k)
-          for (int c = 0; c < 3; ++c) {
-            const double value = in[3 * size_t(k) + size_t(c)];
-            const bool has = !std::isnan(value);
-            sums[3 * size_t(x) + size_t(c)] += has ? value : 0;
-            counts[3 * size_t(x) + size_t(c)] += has ? 1 : 0;
+      for (int c = 0; c < 3; ++c) {
+        auto value = [&](int x) { return in[3 * size_t(x) + size_t(c)]; };
+        double sum = 0, count = 0;
+        for (int x = 0; x <= std::min(w - 1, r); ++x)
+          if (!std::isnan(value(x))) sum += value(x), count += 1;
+        for (int x = 0; x < w; ++x) {
+          if (x > 0) {
+            if (x + r < w && !std::isnan(value(x + r))) sum += value(x + r), count += 1;
+            if (x - r - 1 >= 0 && !std::isnan(value(x - r - 1))) sum -= value(x - r - 1), count -= 1;
           }
+          sums[3 * size_t(x) + size_t(c)] = sum;
+          counts[3 * size_t(x) + size_t(c)] = count;
+        }
+      }
     }
   });
   BoxSums box;
   box.sums.assign(v.size(), 0);
   box.counts.assign(v.size(), 0);
-  tbb::parallel_for(tbb::blocked_range<int>(0, h, 16), [&](const tbb::blocked_range<int>& range) {
-    for (int y = range.begin(); y < range.end(); ++y) {
-      double* sums = box.sums.data() + size_t(y) * row;
-      double* counts = box.counts.data() + size_t(y) * row;
-      for (int k = std::max(0, y - r); k <= std::min(h - 1, y + r); ++k) {
-        const double* from_sums = row_sums.data() + size_t(k) * row;
-        const double* from_counts = row_counts.data() + size_t(k) * row;
-        for (size_t i = 0; i < row; ++i) {
-          sums[i] += from_sums[i];
-          counts[i] += from_counts[i];
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, row, 64), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i < range.end(); ++i) {
+      double sum = 0, count = 0;
+      for (int y = 0; y <= std::min(h - 1, r); ++y) sum += row_sums[size_t(y) * row + i], count += row_counts[size_t(y) * row + i];
+      for (int y = 0; y < h; ++y) {
+        if (y > 0) {
+          if (y + r < h) sum += row_sums[size_t(y + r) * row + i], count += row_counts[size_t(y + r) * row + i];
+          if (y - r - 1 >= 0)
+            sum -= row_sums[size_t(y - r - 1) * row + i], count -= row_counts[size_t(y - r - 1) * row + i];
         }
+        box.sums[size_t(y) * row + i] = sum;
+        box.counts[size_t(y) * row + i] = count;
       }
     }
   });
@@ -144,25 +151,21 @@ HalfStatistics half_statistics(const Film& film, double scale_relative_error) {
         const PixelSums& p = film.pixel(x, y);
         if (p.count == 0) continue;  // not rendered (a part, one pixel)
         ++counts.rendered;
-        const double w_a = p.half_weight, w_b = p.weight - p.half_weight;
-        if (p.half_count == 0 || p.half_count == p.count || w_a == 0 || w_b == 0) {
+        PixelHalves halves;
+        if (!film.pixel_halves(x, y, halves)) {
           ++counts.missing;
           continue;
         }
-        // The pixel sums' share of the weight in the first half sets how the halves combine (the
-        // splats split about evenly too).
-        const double f = w_a / p.weight;
+        const double f = halves.share_a;
         const RGB splat_all = splats ? film.splats().at(x, y) : RGB(0.0f);
-        const RGB splat_a = splats ? film.half_splats().at(x, y) : RGB(0.0f);
         for (int c = 0; c < 3; ++c) {
-          const double s_all = double(splat_all[c]) * scale, s_a = double(splat_a[c]) * scale;
-          const double a = p.half_weighted[c] / w_a + (splats ? s_a / f_splat : 0);
-          const double b = (p.weighted[c] - p.half_weighted[c]) / w_b + (splats ? (s_all - s_a) / (1 - f_splat) : 0);
+          const double s_all = double(splat_all[c]) * scale;
+          const double a = halves.a[c], b = halves.b[c];
           mean[3 * i + size_t(c)] = p.weighted[c] / p.weight + s_all;
           counts.negative = counts.negative || mean[3 * i + size_t(c)] < 0;
           lesser_half[3 * i + size_t(c)] = std::min(a, b);
           if (splats) {
-            const double sa = s_a / f_splat, sb = (s_all - s_a) / (1 - f_splat);
+            const double sa = halves.splat_a[c], sb = halves.splat_b[c];
             splat_variance[3 * i + size_t(c)] = f_splat * (1 - f_splat) * (sa - sb) * (sa - sb);
           }
           variance[3 * i + size_t(c)] =
@@ -278,6 +281,34 @@ ErrorSums sum_pixel_errors(const HalfStatistics& s, bool splats, int w, int h, s
   return total;
 }
 }  // namespace
+
+std::vector<double> estimated_truth_squared(int w, int h, const std::vector<float>& a, const std::vector<float>& b,
+                                            const std::vector<float>& share_a) {
+  const size_t n = size_t(w) * size_t(h);
+  HalfStatistics s;
+  s.mean.resize(3 * n);
+  s.variance.resize(3 * n);
+  s.lesser_half.resize(3 * n);
+  for (size_t i = 0; i < 3 * n; ++i) {
+    const double f = share_a[i / 3];
+    s.mean[i] = f * a[i] + (1 - f) * b[i];
+    s.variance[i] = f * (1 - f) * (double(a[i]) - b[i]) * (double(a[i]) - b[i]);
+    s.lesser_half[i] = std::min(a[i], b[i]);
+    s.any_negative = s.any_negative || s.mean[i] < 0;
+  }
+  const std::vector<double> local = box_mean(s.mean, w, h, kLocalRadius);
+  const BoxSums firefly_box = box_sums(s.mean, w, h, kFireflyRadius);
+  std::vector<double> truth_sq(3 * n);
+  tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& range) {
+    for (int y = range.begin(); y < range.end(); ++y)
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < 3; ++c) {
+          const size_t at = 3 * (size_t(y) * size_t(w) + size_t(x)) + size_t(c);
+          truth_sq[at] = truth_squared(s, local, firefly_box, w, h, x, y, c, at);
+        }
+  });
+  return truth_sq;
+}
 
 ErrorEstimate estimate_error(const Film& film, double scale_relative_error, std::vector<double>* pixel_errors) {
   ErrorEstimate e;

@@ -39,6 +39,27 @@ RGB PixelSums::standard_error() const {
   return RGB(se[0], se[1], se[2]);
 }
 
+bool Film::pixel_halves(int x, int y, PixelHalves& out) const {
+  const PixelSums& p = pixel(x, y);
+  const double w_a = p.half_weight, w_b = p.weight - p.half_weight;
+  if (p.count == 0 || p.half_count == 0 || p.half_count == p.count || w_a == 0 || w_b == 0) return false;
+  // The pixel sums' share of the weight in the first half sets how the halves combine (the splats
+  // split about evenly too).
+  out.share_a = w_a / p.weight;
+  const bool splats = has_splats();
+  const double scale = splats ? splat_scale() : 0, f_splat = splats ? splat_half_fraction() : 0.5;
+  const RGB splat_all = splats ? splats_.at(x, y) : RGB(0.0f);
+  const RGB splat_first = splats ? half_splats_.at(x, y) : RGB(0.0f);
+  for (int c = 0; c < 3; ++c) {
+    const double s_all = double(splat_all[c]) * scale, s_a = double(splat_first[c]) * scale;
+    out.splat_a[c] = splats ? s_a / f_splat : 0;
+    out.splat_b[c] = splats ? (s_all - s_a) / (1 - f_splat) : 0;
+    out.a[c] = p.half_weighted[c] / w_a + out.splat_a[c];
+    out.b[c] = (p.weighted[c] - p.half_weighted[c]) / w_b + out.splat_b[c];
+  }
+  return true;
+}
+
 Image Film::mean_image() const {
   const double scale = has_splats() ? splat_scale() : 0;
   return image_of(width_, height_, [&](int x, int y) {

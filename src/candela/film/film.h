@@ -60,6 +60,15 @@ class SplatImage {
   std::vector<int64_t> sums_;
 };
 
+// A pixel's two independent estimates (film/error_estimate.h): the first half's samples and splats
+// (A) and the second half's (B), the splats' part of each, and A's share of the pixel's weight, so
+// that the pixel's mean is share_a A + (1 - share_a) B.
+struct PixelHalves {
+  double a[3] = {0, 0, 0}, b[3] = {0, 0, 0};
+  double splat_a[3] = {0, 0, 0}, splat_b[3] = {0, 0, 0};
+  double share_a = 0.5;
+};
+
 class Film {
  public:
   Film(int width, int height) : width_(width), height_(height), pixels_(size_t(width) * size_t(height)) {}
@@ -107,6 +116,9 @@ class Film {
   // All pixels, row-major: for checkpoints, which store and restore the sums bit for bit.
   const std::vector<PixelSums>& pixels() const { return pixels_; }
   std::vector<PixelSums>& pixels() { return pixels_; }
+
+  // Pixel (x, y)'s halves; false (and `out` untouched) where it has no samples or lacks a half.
+  bool pixel_halves(int x, int y, PixelHalves& out) const;
 
   // Per pixel: the mean of its samples plus its splats times splat_scale().
   Image mean_image() const;

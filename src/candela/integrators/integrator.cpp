@@ -119,6 +119,10 @@ void check_capabilities(const IntegratorTraits& integrator, const CapabilityNeed
     throw UsageError(fmt::format("--target-error: the {} integrator gives no error estimate (its pixels have no two "
                                  "independent halves)",
                                  name));
+  if (needs.denoise && integrator.progressive)
+    throw UsageError(fmt::format("--denoise: the {} integrator's pixels have no two independent halves, from which the "
+                                 "denoiser estimates its filters' error",
+                                 name));
   if (needs.media && !integrator.participating_media)
     throw UsageError(fmt::format(
         "the scene has participating media, which the {} integrator does not render: use --integrator volpath", name));

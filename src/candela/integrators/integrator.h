@@ -52,6 +52,7 @@ struct CapabilityNeeds {
   bool adaptive = false;         // adaptive sampling
   bool media = false;            // a scene with participating media
   bool target_error = false;     // stop at an error target (--target-error), from the film's two halves
+  bool denoise = false;          // denoise from the film's two halves (--denoise)
   bool spectral_layer = false;   // a spectral film's buckets (pbrt-v4's Film "spectral", --aov spectral)
 };
 

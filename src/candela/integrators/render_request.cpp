@@ -13,6 +13,7 @@
 #include <tuple>
 
 #include "candela/integrators/integrator.h"
+#include "candela/sampling/zsobol_sampler.h"
 
 namespace candela {
 namespace {
@@ -64,9 +65,9 @@ void apply_options(const RenderRequest& request, SceneDesc& scene) {
   // budget, not the count.
   const IntegratorTraits* traits = find_integrator_traits(rs.integrator);
   const bool chooses = traits && traits->chooses;
-  // An error estimate needs two independent halves of every pixel's samples; with a target the
-  // spp is the most a pixel may get (--spp, or 65536).
-  if (request.estimate_error || request.target_error || chooses) rs.sampler.replicas = true;
+  // An error estimate, and the denoiser's choice of filters, need two independent halves of every
+  // pixel's samples; with a target the spp is the most a pixel may get (--spp, or 65536).
+  if (request.estimate_error || request.target_error || request.denoise || chooses) rs.sampler.replicas = true;
   if (chooses && !request.target_error) rs.spp = kTargetErrorMaxSpp;
   if (request.target_error) rs.spp = request.spp.value_or(kTargetErrorMaxSpp);
 }
@@ -74,6 +75,13 @@ void apply_options(const RenderRequest& request, SceneDesc& scene) {
 // The settings as applied agree with each other.
 void check_settings(const RenderRequest& request, const SceneDesc& scene) {
   const RenderSettings& rs = scene.settings;
+  // ZSobol's replicas alternate in blocks of 8 samples (sampling/samplers.h): fewer than two blocks
+  // leave a pixel one half, and the denoiser nothing to check its fits against.
+  if (request.denoise && rs.sampler.type == SamplerType::ZSobol && !rs.adaptive() && !request.target_error &&
+      rs.spp < 2 * int(ZSobolSampler::kReplicaBlock))
+    throw UsageError(fmt::format("--denoise needs two independent halves of every pixel's samples, which the zsobol "
+                                 "sampler makes in blocks of {} samples: give at least {} spp, or --sampler independent",
+                                 ZSobolSampler::kReplicaBlock, 2 * ZSobolSampler::kReplicaBlock));
   if (std::string problem = rs.mlt.problem(); !problem.empty())
     throw UsageError("--mlt-large-step, --mlt-lens, --mlt-caustic: " + problem);
   if (std::optional<SettingProblem> problem = adaptive_problem(rs))
@@ -149,6 +157,13 @@ void plan_pixels(const RenderRequest& request, const SceneDesc& scene, RenderPla
       throw UsageError("--part cannot be combined with --target-error (the error is the whole image's)");
     if (plan.one_pixel()) throw UsageError("--part cannot be combined with --pixel");
   }
+  // The denoiser reads the whole image's AOVs, which neither parts nor checkpoints keep.
+  if (request.denoise && plan.one_pixel())
+    throw UsageError("--denoise cannot be combined with --pixel (it denoises a whole image)");
+  if (request.denoise && !request.part.empty())
+    throw UsageError("--denoise cannot be combined with --part (parts do not keep the AOVs the denoiser reads)");
+  if (request.denoise && !request.resume.empty())
+    throw UsageError("--denoise cannot be combined with --resume (checkpoints do not keep the AOVs the denoiser reads)");
 }
 
 // The outputs besides the image, and whether they can be made.
@@ -160,6 +175,7 @@ void plan_outputs(const RenderRequest& request, RenderPlan& plan) {
   plan.strategy_images = request.bdpt_strategies;
   plan.strategy_images_unweighted = request.bdpt_unweighted;
   plan.report_error = request.estimate_error;
+  plan.denoise = request.denoise;
   plan.checkpoint = request.checkpoint;
   plan.resume = request.resume;
 }
@@ -182,7 +198,8 @@ RenderPlan plan_render(const RenderRequest& request, SceneDesc& scene) {
                                         .strategy_images = !request.bdpt_strategies.empty(),
                                         .adaptive = scene.settings.adaptive(),
                                         .media = !scene.media.empty(),
-                                        .target_error = request.target_error.has_value()});
+                                        .target_error = request.target_error.has_value(),
+                                        .denoise = request.denoise});
   plan_outputs(request, plan);
   plan.time_limit_seconds = request.time_limit.empty() ? 0 : parse_duration("--time-limit", request.time_limit);
   plan.target_error = request.target_error.value_or(0.0);

@@ -45,6 +45,9 @@ struct RenderPlan {
   // halves), the film's checkpoint (empty: none) and the integrator's strategy images (a directory;
   // empty: none), MIS weighted or not.
   bool report_error = false;
+  // Denoise the image (denoise/denoised_render.h): the AOV film collects the denoiser's features
+  // (kDenoiseFeatures) and the sampler makes two independent halves.
+  bool denoise = false;
   std::string checkpoint, resume;
   std::string strategy_images;
   bool strategy_images_unweighted = false;

@@ -91,7 +91,8 @@ class CameraSampleTiles final : public TileIntegrator {
       // are their own: the sampler above is untouched).
       if (context.aovs && context.aovs->has_first_hit_layers())
         context.aovs->add_sample(
-            x, y, first_hit_aovs(context.scene, ray, context.aovs->needs_shading(), x, y, s, context.seed), fs.weight);
+            x, y, first_hit_aovs(context.scene, ray, context.aovs->needs_shading(), x, y, s, context.seed), fs.weight,
+            first_half);
     }
   }
 
