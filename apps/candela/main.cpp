@@ -832,7 +832,7 @@ int main(int argc, char** argv) {
   CLI::App* denoise_cmd = app.add_subcommand(
       "denoise", "Denoise an .exr written with --aov halves (docs/denoising.md): the output's "
                  "colour is denoised, the raw image kept as its layer Noisy, the denoised image's estimated relMSE reported");
-  denoise_cmd->add_option("input", denoise_input_file, "The render (.exr with the halves, albedo, normal and depth layers)")
+  denoise_cmd->add_option("input", denoise_input_file, "The render (an .exr written with --aov halves)")
       ->required();
   denoise_cmd->add_option("-o,--output", denoise_output, "The image to write (.exr, .png or .pfm)")->required();
   std::vector<std::string> merge_inputs;
