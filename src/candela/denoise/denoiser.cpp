@@ -8,8 +8,10 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <span>
 
 #include "candela/base/error.h"
+#include "candela/base/image_buffer.h"
 #include "candela/film/aov_film.h"
 #include "candela/film/film.h"
 
@@ -28,7 +30,7 @@ constexpr int kTargets = 3;  // the colour's three channels
 constexpr int kMomentF = 0, kMomentFF = kFeatures, kMomentY = kMomentFF + kFeaturePairs,
               kMomentFY = kMomentY + kTargets, kMoments = kMomentFY + kFeatures * kTargets;
 // Rows per strip: each strip starts its running sums afresh, so strips (not threads) fix the rounding.
-constexpr int kStripRows = 32;
+constexpr int kStripRows = 64;
 // The ridge added to each feature's variance in a window: relative (so that a feature's scale does
 // not matter) and absolute (so that a feature constant over the window gets no weight).
 constexpr double kRidgeRelative = 0.01, kRidgeAbsolute = 1e-4;
@@ -39,6 +41,14 @@ constexpr float kFireflyNeighbourFactor = 2, kFireflyMeanFactor = 4;
 // 16, 32 and 64 spp lay in 0.49-1.82 (docs/denoising.md).
 constexpr double kSystematicFactor = 2.5;
 
+// f(i) for every i < count, in parallel (each i on its own: the same result for any thread count).
+template <class F>
+void for_each_index(size_t count, const F& f) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, size_t(1) << 14), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i < range.end(); ++i) f(i);
+  });
+}
+
 int feature_pair(int k, int l) {  // k <= l
   return k * kFeatures - k * (k - 1) / 2 + (l - k);
 }
@@ -46,9 +56,9 @@ int feature_pair(int k, int l) {  // k <= l
 // Sums of `values` (`channels` floats per pixel) over the (2r+1)^2 window around each pixel (clipped
 // at the image's edges), divided by the window's pixel count: separable running sums in double, rows
 // and then columns each in one order, so the same for any number of threads.
-std::vector<float> box_mean(const std::vector<float>& values, int channels, int w, int h, int r) {
+ImageBuffer<float> box_mean(std::span<const float> values, int channels, int w, int h, int r) {
   const size_t row = size_t(w) * size_t(channels);
-  std::vector<double> along_x(values.size());
+  ImageBuffer<double> along_x(values.size());
   tbb::parallel_for(tbb::blocked_range<int>(0, h, 16), [&](const tbb::blocked_range<int>& range) {
     std::vector<double> sum(static_cast<size_t>(channels));
     for (int y = range.begin(); y < range.end(); ++y) {
@@ -68,7 +78,7 @@ std::vector<float> box_mean(const std::vector<float>& values, int channels, int 
       }
     }
   });
-  std::vector<float> mean(values.size());
+  ImageBuffer<float> mean(values.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, row, 256), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i < range.end(); ++i) {
       const int x = int(i / size_t(channels));
@@ -91,8 +101,8 @@ std::vector<float> box_mean(const std::vector<float>& values, int channels, int 
 // The mean of `values` (one per pixel) over the (2r+1)^2 window around each pixel without the pixel
 // itself: a pixel's choice then does not depend on its own estimated error, so that the chosen
 // candidates' estimates, added up, are not biased low by the choice.
-std::vector<float> leave_one_out_mean(const std::vector<float>& values, int w, int h, int r) {
-  std::vector<float> mean = box_mean(values, 1, w, h, r);
+ImageBuffer<float> leave_one_out_mean(const ImageBuffer<float>& values, int w, int h, int r) {
+  ImageBuffer<float> mean = box_mean(values, 1, w, h, r);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const size_t i = size_t(y) * size_t(w) + size_t(x);
@@ -105,10 +115,10 @@ std::vector<float> leave_one_out_mean(const std::vector<float>& values, int w, i
 
 // The features of every pixel (kFeatures floats each) from one half's albedo, normal and depth;
 // `median` is the median depth of the pixels that hit something (inverse depth is relative to it).
-std::vector<float> make_features(const DenoiseInput& in, const std::vector<float>& albedo,
+ImageBuffer<float> make_features(const DenoiseInput& in, const std::vector<float>& albedo,
                                  const std::vector<float>& normal, const std::vector<float>& depth, float median) {
   const size_t n = size_t(in.width) * size_t(in.height);
-  std::vector<float> f(n * kFeatures);
+  ImageBuffer<float> f(n * kFeatures);
   tbb::parallel_for(tbb::blocked_range<int>(0, in.height, 16), [&](const tbb::blocked_range<int>& range) {
     for (int y = range.begin(); y < range.end(); ++y)
       for (int x = 0; x < in.width; ++x) {
@@ -151,63 +161,108 @@ struct WindowFit {
   }
 };
 
-// Solves the window's regression from its moment sums `S` over `count` pixels.
-inline void fit_window(const double* S, double count, WindowFit& fit) {
-  const double inv = 1.0 / count;
-  double* mean_f = fit.mean_f;
-  double* mean_y = fit.mean_y;
-  auto& beta = fit.beta;
-  for (int k = 0; k < kFeatures; ++k) mean_f[k] = S[kMomentF + k] * inv;
-  for (int j = 0; j < kTargets; ++j) mean_y[j] = S[kMomentY + j] * inv;
+// Windows fitted together: every step of a fit runs across the batch's windows in its innermost loop,
+// which the compiler vectorises (4 doubles per instruction with AVX2, chosen at run time where the CPU
+// has it; 2 with SSE2). Each window's arithmetic is the same either way: the same bytes on every CPU.
+constexpr int kBatch = 4;
+struct WindowBatch {
+  double S[kMoments][kBatch];  // the windows' moment sums
+  double count[kBatch];        // and pixel counts
+};
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define CANDELA_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define CANDELA_VECTOR_CLONES
+#endif
+
+// Solves the batch's regressions: the first `used` windows' fits into `fits`.
+CANDELA_VECTOR_CLONES void fit_windows(const WindowBatch& batch, int used, WindowFit* fits) {
+  using Lanes = double[kBatch];
+  const auto& S = batch.S;
+  Lanes inv, mean_f[kFeatures], mean_y[kTargets];
+  for (int p = 0; p < kBatch; ++p) inv[p] = 1.0 / batch.count[p];
+  for (int k = 0; k < kFeatures; ++k)
+    for (int p = 0; p < kBatch; ++p) mean_f[k][p] = S[kMomentF + k][p] * inv[p];
+  for (int j = 0; j < kTargets; ++j)
+    for (int p = 0; p < kBatch; ++p) mean_y[j][p] = S[kMomentY + j][p] * inv[p];
   // The features' covariance over the window, with the ridge; its Cholesky factor in place (lower),
   // with the reciprocals of its diagonal (multiplying is much faster than dividing).
-  double L[kFeatures][kFeatures], inv_diag[kFeatures];
+  Lanes L[kFeatures][kFeatures], inv_diag[kFeatures];
   for (int k = 0; k < kFeatures; ++k)
-    for (int l = k; l < kFeatures; ++l) L[l][k] = S[kMomentFF + feature_pair(k, l)] * inv - mean_f[k] * mean_f[l];
-  for (int k = 0; k < kFeatures; ++k) L[k][k] += kRidgeRelative * std::max(L[k][k], 0.0) + kRidgeAbsolute;
+    for (int l = k; l < kFeatures; ++l)
+      for (int p = 0; p < kBatch; ++p)
+        L[l][k][p] = S[kMomentFF + feature_pair(k, l)][p] * inv[p] - mean_f[k][p] * mean_f[l][p];
+  for (int k = 0; k < kFeatures; ++k)
+    for (int p = 0; p < kBatch; ++p) L[k][k][p] += kRidgeRelative * std::max(L[k][k][p], 0.0) + kRidgeAbsolute;
   for (int k = 0; k < kFeatures; ++k) {
-    double d = L[k][k];
-    for (int m = 0; m < k; ++m) d -= L[k][m] * L[k][m];
-    inv_diag[k] = 1.0 / std::sqrt(std::max(d, kRidgeAbsolute));
+    Lanes d;
+    for (int p = 0; p < kBatch; ++p) d[p] = L[k][k][p];
+    for (int m = 0; m < k; ++m)
+      for (int p = 0; p < kBatch; ++p) d[p] -= L[k][m][p] * L[k][m][p];
+    for (int p = 0; p < kBatch; ++p) inv_diag[k][p] = 1.0 / std::sqrt(std::max(d[p], kRidgeAbsolute));
     for (int l = k + 1; l < kFeatures; ++l) {
-      double v = L[l][k];
-      for (int m = 0; m < k; ++m) v -= L[l][m] * L[k][m];
-      L[l][k] = v * inv_diag[k];
+      Lanes v;
+      for (int p = 0; p < kBatch; ++p) v[p] = L[l][k][p];
+      for (int m = 0; m < k; ++m)
+        for (int p = 0; p < kBatch; ++p) v[p] -= L[l][m][p] * L[k][m][p];
+      for (int p = 0; p < kBatch; ++p) L[l][k][p] = v[p] * inv_diag[k][p];
     }
   }
   // The targets' covariances with the features; solve L L^T beta = c for all targets at once.
+  Lanes beta[kFeatures][kTargets];
   for (int k = 0; k < kFeatures; ++k) {
-    double v[kTargets];
-    for (int j = 0; j < kTargets; ++j) v[j] = S[kMomentFY + k * kTargets + j] * inv - mean_f[k] * mean_y[j];
+    Lanes v[kTargets];
+    for (int j = 0; j < kTargets; ++j)
+      for (int p = 0; p < kBatch; ++p) v[j][p] = S[kMomentFY + k * kTargets + j][p] * inv[p] - mean_f[k][p] * mean_y[j][p];
     for (int m = 0; m < k; ++m)
-      for (int j = 0; j < kTargets; ++j) v[j] -= L[k][m] * beta[m][j];
-    for (int j = 0; j < kTargets; ++j) beta[k][j] = v[j] * inv_diag[k];
+      for (int j = 0; j < kTargets; ++j)
+        for (int p = 0; p < kBatch; ++p) v[j][p] -= L[k][m][p] * beta[m][j][p];
+    for (int j = 0; j < kTargets; ++j)
+      for (int p = 0; p < kBatch; ++p) beta[k][j][p] = v[j][p] * inv_diag[k][p];
   }
   for (int k = kFeatures - 1; k >= 0; --k) {
-    double v[kTargets];
-    for (int j = 0; j < kTargets; ++j) v[j] = beta[k][j];
+    Lanes v[kTargets];
+    for (int j = 0; j < kTargets; ++j)
+      for (int p = 0; p < kBatch; ++p) v[j][p] = beta[k][j][p];
     for (int m = k + 1; m < kFeatures; ++m)
-      for (int j = 0; j < kTargets; ++j) v[j] -= L[m][k] * beta[m][j];
-    for (int j = 0; j < kTargets; ++j) beta[k][j] = v[j] * inv_diag[k];
+      for (int j = 0; j < kTargets; ++j)
+        for (int p = 0; p < kBatch; ++p) v[j][p] -= L[m][k][p] * beta[m][j][p];
+    for (int j = 0; j < kTargets; ++j)
+      for (int p = 0; p < kBatch; ++p) beta[k][j][p] = v[j][p] * inv_diag[k][p];
+  }
+  for (int p = 0; p < used; ++p) {
+    WindowFit& fit = fits[p];
+    for (int k = 0; k < kFeatures; ++k) fit.mean_f[k] = mean_f[k][p];
+    for (int j = 0; j < kTargets; ++j) fit.mean_y[j] = mean_y[j][p];
+    for (int k = 0; k < kFeatures; ++k)
+      for (int j = 0; j < kTargets; ++j) fit.beta[k][j] = beta[k][j][p];
   }
 }
 
-// Adds `sign` times the moments of row y's pixels (features `f`, targets `targets`) to `columns`.
-void add_row_moments(const float* f, const float* targets, int w, int y, double sign, std::vector<double>& columns) {
+// The moments of pixel i (features `f`, targets `targets`) into `m`.
+inline void pixel_moments(const float* f, const float* targets, size_t i, double* m) {
+  const float* F = f + i * kFeatures;
+  const float* Y = targets + i * kTargets;
+  for (int k = 0; k < kFeatures; ++k) {
+    m[kMomentF + k] = F[k];
+    for (int l = k; l < kFeatures; ++l) m[kMomentFF + feature_pair(k, l)] = double(F[k]) * double(F[l]);
+  }
+  for (int j = 0; j < kTargets; ++j) m[kMomentY + j] = Y[j];
+  for (int k = 0; k < kFeatures; ++k)
+    for (int j = 0; j < kTargets; ++j) m[kMomentFY + k * kTargets + j] = double(F[k]) * double(Y[j]);
+}
+
+// Moves the windows' column sums `columns` down: adds the moments of row `entering`'s pixels and takes
+// off those of row `leaving` (-1: none), in one pass over the columns.
+void slide_row_moments(const float* f, const float* targets, int w, int entering, int leaving,
+                       std::vector<double>& columns) {
+  double in[kMoments] = {}, out[kMoments] = {};
   for (int x = 0; x < w; ++x) {
-    const size_t i = size_t(y) * size_t(w) + size_t(x);
-    const float* F = f + i * kFeatures;
-    const float* Y = targets + i * kTargets;
+    if (entering >= 0) pixel_moments(f, targets, size_t(entering) * size_t(w) + size_t(x), in);
+    if (leaving >= 0) pixel_moments(f, targets, size_t(leaving) * size_t(w) + size_t(x), out);
     double* S = columns.data() + size_t(x) * kMoments;
-    double fs[kFeatures];
-    for (int k = 0; k < kFeatures; ++k) fs[k] = sign * double(F[k]);
-    for (int k = 0; k < kFeatures; ++k) {
-      S[kMomentF + k] += fs[k];
-      for (int l = k; l < kFeatures; ++l) S[kMomentFF + feature_pair(k, l)] += fs[k] * double(F[l]);
-    }
-    for (int j = 0; j < kTargets; ++j) S[kMomentY + j] += sign * double(Y[j]);
-    for (int k = 0; k < kFeatures; ++k)
-      for (int j = 0; j < kTargets; ++j) S[kMomentFY + k * kTargets + j] += fs[k] * double(Y[j]);
+    for (int m = 0; m < kMoments; ++m) S[m] = S[m] + in[m] - out[m];
   }
 }
 
@@ -215,9 +270,9 @@ void add_row_moments(const float* f, const float* targets, int w, int y, double 
 // floats per pixel. With `stride` 2 the windows are fitted at every other pixel of every other row
 // and each pixel takes the fit of the window centred at most a pixel away (a quarter of the solves;
 // for the wide windows the fit hardly moves in a pixel).
-std::vector<float> regress(const std::vector<float>& f, const std::vector<float>& targets, int w, int h, int r,
+ImageBuffer<float> regress(const ImageBuffer<float>& f, const ImageBuffer<float>& targets, int w, int h, int r,
                            int stride) {
-  std::vector<float> out(targets.size());
+  ImageBuffer<float> out(targets.size());
   const int strips = (h + kStripRows - 1) / kStripRows;  // kStripRows is a multiple of the stride
   tbb::parallel_for(tbb::blocked_range<int>(0, strips, 1), [&](const tbb::blocked_range<int>& range) {
     std::vector<double> columns(size_t(w) * kMoments);
@@ -226,19 +281,21 @@ std::vector<float> regress(const std::vector<float>& f, const std::vector<float>
       const int y0 = strip * kStripRows, y1 = std::min(h, y0 + kStripRows);
       std::fill(columns.begin(), columns.end(), 0.0);
       for (int y = std::max(0, y0 - r); y <= std::min(h - 1, y0 + r); ++y)
-        add_row_moments(f.data(), targets.data(), w, y, 1, columns);
+        slide_row_moments(f.data(), targets.data(), w, y, -1, columns);
       double S[kMoments];
+      WindowBatch batch{};
+      for (int p = 0; p < kBatch; ++p) batch.count[p] = 1;  // unused lanes: harmless numbers
       for (int y = y0; y < y1; ++y) {
-        if (y > y0) {
-          if (y + r < h) add_row_moments(f.data(), targets.data(), w, y + r, 1, columns);
-          if (y - r - 1 >= 0) add_row_moments(f.data(), targets.data(), w, y - r - 1, -1, columns);
-        }
+        if (y > y0 && (y + r < h || y - r - 1 >= 0))
+          slide_row_moments(f.data(), targets.data(), w, y + r < h ? y + r : -1, y - r - 1, columns);
         if ((y - y0) % stride == 0) {
           // A fitted row: the window sums along it, fitted at every stride-th pixel.
           const double rows = double(std::min(h - 1, y + r) - std::max(0, y - r) + 1);
           std::fill(S, S + kMoments, 0.0);
           for (int x = 0; x <= std::min(w - 1, r); ++x)
             for (int m = 0; m < kMoments; ++m) S[m] += columns[size_t(x) * kMoments + size_t(m)];
+          int batched = 0;  // windows waiting in the batch; the first is fit number `first`
+          size_t first = 0;
           for (int x = 0; x < w; ++x) {
             if (x > 0) {
               if (x + r < w)
@@ -247,9 +304,15 @@ std::vector<float> regress(const std::vector<float>& f, const std::vector<float>
                 for (int m = 0; m < kMoments; ++m) S[m] -= columns[size_t(x - r - 1) * kMoments + size_t(m)];
             }
             if (x % stride != 0) continue;
-            const double cols = double(std::min(w - 1, x + r) - std::max(0, x - r) + 1);
-            fit_window(S, rows * cols, row_fits[size_t(x / stride)]);
+            if (batched == 0) first = size_t(x / stride);
+            for (int m = 0; m < kMoments; ++m) batch.S[m][batched] = S[m];
+            batch.count[batched] = rows * double(std::min(w - 1, x + r) - std::max(0, x - r) + 1);
+            if (++batched == kBatch) {
+              fit_windows(batch, batched, &row_fits[first]);
+              batched = 0;
+            }
           }
+          if (batched > 0) fit_windows(batch, batched, &row_fits[first]);
         }
         for (int x = 0; x < w; ++x) {
           const size_t i = size_t(y) * size_t(w) + size_t(x);
@@ -264,13 +327,13 @@ std::vector<float> regress(const std::vector<float>& f, const std::vector<float>
 // The halves as regression targets (RGB per pixel, A's and B's), each pixel-channel capped where it
 // is a firefly: above both twice the brightest of its neighbours in both halves (and its own other
 // half) and four times the mean of its 11 x 11 neighbourhood.
-std::array<std::vector<float>, 2> capped_targets(const DenoiseInput& in) {
+std::array<ImageBuffer<float>, 2> capped_targets(const DenoiseInput& in) {
   const int w = in.width, h = in.height;
   const size_t n = size_t(w) * size_t(h);
-  std::vector<float> mean_of_halves(3 * n);
-  for (size_t i = 0; i < 3 * n; ++i) mean_of_halves[i] = 0.5f * (in.half_a[i] + in.half_b[i]);
-  const std::vector<float> local = box_mean(mean_of_halves, 3, w, h, kFireflyRadius);
-  std::array<std::vector<float>, 2> targets{std::vector<float>(3 * n), std::vector<float>(3 * n)};
+  ImageBuffer<float> mean_of_halves(3 * n);
+  for_each_index(3 * n, [&](size_t i) { mean_of_halves[i] = 0.5f * (in.half_a[i] + in.half_b[i]); });
+  const ImageBuffer<float> local = box_mean(mean_of_halves, 3, w, h, kFireflyRadius);
+  std::array<ImageBuffer<float>, 2> targets{ImageBuffer<float>(3 * n), ImageBuffer<float>(3 * n)};
   tbb::parallel_for(tbb::blocked_range<int>(0, h, 16), [&](const tbb::blocked_range<int>& range) {
     for (int y = range.begin(); y < range.end(); ++y)
       for (int x = 0; x < w; ++x) {
@@ -321,9 +384,9 @@ DenoiseResult denoise(const DenoiseInput& in) {
   const size_t n = size_t(w) * size_t(h);
   // Fit each half on its own features (DenoiseInput says why).
   const float median = median_depth(in);
-  const std::array<std::vector<float>, 2> features{make_features(in, in.albedo_a, in.normal_a, in.depth_a, median),
+  const std::array<ImageBuffer<float>, 2> features{make_features(in, in.albedo_a, in.normal_a, in.depth_a, median),
                                                    make_features(in, in.albedo_b, in.normal_b, in.depth_b, median)};
-  const std::array<std::vector<float>, 2> targets = capped_targets(in);
+  const std::array<ImageBuffer<float>, 2> targets = capped_targets(in);
 
   // Radiance is not negative: the denoised image's overshoot below 0 is cut off, unless the film's
   // filter made negative pixels (a negative lobe), which the image then keeps.
@@ -331,10 +394,11 @@ DenoiseResult denoise(const DenoiseInput& in) {
                             std::any_of(in.half_b.begin(), in.half_b.end(), [](float v) { return v < 0; });
   // Each candidate's filtered halves D_A, D_B (the raw image's are the halves themselves).
   auto filter = [&](int candidate) {
-    std::array<std::vector<float>, 2> filtered;
+    std::array<ImageBuffer<float>, 2> filtered;
     for (int half = 0; half < 2; ++half) {
       if (candidate == 0) {
-        filtered[size_t(half)] = half == 0 ? in.half_a : in.half_b;
+        const std::vector<float>& raw = half == 0 ? in.half_a : in.half_b;
+        filtered[size_t(half)].assign(raw.begin(), raw.end());
         continue;
       }
       const int r = kDenoiseRadii[candidate - 1];
@@ -344,18 +408,20 @@ DenoiseResult denoise(const DenoiseInput& in) {
   };
   // The widest candidate's image weighs pixels against each other in the choice (smooth, so that the
   // noisiest pixels do not dominate a neighbourhood's sum; where it blows up, the choice goes elsewhere).
-  std::array<std::vector<float>, 2> widest = filter(kDenoiseCandidates - 1);
-  std::vector<float> choice_truth(3 * n);
-  for (size_t i = 0; i < 3 * n; ++i) choice_truth[i] = in.share_a[i / 3] * widest[0][i] + (1 - in.share_a[i / 3]) * widest[1][i];
+  std::array<ImageBuffer<float>, 2> widest = filter(kDenoiseCandidates - 1);
+  ImageBuffer<float> choice_truth(3 * n);
+  for_each_index(3 * n, [&](size_t i) {
+    choice_truth[i] = in.share_a[i / 3] * widest[0][i] + (1 - in.share_a[i / 3]) * widest[1][i];
+  });
 
-  std::array<std::vector<float>, 2> best;
-  std::vector<float> best_smoothed(n), choice_error(n), mse(3 * n), best_mse(3 * n);
+  std::array<ImageBuffer<float>, 2> best;
+  ImageBuffer<float> best_smoothed(n), choice_error(n), mse(3 * n), best_mse(3 * n);
   DenoiseResult result;
   result.choice.assign(n, 0);
   // The raw image first: a candidate replaces it only where it is estimated strictly better.
   for (int candidate = 0; candidate < kDenoiseCandidates; ++candidate) {
-    std::array<std::vector<float>, 2> filtered = candidate == kDenoiseCandidates - 1 ? std::move(widest) : filter(candidate);
-    const std::vector<float>&da = filtered[0], &db = filtered[1];
+    std::array<ImageBuffer<float>, 2> filtered = candidate == kDenoiseCandidates - 1 ? std::move(widest) : filter(candidate);
+    const ImageBuffer<float>&da = filtered[0], &db = filtered[1];
     // Each pixel-channel's estimated squared error of f D_A + (1 - f) D_B (denoiser.h, step 3),
     // against the capped halves for a fit (a firefly's residual would swamp the sum; the cap's
     // bias is added to the chosen fits' below), and the pixel's relative error for the choice.
@@ -374,29 +440,28 @@ DenoiseResult denoise(const DenoiseInput& in) {
         choice_error[i] = float(relative / 3);
       }
     });
-    const std::vector<float> smoothed = leave_one_out_mean(choice_error, w, h, kErrorSmoothingRadius);
+    ImageBuffer<float> smoothed = leave_one_out_mean(choice_error, w, h, kErrorSmoothingRadius);
     if (candidate == 0) {
       best = std::move(filtered);
       best_mse = mse;
-      best_smoothed = smoothed;
+      best_smoothed = std::move(smoothed);
       continue;
     }
-    for (size_t i = 0; i < n; ++i) {
-      if (!(smoothed[i] < best_smoothed[i])) continue;
+    for_each_index(n, [&](size_t i) {
+      if (!(smoothed[i] < best_smoothed[i])) return;
       best_smoothed[i] = smoothed[i];
       result.choice[i] = uint8_t(candidate);
       for (int half = 0; half < 2; ++half) std::copy_n(&filtered[size_t(half)][3 * i], 3, &best[size_t(half)][3 * i]);
       std::copy_n(&mse[3 * i], 3, &best_mse[3 * i]);
-    }
+    });
   }
 
-  // The chosen candidates' combination of the halves.
   result.image = Image(w, h);
-  for (size_t i = 0; i < 3 * n; ++i) {
+  for_each_index(3 * n, [&](size_t i) {
     const float f = in.share_a[i / 3];
     result.image.rgb[i] = f * best[0][i] + (1 - f) * best[1][i];
     if (!any_negative) result.image.rgb[i] = std::max(result.image.rgb[i], 0.0f);
-  }
+  });
   // Its relMSE: the chosen candidates' squared errors over the truth's square. Neither the raw
   // image's estimate of the square (film/error_estimate.h: too small where a dark pixel's samples
   // have mostly not found the light yet) nor the denoised image's (too large where a fit bleeds a
@@ -406,28 +471,37 @@ DenoiseResult denoise(const DenoiseInput& in) {
     result.error.why_not = "the pixels' samples are not split into two independent halves";
     return result;
   }
-  const std::vector<double> raw_truth_sq = estimated_truth_squared(w, h, in.half_a, in.half_b, in.share_a);
+  const ImageBuffer<double> raw_truth_sq = estimated_truth_squared(w, h, in.half_a, in.half_b, in.share_a);
   // What the firefly cap took from each half, averaged over the 11 x 11 window: each an estimate of the
   // cap's bias there, so that their product estimates its square (the halves' caps are independent).
-  std::array<std::vector<float>, 2> removed{std::vector<float>(3 * n), std::vector<float>(3 * n)};
-  for (size_t i = 0; i < 3 * n; ++i) {
+  std::array<ImageBuffer<float>, 2> removed{ImageBuffer<float>(3 * n), ImageBuffer<float>(3 * n)};
+  for_each_index(3 * n, [&](size_t i) {
     removed[0][i] = in.half_a[i] - targets[0][i];
     removed[1][i] = in.half_b[i] - targets[1][i];
-  }
+  });
   for (auto& r : removed) r = box_mean(r, 3, w, h, kFireflyRadius);
-  double sum = 0, sum_sq = 0;
-  for (size_t i = 0; i < n; ++i) {
-    double relative = 0;
-    for (size_t c = 0; c < 3; ++c) {
-      const size_t at = 3 * i + c;
-      const double denoised_sq = double(result.image.rgb[at]) * result.image.rgb[at];
-      const double truth_sq = std::sqrt(denoised_sq * std::max(raw_truth_sq[at], denoised_sq / 4));
-      const double cap_bias_sq = result.choice[i] > 0 ? double(removed[0][at]) * removed[1][at] : 0.0;
-      relative += (best_mse[at] + cap_bias_sq) / (truth_sq + kErrorEpsilon);
+  // Rows in parallel, their sums added in row order: the same estimate for any number of threads.
+  std::vector<std::array<double, 2>> row_sums(static_cast<size_t>(h));
+  tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& range) {
+    for (int y = range.begin(); y < range.end(); ++y) {
+      double sum = 0, sum_sq = 0;
+      for (size_t i = size_t(y) * size_t(w); i < size_t(y + 1) * size_t(w); ++i) {
+        double relative = 0;
+        for (size_t c = 0; c < 3; ++c) {
+          const size_t at = 3 * i + c;
+          const double denoised_sq = double(result.image.rgb[at]) * result.image.rgb[at];
+          const double truth_sq = std::sqrt(denoised_sq * std::max(raw_truth_sq[at], denoised_sq / 4));
+          const double cap_bias_sq = result.choice[i] > 0 ? double(removed[0][at]) * removed[1][at] : 0.0;
+          relative += (best_mse[at] + cap_bias_sq) / (truth_sq + kErrorEpsilon);
+        }
+        sum += relative / 3;
+        sum_sq += relative / 3 * relative / 3;
+      }
+      row_sums[size_t(y)] = {sum, sum_sq};
     }
-    sum += relative / 3;
-    sum_sq += relative / 3 * relative / 3;
-  }
+  });
+  double sum = 0, sum_sq = 0;
+  for (const auto& [row_sum, row_sum_sq] : row_sums) sum += row_sum, sum_sq += row_sum_sq;
   ErrorEstimate& e = result.error;
   e.valid = true;
   e.pixels = n;

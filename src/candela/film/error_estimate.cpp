@@ -9,6 +9,8 @@
 #include <limits>
 #include <vector>
 
+#include "candela/base/image_buffer.h"
+
 namespace candela {
 
 namespace {
@@ -20,16 +22,24 @@ constexpr size_t kMostDropped = 8;  // the most fireflies left out of that mean
 // Per channel, the sums and counts of the values of `v` (3 values per pixel, NaN = no value) over the
 // (2r+1)^2 pixels around each pixel, separably.
 struct BoxSums {
-  std::vector<double> sums, counts;
+  ImageBuffer<double> sums;
+  ImageBuffer<double> counts;  // empty where every pixel has a value: then a window's count is its size
+  int w = 0, h = 0, r = 0;
+  double count(size_t at) const {
+    if (!counts.empty()) return counts[at];
+    const int x = int(at / 3 % size_t(w)), y = int(at / 3 / size_t(w));
+    return double(std::min(h - 1, y + r) - std::max(0, y - r) + 1) *
+           double(std::min(w - 1, x + r) - std::max(0, x - r) + 1);
+  }
 };
-BoxSums box_sums(const std::vector<double>& v, int w, int h, int r);
+BoxSums box_sums(const ImageBuffer<double>& v, int w, int h, int r);
 
 // The mean of channel c of `mean` over the (2r+1)^2 pixels around (x, y) (`box` holds their sums and
 // counts), without its largest 1/24 (5 of 121): the fireflies among them.
-double trimmed_local_mean(const std::vector<double>& mean, const BoxSums& box, int w, int h, int x, int y, int c,
+double trimmed_local_mean(const ImageBuffer<double>& mean, const BoxSums& box, int w, int h, int x, int y, int c,
                           int r) {
   const size_t at = 3 * (size_t(y) * size_t(w) + size_t(x)) + size_t(c);
-  const size_t n = size_t(box.counts[at]), drop = n / 24;
+  const size_t n = size_t(box.count(at)), drop = n / 24;
   if (n == drop) return 0;
   // The `drop` largest values (at most a few): kept in descending order.
   double largest[kMostDropped];
@@ -53,22 +63,24 @@ double trimmed_local_mean(const std::vector<double>& mean, const BoxSums& box, i
 // the scan over the window when a bound on it says not. Removing the largest values never raises a
 // mean, and where no mean is negative the removed ones sum to at least the pixel's own.
 bool floor_can_matter(const BoxSums& box, size_t at, double own, bool any_negative, double truth_sq) {
-  const double n = box.counts[at], held = std::min(std::floor(n / 24), double(kMostDropped));
+  const double n = box.count(at), held = std::min(std::floor(n / 24), double(kMostDropped));
   if (any_negative || held == 0 || n == held) return true;
   const double bound = (box.sums[at] - own) / (n - held);
   return bound * bound > truth_sq;
 }
 
-BoxSums box_sums(const std::vector<double>& v, int w, int h, int r) {
+BoxSums box_sums(const ImageBuffer<double>& v, int w, int h, int r) {
   const size_t row = 3 * size_t(w);
   // Along x: each row's window sums, as running sums; then along y, each column's running sums.
   // Rows (then columns) in parallel, each summed in one order: the same sums for any thread count.
-  std::vector<double> row_sums(v.size()), row_counts(v.size());
+  // Without gaps (NaN) the counts are the windows' sizes: not summed.
+  const bool gaps = std::any_of(v.begin(), v.end(), [](double value) { return std::isnan(value); });
+  ImageBuffer<double> row_sums(v.size()), row_counts(gaps ? v.size() : 0);
   tbb::parallel_for(tbb::blocked_range<int>(0, h, 16), [&](const tbb::blocked_range<int>& range) {
     for (int y = range.begin(); y < range.end(); ++y) {
       const double* in = v.data() + size_t(y) * row;
       double* sums = row_sums.data() + size_t(y) * row;
-      double* counts = row_counts.data() + size_t(y) * row;
+      double* counts = gaps ? row_counts.data() + size_t(y) * row : nullptr;
       for (int c = 0; c < 3; ++c) {
         auto value = [&](int x) { return in[3 * size_t(x) + size_t(c)]; };
         double sum = 0, count = 0;
@@ -80,44 +92,52 @@ BoxSums box_sums(const std::vector<double>& v, int w, int h, int r) {
             if (x - r - 1 >= 0 && !std::isnan(value(x - r - 1))) sum -= value(x - r - 1), count -= 1;
           }
           sums[3 * size_t(x) + size_t(c)] = sum;
-          counts[3 * size_t(x) + size_t(c)] = count;
+          if (gaps) counts[3 * size_t(x) + size_t(c)] = count;
         }
       }
     }
   });
   BoxSums box;
-  box.sums.assign(v.size(), 0);
-  box.counts.assign(v.size(), 0);
+  box.w = w, box.h = h, box.r = r;
+  box.sums.resize(v.size());
+  box.counts.resize(gaps ? v.size() : 0);
+  auto column = [&](const ImageBuffer<double>& in, ImageBuffer<double>& out, size_t i) {
+    double sum = 0;
+    for (int y = 0; y <= std::min(h - 1, r); ++y) sum += in[size_t(y) * row + i];
+    for (int y = 0; y < h; ++y) {
+      if (y > 0) {
+        if (y + r < h) sum += in[size_t(y + r) * row + i];
+        if (y - r - 1 >= 0) sum -= in[size_t(y - r - 1) * row + i];
+      }
+      out[size_t(y) * row + i] = sum;
+    }
+  };
   tbb::parallel_for(tbb::blocked_range<size_t>(0, row, 64), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i < range.end(); ++i) {
-      double sum = 0, count = 0;
-      for (int y = 0; y <= std::min(h - 1, r); ++y) sum += row_sums[size_t(y) * row + i], count += row_counts[size_t(y) * row + i];
-      for (int y = 0; y < h; ++y) {
-        if (y > 0) {
-          if (y + r < h) sum += row_sums[size_t(y + r) * row + i], count += row_counts[size_t(y + r) * row + i];
-          if (y - r - 1 >= 0)
-            sum -= row_sums[size_t(y - r - 1) * row + i], count -= row_counts[size_t(y - r - 1) * row + i];
-        }
-        box.sums[size_t(y) * row + i] = sum;
-        box.counts[size_t(y) * row + i] = count;
-      }
+      column(row_sums, box.sums, i);
+      if (gaps) column(row_counts, box.counts, i);
     }
   });
   return box;
 }
 
-// Per channel, the mean of `v` (NaN = no value) over the (2r+1)^2 pixels around each pixel.
-std::vector<double> box_mean(const std::vector<double>& v, int w, int h, int r) {
-  BoxSums box = box_sums(v, w, h, r);
-  for (size_t i = 0; i < v.size(); ++i) box.sums[i] = box.counts[i] > 0 ? box.sums[i] / box.counts[i] : 0;
-  return box.sums;
+// The mean of channel c of `mean` (NaN = no value) over the (2r+1)^2 pixels around (x, y), 0 where
+// none has a value. Summed on demand: few pixels need it.
+double local_mean(const ImageBuffer<double>& mean, int w, int h, int x, int y, int c, int r) {
+  double sum = 0, count = 0;
+  for (int yy = std::max(0, y - r); yy <= std::min(h - 1, y + r); ++yy)
+    for (int xx = std::max(0, x - r); xx <= std::min(w - 1, x + r); ++xx) {
+      const double v = mean[3 * (size_t(yy) * size_t(w) + size_t(xx)) + size_t(c)];
+      if (!std::isnan(v)) sum += v, count += 1;
+    }
+  return count > 0 ? sum / count : 0;
 }
 // Per pixel and channel (3 values per pixel): the mean and the variance of the mean from the
 // pixel's two halves, NaN where a pixel has no samples (not rendered) or lacks a half; the lesser
 // of the two halves' estimates; the variance of the splats' part alone. Also how many pixels were
 // rendered and how many lack a half, and whether any mean is negative (a filter's negative lobe).
 struct HalfStatistics {
-  std::vector<double> mean, variance, lesser_half, splat_variance;
+  ImageBuffer<double> mean, variance, lesser_half, splat_variance;
   uint64_t missing = 0, rendered = 0;
   bool any_negative = false;
 };
@@ -133,10 +153,10 @@ HalfStatistics half_statistics(const Film& film, double scale_relative_error) {
   s.variance.assign(3 * n, std::nan(""));
   s.lesser_half.assign(3 * n, 0);
   s.splat_variance.assign(splats ? 3 * n : 0, 0);
-  std::vector<double>& mean = s.mean;
-  std::vector<double>& variance = s.variance;
-  std::vector<double>& lesser_half = s.lesser_half;
-  std::vector<double>& splat_variance = s.splat_variance;
+  ImageBuffer<double>& mean = s.mean;
+  ImageBuffer<double>& variance = s.variance;
+  ImageBuffer<double>& lesser_half = s.lesser_half;
+  ImageBuffer<double>& splat_variance = s.splat_variance;
   // Rows in parallel, each writing its own pixels, with its own counts.
   struct RowCounts {
     uint64_t missing = 0, rendered = 0;
@@ -183,7 +203,7 @@ HalfStatistics half_statistics(const Film& film, double scale_relative_error) {
 }
 
 // The truth's square in the denominator of channel c of pixel (x, y) (at `at` = 3 i + c), from the
-// pixel's mean `s.mean`, its neighbours' and `local`, the 7 x 7 neighbourhood's mean.
+// pixel's mean `s.mean` and its neighbours'.
 //
 // Where a rare bright path (a firefly) lifted one half, the pixel's mean is far above the truth and
 // would shrink its relative error many times over: the mean is capped by the brightest of the eight
@@ -203,9 +223,26 @@ HalfStatistics half_statistics(const Film& film, double scale_relative_error) {
 // that neighbourhood's own fireflies (its largest 1/24). Estimate / truth on veach-ajar at 16 spp
 // 3.9-6.1 -> 1.18-1.22, at 64 spp 1.61-2.57 -> 0.98-1.20; within 0.03 elsewhere
 // (docs/error-estimates.md).
-inline double truth_squared(const HalfStatistics& s, const std::vector<double>& local, const BoxSums& firefly_box,
-                            int w, int h, int x, int y, int c, size_t at) {
-  const std::vector<double>& mean = s.mean;
+// The 5th smallest of 8 values (the upper median), by Batcher's odd-even merge sorting network:
+// branch-free, where std::nth_element's branches mispredict on noise.
+inline double upper_median_of_8(double* v) {
+  auto order = [v](int i, int j) {
+    const double lo = std::min(v[i], v[j]), hi = std::max(v[i], v[j]);
+    v[i] = lo, v[j] = hi;
+  };
+  order(0, 1), order(2, 3), order(4, 5), order(6, 7);
+  order(0, 2), order(1, 3), order(4, 6), order(5, 7);
+  order(1, 2), order(5, 6), order(0, 4), order(3, 7);
+  order(1, 5), order(2, 6);
+  order(1, 4), order(3, 6);
+  order(2, 4), order(3, 5);
+  order(3, 4);
+  return v[4];
+}
+
+inline double truth_squared(const HalfStatistics& s, const BoxSums& firefly_box, int w, int h, int x, int y, int c,
+                            size_t at) {
+  const ImageBuffer<double>& mean = s.mean;
   const double own = mean[at], var = s.variance[at];
   const double lesser = s.lesser_half[at];
   double around[8];
@@ -221,13 +258,12 @@ inline double truth_squared(const HalfStatistics& s, const std::vector<double>& 
   if (k == 0) {
     brightest = own;  // no neighbour rendered
   } else {
-    std::nth_element(around, around + k / 2, around + k);
-    brightest = std::max(brightest, around[k / 2]);
+    brightest = std::max(brightest, k == 8 ? upper_median_of_8(around) : (std::nth_element(around, around + k / 2, around + k), around[k / 2]));
   }
   const bool firefly = own > brightest;
   // Where every neighbour and both halves saw nothing yet but this pixel saw something (a
-  // render so short that most paths find no light), the wider neighbourhood's mean.
-  if (brightest <= 0 && lesser <= 0) brightest = local[at];
+  // render so short that most paths find no light), the 7 x 7 neighbourhood's mean.
+  if (brightest <= 0 && lesser <= 0) brightest = local_mean(mean, w, h, x, y, c, kLocalRadius);
   const double capped = std::max(std::min(own, brightest), lesser);
   double truth_sq = std::max({capped * capped - var / 2, capped * capped / 2, lesser * lesser});
   if (firefly && floor_can_matter(firefly_box, at, own, s.any_negative, truth_sq)) {
@@ -245,7 +281,6 @@ struct ErrorSums {
 };
 
 ErrorSums sum_pixel_errors(const HalfStatistics& s, bool splats, int w, int h, std::vector<double>* pixel_errors) {
-  const std::vector<double> local = box_mean(s.mean, w, h, kLocalRadius);
   const BoxSums firefly_box = box_sums(s.mean, w, h, kFireflyRadius);
   // Rows in parallel, their sums added in row order: the same estimate for any number of threads.
   std::vector<ErrorSums> rows(static_cast<size_t>(h));
@@ -258,7 +293,7 @@ ErrorSums sum_pixel_errors(const HalfStatistics& s, bool splats, int w, int h, s
         double pixel_error = 0, splat_error = 0;
         for (int c = 0; c < 3; ++c) {
           const size_t at = 3 * i + size_t(c);
-          const double truth_sq = truth_squared(s, local, firefly_box, w, h, x, y, c, at);
+          const double truth_sq = truth_squared(s, firefly_box, w, h, x, y, c, at);
           pixel_error += s.variance[at] / (truth_sq + kErrorEpsilon);
           if (splats) splat_error += s.splat_variance[at] / (truth_sq + kErrorEpsilon);
         }
@@ -282,29 +317,30 @@ ErrorSums sum_pixel_errors(const HalfStatistics& s, bool splats, int w, int h, s
 }
 }  // namespace
 
-std::vector<double> estimated_truth_squared(int w, int h, const std::vector<float>& a, const std::vector<float>& b,
+ImageBuffer<double> estimated_truth_squared(int w, int h, const std::vector<float>& a, const std::vector<float>& b,
                                             const std::vector<float>& share_a) {
   const size_t n = size_t(w) * size_t(h);
   HalfStatistics s;
   s.mean.resize(3 * n);
   s.variance.resize(3 * n);
   s.lesser_half.resize(3 * n);
-  for (size_t i = 0; i < 3 * n; ++i) {
-    const double f = share_a[i / 3];
-    s.mean[i] = f * a[i] + (1 - f) * b[i];
-    s.variance[i] = f * (1 - f) * (double(a[i]) - b[i]) * (double(a[i]) - b[i]);
-    s.lesser_half[i] = std::min(a[i], b[i]);
-    s.any_negative = s.any_negative || s.mean[i] < 0;
-  }
-  const std::vector<double> local = box_mean(s.mean, w, h, kLocalRadius);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, 3 * n, 1 << 14), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i < range.end(); ++i) {
+      const double f = share_a[i / 3];
+      s.mean[i] = f * a[i] + (1 - f) * b[i];
+      s.variance[i] = f * (1 - f) * (double(a[i]) - b[i]) * (double(a[i]) - b[i]);
+      s.lesser_half[i] = std::min(a[i], b[i]);
+    }
+  });
+  s.any_negative = std::any_of(s.mean.begin(), s.mean.end(), [](double m) { return m < 0; });
   const BoxSums firefly_box = box_sums(s.mean, w, h, kFireflyRadius);
-  std::vector<double> truth_sq(3 * n);
+  ImageBuffer<double> truth_sq(3 * n);
   tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& range) {
     for (int y = range.begin(); y < range.end(); ++y)
       for (int x = 0; x < w; ++x)
         for (int c = 0; c < 3; ++c) {
           const size_t at = 3 * (size_t(y) * size_t(w) + size_t(x)) + size_t(c);
-          truth_sq[at] = truth_squared(s, local, firefly_box, w, h, x, y, c, at);
+          truth_sq[at] = truth_squared(s, firefly_box, w, h, x, y, c, at);
         }
   });
   return truth_sq;

@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "candela/base/image_buffer.h"
 #include "candela/film/film.h"
 
 namespace candela {
@@ -52,7 +53,7 @@ ErrorEstimate estimate_error(const Film& film, double scale_relative_error = 0,
 // Per pixel and channel (3 per pixel, row-major), the truth's square that estimate_error divides by,
 // from each pixel's two halves `a` and `b` (3 values per pixel) and a's share of its weight: for the
 // denoiser's error estimate (denoise/denoiser.h), whose denominators are the raw image's.
-std::vector<double> estimated_truth_squared(int width, int height, const std::vector<float>& a,
+ImageBuffer<double> estimated_truth_squared(int width, int height, const std::vector<float>& a,
                                             const std::vector<float>& b, const std::vector<float>& share_a);
 
 // "relMSE 0.0031 (95% interval 0.0028-0.0034)" or "not available: ...".
