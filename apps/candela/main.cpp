@@ -725,7 +725,8 @@ int run_merge(const std::vector<std::string>& inputs, const std::string& output)
 // denoised (denoise/denoiser.h); an .exr output keeps the input's layers and the raw image as Noisy.
 int run_denoise(const std::string& input, const std::string& output) {
   check_outputs({output});
-  const DenoiseInput in = read_denoise_input(input);
+  const DenoiseFile file = read_denoise_file(input);
+  const DenoiseInput& in = file.input;
   std::map<std::string, std::string> metadata;
   for (const auto& [key, value] : read_image_metadata(input))
     if (key.rfind("candela:", 0) == 0 || key == "Software") metadata[key] = value;
@@ -735,21 +736,8 @@ int run_denoise(const std::string& input, const std::string& output) {
   add_denoise_metadata(metadata, result, seconds);
   g_phase.store(kWriting);
   if (is_exr(output)) {
-    // The input's layers but its colour and an earlier Noisy layer, then the raw image as Noisy.
-    const FloatChannels all = read_float_channels(input, "");
-    FloatChannels layers;
-    std::vector<size_t> kept;
-    for (size_t k = 0; k < all.names.size(); ++k) {
-      const std::string& name = all.names[k];
-      if (name == "R" || name == "G" || name == "B" || name == "A" || name.rfind("Noisy.", 0) == 0) continue;
-      kept.push_back(k);
-      layers.names.push_back(name);
-    }
-    const size_t pixels = size_t(in.width) * size_t(in.height);
-    layers.values.resize(pixels * kept.size());
-    for (size_t i = 0; i < pixels; ++i)
-      for (size_t k = 0; k < kept.size(); ++k) layers.values[i * kept.size() + k] = all.values[i * all.names.size() + kept[k]];
-    write_image(output, result.image, metadata, append_channels(layers, noisy_layer(in.raw())));
+    // The input's layers, then the raw image as Noisy.
+    write_image(output, result.image, metadata, append_channels(file.layers, noisy_layer(in.raw())));
   } else {
     write_image(output, result.image, metadata);
   }

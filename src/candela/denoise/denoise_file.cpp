@@ -43,10 +43,9 @@ std::string describe_denoised(const DenoiseResult& result, double seconds) {
 }
 
 namespace {
-// The channels `names` (a layer's, in this order) of `file`, one float each per pixel.
-std::vector<float> denoise_read_layer(const std::filesystem::path& file, const std::string& layer,
-                              const std::vector<std::string>& names, size_t pixels) {
-  const FloatChannels found = read_float_channels(file, layer + ".");
+// The channels `names` (a layer's, in this order) of `found` (read from `file`), one float each per pixel.
+std::vector<float> layer_channels(const FloatChannels& found, const std::filesystem::path& file,
+                                  const std::string& layer, const std::vector<std::string>& names, size_t pixels) {
   std::vector<float> values(pixels * names.size());
   for (size_t k = 0; k < names.size(); ++k) {
     const std::string wanted = layer + "." + names[k];
@@ -62,21 +61,36 @@ std::vector<float> denoise_read_layer(const std::filesystem::path& file, const s
 }
 }  // namespace
 
-DenoiseInput read_denoise_input(const std::filesystem::path& file) {
-  const Image rgb = read_image(file);
-  const size_t pixels = size_t(rgb.width) * size_t(rgb.height);
-  const std::vector<float> halves = denoise_read_layer(
-      file, "Halves",
+DenoiseFile read_denoise_file(const std::filesystem::path& file) {
+  const FloatChannels all = read_float_channels(file, "");
+  const size_t pixels = size_t(all.width) * size_t(all.height);
+  const std::vector<float> halves = layer_channels(
+      all, file, "Halves",
       {"A.R", "A.G", "A.B", "B.R", "B.G", "B.B", "ShareA", "A.Albedo.R", "A.Albedo.G", "A.Albedo.B", "A.Normal.X",
        "A.Normal.Y", "A.Normal.Z", "A.Depth.Z", "B.Albedo.R", "B.Albedo.G", "B.Albedo.B", "B.Normal.X", "B.Normal.Y",
        "B.Normal.Z", "B.Depth.Z"},
       pixels);
-  DenoiseInput in = denoise_input(rgb.width, rgb.height, halves);
+  DenoiseFile result;
+  DenoiseInput& in = result.input;
+  in = denoise_input(all.width, all.height, halves);
   for (size_t i = 0; i < pixels; ++i)
     if (!(in.share_a[i] > 0 && in.share_a[i] < 1))
       throw FileContentError(fmt::format("{}: pixel ({}, {}) has Halves.ShareA {}, outside (0, 1)", file.string(),
                                          i % size_t(in.width), i / size_t(in.width), in.share_a[i]));
-  return in;
+  // The layers kept: all but the colour and an earlier Noisy layer.
+  std::vector<size_t> kept;
+  for (size_t k = 0; k < all.names.size(); ++k) {
+    const std::string& name = all.names[k];
+    if (name == "R" || name == "G" || name == "B" || name == "A" || name.rfind("Noisy.", 0) == 0) continue;
+    kept.push_back(k);
+    result.layers.names.push_back(name);
+  }
+  result.layers.width = all.width, result.layers.height = all.height;
+  result.layers.values.resize(pixels * kept.size());
+  for (size_t i = 0; i < pixels; ++i)
+    for (size_t k = 0; k < kept.size(); ++k)
+      result.layers.values[i * kept.size() + k] = all.values[i * all.names.size() + kept[k]];
+  return result;
 }
 
 }  // namespace candela

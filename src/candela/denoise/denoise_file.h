@@ -22,8 +22,13 @@ void add_denoise_metadata(std::map<std::string, std::string>& metadata, const De
 // "denoised: relMSE 0.0012 (95% interval ..., eps 0.01) in 0.41 s": the closing line's report.
 std::string describe_denoised(const DenoiseResult& result, double seconds);
 
-// The denoiser's input from `file`'s Halves layer. Throws FileContentError
-// naming the file and the missing channels (and how to write them) where it lacks one.
-DenoiseInput read_denoise_input(const std::filesystem::path& file);
+// An .exr written with --aov halves, read once: the denoiser's input (its Halves layer) and the layers
+// a denoised file keeps (every channel but the colour R, G, B, A and an earlier Noisy layer).
+struct DenoiseFile {
+  DenoiseInput input;
+  FloatChannels layers;
+};
+// Throws FileContentError naming the file and the missing channel (and how to write it) where it lacks one.
+DenoiseFile read_denoise_file(const std::filesystem::path& file);
 
 }  // namespace candela

@@ -348,7 +348,9 @@ ExactChannels read_exact_channels(const std::filesystem::path& file, const std::
 
 FloatChannels read_float_channels(const std::filesystem::path& file, const std::string& prefix) {
   FloatChannels result;
-  result.names = read_channels(file, prefix, OIIO::TypeDesc::FLOAT, [](const OIIO::ImageSpec&, int) {}, result.values);
+  result.names = read_channels(
+      file, prefix, OIIO::TypeDesc::FLOAT,
+      [&](const OIIO::ImageSpec& spec, int) { result.width = spec.width, result.height = spec.height; }, result.values);
   return result;
 }
 

@@ -44,6 +44,7 @@ ExactChannels read_exact_channels(const std::filesystem::path& file, const std::
 struct FloatChannels {
   std::vector<std::string> names;
   std::vector<float> values;
+  int width = 0, height = 0;  // the image's, where read from a file (read_float_channels)
 };
 // write_image for an .exr with `extra` after its R, G, B channels.
 void write_image(const std::filesystem::path& file, const Image& image, const std::map<std::string, std::string>& metadata,
