@@ -545,9 +545,7 @@ DenoiseInput denoise_input(int width, int height, const std::vector<float>& halv
 
 DenoiseInput denoise_input(const Film& film, const AovFilm& aovs) {
   if (!aovs.wants(Aov::Halves)) throw InternalError("denoise_input: the AOV film has no halves layer");
-  for (AovLayer& layer : aovs.images(film))
-    if (layer.aov == Aov::Halves) return denoise_input(film.width(), film.height(), layer.values);
-  throw InternalError("denoise_input: the AOV film made no halves layer");
+  return denoise_input(film.width(), film.height(), aovs.image(film, Aov::Halves).values);
 }
 
 }  // namespace candela

@@ -325,8 +325,16 @@ bool AovFilm::empty() const {
 void AovFilm::clear() { std::fill(sums_.begin(), sums_.end(), 0.0); }
 
 std::vector<AovLayer> AovFilm::images(const Film& film) const {
+  std::vector<AovLayer> result;
+  for (Aov aov : layers_) result.push_back(image(film, aov));
+  return result;
+}
+
+AovLayer AovFilm::image(const Film& film, Aov aov) const {
+  if (std::find(layers_.begin(), layers_.end(), aov) == layers_.end())
+    throw InternalError("AovFilm::image: the film does not collect that layer");
   if (film.width() != width_ || film.height() != height_)
-    throw InternalError(fmt::format("AovFilm::images: the film is {}x{}, the AOVs {}x{}", film.width(), film.height(),
+    throw InternalError(fmt::format("AovFilm::image: the film is {}x{}, the AOVs {}x{}", film.width(), film.height(),
                                     width_, height_));
   const bool pbrt = naming_ == AovNaming::PbrtGbuffer;
   // The variance a pixel's layers report: of the mean (candela's), or of the samples themselves
@@ -338,108 +346,104 @@ std::vector<AovLayer> AovFilm::images(const Film& film) const {
     if (pbrt) v = v * float(sums.count);
     return v;
   };
-  std::vector<AovLayer> result;
-  for (Aov aov : layers_) {
-    const LayerNames& names = pbrt ? pbrt_gbuffer_names_of(aov) : names_of(aov);
-    AovLayer layer{aov, std::string(names.layer), names.channels, width_, height_, {}};
-    if (aov == Aov::Spectral)
-      for (int i = 0; i < spectral_.count; ++i) layer.channels.push_back(spectral_.channel_name(i));
-    const size_t n = layer.channels.size();
-    layer.values.resize(size_t(width_) * size_t(height_) * n);
-    for (int y = 0; y < height_; ++y)
-      for (int x = 0; x < width_; ++x) {
-        const double* px = sums(x, y);
-        float* out = &layer.values[(size_t(y) * size_t(width_) + size_t(x)) * n];
-        // Means over all samples, or over those that hit a surface (none: the miss values).
-        const double weight = px[0];
-        const double hit_weight = hit_weight_ >= 0 ? px[hit_weight_] : 0;
-        auto mean = [&](int offset, int count) {
-          for (int c = 0; c < count; ++c) out[c] = weight != 0 ? float(px[offset + c] / weight) : 0.0f;
-        };
-        auto hit_mean = [&](int offset, int count, float miss) {
-          for (int c = 0; c < count; ++c) out[c] = hit_weight > 0 ? float(px[offset + c] / hit_weight) : miss;
-        };
-        auto normalized = [&](int offset) {
-          const Vec3 n = normalized_or_zero(px[offset], px[offset + 1], px[offset + 2]);
-          out[0] = n.x, out[1] = n.y, out[2] = n.z;
-        };
-        switch (aov) {
-          case Aov::Albedo: mean(albedo_, 3); break;
-          case Aov::Normal:
-            if (pbrt)
-              normalized(normal_);
-            else
-              mean(normal_, 3);
-            break;
-          case Aov::Depth: hit_mean(depth_, 1, kAovMissDepth); break;
-          case Aov::Position: hit_mean(position_, 3, 0.0f); break;
-          case Aov::SampleCount: out[0] = float(film.pixel(x, y).count); break;
-          case Aov::Variance: {
-            const RGB v = pixel_variance(x, y);
-            for (int c = 0; c < 3; ++c) out[c] = v[c];
-            break;
-          }
-          case Aov::GeometricNormal: normalized(geometric_normal_); break;
-          case Aov::Uv: hit_mean(uv_, 2, 0.0f); break;
-          case Aov::DepthDerivatives: {
-            hit_mean(depth_derivatives_, 2, 0.0f);
-            // pbrt-v4 scales camera ray differentials by max(1/8, 1/sqrt(spp)) before the first hit
-            // takes them (a pixel's samples then cover about its own footprint).
-            const float scale =
-                pbrt ? std::max(0.125f, 1.0f / std::sqrt(float(std::max<uint64_t>(1, film.pixel(x, y).count)))) : 1.0f;
-            for (int c = 0; c < 2; ++c) out[c] = std::abs(out[c]) * scale;
-            break;
-          }
-          case Aov::RelativeVariance: {
-            // pbrt-v4's VarianceEstimator::RelativeVariance: the variance over the mean (0 for a zero mean).
-            const RGB v = pixel_variance(x, y);
-            const RGB m = film.pixel(x, y).mean();
-            for (int c = 0; c < 3; ++c) out[c] = m[c] != 0 ? v[c] / m[c] : 0.0f;
-            break;
-          }
-          case Aov::Halves: {
-            // A pixel without both halves: its mean twice.
-            PixelHalves halves;
-            if (!film.pixel_halves(x, y, halves)) {
-              const RGB m = film.pixel(x, y).mean();
-              for (int c = 0; c < 3; ++c) halves.a[c] = halves.b[c] = m[c];
-            }
-            for (int c = 0; c < 3; ++c) {
-              out[c] = float(halves.a[c]);
-              out[3 + c] = float(halves.b[c]);
-            }
-            out[6] = float(halves.share_a);
-            // Each half's features: A's sums, and B's as the totals less A's (a half without samples,
-            // as where the AOVs had a pass of their own: the pixel's).
-            const double* half = px + half_features_;
-            const double weight_b = weight - half[0], hit_b = hit_weight - half[7];
-            const bool split = half[0] > 0 && weight_b > 0;
-            for (int h = 0; h < 2; ++h) {
-              float* f = out + 7 + 7 * h;
-              const double wsum = !split ? weight : h == 0 ? half[0] : weight_b;
-              const double hsum = !split ? hit_weight : h == 0 ? half[7] : hit_b;
-              for (int c = 0; c < 6; ++c) {
-                const double total = px[(c < 3 ? albedo_ : normal_) + c % 3];
-                const double v = !split ? total : h == 0 ? half[1 + c] : total - half[1 + c];
-                f[c] = wsum > 0 ? float(v / wsum) : 0.0f;
-              }
-              const double depth = !split ? px[depth_] : h == 0 ? half[8] : px[depth_] - half[8];
-              f[6] = hsum > 0 ? float(depth / hsum) : kAovMissDepth;
-            }
-            break;
-          }
-          case Aov::Spectral:
-            // A bucket no wavelength fell in stays 0, as in pbrt-v4.
-            for (int b = 0; b < spectral_.count; ++b) {
-              const double w = px[spectral_offset_ + 2 * b + 1];
-              out[b] = w > 0 ? float(px[spectral_offset_ + 2 * b] / w) : 0.0f;
-            }
-            break;
+  const LayerNames& names = pbrt ? pbrt_gbuffer_names_of(aov) : names_of(aov);
+  AovLayer layer{aov, std::string(names.layer), names.channels, width_, height_, {}};
+  if (aov == Aov::Spectral)
+    for (int i = 0; i < spectral_.count; ++i) layer.channels.push_back(spectral_.channel_name(i));
+  const size_t n = layer.channels.size();
+  layer.values.resize(size_t(width_) * size_t(height_) * n);
+  for (int y = 0; y < height_; ++y)
+    for (int x = 0; x < width_; ++x) {
+      const double* px = sums(x, y);
+      float* out = &layer.values[(size_t(y) * size_t(width_) + size_t(x)) * n];
+      // Means over all samples, or over those that hit a surface (none: the miss values).
+      const double weight = px[0];
+      const double hit_weight = hit_weight_ >= 0 ? px[hit_weight_] : 0;
+      auto mean = [&](int offset, int count) {
+        for (int c = 0; c < count; ++c) out[c] = weight != 0 ? float(px[offset + c] / weight) : 0.0f;
+      };
+      auto hit_mean = [&](int offset, int count, float miss) {
+        for (int c = 0; c < count; ++c) out[c] = hit_weight > 0 ? float(px[offset + c] / hit_weight) : miss;
+      };
+      auto normalized = [&](int offset) {
+        const Vec3 n = normalized_or_zero(px[offset], px[offset + 1], px[offset + 2]);
+        out[0] = n.x, out[1] = n.y, out[2] = n.z;
+      };
+      switch (aov) {
+        case Aov::Albedo: mean(albedo_, 3); break;
+        case Aov::Normal:
+          if (pbrt)
+            normalized(normal_);
+          else
+            mean(normal_, 3);
+          break;
+        case Aov::Depth: hit_mean(depth_, 1, kAovMissDepth); break;
+        case Aov::Position: hit_mean(position_, 3, 0.0f); break;
+        case Aov::SampleCount: out[0] = float(film.pixel(x, y).count); break;
+        case Aov::Variance: {
+          const RGB v = pixel_variance(x, y);
+          for (int c = 0; c < 3; ++c) out[c] = v[c];
+          break;
         }
+        case Aov::GeometricNormal: normalized(geometric_normal_); break;
+        case Aov::Uv: hit_mean(uv_, 2, 0.0f); break;
+        case Aov::DepthDerivatives: {
+          hit_mean(depth_derivatives_, 2, 0.0f);
+          // pbrt-v4 scales camera ray differentials by max(1/8, 1/sqrt(spp)) before the first hit
+          // takes them (a pixel's samples then cover about its own footprint).
+          const float scale =
+              pbrt ? std::max(0.125f, 1.0f / std::sqrt(float(std::max<uint64_t>(1, film.pixel(x, y).count)))) : 1.0f;
+          for (int c = 0; c < 2; ++c) out[c] = std::abs(out[c]) * scale;
+          break;
+        }
+        case Aov::RelativeVariance: {
+          // pbrt-v4's VarianceEstimator::RelativeVariance: the variance over the mean (0 for a zero mean).
+          const RGB v = pixel_variance(x, y);
+          const RGB m = film.pixel(x, y).mean();
+          for (int c = 0; c < 3; ++c) out[c] = m[c] != 0 ? v[c] / m[c] : 0.0f;
+          break;
+        }
+        case Aov::Halves: {
+          // A pixel without both halves: its mean twice.
+          PixelHalves halves;
+          if (!film.pixel_halves(x, y, halves)) {
+            const RGB m = film.pixel(x, y).mean();
+            for (int c = 0; c < 3; ++c) halves.a[c] = halves.b[c] = m[c];
+          }
+          for (int c = 0; c < 3; ++c) {
+            out[c] = float(halves.a[c]);
+            out[3 + c] = float(halves.b[c]);
+          }
+          out[6] = float(halves.share_a);
+          // Each half's features: A's sums, and B's as the totals less A's (a half without samples,
+          // as where the AOVs had a pass of their own: the pixel's).
+          const double* half = px + half_features_;
+          const double weight_b = weight - half[0], hit_b = hit_weight - half[7];
+          const bool split = half[0] > 0 && weight_b > 0;
+          for (int h = 0; h < 2; ++h) {
+            float* f = out + 7 + 7 * h;
+            const double wsum = !split ? weight : h == 0 ? half[0] : weight_b;
+            const double hsum = !split ? hit_weight : h == 0 ? half[7] : hit_b;
+            for (int c = 0; c < 6; ++c) {
+              const double total = px[(c < 3 ? albedo_ : normal_) + c % 3];
+              const double v = !split ? total : h == 0 ? half[1 + c] : total - half[1 + c];
+              f[c] = wsum > 0 ? float(v / wsum) : 0.0f;
+            }
+            const double depth = !split ? px[depth_] : h == 0 ? half[8] : px[depth_] - half[8];
+            f[6] = hsum > 0 ? float(depth / hsum) : kAovMissDepth;
+          }
+          break;
+        }
+        case Aov::Spectral:
+          // A bucket no wavelength fell in stays 0, as in pbrt-v4.
+          for (int b = 0; b < spectral_.count; ++b) {
+            const double w = px[spectral_offset_ + 2 * b + 1];
+            out[b] = w > 0 ? float(px[spectral_offset_ + 2 * b] / w) : 0.0f;
+          }
+          break;
       }
-    result.push_back(std::move(layer));
-  }
-  return result;
+    }
+  return layer;
 }
 
 FloatChannels exr_channels(const std::vector<AovLayer>& layers) {

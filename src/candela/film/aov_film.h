@@ -218,6 +218,8 @@ class AovFilm {
   // The layers as images, in the order of layers(); the sample count and the variance from `film`
   // (the film these samples went with).
   std::vector<AovLayer> images(const Film& film) const;
+  // One of them (one of layers()).
+  AovLayer image(const Film& film, Aov aov) const;
 
  private:
   int width_, height_;
