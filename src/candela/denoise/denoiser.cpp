@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <array>
@@ -103,13 +104,12 @@ ImageBuffer<float> box_mean(std::span<const float> values, int channels, int w, 
 // candidates' estimates, added up, are not biased low by the choice.
 ImageBuffer<float> leave_one_out_mean(const ImageBuffer<float>& values, int w, int h, int r) {
   ImageBuffer<float> mean = box_mean(values, 1, w, h, r);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const size_t i = size_t(y) * size_t(w) + size_t(x);
-      const double count = double(std::min(h - 1, y + r) - std::max(0, y - r) + 1) *
-                           double(std::min(w - 1, x + r) - std::max(0, x - r) + 1);
-      mean[i] = count > 1 ? float((double(mean[i]) * count - values[i]) / (count - 1)) : 0.0f;
-    }
+  for_each_index(size_t(w) * size_t(h), [&](size_t i) {
+    const int x = int(i % size_t(w)), y = int(i / size_t(w));
+    const double count = double(std::min(h - 1, y + r) - std::max(0, y - r) + 1) *
+                         double(std::min(w - 1, x + r) - std::max(0, x - r) + 1);
+    mean[i] = count > 1 ? float((double(mean[i]) * count - values[i]) / (count - 1)) : 0.0f;
+  });
   return mean;
 }
 
@@ -164,7 +164,7 @@ struct WindowFit {
 // Windows fitted together: every step of a fit runs across the batch's windows in its innermost loop,
 // which the compiler vectorises (4 doubles per instruction with AVX2, chosen at run time where the CPU
 // has it; 2 with SSE2). Each window's arithmetic is the same either way: the same bytes on every CPU.
-constexpr int kBatch = 4;
+constexpr int kBatch = 8;
 struct WindowBatch {
   double S[kMoments][kBatch];  // the windows' moment sums
   double count[kBatch];        // and pixel counts
@@ -408,6 +408,12 @@ DenoiseResult denoise(const DenoiseInput& in) {
   };
   // The widest candidate's image weighs pixels against each other in the choice (smooth, so that the
   // noisiest pixels do not dominate a neighbourhood's sum; where it blows up, the choice goes elsewhere).
+  // The raw image's truth estimate (for step 6) meanwhile: it needs only the halves, and its serial
+  // parts then overlap the fits.
+  ImageBuffer<double> raw_truth_sq;
+  tbb::task_group truth_estimate;
+  if (in.has_halves)
+    truth_estimate.run([&] { raw_truth_sq = estimated_truth_squared(w, h, in.half_a, in.half_b, in.share_a); });
   std::array<ImageBuffer<float>, 2> widest = filter(kDenoiseCandidates - 1);
   ImageBuffer<float> choice_truth(3 * n);
   for_each_index(3 * n, [&](size_t i) {
@@ -467,11 +473,11 @@ DenoiseResult denoise(const DenoiseInput& in) {
   // have mostly not found the light yet) nor the denoised image's (too large where a fit bleeds a
   // bright neighbour into a dark pixel, just where its error is) will do: their geometric mean, the
   // raw one floored at a quarter of the denoised one (measured on Bitterli's scenes, docs/denoising.md).
+  truth_estimate.wait();
   if (!in.has_halves) {
     result.error.why_not = "the pixels' samples are not split into two independent halves";
     return result;
   }
-  const ImageBuffer<double> raw_truth_sq = estimated_truth_squared(w, h, in.half_a, in.half_b, in.share_a);
   // What the firefly cap took from each half, averaged over the 11 x 11 window: each an estimate of the
   // cap's bias there, so that their product estimates its square (the halves' caps are independent).
   std::array<ImageBuffer<float>, 2> removed{ImageBuffer<float>(3 * n), ImageBuffer<float>(3 * n)};
