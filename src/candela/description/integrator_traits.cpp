@@ -27,8 +27,9 @@ const std::vector<IntegratorTraits>& integrator_traits() {
        .samples_are_mutations = true,
        .participating_media = true},
       {.name = "volpath",
-       .description = "volumetric path tracing: participating media by delta and ratio tracking, spectral MIS, NEE",
-       .reads = {"rr_start_depth", "adaptive"},
+       .description = "volumetric path tracing: participating media by delta and ratio tracking, spectral MIS, NEE, "
+                      "equiangular light sampling in homogeneous media",
+       .reads = {"equiangular", "rr_start_depth", "adaptive"},
        .resumable = true,
        .single_pixel = true,
        .participating_media = true,

@@ -36,6 +36,8 @@ inline constexpr SelectiveSetting kSelectiveSettings[] = {
      [](const RenderSettings& s) { return s.path.shadow_rays != PathSettings{}.shadow_rays; }},
     {"light_selection=paper", "the paper's rule for choosing lights for shadow rays",
      [](const RenderSettings& s) { return s.light_selection == LightSelection::Paper; }},
+    {"equiangular", "equiangular sampling of lights in homogeneous media",
+     [](const RenderSettings& s) { return s.volpath != VolPathSettings{}; }},
     {"rr_start_depth", "the depth where Russian roulette starts",
      [](const RenderSettings& s) { return s.rr_start_depth != RenderSettings{}.rr_start_depth; }},
     {"adaptive", "adaptive sampling", [](const RenderSettings& s) { return s.adaptive(); }},

@@ -155,6 +155,19 @@ std::vector<RenderOption> make_table() {
        .reads = "sppm", .scene_key = "sppm.radius",
        .extract = [](S d, R& r) { r.sppm_radius = d.settings.sppm.radius; },
        .apply = [](Q r, SceneDesc& d) { d.settings.sppm.radius = *r.sppm_radius; }},
+      {.name = "equiangular", .field = &R::equiangular, .rule = ChoiceValue{{"on", "off"}},
+       .help = "volpath: direct light on each ray segment through a homogeneous medium also from a point drawn "
+               "by equiangular sampling towards a light point, combined by MIS with distance sampling (default on)",
+       .reads = "equiangular", .scene_key = "equiangular", .scene_true = "on",
+       .extract = [](S d, R& r) {
+         if (!d.settings.volpath.equiangular) r.equiangular = "off";  // on, the default, is not written
+       },
+       .apply = [](Q r, SceneDesc& d) { d.settings.volpath.equiangular = r.equiangular == "on"; },
+       .fingerprint_key = "equiangular",
+       .fingerprint = [](S d, Q) -> std::optional<std::string> {
+         if (!may_read_setting(*find_integrator_traits(d.settings.integrator), "equiangular")) return std::nullopt;
+         return d.settings.volpath.equiangular ? "on" : "off";
+       }},
       {.name = "sampler", .field = &R::sampler, .rule = choices_of<SamplerType>({"random"}),
        .help = "Pixel sampler: random (independent), stratified (jittered, every dimension), poisson "
                "(Poisson-disc pixel positions), zsobol (Owen-scrambled Sobol' in Morton order)",

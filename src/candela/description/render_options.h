@@ -53,6 +53,7 @@ struct RenderRequest {
   std::string ao_sampling;  // "cosine" or "uniform"
   std::optional<int> sppm_photons;
   std::optional<float> sppm_radius;
+  std::string equiangular;  // "on" or "off"
   bool quiet = false;  // no progress bar, no notes (the command line's -q; Python renders quietly)
   // What only the command line asks (flags of its own, no Python keywords), checked by plan_render
   // with the rest because each asks something of the integrator.

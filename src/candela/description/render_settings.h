@@ -200,7 +200,16 @@ struct SppmSettings {
   }
 };
 
-// What a render does. The fields outside `path`, `mlt`, `ambient_occlusion` and `sppm` are read by more than one integrator;
+// Settings only the volumetric path tracer reads (integrator "volpath").
+struct VolPathSettings {
+  // Equiangular sampling of the lights on every ray segment through a homogeneous medium (Kulla and
+  // Fajardo 2012), combined by MIS with distance sampling for direct light (integrators/volpath.h);
+  // off: distance sampling alone, as before.
+  bool equiangular = true;
+  bool operator==(const VolPathSettings&) const = default;
+};
+
+// What a render does. The fields outside `path`, `volpath`, `mlt`, `ambient_occlusion` and `sppm` are read by more than one integrator;
 // integrators/integrator.h's registry says which integrator reads which, and the readers and the
 // command line reject a setting the chosen integrator does not read.
 struct RenderSettings {
@@ -236,6 +245,7 @@ struct RenderSettings {
     return adaptive_spp > 0 ? int(std::min<int64_t>(8 * int64_t(adaptive_spp), std::numeric_limits<int>::max())) : 1024;
   }
   PathSettings path;
+  VolPathSettings volpath;
   MltSettings mlt;
   AmbientOcclusionSettings ambient_occlusion;
   SppmSettings sppm;

@@ -310,6 +310,8 @@ std::map<std::string, std::string> image_metadata(const std::string& scene_name,
   if (non_finite_samples > 0) metadata["candela:non_finite_samples"] = std::to_string(non_finite_samples);
   if (find_integrator(settings.integrator)->reads_setting("mlt")) metadata["candela:mlt"] = settings.mlt.describe();
   if (find_integrator(settings.integrator)->reads_setting("sppm")) metadata["candela:sppm"] = settings.sppm.describe();
+  if (find_integrator(settings.integrator)->reads_setting("equiangular"))
+    metadata["candela:equiangular"] = settings.volpath.equiangular ? "on" : "off";
   if (outcome.choice) metadata["candela:auto"] = outcome.choice->summary();
   return metadata;
 }

@@ -1,13 +1,17 @@
 #include "candela/integrators/volpath.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <type_traits>
 
 #include "candela/materials/spectral_bsdf.h"
 #include "candela/render/camera_sample_tiles.h"
 #include "candela/sampling/rng.h"
 #include "candela/sampling/samplers.h"
+#include "candela/sampling/warp.h"
 
 namespace candela {
 
@@ -18,6 +22,9 @@ constexpr float kInfinity = std::numeric_limits<float>::infinity();
 // guard against walks that would not end in any reasonable time (a non-absorbing medium many thousands
 // of mean free paths across), far beyond what any medium that lets light out again needs.
 constexpr int kMaxSubsurfaceScatterings = 1 << 16;
+// The probability that a segment's direct light from lights equiangular sampling can choose comes from
+// equiangular sampling rather than from the point distance sampling chose (one-sample MIS, as Cycles).
+constexpr float kEquiangularShare = 0.5f;
 
 // exp(-sigma dt) per lane; 1 where sigma is 0, also over an infinite distance.
 RGB exp_neg(const RGB& sigma, float dt) {
@@ -25,6 +32,38 @@ RGB exp_neg(const RGB& sigma, float dt) {
 }
 
 RGB clamp_zero(const RGB& c) { return c.map([](float v) { return std::max(v, 0.0f); }); }
+
+// Lights whose point light_sample_li(light, ctx, u) chooses is the same for every ctx that sees it:
+// lights of one point, and lights sampled by area. Not the lights whose point depends on where they
+// are seen from (a sphere samples the cone it subtends) or that have none (lights at infinity):
+// equiangular sampling leaves those to distance sampling.
+template <typename T>
+constexpr bool kPointLightType = std::is_same_v<T, PointLightSource> || std::is_same_v<T, SpotLightSource> ||
+                                 std::is_same_v<T, ProjectorLightSource> || std::is_same_v<T, GoniometricLightSource>;
+template <typename T>
+constexpr bool kAreaSampledLightType = std::is_same_v<T, TriangleLight> || std::is_same_v<T, RectangleLight> ||
+                                       std::is_same_v<T, DiskLight> || std::is_same_v<T, CylinderLight> ||
+                                       std::is_same_v<T, PartialSphereLight>;
+bool light_has_fixed_point(const Light& light) {
+  return std::visit(
+      [](const auto& x) {
+        using T = std::decay_t<decltype(x)>;
+        return kPointLightType<T> || kAreaSampledLightType<T>;
+      },
+      light);
+}
+// That point for u: the light's position, or its area sample (the one its emitted rays start from
+// for the same u, light_sample_le: the same mapping, tested in volpath_test.cpp).
+std::optional<Point3> fixed_light_point(const Light& light, Vec2 u) {
+  return std::visit(
+      [&](const auto& x) -> std::optional<Point3> {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (kPointLightType<T>) return x.position;
+        else if constexpr (kAreaSampledLightType<T>) return x.sample_le(u, Vec2(0.5f, 0.5f), SceneSphere{}).p;
+        else return std::nullopt;
+      },
+      light);
+}
 
 // A medium's coefficients at a path's wavelengths (RGB when there are none).
 struct MediumValues {
@@ -97,13 +136,43 @@ struct VolPathIntegrator::ScatterPoint {
   int medium = -1;                          // the medium the path is in at this point
   float time = 0;
   const Wavelengths* wl = nullptr;
+  // On a segment where equiangular sampling took part (one-sample MIS between it and light sampling
+  // from this point, for the lights it can choose): whether it did, that is whether light sampling
+  // here leaves those lights out; the probability that light sampling here takes them (a_share);
+  // and, where equiangular sampling could have made this path, the segment, the point's distance
+  // along it and what multiplies equiangular sampling's density in the weights (the channels'
+  // densities at the segment's start over this point's hero density, times its probability).
+  bool mixed = false;
+  bool skip_fixed_lights = false;
+  float a_share = 1;
+  const MediumSegment* segment = nullptr;
+  float segment_t = 0;
+  RGB r_e{0.0f};
+};
+
+struct VolPathIntegrator::MediumSegment {
+  Ray ray;  // unit direction
+  float t0 = 0, t1 = kInfinity;
+  int medium = -1;
+  const Wavelengths* wl = nullptr;
+  // Where the light is chosen: the segment's midpoint (its start when it is infinite).
+  LightSampleContext ref;
+  // Equiangular sampling over [t0, t1) towards light point y.
+  EquiangularSegment towards(const Point3& y) const {
+    const Vec3 v = y - ray.origin;
+    const float delta = dot(v, ray.direction);
+    return equiangular_segment(delta, length(v - ray.direction * delta), t0, t1);
+  }
 };
 
 VolPathIntegrator::VolPathIntegrator(const Scene& scene, const RenderSettings& settings)
     : scene_(scene),
       max_depth_(settings.max_depth),
       rr_start_depth_(settings.rr_start_depth),
-      hide_emitters_(settings.hide_emitters) {}
+      hide_emitters_(settings.hide_emitters),
+      // Equiangular sampling runs only where it may choose a light (else it would cost sample dimensions).
+      equiangular_(settings.volpath.equiangular &&
+                   std::any_of(scene.lights().begin(), scene.lights().end(), light_has_fixed_point)) {}
 
 template <typename Sampler>
 RGB VolPathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, const Wavelengths* wl) const {
@@ -160,9 +229,31 @@ RGB VolPathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, co
       Ray scattered_ray;  // the continuation after a real scattering event
       const Medium& m = scene_.media()[size_t(medium)];
       const MediumValues mv(m, wl);
+      const float t_end = found ? hit.t : kInfinity;
+      // Equiangular sampling of direct light scattered from the segment, in a medium of constant
+      // density where the path may still scatter (a scattering point here would be a bounce of depth + 1).
+      MediumSegment segment;
+      const bool equiangular = equiangular_ && m.has_constant_density() && !m.is_subsurface() &&
+                               depth < max_depth_ && !scene_.lights().empty() && t_end > ray.t_min;
+      // One-sample MIS: with probability kEquiangularShare the light of the lights it can choose
+      // comes from equiangular sampling on this segment, else from light sampling at the point
+      // distance sampling chooses (if it scatters here).
+      bool equiangular_chosen = false;
+      if (equiangular) {
+        segment.ray = ray;
+        segment.t0 = ray.t_min;
+        segment.t1 = t_end;
+        segment.medium = medium;
+        segment.wl = wl;
+        segment.ref = {ray.at(std::isinf(t_end) ? ray.t_min : 0.5f * (ray.t_min + t_end)), Normal3(0.0f)};
+        equiangular_chosen = sampler.get_1d() < kEquiangularShare;
+        if (equiangular_chosen) L += sample_equiangular_direct(segment, sampler, beta, r_u, hero, counts);
+      }
+      const RGB r_segment = r_u;  // the channels' densities at the segment's start
+      bool null_collided = false;  // then equiangular sampling cannot make the path (it has a null vertex)
       Rng rng = medium_walk_rng(sampler);
       RGB T_maj = sample_majorant(
-          mv, ray, ray.t_min, found ? hit.t : kInfinity, hero, rng,
+          mv, ray, ray.t_min, t_end, hero, rng,
           [&](const Point3& p, const MediumPoint& mp, const RGB& sigma_maj, const RGB& T) {
             // Add the medium's emission (source term sigma_a Le) at every tentative collision. Light
             // emitted on the segment after `depth` scattering events is a path of that depth, as a
@@ -198,6 +289,16 @@ RGB VolPathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, co
               at.medium = medium;
               at.time = ray.time;
               at.wl = wl;
+              if (equiangular) {
+                at.mixed = true;
+                at.skip_fixed_lights = equiangular_chosen;
+                at.a_share = 1 - kEquiangularShare;
+                if (!null_collided) {
+                  at.segment = &segment;
+                  at.segment_t = dot(p - ray.origin, ray.direction);
+                  at.r_e = r_segment * (kEquiangularShare / pdf);
+                }
+              }
               if (!scene_.lights().empty()) L += sample_direct(at, sampler, beta, r_u, hero, counts);
               PhaseSample ps = m.phase().sample(at.wo, sampler.get_2d());
               if (!(ps.pdf > 0)) {
@@ -214,6 +315,7 @@ RGB VolPathIntegrator::radiance(Ray ray, Sampler& sampler, RayCounts& counts, co
               return false;
             }
             // A null collision: walk on, carrying sigma_n over the hero's density.
+            null_collided = true;
             RGB sigma_n = clamp_zero(sigma_maj - mp.sigma_a - mp.sigma_s);
             float pdf = T[hero] * sigma_n[hero];
             if (!(pdf > 0)) {
@@ -324,10 +426,16 @@ RGB VolPathIntegrator::sample_direct(const ScatterPoint& at, Sampler& sampler, c
   const SampledLight chosen = scene_.light_sampler().sample(at.ctx, sampler.get_1d());
   const Vec2 u = sampler.get_2d();
   Rng rng = medium_walk_rng(sampler);
-  const float pmf = chosen.pmf;
-  const size_t li = chosen.light;
-  if (!(pmf > 0)) return RGB(0.0f);
+  if (!(chosen.pmf > 0)) return RGB(0.0f);
+  const uint64_t seed = hash_values(rng.next_u32(), rng.next_u32());
+  return light_contribution(at, chosen.light, chosen.pmf, u, seed, beta, r_p, hero, counts);
+}
+
+RGB VolPathIntegrator::light_contribution(const ScatterPoint& at, size_t li, float pmf, Vec2 u, uint64_t seed,
+                                          const RGB& beta, const RGB& r_p, int hero, RayCounts& counts) const {
   const Light& light = scene_.lights()[li];
+  const bool mixed = at.mixed && light_has_fixed_point(light);
+  if (mixed && at.skip_fixed_lights) return RGB(0.0f);  // equiangular sampling's turn on this segment
   const LightSample ls = light_sample_li(light, at.ctx, u);
   if (!(ls.pdf > 0) || ls.radiance.is_black()) return RGB(0.0f);
 
@@ -352,15 +460,83 @@ RGB VolPathIntegrator::sample_direct(const ScatterPoint& at, Sampler& sampler, c
   float t_max = kInfinity;
   if (!std::isinf(ls.distance)) t_max = length(ls.p_light - origin) * (1 - 1e-4f);
   RGB r_u(1.0f), r_l(1.0f);
-  uint64_t seed = hash_values(rng.next_u32(), rng.next_u32());
   RGB T_ray = trace_transmittance(origin, ls.wi, t_max, medium, hero, seed, at.time, at.wl, r_u, r_l, counts);
   if (T_ray.is_black()) return RGB(0.0f);
 
   const RGB Le = illuminant_at(ls.radiance, at.wl);
+  const int lanes = transport_lanes(at.wl);
+  // Equiangular sampling's density of the same path (e) times its probability, where it could have
+  // made this path: its light choice at the segment's midpoint, the point's density (ls.pdf, as for
+  // light sampling here: the same point), and the distance's equiangular density.
+  RGB r_e(0.0f);
+  if (mixed && at.segment) {
+    const float p = scene_.light_sampler().pmf(at.segment->ref, li) *
+                    equiangular_pdf(at.segment->towards(ls.p_light), at.segment_t);
+    if (p > 0) r_e = r_l * at.r_e * (p * ls.pdf);
+  }
   r_l *= r_p * (pmf * ls.pdf);
-  if (ls.is_delta) return beta * f_hat * T_ray * Le / r_l.lane_average(transport_lanes(at.wl));
+  if (ls.is_delta) {
+    if (!mixed) return beta * f_hat * T_ray * Le / r_l.lane_average(lanes);
+    // Light sampling (a, taken with probability a_share) and equiangular sampling (e) are the only
+    // strategies: the one-sample balance heuristic's 1 / avg(a_share a + e).
+    const float ae = (r_l * at.a_share + r_e).lane_average(lanes);
+    return ae > 0 ? beta * f_hat * T_ray * Le / ae : RGB(0.0f);
+  }
   r_u *= r_p * scatter_pdf;
-  return beta * f_hat * T_ray * Le / (r_l + r_u).lane_average(transport_lanes(at.wl));
+  if (!mixed) return beta * f_hat * T_ray * Le / (r_l + r_u).lane_average(lanes);
+  // Light sampling's share against phase or BSDF sampling, avg(a) / avg(a + b), split between
+  // light sampling here and equiangular sampling by the one-sample balance heuristic: the weight
+  // over the density is avg(a) / (avg(a + b) avg(a_share a + e)).
+  const float a = r_l.lane_average(lanes), ab = (r_l + r_u).lane_average(lanes),
+              ae = (r_l * at.a_share + r_e).lane_average(lanes);
+  if (!(ab > 0 && ae > 0)) return RGB(0.0f);
+  return beta * f_hat * T_ray * Le * (a / (ab * ae));
+}
+
+template <typename Sampler>
+RGB VolPathIntegrator::sample_equiangular_direct(const MediumSegment& segment, Sampler& sampler, const RGB& beta,
+                                                 const RGB& r_u, int hero, RayCounts& counts) const {
+  // The sample dimensions, in a fixed order whatever happens below: the light, the point on it, the
+  // distance, the shadow ray's random stream.
+  const float u_light = sampler.get_1d();
+  const Vec2 u = sampler.get_2d();
+  const float u_t = sampler.get_1d();
+  Rng rng = medium_walk_rng(sampler);
+  const uint64_t seed = hash_values(rng.next_u32(), rng.next_u32());
+
+  // 1. A light, chosen at the segment's midpoint, and the point y it samples for u.
+  const SampledLight chosen = scene_.light_sampler().sample(segment.ref, u_light);
+  if (!(chosen.pmf > 0)) return RGB(0.0f);
+  const std::optional<Point3> y = fixed_light_point(scene_.lights()[chosen.light], u);
+  if (!y) return RGB(0.0f);
+  // 2. A distance t along the segment, with density proportional to the inverse squared distance to y.
+  const EquiangularSegment towards = segment.towards(*y);
+  if (!towards.valid()) return RGB(0.0f);
+  const float t = sample_equiangular(towards, u_t, segment.t0, segment.t1);
+  // 3. Scattering at t: the transmittance from the segment's start (exact: the extinction is the
+  //    majorant) times sigma_s; and the channels' densities distance sampling gives the same point,
+  //    sigma_t T, for the weights. The path's densities are relative to its hero's at the segment's
+  //    start; light_contribution's weights hold equiangular sampling's density.
+  const Medium& m = scene_.media()[size_t(segment.medium)];
+  const MediumValues mv(m, segment.wl);
+  const Point3 p = segment.ray.at(t);
+  const MediumPoint mp = mv.at(p);
+  const RGB T = exp_neg(mv.sigma_t * m.density(p), t - segment.t0);
+  ScatterPoint at;
+  at.ctx = {p, Normal3(0.0f)};
+  at.phase = &m.phase();
+  at.wo = -segment.ray.direction;
+  at.medium = segment.medium;
+  at.time = segment.ray.time;
+  at.wl = segment.wl;
+  at.mixed = true;
+  at.a_share = 1 - kEquiangularShare;
+  at.segment = &segment;
+  at.segment_t = t;
+  at.r_e = r_u * kEquiangularShare;
+  const float pmf = scene_.light_sampler().pmf(at.ctx, chosen.light);
+  return light_contribution(at, chosen.light, pmf, u, seed, beta * T * mp.sigma_s, r_u * T * (mp.sigma_a + mp.sigma_s),
+                            hero, counts);
 }
 
 RGB VolPathIntegrator::trace_transmittance(Point3 origin, const Vec3& dir, float t_max, int medium, int hero,

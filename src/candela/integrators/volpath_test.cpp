@@ -2,8 +2,9 @@
 // furnaces of media in closed enclosures (albedo 1 inside an emitter; an emitting, absorbing medium;
 // Kirchhoff's equilibrium of emitting walls and an emitting, scattering medium), a heterogeneous
 // grid's transmittance by ratio tracking and by delta tracking against quadrature, a subsurface
-// slab's reflectance against the exact transport (adding-doubling), and the refusal of scenes with
-// media by integrators that do not render them. Each render is repeated over seeds;
+// slab's reflectance against the exact transport (adding-doubling), equiangular sampling on against
+// off and BDPT (and its determinism), and the refusal of scenes with media by integrators that do not
+// render them. Each render is repeated over seeds;
 // tolerances are 5 standard errors of the mean over seeds (Student's t, 7 degrees of freedom).
 #include "candela/integrators/volpath.h"
 
@@ -398,6 +399,128 @@ TEST(VolPath, ForwardScatteringSubsurfaceSlabReflectsTheExactTransportsEffective
 // Dozens of scattering events inside, yet max_depth 1 (the bounce that entered) renders all of them.
 TEST(VolPath, ASubsurfaceExcursionIsOneBounce) {
   expect_subsurface_slab_reflectance({0.6f, 0.9f, 0.97f}, 0.2f, 1.33f, 1);
+}
+
+// ---------------------------------------------------------------- equiangular sampling
+
+// Equiangular sampling (integrators/volpath.h) takes a light's point for a 2D sample as the light
+// samples it from any point that sees it, and as its emitted rays start: for the area-sampled lights
+// the two are the same mapping.
+TEST(VolPath, AreaSampledLightsSampleTheSamePointForLightAndEmissionSampling) {
+  SceneDesc d = volpath_scene(4, 1);
+  d.materials = {DiffuseMaterial{RGB(0.5f)}};
+  auto emitter = [&](ShapeGeometry geometry, const Transform& to_world = {}) {
+    ShapeDesc s;
+    s.geometry = std::move(geometry);
+    s.to_world = to_world;
+    s.material = 0;
+    s.emission = AreaEmission{RGB(1.0f), true};
+    d.shapes.push_back(s);
+  };
+  emitter(RectangleShape{{-1, 2, -1}, {2, 0, 0}, {0, 0, 2}});
+  emitter(DiskShape{}, Transform::translate({0, 3, 0}) * Transform::scale({0.5f, 0.5f, 0.5f}));
+  emitter(CylinderShape{{2, 0, 0}, {2, 1, 0}, 0.3f, 360});
+  emitter(BoxShape{{-3, -3, -3}, {-2, -2, -2}});
+  const Scene scene(d);
+  ASSERT_GE(scene.lights().size(), 4u);
+  Rng rng(31, 32);
+  int compared = 0;
+  for (const Light& light : scene.lights())
+    for (int i = 0; i < 100; ++i) {
+      const Vec2 u(rng.next_float(), rng.next_float());
+      const LightSampleContext ctx{Point3(4 * rng.next_float() - 2, 4 * rng.next_float() - 2, 4 * rng.next_float() - 2),
+                                   Normal3(0.0f)};
+      const LightSample ls = light_sample_li(light, ctx, u);
+      if (!(ls.pdf > 0)) continue;
+      const Point3 p = light_sample_le(light, u, Vec2(0.5f, 0.5f), SceneSphere{}).p;
+      EXPECT_LT(length(p - ls.p_light), 1e-5f * (1 + length(p)));
+      ++compared;
+    }
+  EXPECT_GT(compared, 100 * int(scene.lights().size()) / 4);
+}
+
+// A chromatic homogeneous fog lit by a point light and a small one-sided rectangle light, over a
+// diffuse floor: bounded by an interface sphere with the camera outside, or (unbounded) around the
+// camera under a sky (segments to infinity, and a light equiangular sampling leaves out).
+SceneDesc lit_fog(bool bounded) {
+  SceneDesc d = volpath_scene(12, 16);
+  d.settings.max_depth = 4;
+  MediumDesc fog;
+  fog.sigma_t = {0.3f, 0.6f, 1.2f};
+  fog.albedo.constant = {0.9f, 0.7f, 0.8f};
+  fog.g = 0.3f;
+  d.media = {fog};
+  d.materials = {InterfaceMaterial{}, DiffuseMaterial{RGB(0.6f, 0.5f, 0.4f)}, BlackMaterial{}};
+  ShapeDesc floor;
+  floor.geometry = RectangleShape{{-1.2f, -1, -1.2f}, {0, 0, 2.4f}, {2.4f, 0, 0}};
+  floor.material = 1;
+  if (bounded) {
+    d.camera = look_at_camera({0, 0.2f, -4}, {0, 0, 0}, 50);
+    ShapeDesc ball;
+    ball.geometry = SphereShape{{0, 0, 0}, 2};
+    ball.material = 0;
+    ball.interior_medium = 0;
+    d.shapes.push_back(ball);
+  } else {
+    d.camera = look_at_camera({0, 0.2f, -1.8f}, {0, 0, 0}, 60);
+    d.camera.medium = 0;
+    d.lights.push_back(SkyLight{RGB(0.3f), RGB(0.2f), RGB(0.1f), {0, 1, 0}});
+  }
+  d.shapes.push_back(floor);
+  ShapeDesc lamp;
+  lamp.geometry = RectangleShape{{-0.6f, 1.2f, -0.2f}, {0.4f, 0, 0}, {0, 0, 0.4f}};  // facing down
+  lamp.material = 2;
+  lamp.emission = AreaEmission{RGB(6.0f, 5.0f, 3.0f), false};
+  d.shapes.push_back(lamp);
+  d.lights.push_back(PointLight{{0.5f, 0.3f, 0.4f}, RGB(1.0f, 2.0f, 1.5f)});
+  return d;
+}
+
+// Equiangular sampling on and off estimate the same image: the means over seeds agree within 5
+// standard errors of their difference, in RGB and spectral transport, with lights chosen by power and
+// through the light BVH (a choice that depends on the point); and with BDPT's.
+TEST(VolPath, EquiangularSamplingOnAndOffAgree) {
+  for (bool bounded : {true, false})
+    for (bool spectral : {false, true}) {
+      SceneDesc d = lit_fog(bounded);
+      d.settings.spectral = spectral;
+      d.settings.spp = 128;
+      if (spectral) d.settings.light_selection = LightSelection::Bvh;
+      d.settings.volpath.equiangular = false;
+      const ChannelMeans off = render_means(d);
+      d.settings.volpath.equiangular = true;
+      const ChannelMeans on = render_means(d);
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_GT(on.mean[c], 0.01f);
+        const float se = std::hypot(on.standard_error[c], off.standard_error[c]);
+        EXPECT_NEAR(on.mean[c], off.mean[c], 5 * se + 1e-4f * off.mean[c])
+            << (bounded ? "bounded" : "unbounded") << (spectral ? ", spectral" : ", rgb") << ", channel " << c
+            << ": standard errors " << on.standard_error[c] << " (on), " << off.standard_error[c] << " (off)";
+      }
+      // Distance sampling alone has heavy tails near the point light (its 1 / d^2 at scattering points
+      // close to it), so its standard error over 8 seeds is itself uncertain: BDPT, which reaches the
+      // point light from light subpaths too, is a second opinion with light tails.
+      if (bounded && !spectral) {
+        d.settings.integrator = "bdpt";
+        const ChannelMeans bdpt = render_means(d);
+        for (int c = 0; c < 3; ++c)
+          EXPECT_NEAR(on.mean[c], bdpt.mean[c], 5 * std::hypot(on.standard_error[c], bdpt.standard_error[c]))
+              << "against bdpt, channel " << c;
+      }
+    }
+}
+
+// Equiangular sampling draws its sample dimensions in a fixed order: 1 and 2 threads give the same
+// image, bit for bit; and it changes the image (it runs).
+TEST(VolPath, EquiangularSamplingIsTheSameForOneAndTwoThreads) {
+  SceneDesc d = lit_fog(true);
+  d.settings.seed = 3;
+  const Image one = testing::render_description(d, 1).mean_image();
+  const Image two = testing::render_description(d, 2).mean_image();
+  ASSERT_EQ(one.rgb.size(), two.rgb.size());
+  EXPECT_TRUE(one.rgb == two.rgb);
+  d.settings.volpath.equiangular = false;
+  EXPECT_FALSE(testing::render_description(d, 1).mean_image().rgb == one.rgb);
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 #pragma once
 // Warps from the unit square to common domains, each with its pdf (pbrt-v4 ch. A.5 / Mitsuba's warp.h).
 // Directions on the hemisphere are in local coordinates with the normal along +z.
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "candela/math/vec.h"
 
@@ -130,6 +132,37 @@ inline Vec2 equal_area_sphere_to_square(const Vec3& d) {
   u = std::copysign(u, d.x);
   v = std::copysign(v, d.y);
   return {0.5f * (u + 1), 0.5f * (v + 1)};
+}
+
+// Equiangular sampling (Kulla and Fajardo, "Importance Sampling Techniques for Path Tracing in
+// Participating Media", EGSR 2012, sec. 4.1): a distance t in [t0, t1) along a line, with density
+// proportional to 1 / (h^2 + (t - delta)^2), the inverse squared distance to a point at distance h > 0
+// from the line whose foot on it is at t = delta: uniform in the angle under which the point sees the
+// line. t1 may be infinite. The density is 0 (no sample) where h is not positive (or so small that h^2
+// underflows) or the interval is empty; equiangular_pdf gives what sample_equiangular does, for the
+// same arguments.
+struct EquiangularSegment {
+  float delta = 0, h = 0;              // the foot of the point on the line, and its distance from it
+  float theta_a = 0, theta_b = 0;      // the angles of t0 and t1 as the point sees them
+  bool valid() const { return theta_b > theta_a; }
+};
+inline EquiangularSegment equiangular_segment(float delta, float h, float t0, float t1) {
+  // (h^2 must be a normal float: the density's peak h / (h^2 (theta_b - theta_a)) stays finite.)
+  if (!(h * h >= std::numeric_limits<float>::min()) || !(t1 > t0) || !std::isfinite(delta) || !std::isfinite(h))
+    return {};
+  const float theta_a = std::atan2(t0 - delta, h);
+  const float theta_b = std::isinf(t1) ? kPi / 2 : std::atan2(t1 - delta, h);
+  return {delta, h, theta_a, theta_b};
+}
+inline float equiangular_pdf(const EquiangularSegment& s, float t) {
+  if (!s.valid()) return 0;
+  const float x = t - s.delta;
+  return s.h / ((s.theta_b - s.theta_a) * (s.h * s.h + x * x));
+}
+// The distance for u in [0, 1), clamped into [t0, t1) against rounding; pdf: equiangular_pdf there.
+inline float sample_equiangular(const EquiangularSegment& s, float u, float t0, float t1) {
+  float t = s.delta + s.h * std::tan(s.theta_a + u * (s.theta_b - s.theta_a));
+  return std::clamp(t, t0, std::nextafter(t1, t0));
 }
 
 }  // namespace candela

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <functional>
+#include <limits>
 
 #include "candela/sampling/distribution1d.h"
 #include "candela/sampling/rng.h"
@@ -159,6 +160,56 @@ TEST(Distribution1D, SamplesProportionally) {
   for (int i = 0; i < kChiSquareSamples; ++i) observed[d.sample(rng.next_float())] += 1;
   EXPECT_EQ(observed[1], 0);
   EXPECT_GT(testing::chi_square_p_value(observed, expected), testing::kChiSquareAlpha);
+}
+
+TEST(Warp, EquiangularSamplingMatchesItsPdf) {
+  // Distances binned over [t0, t1) (an infinite t1: up to delta + 40 h, then one tail cell), against the
+  // pdf's integral per cell, the closed form (atan((t - delta) / h) - theta_a) / (theta_b - theta_a):
+  // the foot of the point inside, before and beyond the interval, and a half-line.
+  struct Case {
+    float delta, h, t0, t1;
+  };
+  const float inf = std::numeric_limits<float>::infinity();
+  uint64_t seed = 20;
+  for (const Case& c : {Case{3, 0.5f, 1, 7}, Case{-2, 1.5f, 0, 4}, Case{9, 0.2f, 0, 4}, Case{2, 0.3f, 0.5f, inf}}) {
+    const EquiangularSegment s = equiangular_segment(c.delta, c.h, c.t0, c.t1);
+    ASSERT_TRUE(s.valid());
+    const double a = std::atan2(double(c.t0) - c.delta, double(c.h));
+    const double b = std::isinf(c.t1) ? kPi / 2 : std::atan2(double(c.t1) - c.delta, double(c.h));
+    auto cdf = [&](double t) { return (std::atan2(t - c.delta, double(c.h)) - a) / (b - a); };
+    const double end = std::isinf(c.t1) ? c.delta + 40 * c.h : c.t1;
+    const int bins = 60;
+    std::vector<double> observed(bins + 1, 0), expected(bins + 1, 0);
+    for (int i = 0; i < bins; ++i)
+      expected[i] = kChiSquareSamples * (cdf(c.t0 + (end - c.t0) * (i + 1) / bins) - cdf(c.t0 + (end - c.t0) * i / bins));
+    expected[bins] = kChiSquareSamples * (1 - cdf(end));
+    Rng rng(seed++, 3);
+    double inv_sum = 0, inv_sum2 = 0;
+    for (int i = 0; i < kChiSquareSamples; ++i) {
+      const float t = sample_equiangular(s, rng.next_float(), c.t0, c.t1);
+      ASSERT_GE(t, c.t0);
+      ASSERT_LT(t, c.t1);
+      const double x = (t - c.t0) / (end - c.t0);
+      observed[x >= 1 ? bins : std::min(bins - 1, int(x * bins))] += 1;
+      // The pdf against the closed form's derivative.
+      const double exact = double(c.h) / ((b - a) * (double(c.h) * c.h + (double(t) - c.delta) * (double(t) - c.delta)));
+      ASSERT_NEAR(equiangular_pdf(s, t), exact, 1e-4 * exact) << t;
+      inv_sum += 1 / exact;
+      inv_sum2 += 1 / (exact * exact);
+    }
+    EXPECT_GT(testing::chi_square_p_value(observed, expected), testing::kChiSquareAlpha)
+        << "delta " << c.delta << " h " << c.h << " [" << c.t0 << ", " << c.t1 << ")";
+    // The mean of 1 / pdf estimates the interval's length (finite intervals), within 5 standard errors.
+    if (std::isfinite(c.t1)) {
+      const double mean = inv_sum / kChiSquareSamples;
+      const double se = std::sqrt(std::max(0.0, inv_sum2 / kChiSquareSamples - mean * mean) / kChiSquareSamples);
+      EXPECT_NEAR(mean, c.t1 - c.t0, 5 * se + 1e-6);
+    }
+  }
+  // No sample where the point lies on the line or the interval is empty.
+  EXPECT_FALSE(equiangular_segment(1, 0, 0, 2).valid());
+  EXPECT_FALSE(equiangular_segment(1, 1, 2, 2).valid());
+  EXPECT_EQ(equiangular_pdf(equiangular_segment(1, 0, 0, 2), 1), 0);
 }
 
 }  // namespace
