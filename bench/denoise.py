@@ -27,11 +27,14 @@ Scenes (the references' resolution): cornell-box, veach-mis, veach-ajar (Bitterl
 spp), shapes-checker (Mitsuba's test_various_shapes: checkerboard-textured shapes, 480 x 480), wood-sphere
 (Mitsuba's test_textured_diffuse: a bitmap-textured sphere, 48 x 48), fog-cornell (the Cornell box filled with
 bench/cycles_fog_vs_candela.py's homogeneous fog, volpath, 128 x 128; reference: candela volpath at
---fog-reference-spp, made once and kept in --cache), fog-sphere (Mitsuba's test_homo_obj_inside_medium:
+--fog-reference-spp, made once and kept in --cache with its own estimated relMSE, which is subtracted from every
+truth measured against it), fog-sphere (Mitsuba's test_homo_obj_inside_medium:
 homogeneous media in glass spheres over a checkerboard, 48 x 48). Mitsuba's references are means of 32,000 spp.
 
 Usage: /usr/bin/python3 bench/denoise.py [--build build] [--threads 2] [--seeds 3] [--scenes a,b,...] [--quick]
-       [--markdown] [--max-raw-spp 256] [--skip-hd | --hd-only] [--skip-cycles] [--cache DIR] [--fog-reference-spp 4096]
+       [--markdown] [--max-raw-spp 256] [--skip-hd | --hd-only] [--skip-cycles] [--estimates-only] [--cache DIR]
+       [--fog-reference-spp 4096]
+--estimates-only: part 2 alone (no plain renders; with --skip-hd --skip-cycles, about 5 minutes).
 --quick: cornell-box and fog-sphere, one seed, 16 spp, plain renders up to 64 spp, the error estimate at 16 and 32
 spp, part 3, no Cycles (a smoke run of about a minute). A full run took 13 minutes on 2 threads (a busy 2-core machine), plus 3 to 5
 minutes for fog-cornell's reference the first time.
@@ -146,6 +149,7 @@ class Bench:
         self.out = os.path.join(self.tmp, "image.exr")
         self.fog_scene = None
         self.refs = {}
+        self.ref_noise = {}  # a reference's own estimated relMSE, where it is known (candela's own references)
 
     # --- scenes and references ---------------------------------------------------------------------------------
 
@@ -174,13 +178,25 @@ class Bench:
             spp = self.args.fog_reference_spp
             os.makedirs(self.args.cache, exist_ok=True)
             path = os.path.join(self.args.cache, f"fog-cornell-{SCENES[name][1]}-{spp}spp.exr")
-            if not os.path.exists(path):
+            # Its own error, estimated from its halves (docs/error-estimates.md), kept beside it: a truth
+            # measured against it holds that error too (the two are independent), which is subtracted.
+            noise_file = path + ".relmse"
+            if not os.path.exists(path) or not os.path.exists(noise_file):
                 log(f"fog-cornell reference: candela volpath at {spp} spp (once; kept as {path})")
                 partial = path + ".partial.exr"
-                self.render(name, ["--spp", str(spp), "--seed", "1000"], partial)
+                text, _ = self.render(name, ["--spp", str(spp), "--seed", "1000", "--estimate-error"], partial)
+                with open(noise_file, "w") as f:
+                    f.write(ESTIMATE.search(text).group(1))
                 os.replace(partial, path)
+            with open(noise_file) as f:
+                self.ref_noise[name] = float(f.read())
+            log(f"fog-cornell reference: its own estimated relMSE {self.ref_noise[name]:.3g}, subtracted from each truth")
         self.refs[name] = rgb(path)
         return self.refs[name]
+
+    def truth(self, name, image):
+        """relMSE of `image` against the scene's reference, less the reference's own (where known)."""
+        return relmse(image, self.reference(name)) - self.ref_noise.get(name, 0.0)
 
     def render(self, name, extra, out=None, timed=False, resolution=None):
         """Renders scene `name`: (output text, render seconds from the closing line[, max RSS MiB])."""
@@ -203,14 +219,13 @@ class Bench:
         # Without both halves in every pixel (the zsobol sampler below 16 spp: its halves are blocks of 8
         # samples) the estimates are missing: "not available: ...", or from the raw line's absence.
         halves = e is not None
-        ref = self.reference(name)
         return {
             "render_s": t, "denoise_s": denoise_seconds(text),
             "estimate": float(d.group(1)) if d and halves else None,
             "low": float(d.group(2)) if d and halves else None, "high": float(d.group(3)) if d and halves else None,
             "raw_estimate": float(e.group(1)) if halves else None,
-            "denoised": relmse(rgb(self.out), ref),
-            "raw": relmse(channels(self.out, ["Noisy.R", "Noisy.G", "Noisy.B"]), ref),
+            "denoised": self.truth(name, rgb(self.out)),
+            "raw": self.truth(name, channels(self.out, ["Noisy.R", "Noisy.G", "Noisy.B"])),
         }
 
     # --- part 1: quality and equal-quality spp ----------------------------------------------------------------
@@ -221,7 +236,7 @@ class Bench:
         ladder, spp = [], 16
         while spp <= self.args.max_raw_spp:
             _, t = self.render(name, ["--spp", str(spp), "--seed", "1"])
-            ladder.append((spp, relmse(rgb(self.out), self.reference(name)), t))
+            ladder.append((spp, self.truth(name, rgb(self.out)), t))
             log(f"  {name} plain {spp} spp: relMSE {ladder[-1][1]:.4g} in {t:.2f} s")
             if ladder[-1][1] <= min(targets):
                 break
@@ -257,7 +272,7 @@ class Bench:
                     log(f"  {name} {spp} spp seed {seed}: denoised {r['denoised']:.4g} (estimate {r['estimate']}), "
                         f"raw {r['raw']:.4g}; {r['render_s']:.2f} + {r['denoise_s']:.2f} s")
         quality_rows, verdicts = [], []
-        for name in scenes:
+        for name in scenes if a.quality else []:
             targets = [statistics.median(r["denoised"] for r in runs[(name, spp)]) for spp in a.quality_spp]
             ladder = self.plain_ladder(name, targets)
             per_spp_s = ladder[-1][2] / ladder[-1][0]
@@ -409,12 +424,14 @@ def main():
     ap.add_argument("--hd-spp", type=int, default=16)
     ap.add_argument("--skip-hd", action="store_true")
     ap.add_argument("--hd-only", action="store_true", help="part 3 alone")
+    ap.add_argument("--estimates-only", action="store_true", help="part 2 alone (with --skip-hd --skip-cycles)")
     ap.add_argument("--skip-cycles", action="store_true")
     ap.add_argument("--fog-reference-spp", type=int, default=4096)
     ap.add_argument("--cache", default=os.path.join(os.path.expanduser("~"), ".cache", "candela-bench"),
                     help="where fog-cornell's reference is kept")
     a = ap.parse_args()
     a.quality_spp, a.estimate_spp = [16, 64], [16, 32, 64]
+    a.quality = not a.estimates_only
     scenes = a.scenes.split(",")
     if a.quick:
         a.seeds, a.max_raw_spp, a.skip_cycles, a.estimate_spp = 1, min(a.max_raw_spp, 64), True, [16, 32]
@@ -436,16 +453,8 @@ def main():
         table(m, ["render", "render s", "denoise s", "both halves (an estimate)", "wall s", "max RSS MiB"], bench.hd())
         return
     quality, estimates, summary, verdicts = bench.quality_and_estimates(scenes)
-    heading(m, "Denoised against raw, and the equal-quality spp")
-    print("raw: the same render's layer Noisy (the same samples, in two halves); equal-quality spp: where plain renders "
-          f"(the scene's sampler, seed 1, 16-{a.max_raw_spp} spp) reach the denoised relMSE, ~ = beyond them by "
-          "the 1/spp law; time: render + denoise s (median), plain s = plain seconds per spp x that spp.\n")
-    table(m, ["scene", "resolution", "spp", "raw relMSE", "denoised relMSE", "raw / denoised", "equal-quality spp",
-              "speed-up (spp)", "denoised s", "of which denoise s", "plain s at equal quality", "speed-up (time)"],
-          quality)
-    if not any("WORSE" in v for v in verdicts):
-        verdicts.append("No denoised image was worse than its raw one (every scene, spp and seed).")
-    print("\n".join(verdicts) + "\n")
+    if a.quality:
+        quality_table(m, a, quality, verdicts)
     heading(m, "The denoiser's error estimate")
     table(m, ["scene", "spp", "true relMSE of the denoised image (median)", "estimate / truth: median, min, max",
               "within 1.5x", "truth in the 95% interval", "raw estimate / raw truth (median)"], estimates)
@@ -463,6 +472,19 @@ def main():
             table(m, ["renderer", "spp", "relMSE (median)", "time s (render + denoise, median)"], rows)
     log(f"done in {time.monotonic() - start:.0f} s")
     shutil.rmtree(bench.tmp, ignore_errors=True)
+
+
+def quality_table(m, a, quality, verdicts):
+    heading(m, "Denoised against raw, and the equal-quality spp")
+    print("raw: the same render's layer Noisy (the same samples, in two halves); equal-quality spp: where plain renders "
+          f"(the scene's sampler, seed 1, 16-{a.max_raw_spp} spp) reach the denoised relMSE, ~ = beyond them by "
+          "the 1/spp law; time: render + denoise s (median), plain s = plain seconds per spp x that spp.\n")
+    table(m, ["scene", "resolution", "spp", "raw relMSE", "denoised relMSE", "raw / denoised", "equal-quality spp",
+              "speed-up (spp)", "denoised s", "of which denoise s", "plain s at equal quality", "speed-up (time)"],
+          quality)
+    if not any("WORSE" in v for v in verdicts):
+        verdicts.append("No denoised image was worse than its raw one (every scene, spp and seed).")
+    print("\n".join(verdicts) + "\n")
 
 
 if __name__ == "__main__":

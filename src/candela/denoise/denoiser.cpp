@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <array>
@@ -38,8 +37,12 @@ constexpr double kRidgeRelative = 0.01, kRidgeAbsolute = 1e-4;
 constexpr int kErrorSmoothingRadius = 5;      // the 11 x 11 box over which candidates' errors compare
 constexpr int kFireflyRadius = 5;             // the 11 x 11 box whose mean bounds a firefly
 constexpr float kFireflyNeighbourFactor = 2, kFireflyMeanFactor = 4;
+// How far the denoiser's estimate trusts the raw halves' product A B as the truth's square (where a
+// fit was chosen): by weight 1 / (1 + kRawProductTrust v), v the raw image's relative variance around
+// the pixel; a half at v = 1/16, a relative standard deviation of a quarter (docs/denoising.md).
+constexpr double kRawProductTrust = 16;
 // The estimate's systematic uncertainty, a factor: its ratio to the true relMSE measured on seven scenes at
-// 16, 32 and 64 spp lay in 0.49-1.82 (docs/denoising.md).
+// 16, 32 and 64 spp lay in 0.40-1.92, 59 of 63 runs within 1.5 (docs/denoising.md).
 constexpr double kSystematicFactor = 2.5;
 
 // f(i) for every i < count, in parallel (each i on its own: the same result for any thread count).
@@ -408,12 +411,6 @@ DenoiseResult denoise(const DenoiseInput& in) {
   };
   // The widest candidate's image weighs pixels against each other in the choice (smooth, so that the
   // noisiest pixels do not dominate a neighbourhood's sum; where it blows up, the choice goes elsewhere).
-  // The raw image's truth estimate (for step 6) meanwhile: it needs only the halves, and its serial
-  // parts then overlap the fits.
-  ImageBuffer<double> raw_truth_sq;
-  tbb::task_group truth_estimate;
-  if (in.has_halves)
-    truth_estimate.run([&] { raw_truth_sq = estimated_truth_squared(w, h, in.half_a, in.half_b, in.share_a); });
   std::array<ImageBuffer<float>, 2> widest = filter(kDenoiseCandidates - 1);
   ImageBuffer<float> choice_truth(3 * n);
   for_each_index(3 * n, [&](size_t i) {
@@ -422,12 +419,16 @@ DenoiseResult denoise(const DenoiseInput& in) {
 
   std::array<ImageBuffer<float>, 2> best;
   ImageBuffer<float> best_smoothed(n), choice_error(n), mse(3 * n), best_mse(3 * n);
+  // The narrowest fit's halves multiplied, and the raw image's relative variance: for the truth's square
+  // in the estimate (step 5, below).
+  ImageBuffer<float> narrow_fit_product(3 * n), relative_variance(3 * n);
   DenoiseResult result;
   result.choice.assign(n, 0);
   // The raw image first: a candidate replaces it only where it is estimated strictly better.
   for (int candidate = 0; candidate < kDenoiseCandidates; ++candidate) {
     std::array<ImageBuffer<float>, 2> filtered = candidate == kDenoiseCandidates - 1 ? std::move(widest) : filter(candidate);
     const ImageBuffer<float>&da = filtered[0], &db = filtered[1];
+    if (candidate == 1) for_each_index(3 * n, [&](size_t i) { narrow_fit_product[i] = da[i] * db[i]; });
     // Each pixel-channel's estimated squared error of f D_A + (1 - f) D_B (denoiser.h, step 3),
     // against the capped halves for a fit (a firefly's residual would swamp the sum; the cap's
     // bias is added to the chosen fits' below), and the pixel's relative error for the choice.
@@ -468,12 +469,7 @@ DenoiseResult denoise(const DenoiseInput& in) {
     result.image.rgb[i] = f * best[0][i] + (1 - f) * best[1][i];
     if (!any_negative) result.image.rgb[i] = std::max(result.image.rgb[i], 0.0f);
   });
-  // Its relMSE: the chosen candidates' squared errors over the truth's square. Neither the raw
-  // image's estimate of the square (film/error_estimate.h: too small where a dark pixel's samples
-  // have mostly not found the light yet) nor the denoised image's (too large where a fit bleeds a
-  // bright neighbour into a dark pixel, just where its error is) will do: their geometric mean, the
-  // raw one floored at a quarter of the denoised one (measured on Bitterli's scenes, docs/denoising.md).
-  truth_estimate.wait();
+  // Its relMSE: the chosen candidates' squared errors over the truth's square, averaged.
   if (!in.has_halves) {
     result.error.why_not = "the pixels' samples are not split into two independent halves";
     return result;
@@ -486,6 +482,15 @@ DenoiseResult denoise(const DenoiseInput& in) {
     removed[1][i] = in.half_b[i] - targets[1][i];
   });
   for (auto& r : removed) r = box_mean(r, 3, w, h, kFireflyRadius);
+  // The truth's square where a fit was chosen (below): the narrowest fit's product, floored, and the
+  // raw halves' product A B, floored at a quarter of it, combined geometrically with A B's weight
+  // 1 / (1 + kRawProductTrust v), v the raw image's relative variance over the 11 x 11 window.
+  for_each_index(3 * n, [&](size_t i) {
+    const float f = in.share_a[i / 3], denoised = result.image.rgb[i], diff = in.half_a[i] - in.half_b[i];
+    narrow_fit_product[i] = std::max({narrow_fit_product[i], denoised * denoised / 4, 1e-12f});
+    relative_variance[i] = f * (1 - f) * diff * diff / (narrow_fit_product[i] + float(kErrorEpsilon));
+  });
+  relative_variance = box_mean(relative_variance, 3, w, h, kErrorSmoothingRadius);
   // Rows in parallel, their sums added in row order: the same estimate for any number of threads.
   std::vector<std::array<double, 2>> row_sums(static_cast<size_t>(h));
   tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& range) {
@@ -495,8 +500,25 @@ DenoiseResult denoise(const DenoiseInput& in) {
         double relative = 0;
         for (size_t c = 0; c < 3; ++c) {
           const size_t at = 3 * i + c;
+          // The truth's square, from products of two independent estimates, one from each half,
+          // whose expectation is the product of theirs. Not the denoised image's square, whose
+          // expectation also holds the image's variance: that variance is largest just where the
+          // image's error is, and dividing by it would hide the noisiest pixels' errors (estimates
+          // at 0.45-0.6 of the truth on the fog box and veach-mis). A raw pixel: A B, floored at a
+          // quarter of its square (where one half has not yet found the light A B is near 0). A
+          // fit: its narrowest candidate's product, which bleeds least across edges the features do
+          // not show, but still bleeds (a dark pixel beside a bright one looks brighter than it
+          // is, just where the fit's error is); the raw A B does not bleed but is noisy, so it
+          // weighs in as far as the raw image's relative variance around the pixel is small
+          // (docs/denoising.md has what each choice measured).
           const double denoised_sq = double(result.image.rgb[at]) * result.image.rgb[at];
-          const double truth_sq = std::sqrt(denoised_sq * std::max(raw_truth_sq[at], denoised_sq / 4));
+          const double raw_product = double(in.half_a[at]) * in.half_b[at];
+          double truth_sq = std::max(raw_product, denoised_sq / 4);
+          if (result.choice[i] > 0) {
+            const double fit_product = narrow_fit_product[at];
+            const double raw_weight = 1 / (1 + kRawProductTrust * double(relative_variance[at]));
+            truth_sq = std::pow(std::max(raw_product, fit_product / 4), raw_weight) * std::pow(fit_product, 1 - raw_weight);
+          }
           const double cap_bias_sq = result.choice[i] > 0 ? double(removed[0][at]) * removed[1][at] : 0.0;
           relative += (best_mse[at] + cap_bias_sq) / (truth_sq + kErrorEpsilon);
         }

@@ -23,8 +23,10 @@
 //      takes the candidate (the raw image among them) with the least. A candidate must be strictly
 //      better than the raw pixel, so a noiseless image comes back unchanged.
 //   5. The denoised image's relMSE: the chosen candidates' squared errors over an estimate of the
-//      truth's square (denoiser.cpp says which), averaged. A pixel's choice does not see its own
-//      estimate (step 4), so the choice does not bias the sum low.
+//      truth's square, averaged. The square is estimated from products of the two halves'
+//      independent estimates (A B, the narrowest fit's D_A D_B), not from the denoised image's square,
+//      which its own noise inflates just where its error is (denoiser.cpp says how they combine). A
+//      pixel's choice does not see its own estimate (step 4), so the choice does not bias the sum low.
 //
 // Deterministic: rows are processed in strips of fixed height, each from its own running sums, so the
 // image is the same bit for bit whatever the number of threads.

@@ -317,35 +317,6 @@ ErrorSums sum_pixel_errors(const HalfStatistics& s, bool splats, int w, int h, s
 }
 }  // namespace
 
-ImageBuffer<double> estimated_truth_squared(int w, int h, const std::vector<float>& a, const std::vector<float>& b,
-                                            const std::vector<float>& share_a) {
-  const size_t n = size_t(w) * size_t(h);
-  HalfStatistics s;
-  s.mean.resize(3 * n);
-  s.variance.resize(3 * n);
-  s.lesser_half.resize(3 * n);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, 3 * n, 1 << 14), [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t i = range.begin(); i < range.end(); ++i) {
-      const double f = share_a[i / 3];
-      s.mean[i] = f * a[i] + (1 - f) * b[i];
-      s.variance[i] = f * (1 - f) * (double(a[i]) - b[i]) * (double(a[i]) - b[i]);
-      s.lesser_half[i] = std::min(a[i], b[i]);
-    }
-  });
-  s.any_negative = std::any_of(s.mean.begin(), s.mean.end(), [](double m) { return m < 0; });
-  const BoxSums firefly_box = box_sums(s.mean, w, h, kFireflyRadius);
-  ImageBuffer<double> truth_sq(3 * n);
-  tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& range) {
-    for (int y = range.begin(); y < range.end(); ++y)
-      for (int x = 0; x < w; ++x)
-        for (int c = 0; c < 3; ++c) {
-          const size_t at = 3 * (size_t(y) * size_t(w) + size_t(x)) + size_t(c);
-          truth_sq[at] = truth_squared(s, firefly_box, w, h, x, y, c, at);
-        }
-  });
-  return truth_sq;
-}
-
 ErrorEstimate estimate_error(const Film& film, double scale_relative_error, std::vector<double>* pixel_errors) {
   ErrorEstimate e;
   if (pixel_errors) pixel_errors->assign(size_t(film.width()) * size_t(film.height()), std::nan(""));

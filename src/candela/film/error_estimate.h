@@ -26,7 +26,6 @@
 #include <string>
 #include <vector>
 
-#include "candela/base/image_buffer.h"
 #include "candela/film/film.h"
 
 namespace candela {
@@ -49,12 +48,6 @@ inline constexpr double kErrorEpsilon = 0.01;
 // receives each pixel's estimated relative squared error (row-major; NaN where it has none).
 ErrorEstimate estimate_error(const Film& film, double scale_relative_error = 0,
                              std::vector<double>* pixel_errors = nullptr);
-
-// Per pixel and channel (3 per pixel, row-major), the truth's square that estimate_error divides by,
-// from each pixel's two halves `a` and `b` (3 values per pixel) and a's share of its weight: for the
-// denoiser's error estimate (denoise/denoiser.h), whose denominators are the raw image's.
-ImageBuffer<double> estimated_truth_squared(int width, int height, const std::vector<float>& a,
-                                            const std::vector<float>& b, const std::vector<float>& share_a);
 
 // "relMSE 0.0031 (95% interval 0.0028-0.0034)" or "not available: ...".
 std::string describe(const ErrorEstimate& e);
