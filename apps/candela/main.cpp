@@ -22,6 +22,8 @@
 #include <string>
 #include <vector>
 
+#include "candela/animation/frames.h"
+#include "candela/animation/pose.h"
 #include "candela/denoise/denoise_file.h"
 #include "candela/denoise/denoised_render.h"
 #include "candela/film/error_estimate.h"
@@ -128,15 +130,27 @@ struct RenderCommand : RenderRequest {
   std::optional<double> checkpoint_every;  // with --checkpoint (RenderRequest::checkpoint)
   std::string preview;          // [HOST:]PORT of the browser preview; empty = none
   bool preview_public = false;  // allow a preview address reachable from other machines
+  // An animation's frames (animation/frames.h): the list, the frame rate, the shutter's open fraction
+  // of a frame, and whether frames whose images all exist are skipped (a restarted farm job).
+  std::string frames;
+  double fps = 24, shutter = 0.5;
+  bool skip_existing = false;
 };
 
 // The files to write: -o wins, then the scene's own film name, then <scene name>.exr. The built-in
 // scene writes both cornell-box.png and cornell-box.exr.
+// With --frames, the names are patterns with the frame number in a run of '#' (shot_####.exr); a
+// default name without one gets _#### before its extension.
 std::vector<fs::path> output_files(const RenderCommand& cmd, const SceneDesc& scene) {
   if (!cmd.output.empty()) return {cmd.output};
-  if (cmd.scene_file.empty()) return {"cornell-box.png", "cornell-box.exr"};
-  if (!scene.film.filename.empty()) return {scene.film.filename};
-  return {fs::path(cmd.scene_file).stem().string() + ".exr"};
+  std::vector<fs::path> names = cmd.scene_file.empty()         ? std::vector<fs::path>{"cornell-box.png", "cornell-box.exr"}
+                                : !scene.film.filename.empty() ? std::vector<fs::path>{scene.film.filename}
+                                                               : std::vector<fs::path>{fs::path(cmd.scene_file).stem().string() + ".exr"};
+  if (!cmd.frames.empty())
+    for (fs::path& name : names)
+      if (!has_frame_placeholder(name.string()))
+        name = name.parent_path() / (name.stem().string() + "_####" + name.extension().string());
+  return names;
 }
 
 bool is_exr(const fs::path& file) {
@@ -255,6 +269,23 @@ void check_command_flags(const RenderCommand& cmd) {
   }
   if (cmd.checkpoint_every && !(*cmd.checkpoint_every > 0))
     throw UsageError(fmt::format("--checkpoint-every: must be a positive number, got {}", *cmd.checkpoint_every));
+  if (!cmd.frames.empty()) {
+    if (!(cmd.fps > 0 && cmd.fps <= 1e6)) throw UsageError(fmt::format("--fps: must be in (0, 1e6], got {}", cmd.fps));
+    if (!(cmd.shutter >= 0 && cmd.shutter <= 1))
+      throw UsageError(fmt::format("--shutter: the fraction of a frame the shutter is open, in [0, 1], got {}", cmd.shutter));
+    if (pixel_mode) throw UsageError("--frames renders whole images: it cannot be combined with --pixel");
+    if (!cmd.checkpoint.empty() || !cmd.resume.empty())
+      throw UsageError("--frames cannot be combined with --checkpoint or --resume: a restarted job skips the frames "
+                       "it finished with --skip-existing");
+    if (!cmd.preview.empty() || !cmd.display_server.empty())
+      throw UsageError("--frames cannot be combined with --preview or --display-server yet (a viewer shows one image)");
+    if (cmd.denoise) throw UsageError("--frames cannot be combined with --denoise yet");
+    if (!cmd.spp_map.empty() && !has_frame_placeholder(cmd.spp_map))
+      throw UsageError(fmt::format("--spp-map '{}': with --frames, name the frame number with a run of '#' "
+                                   "(spp_####.png)", cmd.spp_map));
+  } else {
+    if (cmd.skip_existing) throw UsageError("--skip-existing needs --frames");
+  }
 }
 
 // The AOV layers: --aov, else the scene's; checkpoints and parts do not keep them.
@@ -297,6 +328,11 @@ void check_command_outputs(const RenderCommand& cmd, const CommandPlan& plan, Cl
     throw UsageError(fmt::format("--spp-map '{}': unsupported image format (use .exr, .png or .pfm)", cmd.spp_map));
   if (!cmd.spp_map.empty() && cluster.is_root()) check_can_write(cmd.spp_map, fmt::format("--spp-map '{}'", cmd.spp_map));
   if (cmd.checkpoint_every && cmd.checkpoint.empty()) throw UsageError("--checkpoint-every needs --checkpoint FILE");
+  if (!cmd.frames.empty() && parse_frame_list(cmd.frames).size() > 1)
+    for (const fs::path& f : plan.outputs)
+      if (!has_frame_placeholder(f.string()))
+        throw UsageError(fmt::format("output '{}': --frames writes one image per frame: name the frame number with "
+                                     "a run of '#' (shot_####.exr)", f.string()));
   if (!cmd.part.empty() && (plan.outputs.size() != 1 || plan.outputs[0].extension() != ".exr"))
     throw UsageError("--part writes a part file for candela merge: give one output ending in .exr (-o part-K.exr)");
   if (!plan.render.one_pixel() && cluster.is_root()) check_outputs(plan.outputs);
@@ -311,6 +347,9 @@ CommandPlan plan_command(const RenderCommand& cmd, Cluster& cluster) {
   CommandPlan plan;
   plan.desc = cmd.scene_file.empty() ? read_json_scene(builtin_scene_json(), "<built-in cornell-box.json>", ".")
                                      : read_scene_file(cmd.scene_file);
+  // An animated scene rendered as one image: at its camera's shutter interval (--frames poses each frame).
+  if (cmd.frames.empty() && is_animated(plan.desc))
+    plan.desc = pose_scene(plan.desc, {plan.desc.camera.shutter_open, plan.desc.camera.shutter_close});
   if (cluster.distributed() || !cmd.checkpoint.empty() || !cmd.resume.empty() || !cmd.part.empty())
     plan.scene_bytes = cmd.scene_file.empty() ? std::string(builtin_scene_json()) : read_bytes(cmd.scene_file);
   plan.render = plan_render(cmd, plan.desc);
@@ -604,10 +643,10 @@ int finish_message(const RenderCommand& cmd, const RenderStats& stats, const Sam
   return kExitInterrupted;
 }
 
-int run_render(const RenderCommand& cmd, Cluster& cluster) {
-  CommandPlan plan;
-  on_every_rank(cluster, [&] { plan = plan_command(cmd, cluster); });
-  if (cluster.distributed()) on_every_rank(cluster, [&] { check_same_scene(cluster, plan, cmd.scene_file); });
+// Renders the planned scene (its description is consumed) and writes its images. `frame`: the
+// frame of a sequence (--frames) it is, or -1; an interrupted frame is not written, so that a
+// restarted job (--skip-existing) renders it again rather than keep a half-converged image.
+int render_planned(const RenderCommand& cmd, CommandPlan& plan, Cluster& cluster, int frame = -1) {
   // What made the image, for checkpoints and parts; a checkpoint also names its part, as it resumes only that.
   const RenderFingerprint made_by = render_fingerprint(plan.scene_bytes, plan.desc, cmd);
   RenderFingerprint fingerprint = made_by;
@@ -645,6 +684,12 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   const RenderStats& stats = outcome.stats;
   g_phase.store(kWriting);  // a signal from here on lets the (complete or partial) images be written
   const uint64_t non_finite = earlier_non_finite + stats.non_finite_samples;
+  if (frame >= 0 && stats.cancelled) {
+    if (cluster.is_root())
+      std::fprintf(stderr, "candela: interrupted in frame %d: its images are not written (the frames before it are)\n",
+                   frame);
+    return kExitInterrupted;
+  }
   if (plan.render.one_pixel()) return report_pixel(plan.render, film, stats, non_finite);
 
   if ((stats.cancelled || stats.time_limited) && !cmd.checkpoint.empty()) checkpoints.save(film, non_finite, false);
@@ -656,6 +701,10 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   std::map<std::string, std::string> metadata =
       image_metadata(cmd.scene_file.empty() ? "<built-in cornell-box.json>" : cmd.scene_file, desc.settings, film,
                      outcome, options, cluster.size(), non_finite);
+  if (frame >= 0) {
+    metadata["candela:frame"] = std::to_string(frame);
+    metadata["candela:shutter"] = fmt::format("{} {}", desc.camera.shutter_open, desc.camera.shutter_close);
+  }
   // --denoise: the root alone denoises the gathered film (denoise/denoised_render.h).
   std::optional<DenoisedRender> denoised;
   if (plan.render.denoise) {
@@ -665,9 +714,66 @@ int run_render(const RenderCommand& cmd, Cluster& cluster) {
   write_images(cmd, plan, scene, film, aov_film ? &*aov_film : nullptr, integrator_outputs.get(), made_by, non_finite,
                metadata, denoised ? &*denoised : nullptr);
   warn_non_finite(stats, non_finite, false);
+  if (frame >= 0) std::printf("frame %d: ", frame);
   print_summary(cmd, plan, outcome, options, samples, cluster, traffic, denoised ? &*denoised : nullptr);
   viewers.end = stats.cancelled ? LiveState::Stopped : LiveState::Finished;
   return finish_message(cmd, stats, samples);
+}
+
+// --frames: the scene read once, then each frame posed (animation/pose.h), rendered and written in
+// turn; with --part K/N only every N-th frame of the list (a job array's share), with --skip-existing
+// only the frames whose images are not all there yet.
+int run_frames(RenderCommand cmd, Cluster& cluster) {
+  std::vector<int> frames;
+  on_every_rank(cluster, [&] {
+    frames = parse_frame_list(cmd.frames);
+    if (!cmd.part.empty()) {
+      const auto [part_index, part_count] = parse_part(cmd.part);
+      frames = frames_of_part(frames, part_index, part_count);
+      cmd.part.clear();  // the part is of the frames, not of each image
+    }
+  });
+  CommandPlan plan;
+  on_every_rank(cluster, [&] { plan = plan_command(cmd, cluster); });
+  if (cluster.distributed()) on_every_rank(cluster, [&] { check_same_scene(cluster, plan, cmd.scene_file); });
+  const SceneDesc animated = std::move(plan.desc);
+  const std::vector<fs::path> patterns = plan.outputs;
+  const auto started = std::chrono::steady_clock::now();
+  int rendered = 0, skipped = 0;
+  for (int frame : frames) {
+    plan.outputs.clear();
+    for (const fs::path& pattern : patterns) plan.outputs.push_back(frame_file_name(pattern.string(), frame));
+    RenderCommand frame_cmd = cmd;
+    if (!cmd.spp_map.empty()) frame_cmd.spp_map = frame_file_name(cmd.spp_map, frame);
+    // A frame is finished when all its images exist: each is written to a temporary name and renamed.
+    bool exists = cmd.skip_existing;
+    for (const fs::path& f : plan.outputs) exists = exists && fs::exists(f);
+    if (cluster.from_root(exists)) {
+      if (cluster.is_root()) std::printf("frame %d: skipped (%s exists)\n", frame, plan.outputs.front().c_str());
+      ++skipped;
+      continue;
+    }
+    const FrameTime time = frame_time(frame, cmd.fps, cmd.shutter);
+    on_every_rank(cluster, [&] {
+      plan.desc = pose_scene(animated, time);
+      check_resources(plan.desc);
+    });
+    const int status = render_planned(frame_cmd, plan, cluster, frame);
+    if (status != 0) return status;
+    ++rendered;
+  }
+  if (cluster.is_root())
+    std::printf("%zu frames: %d rendered, %d skipped, in %.2f s\n", frames.size(), rendered, skipped,
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+  return 0;
+}
+
+int run_render(const RenderCommand& cmd, Cluster& cluster) {
+  if (!cmd.frames.empty()) return run_frames(cmd, cluster);
+  CommandPlan plan;
+  on_every_rank(cluster, [&] { plan = plan_command(cmd, cluster); });
+  if (cluster.distributed()) on_every_rank(cluster, [&] { check_same_scene(cluster, plan, cmd.scene_file); });
+  return render_planned(cmd, plan, cluster);
 }
 
 // `candela convert IN OUT.json`: any scene candela reads, in its JSON format.
@@ -806,6 +912,17 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--part", cmd.part,
                          "Render part K of N of the image (every N-th tile; for job arrays) and write it, with "
                          "its exact sums, to the .exr output for candela merge");
+  render_cmd->add_option("--frames", cmd.frames,
+                         "Render an animation's frames: FIRST-LAST, FIRST-LASTxSTEP, or frames separated by commas "
+                         "(1-240, 1-240x4, 1,5,9); frame F is at time F / --fps; -o names the frame number with a run "
+                         "of '#' (shot_####.exr; docs/animation.md)");
+  render_cmd->add_option("--fps", cmd.fps, "Frames per second of --frames (default 24)");
+  render_cmd->add_option("--shutter", cmd.shutter,
+                         "With --frames: the fraction of a frame the shutter is open, centred on the frame's time "
+                         "(motion blur; default 0.5, 0 = none)");
+  render_cmd->add_flag("--skip-existing", cmd.skip_existing,
+                       "With --frames: skip the frames whose images all exist (a restarted job renders only the "
+                       "missing ones; images are written to a temporary name and renamed, so a file is never half a frame)");
   render_cmd->add_option("--pixel", cmd.pixel,
                          "Render only pixel X,Y (all its samples), print its value and its NaN/inf sample "
                          "indices; writes no image");

@@ -12,6 +12,7 @@
 #include <variant>
 #include <vector>
 
+#include "candela/animation/keyframes.h"
 #include "candela/base/enum_names.h"
 #include "candela/base/error.h"
 #include "candela/math/color.h"
@@ -79,6 +80,10 @@ struct CameraDesc {
   float shutter_open = 0, shutter_close = 1;
   // The participating medium the camera sits in (index into SceneDesc::media; -1 = vacuum).
   int medium = -1;
+  // Animation (SceneDesc::animation): the node whose world transform places the camera
+  // (world_from_camera is then relative to it; -1 = none), and keyframed lens values (none: constant).
+  int animation_node = -1;
+  std::optional<Keyframes> fov_keys, focus_distance_keys, lens_radius_keys;
 };
 
 // For models that bring no camera (OBJ, glTF): a perspective camera looking along -z at the box

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "candela/animation/keyframes.h"
 #include "candela/base/error.h"
 #include "candela/description/camera_film.h"
 #include "candela/description/lights.h"
@@ -32,6 +33,9 @@ struct SceneDesc {
   std::vector<MediumDesc> media;  // referred to by shapes' interior/exterior and the camera
   // The times at which ShapeDesc::to_world and to_world_end hold (pbrt's TransformTimes).
   float transform_start_time = 0, transform_end_time = 1;
+  // What moves over time (keyframes, skins, morph targets): animation/pose.h turns it into the
+  // still scene of one frame, whose moving parts go from transform_start_time to transform_end_time.
+  SceneAnimation animation;
   std::string source_file;  // the file it was read from, for messages and image metadata
   // Where the scene file declares each texture, material and light (parallel to those vectors;
   // shorter, or an empty file, where a reader does not know): errors found while building the

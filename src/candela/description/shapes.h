@@ -152,6 +152,10 @@ struct SchemaOf<RectangleShape> {
 // A triangle mesh: its data is read from a file or given inline, beside the schema.
 struct MeshShape {
   TriangleMesh mesh;
+  // A deforming mesh (animation/pose.h): its positions and normals at SceneDesc::transform_end_time
+  // (mesh holds those at transform_start_time); empty when it keeps its shape.
+  std::vector<Point3> positions_end;
+  std::vector<Normal3> normals_end;
 };
 template <>
 struct SchemaOf<MeshShape> {
@@ -340,6 +344,10 @@ struct ShapeDesc {
   // MediumInterface, Mitsuba's interior/exterior).
   int interior_medium = -1, exterior_medium = -1;
   bool is_medium_transition() const { return interior_medium != exterior_medium; }
+  // Animation (SceneDesc::animation): the node whose world transform places the shape (to_world is
+  // then relative to it), and the deformation of its mesh (skinning, morph targets); -1 = none.
+  int animation_node = -1;
+  int deformation = -1;
   std::string name;      // for messages
   SourceLocation where;  // where the scene file declares it (file empty = unknown), for messages
 };
@@ -357,6 +365,7 @@ struct InstanceDesc {
   int object = 0;  // index into SceneDesc::objects
   Transform to_world;
   std::optional<Transform> to_world_end;  // moving instance, as ShapeDesc::to_world_end
+  int animation_node = -1;  // as ShapeDesc::animation_node
   SourceLocation where;
 };
 

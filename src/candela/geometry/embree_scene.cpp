@@ -286,13 +286,6 @@ bool intersect_unit_quadric(QuadricGeometry::Kind kind, const Point3& o, const V
   return intersect_unit_quadric_d(kind, {o.x, o.y, o.z}, {d.x, d.y, d.z}, t_near, t_far, t_hit, phi_max);
 }
 
-std::optional<Transform> interpolate_transform(const Transform& start, const Transform& end, float t) {
-  Matrix4 m;
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) m.m[r][c] = (1 - double(t)) * start.matrix().m[r][c] + double(t) * end.matrix().m[r][c];
-  return Transform::from_matrix(m);
-}
-
 EmbreeScene::EmbreeScene(float transform_start_time, float transform_end_time, bool compact)
     : time_start_(transform_start_time),
       // A zero-length interval leaves every shape at its start transform.

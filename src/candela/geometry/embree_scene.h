@@ -31,10 +31,6 @@ struct EmbreeHit {
   Vec3 ng{0.0f};       // Embree's geometric normal, not normalised, in the geometry's own space (used for curves)
 };
 
-// The transform (1-t) start + t end, t in [0,1]; nullopt where the interpolated matrix is singular.
-// For affine maps this moves every point linearly, exactly as Embree's vertex motion blur does.
-std::optional<Transform> interpolate_transform(const Transform& start, const Transform& end, float t);
-
 // Analytic shapes kept in object space with both transforms, so non-uniform scales work.
 struct SphereGeometry {
   Transform to_world;

@@ -131,14 +131,6 @@ std::pair<int, int> parse_pixel(const std::string& text, const FilmDesc& film) {
   return {x, y};
 }
 
-// --part K/N: {K - 1, N}.
-std::pair<int, int> parse_part(const std::string& text) {
-  std::smatch m;
-  static const std::regex pattern(R"((\d{1,6})/(\d{1,6}))");
-  if (!std::regex_match(text, m, pattern) || std::stoi(m[1]) < 1 || std::stoi(m[1]) > std::stoi(m[2]))
-    throw UsageError(fmt::format("--part: expected K/N with 1 <= K <= N, such as 2/8, got '{}'", text));
-  return {std::stoi(m[1]) - 1, std::stoi(m[2])};
-}
 
 // Which pixels: --pixel and --part, and what they cannot be combined with.
 void plan_pixels(const RenderRequest& request, const SceneDesc& scene, RenderPlan& plan) {
@@ -207,6 +199,14 @@ RenderPlan plan_render(const RenderRequest& request, SceneDesc& scene) {
   plan.clamp = request.clamp.value_or(0.0f);
   plan.quiet = request.quiet;
   return plan;
+}
+
+std::pair<int, int> parse_part(const std::string& text) {
+  std::smatch m;
+  static const std::regex pattern(R"((\d{1,6})/(\d{1,6}))");
+  if (!std::regex_match(text, m, pattern) || std::stoi(m[1]) < 1 || std::stoi(m[1]) > std::stoi(m[2]))
+    throw UsageError(fmt::format("--part: expected K/N with 1 <= K <= N, such as 2/8, got '{}'", text));
+  return {std::stoi(m[1]) - 1, std::stoi(m[2])};
 }
 
 RenderOptions RenderPlan::options() const {

@@ -62,6 +62,9 @@ struct RenderPlan {
                                                              int height) const;
 };
 
+// --part K/N as {K - 1, N}; throws UsageError naming --part.
+std::pair<int, int> parse_part(const std::string& text);
+
 // Checks each value on its own (ranges, the time limit's and the resolution's form), before a scene is read.
 // Throws UsageError.
 void check_request_values(const RenderRequest& request);

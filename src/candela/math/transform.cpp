@@ -153,4 +153,11 @@ Normal3 Transform::normal(const Normal3& n) const {
           float(a[0][2] * n.x + a[1][2] * n.y + a[2][2] * n.z)};
 }
 
+std::optional<Transform> interpolate_transform(const Transform& start, const Transform& end, float t) {
+  Matrix4 m;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) m.m[r][c] = (1 - double(t)) * start.matrix().m[r][c] + double(t) * end.matrix().m[r][c];
+  return Transform::from_matrix(m);
+}
+
 }  // namespace candela

@@ -48,4 +48,8 @@ class Transform {
   Matrix4 m_, inv_;
 };
 
+// The transform (1-t) start + t end, t in [0,1]; nullopt where the interpolated matrix is singular.
+// For affine maps this moves every point linearly, exactly as Embree's vertex motion blur does.
+std::optional<Transform> interpolate_transform(const Transform& start, const Transform& end, float t);
+
 }  // namespace candela

@@ -261,8 +261,10 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int object, TriangleM
       throw SceneError(fmt::format("{}: refers to medium {}, which does not exist", rec.name, m));
   const Transform& T = desc.to_world;
   const Transform* T_end = moving_end_transform(desc);
+  const auto* mesh_shape = std::get_if<MeshShape>(&desc.geometry);
+  const MeshShape* deforming = mesh_shape && !mesh_shape->positions_end.empty() ? mesh_shape : nullptr;
   // Lights are sampled at fixed positions, so emitters stay put.
-  if (T_end && desc.emission)
+  if ((T_end || deforming) && desc.emission)
     throw SceneError(fmt::format("{}: area lights must not move (an emissive shape has an end transform)",
                                  rec.name));
   if (desc.emission && desc.emission->texture >= 0) {
@@ -273,7 +275,7 @@ void Scene::add_shape(const ShapeDesc& desc, size_t index, int object, TriangleM
 
   auto triangles = [&](TriangleMesh mesh, bool rectangle) {
     add_triangles(std::move(rec), std::move(mesh), T, T_end, desc.reverse_orientation, desc.emission, rectangle,
-                  object);
+                  object, deforming);
   };
   std::visit(
       overloaded{
@@ -506,21 +508,28 @@ void Scene::add_curve(ShapeRecord rec, const CurveShape& shape, const Transform&
 
 void Scene::add_triangles(ShapeRecord rec, TriangleMesh mesh, const Transform& T, const Transform* T_end,
                           bool reverse, const std::optional<AreaEmission>& emission, bool rectangle,
-                          int object) {
+                          int object, const MeshShape* deforming) {
   rec.kind = ShapeRecord::Kind::Triangles;
-  if (T_end) {
+  if (T_end || deforming) {
     // The winding below is baked once from the start transform: an end transform of the other
     // handedness would turn the shape inside out on the way (flattening it at some time).
-    if (T_end->swaps_handedness() != T.swaps_handedness())
+    if (T_end && T_end->swaps_handedness() != T.swaps_handedness())
       throw SceneError(fmt::format("{}: the end transform mirrors the shape relative to the start transform",
                                    rec.name));
-    rec.positions_end.reserve(mesh.positions.size());
-    for (const auto& p : mesh.positions) {
-      rec.positions_end.push_back(T_end->point(p));
+    // Where the vertices are at the end: a deforming mesh's end vertices, or its own, under the end
+    // transform (or the one transform of a mesh that only deforms).
+    const Transform& E = T_end ? *T_end : T;
+    const std::vector<Point3>& end_positions = deforming ? deforming->positions_end : mesh.positions;
+    if (end_positions.size() != mesh.positions.size())
+      throw SceneError(fmt::format("{}: the mesh has {} vertices at the end of its motion, {} at the start", rec.name,
+                                   end_positions.size(), mesh.positions.size()));
+    rec.positions_end.reserve(end_positions.size());
+    for (const auto& p : end_positions) {
+      rec.positions_end.push_back(E.point(p));
       bounds_.extend(rec.positions_end.back());
     }
-    rec.normals_end = mesh.normals;
-    place_normals(rec.normals_end, *T_end, reverse);
+    rec.normals_end = deforming && !deforming->normals_end.empty() ? deforming->normals_end : mesh.normals;
+    place_normals(rec.normals_end, E, reverse);
   }
   // The mesh's own arrays become the record's, placed in world space where they are.
   rec.positions = std::move(mesh.positions);

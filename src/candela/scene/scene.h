@@ -149,9 +149,11 @@ class Scene {
   void build(const SceneDesc& desc, SceneDesc* take_meshes);
   void add_shape(const ShapeDesc& desc, size_t index, int object, TriangleMesh* take_mesh);
   void add_objects_and_instances(const SceneDesc& desc, SceneDesc* take_meshes);
+  // rectangle: one RectangleLight instead of a light per triangle; deforming: a mesh whose vertices
+  // move to MeshShape::positions_end (and normals_end) by the end of the motion.
   void add_triangles(ShapeRecord rec, TriangleMesh mesh, const Transform& to_world,
                      const Transform* to_world_end, bool reverse, const std::optional<AreaEmission>& emission,
-                     bool rectangle, int object);  // rectangle: one RectangleLight instead of a light per triangle
+                     bool rectangle, int object, const MeshShape* deforming = nullptr);
   void add_sphere(ShapeRecord rec, const SphereShape& sphere, const Transform& to_world,
                   const Transform* to_world_end, bool reverse, const std::optional<AreaEmission>& emission,
                   int object);

@@ -10,15 +10,35 @@ namespace candela::gltf {
 // ---------------------------------------------------------------- meshes
 
 void GltfReader::build_meshes() {
-  std::map<int, int> use_count;
-  for (const MeshUse& use : uses_) ++use_count[use.mesh];
+  for (const MeshUse& use : uses_)
+    if (!converted_.count(use.mesh)) converted_[use.mesh] = convert_mesh(use.mesh);
+  // A rigid mesh placed more than once becomes an object and its instances, unless it emits (each
+  // emitting shape is a light of its own); a deforming one is a shape of its own at every use.
+  std::map<int, int> rigid_uses;
+  for (const MeshUse& use : uses_)
+    if (!use.deforms) ++rigid_uses[use.mesh];
+  auto instanced = [&](const MeshUse& use) {
+    const std::vector<Primitive>& primitives = converted_[use.mesh];
+    return !use.deforms && rigid_uses[use.mesh] > 1 &&
+           std::none_of(primitives.begin(), primitives.end(), [](const Primitive& p) { return p.emission; });
+  };
+  // The last use that needs a mesh's triangles (a shape, or the first instance, which makes the
+  // object) takes them; the earlier ones copy them.
+  std::map<int, size_t> last_taker;
+  {
+    std::set<int> has_object;
+    for (size_t u = 0; u < uses_.size(); ++u)
+      if (!instanced(uses_[u]) || has_object.insert(uses_[u].mesh).second) last_taker[uses_[u].mesh] = u;
+  }
   std::map<int, int> object_of_mesh;
-  for (const MeshUse& use : uses_) {
+  for (size_t u = 0; u < uses_.size(); ++u) {
+    const MeshUse& use = uses_[u];
     const int m = use.mesh;
-    if (!converted_.count(m)) converted_[m] = convert_mesh(m);
     std::vector<Primitive>& primitives = converted_[m];
-    bool emissive = std::any_of(primitives.begin(), primitives.end(), [](const Primitive& p) { return p.emission; });
-    if (use_count[m] > 1 && !emissive) {
+    const bool take = last_taker[m] == u;
+    // Where the model is at the start of its animation (at rest when static), for the bounds.
+    const std::optional<Transform> placement = use.animation_node >= 0 ? placement_at_start(use) : use.to_world;
+    if (instanced(use)) {
       auto found = object_of_mesh.find(m);
       if (found == object_of_mesh.end()) {
         ObjectDesc object;
@@ -29,7 +49,7 @@ void GltfReader::build_meshes() {
           for (const Point3& q : p.mesh.positions) bounds.extend(q);
           ShapeDesc shape;
           shape.where = at(p.pointer);
-          shape.geometry = MeshShape{std::move(p.mesh)};
+          shape.geometry = MeshShape{take ? std::move(p.mesh) : p.mesh};
           shape.material = p.material;
           shape.name = p.name;
           object.shapes.push_back(std::move(shape));
@@ -42,21 +62,34 @@ void GltfReader::build_meshes() {
       instance.where = at(use.pointer);
       instance.object = found->second;
       instance.to_world = use.to_world;
+      instance.animation_node = use.animation_node;
       const Bounds3& b = object_bounds_[size_t(found->second)];
-      if (!b.empty())
+      if (!b.empty() && placement)
         for (int corner = 0; corner < 8; ++corner)
-          bounds_.extend(use.to_world.point(
+          bounds_.extend(placement->point(
               {corner & 1 ? b.hi.x : b.lo.x, corner & 2 ? b.hi.y : b.lo.y, corner & 4 ? b.hi.z : b.lo.z}));
       scene_.instances.push_back(instance);
       continue;
     }
-    const bool last_use = --use_count[m] == 0;
     for (Primitive& p : primitives) {
-      for (const Point3& q : p.mesh.positions) bounds_.extend(use.to_world.point(q));
       ShapeDesc shape;
       shape.where = at(p.pointer);
-      shape.geometry = MeshShape{last_use ? std::move(p.mesh) : p.mesh};
+      shape.deformation = use.deforms ? add_deformation(use, p) : -1;
+      if (shape.deformation >= 0) {
+        // The bounds of the deformed mesh (in world space when skinned).
+        std::vector<Point3> positions = p.mesh.positions;
+        std::vector<Normal3> no_normals;
+        const SceneAnimation& animation = scene_.animation;
+        animation.deform(animation.deformations[size_t(shape.deformation)], animation.time_range()[0], positions,
+                         no_normals);
+        if (placement)
+          for (const Point3& q : positions) bounds_.extend(placement->point(q));
+      } else if (placement) {
+        for (const Point3& q : p.mesh.positions) bounds_.extend(placement->point(q));
+      }
+      shape.geometry = MeshShape{take ? std::move(p.mesh) : p.mesh};
       shape.to_world = use.to_world;
+      shape.animation_node = use.animation_node;
       shape.material = p.material;
       shape.emission = p.emission;
       shape.name = p.name;
@@ -96,11 +129,6 @@ std::optional<Primitive> GltfReader::convert_primitive(const tg::Mesh& mesh, con
   if (position == prim.attributes.end()) {
     warn(pointer, "mesh \"{}\": the primitive has no POSITION and is skipped", mesh.name);
     return std::nullopt;
-  }
-  if (!prim.targets.empty()) {
-    bool weighted = false;
-    for (double w : mesh.weights) weighted |= w != 0;
-    if (weighted) warn(pointer, "morph targets are ignored (the base mesh is rendered)");
   }
   Primitive result;
   TriangleMesh& tm = result.mesh;
@@ -154,6 +182,10 @@ std::optional<Primitive> GltfReader::convert_primitive(const tg::Mesh& mesh, con
     tm.attributes.push_back(std::move(attribute));
   }
 
+  // Skinning and morph targets, per vertex in the order above (which the triangles index).
+  if (!model_.skins.empty()) read_skinning_attributes(prim, pointer, result);
+  if (!prim.targets.empty()) read_morph_targets(prim, pointer, result);
+
   // Indices, then strips and fans as triangles.
   std::vector<uint32_t> index;
   if (prim.indices >= 0) {
@@ -194,7 +226,9 @@ std::optional<Primitive> GltfReader::convert_primitive(const tg::Mesh& mesh, con
 void GltfReader::add_camera() {
   CameraDesc& cam = scene_.camera;
   if (camera_) {
-    const auto& [index, T, pointer] = *camera_;
+    const auto& [index, T, pointer, animation_node] = *camera_;
+    // On a moving node, T is the identity and the node places the camera.
+    cam.animation_node = animation_node;
     if (size_t(index) >= model_.cameras.size()) fail(pointer + "/camera", "camera {} does not exist", index);
     const tg::Camera& c = model_.cameras[size_t(index)];
     const std::string cpointer = fmt::format("/cameras/{}", index);
@@ -237,7 +271,7 @@ void GltfReader::add_camera() {
 }
 
 void GltfReader::add_lights() {
-  for (const auto& [index, T, pointer] : lights_) {
+  for (const auto& [index, T, pointer, animation_node] : lights_) {
     if (index < 0 || size_t(index) >= model_.lights.size())
       fail(pointer + "/extensions/KHR_lights_punctual/light", "light {} does not exist", index);
     const tg::Light& l = model_.lights[size_t(index)];

@@ -65,23 +65,6 @@ Matrix4 matrix_from_column_major(const std::vector<double>& a) {
   return m;
 }
 
-// T * R * S as glTF composes a node's (or an instance's) transform; q = (x, y, z, w).
-Matrix4 trs_matrix(std::array<double, 3> t, std::array<double, 4> q, std::array<double, 3> s) {
-  double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  if (n > 0)
-    for (double& v : q) v /= n;
-  const double x = q[0], y = q[1], z = q[2], w = q[3];
-  const double r[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
-                          {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
-                          {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}};
-  Matrix4 m = Matrix4::identity();
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) m.m[i][j] = r[i][j] * s[size_t(j)];
-    m.m[i][3] = t[size_t(i)];
-  }
-  return m;
-}
-
 RGB rgb_of(const std::vector<double>& v, RGB fallback) {
   if (v.size() < 3) return fallback;
   return RGB(float(v[0]), float(v[1]), float(v[2]));
@@ -98,6 +81,7 @@ SceneDesc GltfReader::read() {
   load();
   check_extensions();
   scene_.settings.sampler.type = SamplerType::ZSobol;  // as the other readers do when a file names none
+  build_animation();
   walk_scene();
   build_meshes();
   add_camera();
@@ -148,11 +132,16 @@ void GltfReader::load() {
     if (line.starts_with("Failed to load external 'uri' for image")) continue;  // checked where used
     warn("", "{}", line);
   }
-  if (!ok || !err.empty()) {
+  std::vector<std::string> errors = lines(err);
+  // tinygltf wants every skin to have inverseBindMatrices; the specification makes them optional
+  // (identity matrices when absent), and the skin is read as it says.
+  std::erase_if(errors, [](const std::string& line) {
+    return line.starts_with("'inverseBindMatrices' property is missing");
+  });
+  if (!ok || !errors.empty()) {
     // tinygltf stops at a Draco primitive's missing buffer view before the extensions can be
     // checked: say what the file needs instead.
     refuse_draco_from_raw_json(ext == ".glb");
-    std::vector<std::string> errors = lines(err);
     std::string message;
     for (size_t i = 0; i < errors.size(); ++i) message += (i ? "; " : "") + errors[i];
     if (message.empty()) message = "tinygltf could not load the file";
@@ -225,8 +214,10 @@ AccessorData GltfReader::read_accessor(int index, const std::string& user) {
   const int size = tg::GetComponentSizeInBytes(uint32_t(a.componentType));
   if (components <= 0 || components > 16) fail(pointer, "unknown accessor type {}", a.type);
   if (size <= 0) fail(pointer, "unknown component type {}", a.componentType);
-  if (a.type == TINYGLTF_TYPE_MAT2 || a.type == TINYGLTF_TYPE_MAT3 || a.type == TINYGLTF_TYPE_MAT4)
-    fail(pointer, "matrix accessors are not used by anything candela reads");
+  // MAT4 (a skin's inverse bind matrices) has no column padding; MAT2 and MAT3 of small components
+  // would, and nothing candela reads uses them.
+  if (a.type == TINYGLTF_TYPE_MAT2 || a.type == TINYGLTF_TYPE_MAT3)
+    fail(pointer, "MAT2 and MAT3 accessors are not used by anything candela reads");
   AccessorData data;
   data.components = components;
   data.count = a.count;
@@ -349,7 +340,6 @@ void GltfReader::walk_scene() {
     if (size_t(scene) >= model_.scenes.size()) fail("/scene", "scene {} does not exist", scene);
     roots_ = model_.scenes[size_t(scene)].nodes;
   }
-  if (!model_.animations.empty()) warn("/animations", "animations are ignored (the nodes are rendered at rest)");
   on_path_.assign(model_.nodes.size(), false);
   for (int root : roots_) visit(root, Matrix4::identity(), 0, fmt::format("/scenes/{}/nodes", scene));
 }
@@ -362,33 +352,58 @@ void GltfReader::visit(int index, const Matrix4& parent, int depth, const std::s
   if (depth > kMaxNodeDepth) fail(pointer, "the node hierarchy is deeper than {}", kMaxNodeDepth);
   const tg::Node& node = model_.nodes[size_t(index)];
   const Matrix4 world = parent * local_matrix(node, pointer);
+  // A node whose world transform is keyframed (it or an ancestor) places what it holds through
+  // SceneAnimation: what it holds gets the node and a transform relative to it. Its rest transform
+  // may then be singular (a scale keyed from 0 to make it appear).
+  const bool moves = !scene_.animation.empty() && scene_.animation.node_moves(index);
   std::optional<Transform> T = Transform::from_matrix(world);
-  if (!T) {
+  if (!T && !moves) {
     warn(pointer, "the node's world transform is singular (a zero scale); it and its children are skipped");
     return;
   }
   if (node.camera >= 0) {
-    if (!camera_) camera_ = {node.camera, *T, pointer};
+    if (!camera_) camera_ = moves ? NodeRef{node.camera, Transform(), pointer, index} : NodeRef{node.camera, *T, pointer};
     else ++other_cameras_;
   }
   auto light = node.extensions.find("KHR_lights_punctual");
-  if (light != node.extensions.end() && light->second.Has("light"))
-    lights_.push_back({int(light->second.Get("light").GetNumberAsInt()), *T, pointer});
-  if (node.skin >= 0) warn(pointer, "skinning is ignored (the mesh is rendered in its bind pose)");
+  if (light != node.extensions.end() && light->second.Has("light")) {
+    if (moves)
+      warn(pointer, "animated lights are not supported yet: the light stays where its node is at rest");
+    if (T)
+      lights_.push_back({int(light->second.Get("light").GetNumberAsInt()), *T, pointer});
+    else
+      warn(pointer, "the light's node has a singular rest transform (a zero scale); the light is skipped");
+  }
   if (node.mesh >= 0) {
     if (size_t(node.mesh) >= model_.meshes.size()) fail(pointer + "/mesh", "mesh {} does not exist", node.mesh);
+    MeshUse use{node.mesh, moves ? Transform() : T.value_or(Transform()), pointer, index, moves ? index : -1};
+    if (!scene_.animation.empty()) {
+      if (node.skin >= 0) {
+        if (size_t(node.skin) >= model_.skins.size()) fail(pointer + "/skin", "skin {} does not exist", node.skin);
+        // glTF ignores a skinned mesh's node transform: the joints place the vertices in the world.
+        use.skin = node.skin;
+        use.to_world = Transform();
+        use.animation_node = -1;
+      }
+      use.deforms = use.skin >= 0 || morph_target_count(node.mesh) > 0;
+    }
     auto instancing = node.extensions.find("EXT_mesh_gpu_instancing");
-    if (instancing != node.extensions.end())
-      add_gpu_instances(node, world, instancing->second, pointer);
+    if (instancing != node.extensions.end() && use.deforms)
+      warn(pointer + "/extensions/EXT_mesh_gpu_instancing",
+           "a skinned or morphing mesh is not instanced: one copy is placed where its node is");
+    if (instancing != node.extensions.end() && !use.deforms)
+      add_gpu_instances(node, moves ? Matrix4::identity() : world, instancing->second, pointer, use.animation_node);
     else
-      uses_.push_back({node.mesh, *T, pointer});
+      uses_.push_back(std::move(use));
   }
   on_path_[size_t(index)] = true;
   for (int child : node.children) visit(child, world, depth + 1, pointer + "/children");
   on_path_[size_t(index)] = false;
 }
 
-void GltfReader::add_gpu_instances(const tg::Node& node, const Matrix4& world, const tg::Value& ext, const std::string& pointer) {
+// `world`: the node's world transform, or the identity when animation_node places the instances.
+void GltfReader::add_gpu_instances(const tg::Node& node, const Matrix4& world, const tg::Value& ext, const std::string& pointer,
+                                   int animation_node) {
   const std::string where = pointer + "/extensions/EXT_mesh_gpu_instancing";
   const tg::Value& attributes = ext.Get("attributes");
   std::optional<AccessorData> t, r, s;
@@ -419,7 +434,7 @@ void GltfReader::add_gpu_instances(const tg::Node& node, const Matrix4& world, c
       for (int c = 0; c < 4; ++c) qq[size_t(c)] = r->at(i, c);
     std::optional<Transform> T = Transform::from_matrix(world * trs_matrix(tt, qq, ss));
     if (!T) continue;  // a zero-scaled instance is hidden
-    uses_.push_back({node.mesh, *T, fmt::format("{}[{}]", where, i)});
+    uses_.push_back({node.mesh, *T, fmt::format("{}[{}]", where, i), -1, animation_node});
   }
 }
 

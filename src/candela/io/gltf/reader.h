@@ -1,6 +1,7 @@
 #pragma once
 // The glTF reader's parts (io/gltf/): reader.cpp (loading, accessors, the node tree),
-// meshes_cameras_lights.cpp, images_materials.cpp; gltf_reader.h is the entry.
+// meshes_cameras_lights.cpp, images_materials.cpp, animation.cpp (animations, skins, morph
+// targets); gltf_reader.h is the entry.
 #include <fmt/format.h>
 
 #include <array>
@@ -28,6 +29,7 @@
 #include <tiny_gltf.h>
 #pragma GCC diagnostic pop
 
+#include "candela/animation/keyframes.h"
 #include "candela/base/error.h"
 #include "candela/io/gltf_reader.h"
 
@@ -45,8 +47,6 @@ uint64_t fnv1a(std::string_view bytes, uint64_t h = 1469598103934665603ULL);
 std::string uri_decode(const std::string& uri);
 float srgb_to_linear(float v);
 Matrix4 matrix_from_column_major(const std::vector<double>& a);
-// T * R * S as glTF composes a node's (or an instance's) transform; q = (x, y, z, w).
-Matrix4 trs_matrix(std::array<double, 3> t, std::array<double, 4> q, std::array<double, 3> s);
 RGB rgb_of(const std::vector<double>& v, RGB fallback);
 // A number from a tinygltf Value (ints and reals both), or `fallback`.
 double number_or(const tg::Value& object, const char* key, double fallback);
@@ -75,13 +75,25 @@ struct Primitive {
   std::optional<AreaEmission> emission;
   std::string name;
   std::string pointer;  // /meshes/m/primitives/p
+  // For MeshDeformation, per vertex in `mesh`'s vertex order (convert_primitive keeps the
+  // accessors' order): skinning's JOINTS_n/WEIGHTS_n sets (`influences` = 4 per set, read only
+  // when the file has skins) and each morph target's POSITION and NORMAL displacements (empty
+  // where the target has none; target_normals empty when no target has normals).
+  int influences = 0;
+  std::vector<uint16_t> joints;
+  std::vector<float> weights;
+  std::vector<std::vector<Vec3>> target_positions, target_normals;
 };
 
 // One placement of a mesh in the world.
 struct MeshUse {
   int mesh;
-  Transform to_world;
+  Transform to_world;   // relative to animation_node's world transform where that is set
   std::string pointer;  // of the node
+  int node = -1;
+  int animation_node = -1;  // the moving node that places the mesh (SceneAnimation), or -1
+  int skin = -1;            // the node's skin (model_.skins and SceneAnimation::skins), or -1
+  bool deforms = false;     // skinned or with morph targets: one MeshDeformation per primitive
 };
 
 // What is done to an image before candela reads it.
@@ -152,7 +164,37 @@ class GltfReader {
 
   void visit(int index, const Matrix4& parent, int depth, const std::string& from);
 
-  void add_gpu_instances(const tg::Node& node, const Matrix4& world, const tg::Value& ext, const std::string& pointer);
+  void add_gpu_instances(const tg::Node& node, const Matrix4& world, const tg::Value& ext, const std::string& pointer,
+                         int animation_node);
+
+  // ------------------------------------------------------------ animation (animation.cpp)
+
+  // Whether the file has animations, skins or morph targets (else SceneDesc::animation stays empty).
+  bool file_animates() const;
+
+  // SceneDesc::animation's nodes (one per glTF node, same index), keyframes and skins; before the
+  // node tree is walked, which asks it which nodes move.
+  void build_animation();
+  void read_channels();
+  // A sampler's keyframes for a channel animating `path` ("translation", "rotation", "scale" or
+  // "weights" of `width` morph targets).
+  Keyframes read_keyframes(const tg::AnimationSampler& sampler, const std::string& path, int width,
+                           const std::string& pointer);
+  void read_skins();
+
+  // The number of morph targets of mesh m (the same for all its primitives).
+  int morph_target_count(int m);
+
+  // A primitive's JOINTS_n/WEIGHTS_n and morph targets into `result` (convert_primitive's part).
+  void read_skinning_attributes(const tg::Primitive& prim, const std::string& pointer, Primitive& result);
+  void read_morph_targets(const tg::Primitive& prim, const std::string& pointer, Primitive& result);
+
+  // The MeshDeformation of primitive p where `use` places it (index into animation.deformations),
+  // or -1 when the primitive neither is skinned nor has morph targets.
+  int add_deformation(const MeshUse& use, const Primitive& p);
+
+  // Where a use's mesh is at the start of the animation (for framing the model without a camera).
+  std::optional<Transform> placement_at_start(const MeshUse& use) const;
 
   // ------------------------------------------------------------ meshes
 
@@ -245,8 +287,9 @@ class GltfReader {
   std::vector<bool> on_path_;
   struct NodeRef {
     int index;
-    Transform to_world;
+    Transform to_world;  // relative to animation_node's world transform where that is set
     std::string pointer;
+    int animation_node = -1;
   };
   std::optional<NodeRef> camera_;
   int other_cameras_ = 0;
