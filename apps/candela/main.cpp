@@ -741,6 +741,11 @@ int run_frames(RenderCommand cmd, Cluster& cluster) {
   const auto started = std::chrono::steady_clock::now();
   int rendered = 0, skipped = 0;
   for (int frame : frames) {
+    // Interrupted between frames (while the last one was written): the next one is not begun.
+    if (g_stop.load()) {
+      if (cluster.is_root()) std::fprintf(stderr, "candela: interrupted before frame %d: it is not written\n", frame);
+      return kExitInterrupted;
+    }
     plan.outputs.clear();
     for (const fs::path& pattern : patterns) plan.outputs.push_back(frame_file_name(pattern.string(), frame));
     RenderCommand frame_cmd = cmd;

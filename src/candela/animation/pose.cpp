@@ -12,7 +12,10 @@ FrameTime frame_time(int frame, double fps, double shutter) {
   return {float(t - half), float(t + half)};
 }
 
-bool is_animated(const SceneDesc& desc) { return !desc.animation.empty(); }
+bool is_animated(const SceneDesc& desc) {
+  return !desc.animation.empty() || desc.camera.fov_keys || desc.camera.focus_distance_keys ||
+         desc.camera.lens_radius_keys;
+}
 
 namespace {
 

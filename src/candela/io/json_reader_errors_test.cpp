@@ -40,7 +40,7 @@ TEST(JsonReader, UnknownKeyNamesItsJsonPointer) {
   EXPECT_EQ(message,
             "test.json:3:56: at /shapes/1/radiuss: unknown key (did you mean \"radius\"?); expected one of: type, center, radius, uv, "
             "z_min, z_max, phi_max, material, emission, transform, transform_end, name, reverse_orientation, interior, "
-            "exterior");
+            "exterior, animation_node, animation, deformation");
   expect_error_containing(R"({"camera": {"fov": 40, "zoom": 2}})", "at /camera/zoom: unknown key");
   expect_error_containing(R"({"scene": {}})", "at /scene: unknown key");
   expect_error_containing(R"({"render": {"samples": 4}})", "at /render/samples: unknown key");

@@ -27,12 +27,15 @@ using Json = nlohmann::ordered_json;
 Json vec3(const Vec3& v) { return Json::array({v.x, v.y, v.z}); }
 Json rgb(const RGB& c) { return Json::array({c.r, c.g, c.b}); }
 
-Json matrix(const Transform& t) {
+// 16 numbers row by row, as a "matrix" transform step.
+Json matrix_values(const Matrix4& m) {
   Json values = Json::array();
   for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) values.push_back(t.matrix().m[r][c]);
-  return Json::array({Json{{"matrix", values}}});
+    for (int c = 0; c < 4; ++c) values.push_back(m.m[r][c]);
+  return values;
 }
+
+Json matrix(const Transform& t) { return Json::array({Json{{"matrix", matrix_values(t.matrix())}}}); }
 
 std::string texture_name(int index) { return fmt::format("texture{:05}", index); }
 std::string material_name(int index) { return fmt::format("material{:05}", index); }
@@ -251,6 +254,111 @@ Json shape_json(const ShapeDesc& shape, const std::vector<std::string>& media) {
   if (shape.reverse_orientation) j["reverse_orientation"] = true;
   if (shape.interior_medium >= 0) j["interior"] = media[size_t(shape.interior_medium)];
   if (shape.exterior_medium >= 0) j["exterior"] = media[size_t(shape.exterior_medium)];
+  if (shape.animation_node >= 0) j["animation_node"] = shape.animation_node;
+  if (shape.deformation >= 0) j["deformation"] = shape.deformation;
+  return j;
+}
+
+// ---- animation (docs/animation.md): always in the long form, nodes referred to by index (names
+// need not be unique)
+
+// {"interpolation", "times", "values"}: one value per time, a cubic spline's as [in, value, out]; a
+// value is a number where `numbers` (the camera's), else an array of the track's width.
+Json keyframes_json(const Keyframes& k, bool numbers = false) {
+  const size_t w = size_t(k.width);
+  auto value = [&](size_t offset) -> Json {
+    if (numbers) return k.values[offset];
+    return Json(std::vector<float>(k.values.begin() + std::ptrdiff_t(offset), k.values.begin() + std::ptrdiff_t(offset + w)));
+  };
+  Json values = Json::array();
+  for (size_t key = 0; key < k.size(); ++key) {
+    if (k.interpolation == Interpolation::CubicSpline)
+      values.push_back(Json::array({value(3 * w * key), value(3 * w * key + w), value(3 * w * key + 2 * w)}));
+    else
+      values.push_back(value(w * key));
+  }
+  return Json{{"interpolation", enum_name(k.interpolation)}, {"times", k.times}, {"values", std::move(values)}};
+}
+
+// A node's constant parts only where they are not the identity's; keyframed ones as tracks (whose
+// first value the reader makes the constant).
+Json node_json(const AnimationNode& n) {
+  Json j = Json::object();
+  if (!n.name.empty()) j["name"] = n.name;
+  if (n.parent >= 0) j["parent"] = n.parent;
+  if (n.matrix) {
+    j["matrix"] = matrix_values(*n.matrix);
+  } else {
+    const AnimatedTrs& trs = n.trs;
+    if (trs.translation_keys) j["translation"] = keyframes_json(*trs.translation_keys);
+    else if (trs.translation != std::array<float, 3>{0, 0, 0}) j["translation"] = trs.translation;
+    if (trs.rotation_keys) j["rotation"] = keyframes_json(*trs.rotation_keys);
+    else if (trs.rotation != std::array<float, 4>{0, 0, 0, 1}) j["rotation"] = trs.rotation;
+    if (trs.scale_keys) j["scale"] = keyframes_json(*trs.scale_keys);
+    else if (trs.scale != std::array<float, 3>{1, 1, 1}) j["scale"] = trs.scale;
+  }
+  if (n.weights_keys) j["weights"] = keyframes_json(*n.weights_keys);
+  return j;
+}
+
+Json vec3_list(const std::vector<Vec3>& list) {
+  Json j = Json::array();
+  for (const Vec3& v : list) j.push_back(vec3(v));
+  return j;
+}
+
+// Per-vertex arrays: each vertex's joints and weights, each target's displacements.
+Json deformation_json(const MeshDeformation& d) {
+  Json j = Json::object();
+  if (d.skin >= 0) {
+    j["skin"] = d.skin;
+    const size_t k = size_t(d.influences);
+    Json joints = Json::array(), weights = Json::array();
+    for (size_t v = 0; k > 0 && v < d.joints.size() / k; ++v) {
+      joints.push_back(std::vector<int>(d.joints.begin() + std::ptrdiff_t(v * k), d.joints.begin() + std::ptrdiff_t(v * k + k)));
+      weights.push_back(std::vector<float>(d.weights.begin() + std::ptrdiff_t(v * k), d.weights.begin() + std::ptrdiff_t(v * k + k)));
+    }
+    j["joints"] = std::move(joints);
+    j["weights"] = std::move(weights);
+  }
+  if (!d.target_positions.empty()) {
+    Json targets = Json::array();
+    for (const std::vector<Vec3>& t : d.target_positions) targets.push_back(vec3_list(t));
+    j["target_positions"] = std::move(targets);
+  }
+  if (!d.target_normals.empty()) {
+    Json targets = Json::array();
+    for (const std::vector<Vec3>& t : d.target_normals) targets.push_back(vec3_list(t));
+    j["target_normals"] = std::move(targets);
+  }
+  if (!d.default_weights.empty()) j["default_weights"] = d.default_weights;
+  if (d.weights_node >= 0) j["weights_node"] = d.weights_node;
+  return j;
+}
+
+Json animation_json(const SceneAnimation& a) {
+  Json j = Json::object();
+  Json nodes = Json::array();
+  for (const AnimationNode& n : a.nodes) nodes.push_back(node_json(n));
+  j["nodes"] = std::move(nodes);
+  if (!a.skins.empty()) {
+    Json skins = Json::array();
+    for (const Skin& s : a.skins) {
+      Json skin = Json::object();
+      if (!s.name.empty()) skin["name"] = s.name;
+      skin["joints"] = s.joints;
+      Json inverse = Json::array();
+      for (const Matrix4& m : s.inverse_bind) inverse.push_back(matrix_values(m));
+      skin["inverse_bind"] = std::move(inverse);
+      skins.push_back(std::move(skin));
+    }
+    j["skins"] = std::move(skins);
+  }
+  if (!a.deformations.empty()) {
+    Json deformations = Json::array();
+    for (const MeshDeformation& d : a.deformations) deformations.push_back(deformation_json(d));
+    j["deformations"] = std::move(deformations);
+  }
   return j;
 }
 
@@ -259,7 +367,7 @@ Json camera_json(const SceneDesc& scene, const std::vector<std::string>& media) 
   const bool spherical = c.projection == Projection::Equirectangular || c.projection == Projection::EqualArea;
   Json j{{"transform", matrix(c.world_from_camera)}};
   if (!spherical) {  // a spherical camera has no field of view (nor a lens: its lens_radius is 0)
-    j["fov"] = c.fov_degrees;
+    j["fov"] = c.fov_keys ? keyframes_json(*c.fov_keys, true) : Json(c.fov_degrees);
     j["fov_axis"] = enum_name(c.fov_axis);
   }
   if (c.projection != Projection::Perspective) j["projection"] = enum_name(c.projection);
@@ -272,12 +380,13 @@ Json camera_json(const SceneDesc& scene, const std::vector<std::string>& media) 
   if (const FilmDesc::Sensor& sensor = scene.film.sensor; !sensor.changes_nothing())
     j["sensor"] = Json{{"exposure", sensor.exposure}, {"white_balance", sensor.white_balance},
                        {"max_component", sensor.max_component}};
-  if (c.lens_radius != 0 && !spherical) {
-    j["lens_radius"] = c.lens_radius;
-    j["focus_distance"] = c.focus_distance;
+  if ((c.lens_radius != 0 || c.lens_radius_keys || c.focus_distance_keys) && !spherical) {
+    j["lens_radius"] = c.lens_radius_keys ? keyframes_json(*c.lens_radius_keys, true) : Json(c.lens_radius);
+    j["focus_distance"] = c.focus_distance_keys ? keyframes_json(*c.focus_distance_keys, true) : Json(c.focus_distance);
   }
   j["shutter"] = Json::array({c.shutter_open, c.shutter_close});
   if (c.medium >= 0) j["medium"] = media[size_t(c.medium)];
+  if (c.animation_node >= 0) j["animation_node"] = c.animation_node;
   return j;
 }
 
@@ -363,12 +472,16 @@ std::string scene_to_json(const SceneDesc& scene) {
     Json j{{"type", "instance"}, {"object", object_name(instance.object)}};
     if (!instance.to_world.is_identity()) j["transform"] = matrix(instance.to_world);
     if (instance.to_world_end) j["transform_end"] = matrix(*instance.to_world_end);
+    if (instance.animation_node >= 0) j["animation_node"] = instance.animation_node;
     shapes.push_back(std::move(j));
   }
   root["shapes"] = std::move(shapes);
   Json lights = Json::array();
   for (const LightDesc& light : scene.lights) lights.push_back(schema_json(light));
   root["lights"] = std::move(lights);
+  const SceneAnimation& animation = scene.animation;
+  if (!animation.nodes.empty() || !animation.skins.empty() || !animation.deformations.empty())
+    root["animation"] = animation_json(animation);
   // Shortest round-tripping numbers (nlohmann writes doubles so that they read back exactly).
   return root.dump(1) + "\n";
 }

@@ -289,10 +289,23 @@ int GltfReader::add_deformation(const MeshUse& use, const Primitive& p) {
   return int(animation.deformations.size()) - 1;
 }
 
-std::optional<Transform> GltfReader::placement_at_start(const MeshUse& use) const {
-  const SceneAnimation& animation = scene_.animation;
-  return Transform::from_matrix(animation.world_matrix(use.animation_node, animation.time_range()[0]) *
-                                use.to_world.matrix());
+std::vector<float> GltfReader::framing_times() const {
+  // Enough instants over the animation for the framing to hold the whole motion (the keyframed
+  // paths between them are smooth at this scale).
+  const auto [start, end] = scene_.animation.time_range();
+  std::vector<float> times;
+  constexpr int kSteps = 32;
+  for (int i = 0; i <= kSteps; ++i) times.push_back(start + (end - start) * float(i) / kSteps);
+  return times;
+}
+
+std::vector<Transform> GltfReader::placements_over_time(const MeshUse& use) const {
+  if (use.animation_node < 0) return {use.to_world};
+  std::vector<Transform> placements;
+  for (float t : framing_times())
+    if (auto T = Transform::from_matrix(scene_.animation.world_matrix(use.animation_node, t) * use.to_world.matrix()))
+      placements.push_back(*T);
+  return placements;
 }
 
 }  // namespace candela::gltf

@@ -36,8 +36,8 @@ void GltfReader::build_meshes() {
     const int m = use.mesh;
     std::vector<Primitive>& primitives = converted_[m];
     const bool take = last_taker[m] == u;
-    // Where the model is at the start of its animation (at rest when static), for the bounds.
-    const std::optional<Transform> placement = use.animation_node >= 0 ? placement_at_start(use) : use.to_world;
+    // Where the model is over its animation (at rest when static), for the bounds the camera frames.
+    const std::vector<Transform> placements = placements_over_time(use);
     if (instanced(use)) {
       auto found = object_of_mesh.find(m);
       if (found == object_of_mesh.end()) {
@@ -64,10 +64,11 @@ void GltfReader::build_meshes() {
       instance.to_world = use.to_world;
       instance.animation_node = use.animation_node;
       const Bounds3& b = object_bounds_[size_t(found->second)];
-      if (!b.empty() && placement)
-        for (int corner = 0; corner < 8; ++corner)
-          bounds_.extend(placement->point(
-              {corner & 1 ? b.hi.x : b.lo.x, corner & 2 ? b.hi.y : b.lo.y, corner & 4 ? b.hi.z : b.lo.z}));
+      if (!b.empty())
+        for (const Transform& placement : placements)
+          for (int corner = 0; corner < 8; ++corner)
+            bounds_.extend(placement.point(
+                {corner & 1 ? b.hi.x : b.lo.x, corner & 2 ? b.hi.y : b.lo.y, corner & 4 ? b.hi.z : b.lo.z}));
       scene_.instances.push_back(instance);
       continue;
     }
@@ -76,16 +77,20 @@ void GltfReader::build_meshes() {
       shape.where = at(p.pointer);
       shape.deformation = use.deforms ? add_deformation(use, p) : -1;
       if (shape.deformation >= 0) {
-        // The bounds of the deformed mesh (in world space when skinned).
-        std::vector<Point3> positions = p.mesh.positions;
-        std::vector<Normal3> no_normals;
+        // The bounds of the deformed mesh over the animation (in world space when skinned).
         const SceneAnimation& animation = scene_.animation;
-        animation.deform(animation.deformations[size_t(shape.deformation)], animation.time_range()[0], positions,
-                         no_normals);
-        if (placement)
-          for (const Point3& q : positions) bounds_.extend(placement->point(q));
-      } else if (placement) {
-        for (const Point3& q : p.mesh.positions) bounds_.extend(placement->point(q));
+        for (float t : framing_times()) {
+          std::vector<Point3> positions = p.mesh.positions;
+          std::vector<Normal3> no_normals;
+          animation.deform(animation.deformations[size_t(shape.deformation)], t, positions, no_normals);
+          const Matrix4 place = use.animation_node >= 0 ? animation.world_matrix(use.animation_node, t) * use.to_world.matrix()
+                                                        : use.to_world.matrix();
+          if (const auto T = Transform::from_matrix(place))
+            for (const Point3& q : positions) bounds_.extend(T->point(q));
+        }
+      } else {
+        for (const Transform& placement : placements)
+          for (const Point3& q : p.mesh.positions) bounds_.extend(placement.point(q));
       }
       shape.geometry = MeshShape{take ? std::move(p.mesh) : p.mesh};
       shape.to_world = use.to_world;

@@ -193,8 +193,10 @@ class GltfReader {
   // or -1 when the primitive neither is skinned nor has morph targets.
   int add_deformation(const MeshUse& use, const Primitive& p);
 
-  // Where a use's mesh is at the start of the animation (for framing the model without a camera).
-  std::optional<Transform> placement_at_start(const MeshUse& use) const;
+  // The instants at which the model is framed when the file brings no camera: its animation's time
+  // range in even steps; and where a use's mesh is at each of them (its one placement when static).
+  std::vector<float> framing_times() const;
+  std::vector<Transform> placements_over_time(const MeshUse& use) const;
 
   // ------------------------------------------------------------ meshes
 

@@ -9,6 +9,8 @@ SceneDesc JsonSceneReader::read() {
   CheckedObject root(report_, document, "");
   const Json empty = Json::object();  // absent sections still get their defaults
   if (const Json* media = root.find("media")) read_media(*media, root.pointer_of("media"));
+  // Before the camera and the shapes, which name its nodes and deformations.
+  if (const Json* animation = root.find("animation")) read_animation(*animation, root.pointer_of("animation"));
   const Json* camera = root.find("camera");
   read_camera(camera ? *camera : empty, root.pointer_of("camera"));
   const Json* render = root.find("render");
@@ -19,6 +21,9 @@ SceneDesc JsonSceneReader::read() {
   if (const Json* shapes = root.find("shapes")) read_shapes(*shapes, root.pointer_of("shapes"));
   if (const Json* lights = root.find("lights")) read_lights(*lights, root.pointer_of("lights"));
   root.finish();
+  // Each part was checked where it was read; this is the model's own check of the whole.
+  if (std::string problem = scene_.animation.problem(); !problem.empty())
+    report_.fail(root.pointer_of("animation"), "{}", problem);
   scene_.source_file = report_.file_name();
   locate_places();
   return std::move(scene_);

@@ -2,7 +2,8 @@
 // The reader of candela's JSON scene format (docs/scene-format.md): one JsonSceneReader per file,
 // its sections read by the functions of reader.cpp (the document), settings.cpp (camera and render
 // settings), textures.cpp, materials.cpp, shapes.cpp (shapes, objects and instances, meshes,
-// transforms), lights.cpp and media.cpp. Each reader of a kind of entry (texture, material, shape,
+// transforms), lights.cpp, media.cpp and animation.cpp (keyframes, skins, morph targets:
+// docs/animation.md). Each reader of a kind of entry (texture, material, shape,
 // light) dispatches on a table of type names, from which its "unknown ... type" message lists the names.
 #include <fmt/ranges.h>
 
@@ -33,6 +34,11 @@ constexpr int kMaxTextureDepth = 64;    // textures using textures
 
 // The "type" of an entry of "shapes" that places an object.
 constexpr std::string_view kInstanceType = "instance";
+
+// What one keyframe of a track holds: a number (the camera's fov, focus_distance, lens_radius), a
+// translation or scale [x, y, z], a rotation (a quaternion [x, y, z, w] or {"axis", "angle"}), or
+// morph target weights (an array of as many numbers as the mesh has targets).
+enum class TrackValue { Number, Vec3, Rotation, Weights };
 
 class JsonSceneReader {
  public:
@@ -157,7 +163,7 @@ class JsonSceneReader {
   static bool is_instance(const Json& shape);
   void read_objects(const Json& value, const std::string& pointer);
   ObjectDesc read_object(const Json& value, const std::string& pointer);
-  InstanceDesc read_instance(const Json& value, const std::string& pointer) const;
+  InstanceDesc read_instance(const Json& value, const std::string& pointer);
   int object_by_name(const std::string& name, const std::string& pointer) const;
 
   // ---- meshes
@@ -190,6 +196,33 @@ class JsonSceneReader {
   static Transform rotation_between(Vec3 from, Vec3 to);
   void check_rotation(const Transform& transform, const std::string& pointer) const;
 
+  // ---- animation (animation.cpp): read before the camera and the shapes that refer to its nodes
+  void read_animation(const Json& value, const std::string& pointer);
+  void collect_node_names(const Json& nodes);
+  AnimationNode read_animation_node(const Json& value, const std::string& pointer) const;
+  void read_node_trs(CheckedObject& n, AnimatedTrs& trs) const;
+  Matrix4 read_node_matrix(const Json& value, const std::string& pointer) const;
+  void check_node_cycles() const;
+  Skin read_skin(const Json& value, const std::string& pointer) const;
+  MeshDeformation read_deformation(const Json& value, const std::string& pointer);
+  std::vector<std::vector<Vec3>> read_morph_targets(const Json& value, const std::string& pointer) const;
+  Keyframes read_keyframes(const Json& value, const std::string& pointer, TrackValue kind) const;
+  void read_track_value(const Json& value, const std::string& pointer, TrackValue kind, bool tangent,
+                        Keyframes& keys) const;
+  std::array<float, 4> read_rotation_value(const Json& value, const std::string& pointer) const;
+  // A reference to a node, skin or deformation: an index, or a name for nodes and skins.
+  int node_reference(const Json& value, const std::string& pointer) const;
+  int skin_reference(const Json& value, const std::string& pointer) const;
+  // The node an object (shape, instance, camera) is placed by: its "animation_node", or the node its
+  // inline "animation" adds; -1 for neither.
+  int animation_node_of(CheckedObject& object);
+  // The deformation a shape names (`value`, its "deformation"), checked against the shape.
+  int read_deformation_use(const Json& value, CheckedObject& s, const ShapeDesc& shape) const;
+  // The camera's `key` where it is keyframed (an object), its values checked against `bound` and
+  // `constant` set to its first; nothing where the key is absent or a plain number.
+  std::optional<Keyframes> camera_track(CheckedObject& camera, std::string_view key, const ValueRange& bound,
+                                        float& constant) const;
+
   // ---- participating media (media.cpp): read before the camera and the shapes that name them
   void read_media(const Json& value, const std::string& pointer);
   MediumDesc read_medium(const Json& value, const std::string& pointer);
@@ -209,6 +242,13 @@ class JsonSceneReader {
   std::map<std::string, int> object_index_;
   std::map<std::string, int> medium_index_;
   std::optional<int> black_material_;
+  // Animation: the nodes by name (several nodes may share one: such a name cannot be referred to),
+  // the number of nodes references may name (forward references within "nodes" included), where
+  // each node is declared, and the number of vertices each deformation is for (0: any).
+  std::map<std::string, std::vector<int>, std::less<>> node_names_;
+  int node_count_ = 0;
+  std::vector<std::string> node_pointers_;
+  std::vector<size_t> deformation_vertices_;
 };
 
 }  // namespace candela::json

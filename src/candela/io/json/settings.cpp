@@ -24,9 +24,13 @@ void JsonSceneReader::read_camera(const Json& value, const std::string& pointer)
   Point3 position = camera.vec3_or("position", {0, 0, 0});
   Point3 look_at = camera.vec3_or("look_at", {0, 0, 1});
   Vec3 up = camera.direction_or("up", {0, 1, 0});
-  float fov = camera.number_or("fov", 40);
-  if (!(fov > 0 && fov < 180))
-    report_.fail(camera.pointer_of("fov"), "the field of view must be in (0, 180) degrees, got {}", fov);
+  float fov = 40;
+  scene_.camera.fov_keys = camera_track(camera, "fov", {.lo = 0, .hi = 180, .lo_open = true, .hi_open = true}, fov);
+  if (!scene_.camera.fov_keys) {
+    fov = camera.number_or("fov", 40);
+    if (!(fov > 0 && fov < 180))
+      report_.fail(camera.pointer_of("fov"), "the field of view must be in (0, 180) degrees, got {}", fov);
+  }
   if (const Json* axis = camera.find("fov_axis"))
     scene_.camera.fov_axis = read_enum<FovAxis>(report_, *axis, camera.pointer_of("fov_axis"), "field of view axis");
   else
@@ -48,6 +52,7 @@ void JsonSceneReader::read_camera(const Json& value, const std::string& pointer)
         report_.fail(camera.pointer_of(projective), "a spherical camera (\"projection\": \"{}\") sees every direction: "
                      "it has no \"{}\"", enum_name(scene_.camera.projection), projective);
   scene_.camera.medium = medium_reference(camera, "medium");
+  scene_.camera.animation_node = animation_node_of(camera);
   camera.finish();
   if (int64_t(scene_.film.width) * scene_.film.height > kMaxPixels)
     report_.fail(pointer, "{} x {} pixels exceeds the limit of 2^28 pixels", scene_.film.width, scene_.film.height);
@@ -107,8 +112,12 @@ void JsonSceneReader::read_sensor(const Json& value, const std::string& pointer)
 
 void JsonSceneReader::read_lens_and_shutter(CheckedObject& camera) {
   CameraDesc& desc = scene_.camera;
-  desc.lens_radius = camera.number_or("lens_radius", desc.lens_radius, Bound::NonNegative);
-  desc.focus_distance = camera.number_or("focus_distance", desc.focus_distance, Bound::Positive);
+  // Each a number, or keyframes (docs/animation.md).
+  desc.lens_radius_keys = camera_track(camera, "lens_radius", Bound::NonNegative, desc.lens_radius);
+  if (!desc.lens_radius_keys) desc.lens_radius = camera.number_or("lens_radius", desc.lens_radius, Bound::NonNegative);
+  desc.focus_distance_keys = camera_track(camera, "focus_distance", Bound::Positive, desc.focus_distance);
+  if (!desc.focus_distance_keys)
+    desc.focus_distance = camera.number_or("focus_distance", desc.focus_distance, Bound::Positive);
   if (const Json* shutter = camera.find("shutter")) {
     Vec2 open_close = read_vec2(report_, *shutter, camera.pointer_of("shutter"));
     if (!(open_close.x <= open_close.y))

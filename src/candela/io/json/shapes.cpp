@@ -32,6 +32,10 @@ ShapeDesc JsonSceneReader::read_shape(const Json& value, const std::string& poin
   shape.reverse_orientation = s.boolean_or("reverse_orientation", false);
   shape.interior_medium = medium_reference(s, "interior");
   shape.exterior_medium = medium_reference(s, "exterior");
+  shape.animation_node = animation_node_of(s);
+  if (shape.animation_node >= 0 && shape.to_world_end)
+    report_.fail(s.pointer_of("transform_end"), "an animated shape is moved by its node: it cannot have transform_end");
+  if (const Json* deformation = s.find("deformation")) shape.deformation = read_deformation_use(*deformation, s, shape);
   s.finish();
   return shape;
 }
@@ -158,13 +162,18 @@ ObjectDesc JsonSceneReader::read_object(const Json& value, const std::string& po
     if (shape.to_world_end)
       report_.fail(child_pointer(shape_pointer, "transform_end"),
                    "a shape in an object cannot move; give the instance a transform_end instead");
+    for (std::string_view key : {"animation_node", "animation", "deformation"})
+      if (shapes[i].contains(key))
+        report_.fail(child_pointer(shape_pointer, key),
+                     "a shape in an object cannot be animated or deformed; animate the instance instead, or put the "
+                     "shape in the top-level \"shapes\"");
     object.shapes.push_back(std::move(shape));
   }
   o.finish();
   return object;
 }
 
-InstanceDesc JsonSceneReader::read_instance(const Json& value, const std::string& pointer) const {
+InstanceDesc JsonSceneReader::read_instance(const Json& value, const std::string& pointer) {
   CheckedObject s(report_, value, pointer);
   s.string("type");
   InstanceDesc instance;
@@ -181,6 +190,10 @@ InstanceDesc JsonSceneReader::read_instance(const Json& value, const std::string
                      object.name);
     instance.to_world_end = read_transform(*end, s.pointer_of("transform_end"));
   }
+  instance.animation_node = animation_node_of(s);
+  if (instance.animation_node >= 0 && instance.to_world_end)
+    report_.fail(s.pointer_of("transform_end"),
+                 "an animated instance is moved by its node: it cannot have transform_end");
   s.finish();
   return instance;
 }
