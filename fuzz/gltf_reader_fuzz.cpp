@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "candela/animation/pose.h"
 #include "candela/base/error.h"
 #include "candela/io/gltf_reader.h"
 #include "fuzz_common.h"
@@ -21,7 +22,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   options.film_width = 64;
   candela::Warnings warnings;
   try {
-    (void)candela::read_gltf_scene(file, warnings, options);
+    // Read, then posed as a frame would be (keyframes, skins and morph targets evaluated).
+    const candela::SceneDesc desc = candela::read_gltf_scene(file, warnings, options);
+    if (candela::is_animated(desc)) (void)candela::pose_scene(desc, {0.25f, 0.75f});
   } catch (const candela::SceneError& e) {
     candela_fuzz::rejected(e);
   }

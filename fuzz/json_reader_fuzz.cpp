@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <string_view>
 
+#include "candela/animation/pose.h"
 #include "candela/base/error.h"
 #include "candela/io/scene_reader.h"
 #include "fuzz_common.h"
@@ -10,7 +11,9 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::string_view text(reinterpret_cast<const char*>(data), size);
   try {
-    (void)candela::read_json_scene(text, "fuzz.json", candela_fuzz::scratch_dir());
+    // Read, then posed as a frame would be (keyframes, skins and morph targets evaluated).
+    const candela::SceneDesc desc = candela::read_json_scene(text, "fuzz.json", candela_fuzz::scratch_dir());
+    if (candela::is_animated(desc)) (void)candela::pose_scene(desc, {0.25f, 0.75f});
   } catch (const candela::SceneError& e) {
     candela_fuzz::rejected(e);
   }

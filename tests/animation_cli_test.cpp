@@ -167,6 +167,27 @@ TEST_F(AnimationCli, JobArrayPartsRenderTheSameFrames) {
   }
 }
 
+// Under mpirun the ranks render each frame together: the frames of one process, bit for bit. (A suite
+// of its own: the sanitizer run leaves MPI jobs out, as Open MPI never frees some of its memory.)
+using DistributedFrames = AnimationCli;
+TEST_F(DistributedFrames, RanksRenderTheFramesOfOneProcess) {
+  if (testing::run_command("command -v mpirun").exit_code != 0) GTEST_SKIP() << "mpirun is not installed";
+  const std::string args = kBoxAnimated + " --frames 2-8x3 --fps 4 --spp 8 --resolution 48x48 -q";
+  fs::create_directories(dir_ / "one");
+  fs::create_directories(dir_ / "ranks");
+  ASSERT_EQ(candela(args + " -o one/f_#.exr").exit_code, 0);
+  const auto r = testing::run_command("cd '" + dir_.string() +
+                                      "' && OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
+                                      "OMPI_MCA_btl_vader_single_copy_mechanism=none mpirun --oversubscribe -np 2 " +
+                                      kCli + " render " + args + " -o ranks/f_#.exr");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("3 frames: 3 rendered, 0 skipped"), std::string::npos) << r.output;
+  for (int f : {2, 5, 8}) {
+    const std::string name = fmt::format("f_{}.exr", f);
+    EXPECT_TRUE(same_pixels(path("one/" + name), path("ranks/" + name))) << name;
+  }
+}
+
 TEST_F(AnimationCli, RefusesWhatASequenceCannotDo) {
   struct Case {
     std::string args, expected;

@@ -49,12 +49,17 @@ TEST(Layering, TheReadersAndTheWriterIncludeNoIntegrator) {
                     << " (io/ reads the integrators' traits from description/integrator_traits.h)";
 }
 
-TEST(Layering, TheDescriptionIncludesOnlyBaseAndMath) {
+TEST(Layering, TheDescriptionIncludesOnlyBaseMathAndKeyframes) {
   for (const Include& include : includes_in("description"))
     if (!include.path.starts_with("candela/base/") && !include.path.starts_with("candela/math/") &&
-        !include.path.starts_with("candela/description/"))
+        !include.path.starts_with("candela/description/") && include.path != "candela/animation/keyframes.h")
       ADD_FAILURE() << include.where << ": includes " << include.path
-                    << " (description/ is the bottom layer: base/ and math/ only)";
+                    << " (description/ is the bottom layer: base/, math/ and the animation model only)";
+  // The animation model the description holds is as low: math/ and base/ alone.
+  for (const Include& include : includes_in("animation"))
+    if (include.where.find("keyframes") != std::string::npos && !include.path.starts_with("candela/base/") &&
+        !include.path.starts_with("candela/math/") && include.path != "candela/animation/keyframes.h")
+      ADD_FAILURE() << include.where << ": includes " << include.path << " (the animation model needs math/ only)";
 }
 
 }  // namespace

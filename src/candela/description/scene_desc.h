@@ -2,7 +2,7 @@
 // The format-neutral scene description: plain structs with defaults that every reader (JSON, pbrt-v4,
 // Mitsuba 3, glTF, OBJ) fills in and that scene/build turns into a render scene. Nothing after this
 // point knows which file format a scene came from. Units are whatever the scene uses; colours are linear RGB.
-// The description is the bottom layer (it needs only base/ and math/), split by domain: textures.h,
+// The description is the bottom layer (it needs only base/, math/ and animation/), split by domain: textures.h,
 // materials.h, shapes.h, media.h, lights.h, camera_film.h, render_settings.h; this header holds the
 // whole scene.
 #include <string>
