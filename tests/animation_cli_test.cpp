@@ -57,7 +57,11 @@ float box_height(float t) {
   return 2.52f * (1 - (t - 2.5f) / (3.708329916f - 2.5f));
 }
 
-TEST_F(AnimationCli, TheMovingBoxFollowsItsKeyframes) {
+// The renders that check what a sequence shows (keyframed motion, job-array parts): a suite of their own,
+// which the sanitizer run leaves out (its frame loop runs instrumented in AnimationCli).
+using AnimationFrames = AnimationCli;
+
+TEST_F(AnimationFrames, TheMovingBoxFollowsItsKeyframes) {
   const int size = 96, fps = 4;
   const std::string frames = "3-11x2,12";  // t = 0.75 ... 3 s: the inner box clear of the outer one
   const auto r = candela(kBoxAnimated + " --frames " + frames + " --fps 4 --shutter 0 --spp 4 --resolution 96x96 "
@@ -152,7 +156,7 @@ TEST_F(AnimationCli, AnInterruptedSequenceRestartsWhereItStopped) {
   EXPECT_FALSE(same_pixels(a[0], a[4]));
 }
 
-TEST_F(AnimationCli, JobArrayPartsRenderTheSameFrames) {
+TEST_F(AnimationFrames, JobArrayPartsRenderTheSameFrames) {
   const std::string args = kBoxAnimated + " --frames 0-23x3 --fps 8 --spp 4 --resolution 48x48 -q";
   fs::create_directories(dir_ / "one");
   fs::create_directories(dir_ / "parts");
