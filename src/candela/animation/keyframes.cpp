@@ -207,15 +207,9 @@ void SceneAnimation::deform(const MeshDeformation& d, float t, std::vector<Point
                             float(m.m[1][0] * p.x + m.m[1][1] * p.y + m.m[1][2] * p.z + m.m[1][3]),
                             float(m.m[2][0] * p.x + m.m[2][1] * p.y + m.m[2][2] * p.z + m.m[2][3]));
       if (v < normals.size()) {
-        // Normals by the inverse transpose of the blended matrix's 3x3 part.
+        // Normals by the inverse transpose of the blended matrix (a degenerate blend keeps them).
         m.m[3] = {0, 0, 0, 1};
-        if (const std::optional<Matrix4> inv = m.inverse()) {
-          const Normal3 n = normals[v];
-          const auto& a = inv->m;
-          normals[v] = Normal3(float(a[0][0] * n.x + a[1][0] * n.y + a[2][0] * n.z),
-                               float(a[0][1] * n.x + a[1][1] * n.y + a[2][1] * n.z),
-                               float(a[0][2] * n.x + a[1][2] * n.y + a[2][2] * n.z));
-        }
+        if (const std::optional<Transform> blended = Transform::from_matrix(m)) normals[v] = blended->normal(normals[v]);
       }
     }
   }

@@ -383,14 +383,8 @@ Transform JsonSceneReader::read_scale(const Json& value, const std::string& poin
 }
 
 Transform JsonSceneReader::read_matrix(const Json& value, const std::string& pointer) const {
-  if (!value.is_array() || value.size() != 16)
-    report_.fail(pointer, "expected 16 numbers (a 4x4 matrix, row by row), got {}", describe(value));
-  Matrix4 m;
-  for (size_t i = 0; i < 16; ++i) m.m[i / 4][i % 4] = read_double(report_, value[i], child_pointer(pointer, i));
-  // Normals, bounds and instancing assume affine maps: no projective bottom row.
-  if (m.m[3][0] != 0 || m.m[3][1] != 0 || m.m[3][2] != 0 || m.m[3][3] != 1)
-    report_.fail(pointer, "the matrix must be affine: its last row must be [0, 0, 0, 1]");
-  std::optional<Transform> transform = Transform::from_matrix(m);
+  // Normals, bounds and instancing assume affine maps: read_node_matrix refuses a projective bottom row.
+  std::optional<Transform> transform = Transform::from_matrix(read_node_matrix(value, pointer));
   if (!transform) report_.fail(pointer, "the matrix is singular (not invertible)");
   return *transform;
 }
